@@ -1,0 +1,132 @@
+// crisp: the .crisp font asset, the only contract between the offline baker and the run time.
+//
+// An asset holds, for one face of one font at fixed variation-axis values, every baked glyph as
+// quadratic Bezier curves in em units (y up), cut into horizontal bands that each carry a bitset
+// of the curves touching them; the face's metrics; and the original font bytes, so that HarfBuzz
+// can shape from the asset alone. The byte layout is documented in docs/asset-format.md.
+//
+// Curve storage. A glyph's curves live in `FontAsset::points` as a run of 2 * curve_count + 1
+// points starting at `GlyphRecord::point_offset`: curve i is (points[2i], points[2i+1],
+// points[2i+2]) relative to that offset, so consecutive curves of a contour share their end
+// point. Where one contour ends and the next begins, the slot between them is a pad curve that
+// no band references; readers only ever visit curves through the band bitsets.
+#pragma once
+
+#include <crisp/result.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace crisp {
+
+inline constexpr uint32_t kAssetVersion = 1;
+
+struct Point {
+    float x = 0.0f;
+    float y = 0.0f;
+    friend bool operator==(const Point&, const Point&) = default;
+};
+
+enum GlyphFlags : uint32_t {
+    kGlyphBaked = 1u << 0,   // the glyph was requested and converted (absent glyphs have no curves)
+    kGlyphFailed = 1u << 1,  // conversion failed; baked with --allow-failed as an empty glyph
+};
+
+// One glyph, indexed by the font's glyph index. All lengths are in em (font units / units per em),
+// y up, origin at the pen position on the baseline.
+struct GlyphRecord {
+    float advance = 0.0f;     // horizontal advance
+    float bearing_x = 0.0f;   // left side bearing: pen to the left edge of the outline's bbox
+    float bearing_y = 0.0f;   // top side bearing: baseline to the top edge of the outline's bbox
+    float bbox_min_x = 0.0f;  // bbox of every curve point (on- and off-curve), so all curves lie inside
+    float bbox_min_y = 0.0f;
+    float bbox_max_x = 0.0f;
+    float bbox_max_y = 0.0f;
+    uint32_t point_offset = 0;  // first point in FontAsset::points
+    uint32_t curve_count = 0;   // curve slots, pads included; the glyph owns 2 * curve_count + 1 points
+    uint32_t band_offset = 0;   // first word in FontAsset::band_words
+    uint16_t band_count = 0;    // bands split [bbox_min_y, bbox_max_y] into equal heights
+    uint16_t band_words = 0;    // words per band: ceil(curve_count / 32)
+    uint32_t flags = 0;         // GlyphFlags
+    friend bool operator==(const GlyphRecord&, const GlyphRecord&) = default;
+};
+
+struct AxisValue {
+    uint32_t tag = 0;  // OpenType axis tag, e.g. 'wght' = 0x77676874
+    float value = 0.0f;
+    float minimum = 0.0f;
+    float default_value = 0.0f;
+    float maximum = 0.0f;
+    friend bool operator==(const AxisValue&, const AxisValue&) = default;
+};
+
+enum FontFlags : uint32_t {
+    kFontCubic = 1u << 0,     // outlines were cubic (CFF, CFF2) and have been lowered to quadratics
+    kFontVariable = 1u << 1,  // the face has variation axes; `axes` holds the baked instance
+};
+
+struct FontInfo {
+    std::string family;
+    std::string style;
+    uint32_t units_per_em = 0;
+    int32_t ascender = 0;           // font units, positive above the baseline
+    int32_t descender = 0;          // font units, negative below the baseline
+    int32_t line_gap = 0;           // font units
+    uint32_t face_index = 0;        // face within the font bytes (a collection holds several)
+    uint32_t flags = 0;             // FontFlags
+    float tolerance_em = 0.0f;      // cubic lowering tolerance the asset was baked with
+    float max_deviation_em = 0.0f;  // largest measured cubic-to-quadratic deviation
+    std::vector<AxisValue> axes;
+    friend bool operator==(const FontInfo&, const FontInfo&) = default;
+};
+
+// A font asset in memory. `glyphs` is indexed by glyph index and holds one record for every glyph
+// of the face, baked or not.
+struct FontAsset {
+    FontInfo info;
+    std::vector<GlyphRecord> glyphs;
+    std::vector<Point> points;
+    std::vector<uint32_t> band_words;
+    std::vector<std::byte> font_bytes;
+    friend bool operator==(const FontAsset&, const FontAsset&) = default;
+
+    // The band holding em-space height y: with h = (bbox_max_y - bbox_min_y) / band_count,
+    // clamp(floor((y - bbox_min_y) / h), 0, band_count - 1), evaluated in float in that order (as a
+    // shader does); a y on a band edge belongs to the upper band. 0 when the glyph has no bands,
+    // when h <= 0, or when y is NaN. The baker, the CPU reference and the shaders share this rule.
+    static uint32_t band_of(const GlyphRecord& glyph, float y);
+};
+
+// Parses and validates an asset. Safe to use with untrusted input: every offset, count, float and
+// the checksum is checked before anything is used, and a bad asset returns
+// ErrorCode::asset_invalid (or asset_version) with a message naming the fault; nothing crashes
+// and nothing is read out of bounds.
+Result<FontAsset> load_asset(std::span<const std::byte> bytes);
+
+// Reads a file and loads it as above. An unreadable file returns ErrorCode::io.
+Result<FontAsset> load_asset_file(const std::filesystem::path& path);
+
+// Checks an in-memory asset against the same rules the loader applies (so a baker can refuse to
+// write an asset the loader would reject). Returns ErrorCode::asset_invalid naming the fault.
+Status validate_asset(const FontAsset& asset);
+
+// Encodes an asset in the file format (little-endian, checksummed). The asset must be valid.
+std::vector<std::byte> serialize_asset(const FontAsset& asset);
+
+// Writes serialize_asset(asset) to `path` atomically: the bytes go to a temporary file beside it,
+// which is flushed and renamed over `path` only when complete. On failure (ErrorCode::io) an
+// existing file at `path` is untouched and no temporary file is left behind.
+Status save_asset_file(const FontAsset& asset, const std::filesystem::path& path);
+
+// Writes any bytes to `path` with the same atomic temporary-and-rename protocol. The file gets the
+// usual permissions (0666 less the umask).
+Status write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes);
+
+// CRC-32C (Castagnoli) of `bytes`, continuing from `crc` (0 to start). The asset checksum.
+uint32_t crc32c(std::span<const std::byte> bytes, uint32_t crc = 0);
+
+}  // namespace crisp

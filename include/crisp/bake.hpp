@@ -1,0 +1,113 @@
+// crisp: baking a font (TrueType, OpenType CFF/CFF2, collections, variable fonts) into a FontAsset.
+//
+// The baker reads outlines with FreeType, unhinted and in font units, normalises them to em, turns
+// lines into quadratics, lowers cubics to quadratics within a tolerance, drops zero-length curves,
+// closes open contours, and cuts each glyph into bands. It needs no GPU.
+#pragma once
+
+#include <crisp/asset.hpp>
+#include <crisp/result.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace crisp {
+
+// The default cubic-to-quadratic tolerance in em; docs/cubic-lowering.md shows the measurement
+// behind it (1/4096 em is 1/16 px at 256 px per em).
+inline constexpr float kDefaultToleranceEm = 1.0f / 4096.0f;
+
+// Bands are added until the fullest band holds at most this many curves, or until kMaxBands.
+inline constexpr uint32_t kTargetCurvesPerBand = 8;
+inline constexpr uint32_t kMaxBands = 32;
+// Each band reaches this fraction of its height past both of its edges, so a curve whose y-extent
+// ends exactly on an edge (or within float rounding of it) is listed in both bands.
+inline constexpr float kBandOverlap = 1.0f / 256.0f;
+
+struct Variation {
+    uint32_t tag = 0;  // OpenType axis tag
+    float value = 0.0f;
+};
+
+struct BakeOptions {
+    uint32_t face_index = 0;            // face of a collection (.ttc); 0 for single fonts
+    std::vector<Variation> variations;  // axis values; unnamed axes stay at their default
+    // Code points to bake, with every glyph shaping can substitute for them (GSUB closure) and
+    // .notdef. Empty: every glyph of the face.
+    std::vector<uint32_t> codepoints;
+    bool all_glyphs = true;                    // false: bake only `codepoints` (and their closure)
+    float tolerance_em = kDefaultToleranceEm;  // largest cubic-to-quadratic deviation, in (0, 0.1]
+    bool split_y_extrema = false;              // split quadratics at y-extrema (docs/cubic-lowering.md)
+    uint32_t max_curves_per_glyph = 65535;     // a glyph with more curves fails
+    bool allow_failed = false;                 // keep going past failed glyphs, baking them empty
+    // Called now and then with (glyphs done, glyphs to do); may be empty.
+    std::function<void(uint32_t, uint32_t)> progress;
+};
+
+struct BakeReport {
+    uint32_t glyph_count = 0;   // glyphs in the face
+    uint32_t baked_glyphs = 0;  // glyphs converted (requested and not failed)
+    uint32_t empty_glyphs = 0;  // baked glyphs without an outline (space, ...)
+    uint32_t failed_glyphs = 0;
+    std::vector<uint32_t> failed_glyph_ids;  // the first few failed glyph indices
+    std::string first_failure;               // why the first glyph failed
+    uint64_t curve_count = 0;                // quadratic curves, pads excluded
+    uint64_t line_count = 0;                 // curves that came from lines
+    uint64_t quadratic_count = 0;            // curves that came from quadratics as they were
+    uint64_t cubic_count = 0;                // cubics in the source outlines
+    uint64_t cubic_pieces = 0;               // quadratics the cubics were lowered to
+    uint64_t dropped_zero_length = 0;        // zero-length curves removed
+    uint64_t closed_contours = 0;            // open contours closed with a line
+    uint64_t y_splits = 0;                   // extra curves from splitting at y-extrema
+    uint32_t max_curves_per_glyph = 0;
+    double mean_curves_per_glyph = 0.0;  // over baked glyphs with an outline
+    uint64_t band_count = 0;
+    uint32_t max_bands_per_glyph = 0;
+    uint32_t max_curves_per_band = 0;
+    double mean_curves_per_band = 0.0;  // over all bands of all glyphs
+    // Mean curves a sample ray tests: per glyph, the band curve counts weighted by band height,
+    // then averaged over glyphs with an outline. The cost model of the rasterizer.
+    double mean_curve_tests_per_ray = 0.0;
+    double max_deviation_em = 0.0;       // largest measured cubic-to-quadratic deviation
+    double seed_max_deviation_em = 0.0;  // the same for the seed's fixed split in two
+    uint64_t seed_cubic_pieces = 0;      // 2 per cubic
+    uint64_t asset_bytes = 0;            // size of the serialized asset
+    double seconds = 0.0;
+};
+
+struct BakeResult {
+    FontAsset asset;
+    BakeReport report;
+};
+
+// Bakes a font held in memory. Errors: ErrorCode::font_unreadable (FreeType cannot open the
+// bytes, or face_index is past the collection), font_unsupported (no scalable outlines, a
+// variation on a face without axes or an unknown axis tag), invalid_argument (a tolerance outside
+// (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be converted and
+// allow_failed is false; the report inside the message names them). Hostile font bytes never
+// crash the baker.
+Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options);
+
+// Reads the file, then bake_font. An unreadable file returns ErrorCode::io.
+Result<BakeResult> bake_font_file(const std::filesystem::path& path, const BakeOptions& options);
+
+// Parses "wght=700" into a Variation; returns invalid_argument naming the fault otherwise.
+Result<Variation> parse_variation(std::string_view text);
+
+// Parses code point ranges "U+0020-007E,0x4E00-0x4E10,65" into a sorted list without duplicates.
+Result<std::vector<uint32_t>> parse_codepoint_ranges(std::string_view text);
+
+// Decodes UTF-8 into code points (invalid sequences become U+FFFD).
+std::vector<uint32_t> decode_utf8(std::string_view text);
+
+// A four-character tag as its 32-bit value, and back.
+uint32_t make_tag(std::string_view four_chars);
+std::string tag_to_string(uint32_t tag);
+
+}  // namespace crisp

@@ -1,0 +1,149 @@
+// Small text parsers shared by the baker and the tools: UTF-8, code point ranges, axis values.
+#include <crisp/bake.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+namespace crisp {
+
+std::vector<uint32_t> decode_utf8(std::string_view text) {
+    // Invalid input becomes U+FFFD, one per maximal ill-formed subpart (Unicode 15, 3.9 U+FFFD
+    // substitution), so a truncated sequence costs one replacement, not one per byte.
+    std::vector<uint32_t> out;
+    out.reserve(text.size());
+    const auto* s = reinterpret_cast<const unsigned char*>(text.data());
+    const size_t n = text.size();
+    size_t i = 0;
+    while (i < n) {
+        const unsigned char b = s[i];
+        if (b < 0x80) {
+            out.push_back(b);
+            ++i;
+            continue;
+        }
+        uint32_t need = 0, cp = 0;
+        unsigned char lo = 0x80, hi = 0xBF;
+        if (b >= 0xC2 && b <= 0xDF) {
+            need = 1;
+            cp = b & 0x1Fu;
+        } else if (b >= 0xE0 && b <= 0xEF) {
+            need = 2;
+            cp = b & 0x0Fu;
+            if (b == 0xE0) lo = 0xA0;
+            if (b == 0xED) hi = 0x9F;
+        } else if (b >= 0xF0 && b <= 0xF4) {
+            need = 3;
+            cp = b & 0x07u;
+            if (b == 0xF0) lo = 0x90;
+            if (b == 0xF4) hi = 0x8F;
+        } else {
+            out.push_back(0xFFFD);
+            ++i;
+            continue;
+        }
+        size_t j = i + 1;
+        bool good = true;
+        for (uint32_t k = 0; k < need; ++k, ++j) {
+            if (j >= n || s[j] < lo || s[j] > hi) {
+                good = false;
+                break;
+            }
+            cp = (cp << 6) | (s[j] & 0x3Fu);
+            lo = 0x80;
+            hi = 0xBF;
+        }
+        out.push_back(good ? cp : 0xFFFDu);
+        i = j;
+    }
+    return out;
+}
+
+namespace {
+
+std::string_view trim(std::string_view s) {
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+    return s;
+}
+
+// `base` is 10, or 16 for the end of a range whose start was written in hex (U+0041-005A).
+bool parse_codepoint(std::string_view s, uint32_t& value, int& base) {
+    s = trim(s);
+    if (s.size() > 2 &&
+        (s.substr(0, 2) == "U+" || s.substr(0, 2) == "u+" || s.substr(0, 2) == "0x" || s.substr(0, 2) == "0X")) {
+        s.remove_prefix(2);
+        base = 16;
+    }
+    if (s.empty()) return false;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value, base);
+    return ec == std::errc() && end == s.data() + s.size() && value <= 0x10FFFF;
+}
+
+}  // namespace
+
+Result<std::vector<uint32_t>> parse_codepoint_ranges(std::string_view text) {
+    std::vector<uint32_t> out;
+    if (trim(text).empty()) return Error{ErrorCode::invalid_argument, "code point ranges: empty"};
+    size_t start = 0;
+    while (start <= text.size()) {
+        const size_t comma = std::min(text.find(',', start), text.size());
+        const std::string_view item = trim(text.substr(start, comma - start));
+        const size_t dash = item.find('-');
+        uint32_t first = 0, last = 0;
+        int base = 10;
+        const bool ok = dash == std::string_view::npos ? parse_codepoint(item, first, base) && (last = first, true)
+                                                       : parse_codepoint(item.substr(0, dash), first, base) &&
+                                                             parse_codepoint(item.substr(dash + 1), last, base);
+        if (!ok || first > last) {
+            return Error{ErrorCode::invalid_argument,
+                         "code point ranges: bad item '" + std::string(item) +
+                             "' (expected N, N-M, U+XXXX or 0xXXXX, at most U+10FFFF, first <= last)"};
+        }
+        if (out.size() + (last - first + 1) > 0x110000) {
+            return Error{ErrorCode::invalid_argument, "code point ranges: too many code points"};
+        }
+        for (uint32_t cp = first; cp <= last; ++cp) out.push_back(cp);
+        start = comma + 1;
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+uint32_t make_tag(std::string_view four_chars) {
+    uint32_t tag = 0;
+    for (size_t i = 0; i < 4; ++i) {
+        const char c = i < four_chars.size() ? four_chars[i] : ' ';
+        tag = (tag << 8) | static_cast<unsigned char>(c);
+    }
+    return tag;
+}
+
+std::string tag_to_string(uint32_t tag) {
+    std::string s(4, ' ');
+    for (int i = 0; i < 4; ++i) s[static_cast<size_t>(i)] = static_cast<char>((tag >> (24 - 8 * i)) & 0xFF);
+    return s;
+}
+
+Result<Variation> parse_variation(std::string_view text) {
+    const size_t equals = text.find('=');
+    const std::string_view tag = equals == std::string_view::npos ? std::string_view{} : text.substr(0, equals);
+    if (tag.empty() || tag.size() > 4 ||
+        !std::all_of(tag.begin(), tag.end(), [](char c) { return c >= 0x20 && c <= 0x7E; })) {
+        return Error{
+            ErrorCode::invalid_argument,
+            "variation '" + std::string(text) + "': expected TAG=VALUE with a tag of 1 to 4 characters, e.g. wght=700"};
+    }
+    const std::string value_text(trim(text.substr(equals + 1)));
+    float value = 0.0f;
+    const auto [end, ec] = std::from_chars(value_text.data(), value_text.data() + value_text.size(), value);
+    if (value_text.empty() || ec != std::errc() || end != value_text.data() + value_text.size() ||
+        !std::isfinite(value)) {
+        return Error{ErrorCode::invalid_argument,
+                     "variation '" + std::string(text) + "': value '" + value_text + "' is not a finite number"};
+    }
+    return Variation{make_tag(tag), value};
+}
+
+}  // namespace crisp

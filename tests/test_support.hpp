@@ -1,0 +1,31 @@
+// Shared by the tests: where the fonts are, and reading files.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace crisp::test {
+
+inline std::string source_path(const std::string& relative) {
+    return std::string(CRISP_SOURCE_DIR) + "/" + relative;
+}
+
+inline const std::string kDejaVuSans = source_path("fonts/DejaVuSans.ttf");          // TrueType, 2048 upem
+inline const std::string kInterCff = source_path("fonts/Inter-Regular.otf");         // CFF
+inline const std::string kInterVariable = source_path("fonts/Inter-roman.var.ttf");  // gvar: wght, opsz
+// From Debian packages that scripts/setup.sh installs.
+inline const std::string kNotoCjk = "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc";       // CFF collection
+inline const std::string kCantarell = "/usr/share/fonts/opentype/cantarell/Cantarell-Regular.otf";  // CFF, 1000 upem
+
+inline std::vector<std::byte> read_file(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::vector<char> chars((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    std::vector<std::byte> bytes(chars.size());
+    for (size_t i = 0; i < chars.size(); ++i) bytes[i] = static_cast<std::byte>(chars[i]);
+    return bytes;
+}
+
+}  // namespace crisp::test
