@@ -18,6 +18,8 @@ const char* error_code_name(ErrorCode code) {
             return "asset_invalid";
         case ErrorCode::asset_version:
             return "asset_version";
+        case ErrorCode::vulkan:
+            return "vulkan";
     }
     return "unknown";
 }

@@ -354,6 +354,7 @@ int exit_code_for(crisp::ErrorCode code) {
             return kExitGlyphs;
         case crisp::ErrorCode::asset_invalid:
         case crisp::ErrorCode::asset_version:
+        case crisp::ErrorCode::vulkan:
             return kExitInternal;
     }
     return kExitInternal;

@@ -21,6 +21,7 @@ enum class ErrorCode {
     glyph_failed,      // one or more glyphs could not be converted
     asset_invalid,     // an asset failed validation; the message names the fault
     asset_version,     // an asset of a version this build does not read
+    vulkan,            // a Vulkan call failed, or a required version, feature or extension is missing
 };
 
 // Short stable name of a code ("asset_invalid"), for logs and JSON.

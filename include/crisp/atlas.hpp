@@ -1,0 +1,261 @@
+// crisp: the glyph atlas, CPU side. docs/atlas.md explains how it works.
+//
+// The atlas decides where each glyph's accumulators live in the atlas image and how many samples
+// the rasterizer adds to each glyph in each frame. It owns no GPU object and never calls the
+// renderer: per frame it takes the glyphs to draw and returns a list of raster work.
+//
+// Space. The atlas is cut into cells of kAtlasCellSize x kAtlasCellSize texels. A glyph's rect is
+// rounded up to a power-of-two number of cells per axis and takes a block that is square or twice
+// as tall as wide (a 10x30 texel rect takes 1x2 cells, 16x32 texels): an aligned run of 1, 2, 4,
+// ... bits in a bitset of free cells whose index runs along a transposed Z-order curve (N-order).
+//
+// Residency. Glyphs are found by GlyphKey. A glyph acquired in the current frame is pinned: it is
+// never evicted before the next begin_frame(). Glyphs not used this frame stay resident while the
+// space allows and are evicted least-recently-used when a new glyph needs room.
+//
+// Samples. Every resident glyph counts the samples accumulated in its rect. A glyph drawn this
+// frame and short of AtlasConfig::max_samples gets more: the ramp (8, 4, 2 by default) in its
+// first frames, then `steady` (1) per frame, within a per-frame budget of curve tests.
+//
+// A frame:
+//
+//     atlas.begin_frame();
+//     for (each glyph instance to draw) {
+//         AtlasLookup lookup = atlas.acquire(key, rect.width, rect.height, curve_tests_per_sample);
+//         if (lookup.status == AtlasStatus::placed) remember lookup.entry for the quad;
+//         else skip the glyph (empty: nothing to draw; atlas_full, too_large: report it)
+//     }
+//     std::span<const RasterWork> work = atlas.schedule();  // record the rasterizer dispatch
+//     draw the quads whose entry holds samples > 0
+//
+// Not thread-safe: one thread drives an atlas. An atlas is a plain value (copyable and movable);
+// it holds no global state, so a program may keep several.
+#pragma once
+
+#include <crisp/glyph.hpp>
+#include <crisp/result.hpp>
+
+#include <cstdint>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+namespace crisp {
+
+inline constexpr uint32_t kAtlasCellSize = 16;    // texels per cell side
+inline constexpr uint32_t kAtlasMinSize = 16;     // one cell
+inline constexpr uint32_t kAtlasMaxSize = 16384;  // Vulkan's common maxImageDimension2D
+// The rasterizer places sample n at frac(0.5 + n * alpha) in float; past 2^16 the product loses
+// the bits that separate neighbouring samples.
+inline constexpr uint32_t kAtlasMaxSamples = 65536;
+
+inline constexpr uint32_t kNoAtlasEntry = 0xFFFFFFFFu;
+
+struct AtlasConfig {
+    // Atlas image size in texels: each a power of two from kAtlasMinSize to kAtlasMaxSize.
+    // Width and height may differ; blocks are never wider than tall, so in a wide atlas the
+    // largest glyph is limited by the height (see AtlasStatus::too_large).
+    uint32_t width = 2048;
+    uint32_t height = 2048;
+    // Samples a glyph gets in its first frames on screen (index 0: the first frame), then
+    // `steady` per frame until it holds `max_samples`. A glyph cut short by the budget catches
+    // up: in its k-th served frame it is brought to ramp[0] + ... + ramp[k] samples.
+    // Each entry in [1, max_samples]; the ramp may be empty.
+    std::vector<uint32_t> ramp = {8, 4, 2};
+    uint32_t steady = 1;         // in [1, max_samples]
+    uint32_t max_samples = 512;  // in [1, kAtlasMaxSamples]
+    // Curve tests the rasterizer may spend per frame (one sample of a glyph costs its
+    // curve_tests_per_sample). 2^26 lets a screenful of new small text (about a thousand 13 px
+    // glyphs of ~1300 tests per sample) get its whole first-frame ramp. Not yet measured:
+    // renderers should tune it from GPU timings (set_frame_budget). Must be at least 1.
+    uint64_t frame_budget = uint64_t{1} << 26;
+};
+
+enum class AtlasStatus : uint8_t {
+    placed,      // the glyph has an entry; entry, x, y, width and height are valid
+    empty,       // the rect has no area (a space): nothing to draw, nothing allocated
+    atlas_full,  // glyphs pinned this frame leave no block of the needed size; nothing was evicted
+    too_large,   // the glyph's block is larger than the atlas; it can never be placed
+};
+
+// Short stable name of a status ("atlas_full"), for logs and JSON.
+const char* atlas_status_name(AtlasStatus status);
+
+struct AtlasLookup {
+    AtlasStatus status = AtlasStatus::empty;
+    uint32_t entry = kNoAtlasEntry;  // id of the entry while it stays resident; kNoAtlasEntry unless placed
+    uint32_t x = 0;                  // texel of the rect's top-left corner in the atlas
+    uint32_t y = 0;
+    uint32_t width = 0;  // the glyph rect, texels
+    uint32_t height = 0;
+};
+
+// A resident glyph, read-only.
+struct AtlasEntry {
+    GlyphKey key;
+    uint32_t x = 0;  // texel of the block's (and the rect's) top-left corner
+    uint32_t y = 0;
+    uint32_t width = 0;  // the glyph rect, texels
+    uint32_t height = 0;
+    uint32_t block_width = 0;   // the cells the entry owns, texels: width and height rounded up
+    uint32_t block_height = 0;  // to powers of two of cells, height = width or 2 * width
+    uint64_t curve_tests_per_sample = 0;
+    // Samples in the rect's accumulators, counting those of this frame's schedule() once it ran.
+    uint32_t samples = 0;
+    uint64_t last_used_frame = 0;  // frame() when last acquired
+};
+
+// Samples the rasterizer adds to one entry this frame: sample indices first_sample to
+// first_sample + sample_count - 1 of each texel of the rect at (x, y), width x height.
+// first_sample == 0 means the accumulators hold nothing of this glyph (a new entry, reused cells,
+// or invalidate_samples()): the rasterizer must clear the rect before adding.
+struct RasterWork {
+    uint32_t entry = 0;
+    GlyphKey key;
+    uint32_t x = 0;
+    uint32_t y = 0;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    uint32_t first_sample = 0;
+    uint32_t sample_count = 0;
+};
+
+struct AtlasCounters {
+    uint64_t hits = 0;              // acquire() found the glyph resident
+    uint64_t allocations = 0;       // acquire() placed a new entry
+    uint64_t evictions = 0;         // unpinned entries evicted to make room
+    uint64_t failed_full = 0;       // acquire() calls answered atlas_full
+    uint64_t failed_too_large = 0;  // acquire() calls answered too_large
+    uint64_t samples = 0;           // samples scheduled
+    uint64_t curve_tests = 0;       // curve tests scheduled (samples times each entry's cost)
+    uint64_t budget_overruns = 0;   // frames whose single forced sample exceeded the budget
+};
+
+struct AtlasStats {
+    uint32_t usable_cells = 0;  // cells inside the atlas
+    uint32_t used_cells = 0;    // cells owned by resident entries
+    float occupancy = 0.0f;     // used_cells / usable_cells
+    uint32_t resident_glyphs = 0;
+    uint32_t pinned_glyphs = 0;    // acquired this frame
+    uint32_t refining_glyphs = 0;  // pinned and short of max_samples
+    AtlasCounters frame;           // since the last begin_frame()
+    AtlasCounters total;           // since create()
+};
+
+class GlyphAtlas {
+public:
+    // Makes an empty atlas in frame 0. A size that is not a power of two in [kAtlasMinSize,
+    // kAtlasMaxSize], a ramp or steady value outside [1, max_samples], max_samples outside
+    // [1, kAtlasMaxSamples] or a frame_budget of 0 returns ErrorCode::invalid_argument naming it.
+    static Result<GlyphAtlas> create(const AtlasConfig& config = {});
+
+    // Ends the current frame and starts the next: unpins every entry, clears the work list and
+    // the per-frame counters.
+    void begin_frame();
+
+    // Finds or places the glyph `key` whose rect is width x height texels and costs
+    // curve_tests_per_sample curve tests per sample (over the whole rect), and pins it for this
+    // frame. Returns:
+    // - placed: a resident entry (a hit, O(1)), or a new one with 0 samples. To make room it
+    //   evicts unpinned entries, least recently used first, one at a time until the block fits.
+    // - empty: width or height is 0; no entry.
+    // - atlas_full: entries pinned this frame leave no free aligned block of the needed size.
+    //   Nothing is evicted and nothing else changes: every glyph already placed keeps its
+    //   entry, and the same request can succeed next frame.
+    // - too_large: the block (rect rounded up to cells, powers of two, at least half as wide as
+    //   tall) is wider or taller than the atlas. Such a glyph never fits; skip it.
+    // Failures are counted in stats(). Equal keys must come with equal width and height (the
+    // key determines the rect); a mismatch is a programmer error and asserts, and release builds
+    // keep the first size. The latest curve_tests_per_sample is kept. May be called after
+    // schedule(): the glyph is pinned but gets samples from the next frame on.
+    AtlasLookup acquire(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample);
+
+    // Decides this frame's samples and returns the work list; call once per frame after every
+    // acquire(). Only entries pinned this frame and short of max_samples get samples: first the
+    // new ones (0 samples) in acquire order, then the rest in turn from a cursor that rotates
+    // over entry ids across frames, so with a steady set of glyphs none starves. An entry whose
+    // share does not fit the rest of the budget gets the samples that fit; the first entry that
+    // gets none ends the frame's list. The budget is never exceeded, except when the first entry
+    // waiting cannot afford one sample: it gets one sample anyway and nothing else is scheduled
+    // that frame (counted as a budget overrun), so every glyph can be drawn.
+    // The entries' sample counts include the returned work at once. A glyph still at 0 samples
+    // after schedule() has nothing in its rect (possibly another glyph's old accumulators): do
+    // not draw it this frame. Calling schedule() again in the same frame returns the same list.
+    // The span stays valid until the next begin_frame().
+    std::span<const RasterWork> schedule();
+
+    // Forgets every resident entry's samples (after a subpixel layout change, for example): each
+    // restarts its ramp at sample 0, and its next work item clears the rect. Entries stay resident.
+    // Work already returned by schedule() this frame stays valid to execute.
+    void invalidate_samples();
+
+    // Replaces AtlasConfig::frame_budget from the next schedule() on. 0 is a programmer error
+    // (asserts; release builds use 1).
+    void set_frame_budget(uint64_t curve_tests);
+
+    // The resident entry with `key`, or kNoAtlasEntry. Neither pins nor touches the entry.
+    uint32_t find(const GlyphKey& key) const;
+
+    // The entry with id `id`, or nullptr when no resident entry has that id (ids of evicted
+    // entries are reused by later ones). The pointer stays valid until the next acquire().
+    const AtlasEntry* entry(uint32_t id) const;
+
+    // Every resident entry's id is below this.
+    uint32_t entry_capacity() const { return static_cast<uint32_t>(slots_.size()); }
+
+    AtlasStats stats() const;
+    const AtlasConfig& config() const { return config_; }
+    uint64_t frame() const { return frame_; }
+
+private:
+    struct Slot {
+        AtlasEntry entry;
+        uint32_t first_bit = 0;             // N-order index of the block's first cell
+        uint32_t bit_count = 0;             // cells in the block
+        uint32_t served_frames = 0;         // frames that scheduled samples since the last reset
+        uint32_t lru_prev = kNoAtlasEntry;  // towards more recently used
+        uint32_t lru_next = kNoAtlasEntry;  // towards less recently used
+        bool resident = false;
+    };
+
+    GlyphAtlas() = default;
+
+    bool pinned(const Slot& slot) const { return slot.entry.last_used_frame == frame_; }
+    void pin(uint32_t id);
+    void lru_unlink(uint32_t id);
+    void lru_push_front(uint32_t id);
+    void mark_cells(uint32_t first_bit, uint32_t bit_count, bool used);
+    uint32_t find_block(uint32_t bit_count) const;
+    uint32_t make_room(uint32_t bit_count);
+    void evict(uint32_t id);
+    uint32_t share(const Slot& slot) const;
+
+    AtlasConfig config_;
+    uint32_t cells_x_ = 0;
+    uint32_t cells_y_ = 0;
+    uint32_t usable_cells_ = 0;
+    uint32_t used_cells_ = 0;
+    std::vector<uint64_t> used_words_;       // bit i set: N-order cell i is taken or outside the atlas
+    std::vector<uint64_t> pinned_words_;     // bit i set: cell i is pinned this frame or outside
+    std::vector<uint64_t> permanent_words_;  // bit i set: cell i is outside the atlas
+    uint32_t first_free_word_ = 0;           // every used_words_ word below it is full
+    std::vector<uint64_t> ramp_totals_;      // ramp_totals_[k] = ramp[0] + ... + ramp[k]
+    std::vector<uint32_t> block_used_;       // scratch for make_room(): used cells per block
+
+    std::vector<Slot> slots_;
+    std::vector<uint32_t> free_ids_;
+    std::unordered_map<GlyphKey, uint32_t, GlyphKeyHash> ids_by_key_;
+    uint32_t lru_head_ = kNoAtlasEntry;  // most recently used
+    uint32_t lru_tail_ = kNoAtlasEntry;  // least recently used
+
+    uint64_t frame_ = 0;
+    std::vector<uint32_t> pinned_ids_;   // pinned this frame, in acquire order
+    std::vector<uint32_t> waiting_ids_;  // scratch for schedule()
+    uint32_t cursor_ = 0;                // entry id the next frame's round starts at
+    bool scheduled_ = false;
+    std::vector<RasterWork> work_;
+    AtlasCounters frame_counters_;
+    AtlasCounters total_counters_;
+};
+
+}  // namespace crisp
