@@ -1,0 +1,578 @@
+// HeadlessContext: instance, validation messenger, device choice and creation, one-off submissions.
+// The buffer and image helpers live in vk_resources.cpp.
+#include <crisp/vulkan_context.hpp>
+
+#include "vk_features.hpp"
+#include "vk_resources.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <utility>
+
+namespace crisp {
+
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+// Enough recent messages to see what went wrong without keeping an unbounded log.
+constexpr size_t kKeptValidationMessages = 16;
+
+// Counts what the validation layer reports. One per context, on the heap inside its State: its
+// address is the messenger's user data, so it must not move while the instance exists.
+class ValidationLog {
+public:
+    void add(VkDebugUtilsMessageSeverityFlagBitsEXT severity, const char* text) {
+        const bool error = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) != 0;
+        std::lock_guard lock(mutex_);
+        (error ? messages_.errors : messages_.warnings)++;
+        recent_.push_back(std::string(error ? "error: " : "warning: ") + (text != nullptr ? text : "(no text)"));
+        if (recent_.size() > kKeptValidationMessages) recent_.pop_front();
+    }
+
+    ValidationMessages snapshot() const {
+        std::lock_guard lock(mutex_);
+        ValidationMessages copy = messages_;
+        copy.recent.assign(recent_.begin(), recent_.end());
+        return copy;
+    }
+
+private:
+    mutable std::mutex mutex_;  // the layer may call back from any thread that calls Vulkan
+    ValidationMessages messages_;
+    std::deque<std::string> recent_;
+};
+
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                     VkDebugUtilsMessageTypeFlagsEXT /*types*/,
+                                                     const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                     void* user_data) {
+    // No exception may cross back into the layer's C code; losing one message beats terminating.
+    try {
+        static_cast<ValidationLog*>(user_data)->add(severity, data != nullptr ? data->pMessage : nullptr);
+    } catch (...) {
+    }
+    return VK_FALSE;  // the spec reserves VK_TRUE for layer development
+}
+
+VkDebugUtilsMessengerCreateInfoEXT messenger_info(ValidationLog* log) {
+    VkDebugUtilsMessengerCreateInfoEXT info{};
+    info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+    // Info and verbose messages are chatter (loader and layer status), not faults.
+    info.messageSeverity =
+        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    info.pfnUserCallback = on_validation_message;
+    info.pUserData = log;
+    return info;
+}
+
+bool has_extension(const std::vector<VkExtensionProperties>& extensions, const char* name) {
+    return std::any_of(extensions.begin(), extensions.end(),
+                       [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+std::vector<VkExtensionProperties> instance_extensions(const char* layer) {
+    uint32_t count = 0;
+    if (vkEnumerateInstanceExtensionProperties(layer, &count, nullptr) != VK_SUCCESS) return {};
+    std::vector<VkExtensionProperties> extensions(count);
+    if (vkEnumerateInstanceExtensionProperties(layer, &count, extensions.data()) != VK_SUCCESS) return {};
+    extensions.resize(count);
+    return extensions;
+}
+
+bool has_layer(const char* name) {
+    uint32_t count = 0;
+    if (vkEnumerateInstanceLayerProperties(&count, nullptr) != VK_SUCCESS) return false;
+    std::vector<VkLayerProperties> layers(count);
+    if (vkEnumerateInstanceLayerProperties(&count, layers.data()) != VK_SUCCESS) return false;
+    layers.resize(count);
+    return std::any_of(layers.begin(), layers.end(),
+                       [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+// Ignores the patch number: a 1.2.0 floor accepts a 1.2.x device.
+bool meets_version(uint32_t version, uint32_t floor) {
+    return VK_MAKE_API_VERSION(0, VK_API_VERSION_MAJOR(version), VK_API_VERSION_MINOR(version), 0) >=
+           VK_MAKE_API_VERSION(0, VK_API_VERSION_MAJOR(floor), VK_API_VERSION_MINOR(floor), 0);
+}
+
+std::string join(const std::vector<std::string>& parts, const char* separator) {
+    std::string joined;
+    for (const std::string& part : parts) {
+        if (!joined.empty()) joined += separator;
+        joined += part;
+    }
+    return joined;
+}
+
+// Lower is better: discrete > integrated > virtual > CPU > other.
+int device_type_rank(VkPhysicalDeviceType type) {
+    switch (type) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+            return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+            return 1;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+            return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU:
+            return 3;
+        default:
+            return 4;
+    }
+}
+
+std::string subgroup_operation_names(VkSubgroupFeatureFlags operations) {
+    static constexpr std::pair<VkSubgroupFeatureFlags, const char*> kNames[] = {
+        {VK_SUBGROUP_FEATURE_BASIC_BIT, "basic"},
+        {VK_SUBGROUP_FEATURE_VOTE_BIT, "vote"},
+        {VK_SUBGROUP_FEATURE_ARITHMETIC_BIT, "arithmetic"},
+        {VK_SUBGROUP_FEATURE_BALLOT_BIT, "ballot"},
+        {VK_SUBGROUP_FEATURE_SHUFFLE_BIT, "shuffle"},
+        {VK_SUBGROUP_FEATURE_SHUFFLE_RELATIVE_BIT, "shuffle_relative"},
+        {VK_SUBGROUP_FEATURE_CLUSTERED_BIT, "clustered"},
+        {VK_SUBGROUP_FEATURE_QUAD_BIT, "quad"},
+    };
+    std::vector<std::string> names;
+    for (const auto& [bit, name] : kNames) {
+        if (operations & bit) names.emplace_back(name);
+    }
+    if (names.empty()) names.emplace_back("(unknown bits)");
+    return join(names, ", ");
+}
+
+// What create() learns about one device while deciding whether it qualifies.
+struct DeviceCandidate {
+    VkPhysicalDevice handle = VK_NULL_HANDLE;
+    VkPhysicalDeviceProperties properties{};
+    VkPhysicalDeviceVulkan11Properties vulkan11{};
+    VkPhysicalDeviceVulkan12Properties vulkan12{};
+    uint32_t queue_family = 0;
+};
+
+// Empty when `candidate` meets every requirement; otherwise what it lacks. Fills the candidate's
+// properties and queue family.
+std::vector<std::string> check_device(DeviceCandidate& candidate, const HeadlessContextOptions& options,
+                                      const vk::DeviceFeatures& required) {
+    std::vector<std::string> lacks;
+    const uint32_t device_version = candidate.properties.apiVersion;
+    if (!meets_version(device_version, options.api_version)) {
+        lacks.push_back("the device supports Vulkan " + vk::version_string(device_version) + " only, below " +
+                        vk::version_string(options.api_version));
+        return lacks;  // the 1.2 property and feature structures below may not be queried
+    }
+
+    VkPhysicalDeviceProperties2 properties2{};
+    properties2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    candidate.vulkan11.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES;
+    candidate.vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES;
+    properties2.pNext = &candidate.vulkan11;
+    candidate.vulkan11.pNext = &candidate.vulkan12;
+    vkGetPhysicalDeviceProperties2(candidate.handle, &properties2);
+    candidate.vulkan11.pNext = nullptr;
+
+    uint32_t family_count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(candidate.handle, &family_count, nullptr);
+    std::vector<VkQueueFamilyProperties> families(family_count);
+    vkGetPhysicalDeviceQueueFamilyProperties(candidate.handle, &family_count, families.data());
+    // Graphics and compute together imply transfer; one queue keeps ownership transfers away.
+    const VkQueueFlags wanted = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+    auto family = std::find_if(families.begin(), families.end(), [&](const VkQueueFamilyProperties& f) {
+        return (f.queueFlags & wanted) == wanted && f.queueCount > 0;
+    });
+    if (family == families.end()) {
+        lacks.push_back("the device has no queue family with both graphics and compute");
+    } else {
+        candidate.queue_family = static_cast<uint32_t>(family - families.begin());
+    }
+
+    uint32_t extension_count = 0;
+    vkEnumerateDeviceExtensionProperties(candidate.handle, nullptr, &extension_count, nullptr);
+    std::vector<VkExtensionProperties> extensions(extension_count);
+    vkEnumerateDeviceExtensionProperties(candidate.handle, nullptr, &extension_count, extensions.data());
+    extensions.resize(extension_count);
+    for (const std::string& name : options.required_extensions) {
+        if (!has_extension(extensions, name.c_str())) lacks.push_back("the device lacks extension " + name);
+    }
+
+    const bool vulkan13 =
+        meets_version(device_version, VK_API_VERSION_1_3) && meets_version(options.api_version, VK_API_VERSION_1_3);
+    const std::vector<std::string> missing =
+        vk::missing_features(required, vk::query_features(candidate.handle, vulkan13));
+    if (!missing.empty()) lacks.push_back("the device lacks " + join(missing, ", "));
+
+    const VkSubgroupFeatureFlags wanted_operations = options.required_compute_subgroup_operations;
+    if (wanted_operations != 0) {
+        if ((candidate.vulkan11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT) == 0) {
+            lacks.push_back("the device offers no subgroup operations in compute shaders");
+        } else if (VkSubgroupFeatureFlags absent =
+                       wanted_operations & ~candidate.vulkan11.subgroupSupportedOperations) {
+            lacks.push_back("the device lacks subgroup operations in compute shaders: " +
+                            subgroup_operation_names(absent));
+        }
+    }
+    return lacks;
+}
+
+}  // namespace
+
+struct HeadlessContext::State {
+    VkInstance instance = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+    PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger = nullptr;
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    VkDevice device = VK_NULL_HANDLE;
+    uint32_t queue_family = 0;
+    VkQueue queue = VK_NULL_HANDLE;
+    VkCommandPool command_pool = VK_NULL_HANDLE;
+    VkCommandBuffer command_buffer = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    bool recording = false;  // catches submit_and_wait called from inside its own record callback
+
+    std::string device_name;
+    std::string driver_name;
+    std::string driver_info;
+    VkDriverId driver_id = VK_DRIVER_ID_MAX_ENUM;
+    uint32_t driver_version = 0;
+    uint32_t api_version = 0;
+    VkPhysicalDeviceProperties properties{};
+    VkPhysicalDeviceMemoryProperties memory_properties{};
+    VkPhysicalDeviceSubgroupProperties subgroup{};
+    std::vector<std::string> enabled_extensions;
+
+    ValidationLog validation_log;
+
+    State() = default;
+    State(const State&) = delete;
+    State& operator=(const State&) = delete;
+
+    // Destroys in reverse order of creation; create() relies on this to clean up after a failure
+    // part-way through.
+    ~State() {
+        const ValidationMessages before = validation_log.snapshot();
+        if (device != VK_NULL_HANDLE) {
+            // Nothing may be destroyed while the GPU still uses it.
+            vkDeviceWaitIdle(device);
+            if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
+            if (command_pool != VK_NULL_HANDLE) vkDestroyCommandPool(device, command_pool, nullptr);
+            vkDestroyDevice(device, nullptr);
+        }
+        if (messenger != VK_NULL_HANDLE) destroy_messenger(instance, messenger, nullptr);
+        if (instance != VK_NULL_HANDLE) vkDestroyInstance(instance, nullptr);
+        // What the layer says during teardown (typically: a Buffer or Image outlived its context)
+        // has no one left to read it, so it goes to stderr.
+        const ValidationMessages after = validation_log.snapshot();
+        const size_t added = (after.errors + after.warnings) - (before.errors + before.warnings);
+        const size_t shown = std::min(added, after.recent.size());
+        for (size_t i = after.recent.size() - shown; i < after.recent.size(); ++i) {
+            std::fprintf(stderr, "crisp: validation during HeadlessContext teardown: %s\n", after.recent[i].c_str());
+        }
+    }
+};
+
+Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& options) {
+    if (!meets_version(options.api_version, VK_API_VERSION_1_2)) {
+        return Error{ErrorCode::invalid_argument,
+                     "api_version " + vk::version_string(options.api_version) + " is below crisp's floor of 1.2"};
+    }
+    Result<vk::DeviceFeatures> copied = vk::copy_required_features(options.required_features, options.api_version);
+    if (!copied) return copied.error();
+    vk::DeviceFeatures& required = copied.value();
+
+    uint32_t loader_version = VK_API_VERSION_1_0;
+    if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS ||
+        !meets_version(loader_version, options.api_version)) {
+        return Error{ErrorCode::vulkan, "the Vulkan loader supports Vulkan " + vk::version_string(loader_version) +
+                                            ", below the " + vk::version_string(options.api_version) + " crisp needs"};
+    }
+
+    auto state = std::make_unique<State>();
+
+    std::vector<const char*> layers;
+    std::vector<const char*> extensions;
+    VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info(&state->validation_log);
+    VkValidationFeaturesEXT validation_features{};
+    const VkValidationFeatureEnableEXT sync_validation = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    if (options.validation) {
+        if (!has_layer(kValidationLayer)) {
+            return Error{ErrorCode::vulkan, std::string("validation was requested but ") + kValidationLayer +
+                                                " is not available (Debian: apt install vulkan-validationlayers)"};
+        }
+        layers.push_back(kValidationLayer);
+        std::vector<VkExtensionProperties> available = instance_extensions(nullptr);
+        const std::vector<VkExtensionProperties> from_layer = instance_extensions(kValidationLayer);
+        available.insert(available.end(), from_layer.begin(), from_layer.end());
+        if (!has_extension(available, VK_EXT_DEBUG_UTILS_EXTENSION_NAME)) {
+            return Error{ErrorCode::vulkan, "validation was requested but VK_EXT_debug_utils is not available"};
+        }
+        extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        if (options.synchronization_validation) {
+            if (!has_extension(available, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME)) {
+                return Error{
+                    ErrorCode::vulkan,
+                    "synchronization validation was requested but VK_EXT_validation_features is not available"};
+            }
+            extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+            validation_features.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
+            validation_features.enabledValidationFeatureCount = 1;
+            validation_features.pEnabledValidationFeatures = &sync_validation;
+            messenger.pNext = &validation_features;
+        }
+    }
+
+    VkApplicationInfo application{};
+    application.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+    application.pApplicationName = "crisp";
+    application.pEngineName = "crisp";
+    application.apiVersion = options.api_version;
+    VkInstanceCreateInfo instance_info{};
+    instance_info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+    // Chained here too so that messages from vkCreateInstance and vkDestroyInstance are counted.
+    instance_info.pNext = options.validation ? &messenger : nullptr;
+    instance_info.pApplicationInfo = &application;
+    instance_info.enabledLayerCount = static_cast<uint32_t>(layers.size());
+    instance_info.ppEnabledLayerNames = layers.data();
+    instance_info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+    instance_info.ppEnabledExtensionNames = extensions.data();
+    if (VkResult result = vkCreateInstance(&instance_info, nullptr, &state->instance); result != VK_SUCCESS) {
+        if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
+            return Error{ErrorCode::vulkan, "no Vulkan driver supports Vulkan " +
+                                                vk::version_string(options.api_version) +
+                                                " (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER)"};
+        }
+        return vk::vulkan_error("vkCreateInstance", result);
+    }
+    if (options.validation) {
+        auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(state->instance, "vkCreateDebugUtilsMessengerEXT"));
+        state->destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(state->instance, "vkDestroyDebugUtilsMessengerEXT"));
+        if (create_messenger == nullptr || state->destroy_messenger == nullptr) {
+            return Error{ErrorCode::vulkan, "VK_EXT_debug_utils is enabled but its functions are missing"};
+        }
+        messenger.pNext = nullptr;  // the validation features belong to the instance only
+        if (VkResult result = create_messenger(state->instance, &messenger, nullptr, &state->messenger);
+            result != VK_SUCCESS) {
+            return vk::vulkan_error("vkCreateDebugUtilsMessengerEXT", result);
+        }
+    }
+
+    uint32_t device_count = 0;
+    if (VkResult result = vkEnumeratePhysicalDevices(state->instance, &device_count, nullptr); result != VK_SUCCESS) {
+        return vk::vulkan_error("vkEnumeratePhysicalDevices", result);
+    }
+    std::vector<VkPhysicalDevice> devices(device_count);
+    if (VkResult result = vkEnumeratePhysicalDevices(state->instance, &device_count, devices.data());
+        result != VK_SUCCESS && result != VK_INCOMPLETE) {
+        return vk::vulkan_error("vkEnumeratePhysicalDevices", result);
+    }
+    devices.resize(device_count);
+    if (devices.empty()) return Error{ErrorCode::vulkan, "no Vulkan device found"};
+
+    std::vector<std::string> names;
+    std::vector<std::string> rejections;
+    std::optional<DeviceCandidate> chosen;
+    for (VkPhysicalDevice handle : devices) {
+        DeviceCandidate candidate;
+        candidate.handle = handle;
+        vkGetPhysicalDeviceProperties(handle, &candidate.properties);
+        const std::string name = candidate.properties.deviceName;
+        names.push_back(name);
+        if (name.find(options.device_name_contains) == std::string::npos) continue;
+        const std::vector<std::string> lacks = check_device(candidate, options, required);
+        if (!lacks.empty()) {
+            rejections.push_back(name + ": " + join(lacks, "; "));
+            continue;
+        }
+        if (!chosen ||
+            device_type_rank(candidate.properties.deviceType) < device_type_rank(chosen->properties.deviceType)) {
+            chosen = candidate;
+        }
+    }
+    if (!chosen) {
+        if (rejections.empty()) {
+            return Error{ErrorCode::vulkan, "no Vulkan device name contains \"" + options.device_name_contains +
+                                                "\"; the devices are: " + join(names, ", ")};
+        }
+        return Error{ErrorCode::vulkan, "no suitable Vulkan device: " + join(rejections, " | ")};
+    }
+
+    state->physical_device = chosen->handle;
+    state->queue_family = chosen->queue_family;
+    state->properties = chosen->properties;
+    state->device_name = chosen->properties.deviceName;
+    state->driver_name = chosen->vulkan12.driverName;
+    state->driver_info = chosen->vulkan12.driverInfo;
+    state->driver_id = chosen->vulkan12.driverID;
+    state->driver_version = chosen->properties.driverVersion;
+    state->api_version = std::min(options.api_version, chosen->properties.apiVersion);
+    state->subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    state->subgroup.subgroupSize = chosen->vulkan11.subgroupSize;
+    state->subgroup.supportedStages = chosen->vulkan11.subgroupSupportedStages;
+    state->subgroup.supportedOperations = chosen->vulkan11.subgroupSupportedOperations;
+    state->subgroup.quadOperationsInAllStages = chosen->vulkan11.subgroupQuadOperationsInAllStages;
+    vkGetPhysicalDeviceMemoryProperties(state->physical_device, &state->memory_properties);
+    for (const std::string& name : options.required_extensions) {
+        // Listing an extension twice is harmless to the caller but invalid for vkCreateDevice.
+        if (std::find(state->enabled_extensions.begin(), state->enabled_extensions.end(), name) ==
+            state->enabled_extensions.end()) {
+            state->enabled_extensions.push_back(name);
+        }
+    }
+
+    const float priority = 1.0f;
+    VkDeviceQueueCreateInfo queue_info{};
+    queue_info.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+    queue_info.queueFamilyIndex = state->queue_family;
+    queue_info.queueCount = 1;
+    queue_info.pQueuePriorities = &priority;
+    std::vector<const char*> device_extensions;
+    for (const std::string& name : state->enabled_extensions) device_extensions.push_back(name.c_str());
+    VkDeviceCreateInfo device_info{};
+    device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+    // Exactly what the caller required; the 1.3 structure only when it asks for something, since
+    // a 1.2 device must not see it.
+    device_info.pNext = required.link(required.any_vulkan13());
+    device_info.queueCreateInfoCount = 1;
+    device_info.pQueueCreateInfos = &queue_info;
+    device_info.enabledExtensionCount = static_cast<uint32_t>(device_extensions.size());
+    device_info.ppEnabledExtensionNames = device_extensions.data();
+    if (VkResult result = vkCreateDevice(state->physical_device, &device_info, nullptr, &state->device);
+        result != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateDevice", result);
+    }
+    vkGetDeviceQueue(state->device, state->queue_family, 0, &state->queue);
+
+    VkCommandPoolCreateInfo pool_info{};
+    pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    // One command buffer, re-recorded for every submission.
+    pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT | VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pool_info.queueFamilyIndex = state->queue_family;
+    if (VkResult result = vkCreateCommandPool(state->device, &pool_info, nullptr, &state->command_pool);
+        result != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateCommandPool", result);
+    }
+    VkCommandBufferAllocateInfo buffer_info{};
+    buffer_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    buffer_info.commandPool = state->command_pool;
+    buffer_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    buffer_info.commandBufferCount = 1;
+    if (VkResult result = vkAllocateCommandBuffers(state->device, &buffer_info, &state->command_buffer);
+        result != VK_SUCCESS) {
+        return vk::vulkan_error("vkAllocateCommandBuffers", result);
+    }
+    VkFenceCreateInfo fence_info{};
+    fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+    if (VkResult result = vkCreateFence(state->device, &fence_info, nullptr, &state->fence); result != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateFence", result);
+    }
+    return HeadlessContext(std::move(state));
+}
+
+HeadlessContext::HeadlessContext(std::unique_ptr<State> state) : state_(std::move(state)) {}
+HeadlessContext::HeadlessContext(HeadlessContext&& other) noexcept = default;
+HeadlessContext& HeadlessContext::operator=(HeadlessContext&& other) noexcept = default;
+HeadlessContext::~HeadlessContext() = default;
+
+VkInstance HeadlessContext::instance() const {
+    return state_->instance;
+}
+VkPhysicalDevice HeadlessContext::physical_device() const {
+    return state_->physical_device;
+}
+VkDevice HeadlessContext::device() const {
+    return state_->device;
+}
+uint32_t HeadlessContext::queue_family() const {
+    return state_->queue_family;
+}
+VkQueue HeadlessContext::queue() const {
+    return state_->queue;
+}
+const std::string& HeadlessContext::device_name() const {
+    return state_->device_name;
+}
+const std::string& HeadlessContext::driver_name() const {
+    return state_->driver_name;
+}
+const std::string& HeadlessContext::driver_info() const {
+    return state_->driver_info;
+}
+VkDriverId HeadlessContext::driver_id() const {
+    return state_->driver_id;
+}
+uint32_t HeadlessContext::driver_version() const {
+    return state_->driver_version;
+}
+uint32_t HeadlessContext::api_version() const {
+    return state_->api_version;
+}
+const VkPhysicalDeviceProperties& HeadlessContext::properties() const {
+    return state_->properties;
+}
+const VkPhysicalDeviceMemoryProperties& HeadlessContext::memory_properties() const {
+    return state_->memory_properties;
+}
+const VkPhysicalDeviceSubgroupProperties& HeadlessContext::subgroup_properties() const {
+    return state_->subgroup;
+}
+const std::vector<std::string>& HeadlessContext::enabled_extensions() const {
+    return state_->enabled_extensions;
+}
+
+bool HeadlessContext::supports_compute_subgroup_arithmetic() const {
+    return (state_->subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
+           (state_->subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) != 0;
+}
+
+ValidationMessages HeadlessContext::validation_messages() const {
+    return state_->validation_log.snapshot();
+}
+
+Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {
+    State& s = *state_;
+    assert(!s.recording && "submit_and_wait called from inside its own record callback");
+    // Leaves the command buffer reusable even if `record` throws.
+    struct RecordingGuard {
+        State& s;
+        bool ended = false;
+        explicit RecordingGuard(State& state) : s(state) { s.recording = true; }
+        ~RecordingGuard() {
+            if (!ended) vkResetCommandBuffer(s.command_buffer, 0);
+            s.recording = false;
+        }
+    } guard(s);
+
+    VkCommandBufferBeginInfo begin{};
+    begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    if (VkResult result = vkBeginCommandBuffer(s.command_buffer, &begin); result != VK_SUCCESS) {
+        return vk::vulkan_error("vkBeginCommandBuffer", result);
+    }
+    record(s.command_buffer);
+    VkResult ended = vkEndCommandBuffer(s.command_buffer);
+    guard.ended = ended == VK_SUCCESS;
+    if (ended != VK_SUCCESS) return vk::vulkan_error("vkEndCommandBuffer", ended);
+
+    VkSubmitInfo submit{};
+    submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+    submit.commandBufferCount = 1;
+    submit.pCommandBuffers = &s.command_buffer;
+    if (VkResult result = vkQueueSubmit(s.queue, 1, &submit, s.fence); result != VK_SUCCESS) {
+        return vk::vulkan_error("vkQueueSubmit", result);
+    }
+    if (VkResult result = vkWaitForFences(s.device, 1, &s.fence, VK_TRUE, UINT64_MAX); result != VK_SUCCESS) {
+        return vk::vulkan_error("vkWaitForFences", result);
+    }
+    if (VkResult result = vkResetFences(s.device, 1, &s.fence); result != VK_SUCCESS) {
+        return vk::vulkan_error("vkResetFences", result);
+    }
+    return {};
+}
+
+}  // namespace crisp
