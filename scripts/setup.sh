@@ -7,6 +7,7 @@ packages=(
   build-essential cmake pkg-config git   # the toolchain (CMake 3.25 on Debian 12)
   libfreetype-dev                        # font outlines for the baker
   libharfbuzz-dev                        # shaping, GSUB closure for subset bakes, asset font checks
+  libfribidi-dev                         # the Unicode bidirectional algorithm for mixed-direction text
   libvulkan-dev                          # the Vulkan loader and headers
   mesa-vulkan-drivers                    # lavapipe, the CPU Vulkan driver the GPU tests run on
   vulkan-validationlayers                # the validation layer the tests turn on

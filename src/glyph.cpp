@@ -1,5 +1,6 @@
 #include <crisp/glyph.hpp>
 
+#include <bit>
 #include <cmath>
 
 namespace crisp {
@@ -49,6 +50,28 @@ TexelToEm texel_to_em(const GlyphRect& rect, const GlyphKey& key) {
     mapping.offset_x = static_cast<float>((rect.x - sub_x) / size_x);
     mapping.offset_y = static_cast<float>((sub_y - rect.y) / size_y);
     return mapping;
+}
+
+uint64_t curve_tests_per_sample(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key) {
+    if (glyph.curve_count == 0 || glyph.band_count == 0) return 0;
+    const GlyphRect rect = glyph_rect(glyph, key);
+    const TexelToEm map = texel_to_em(rect, key);
+    uint64_t tests = 0;
+    uint32_t cached_band = UINT32_MAX;
+    uint64_t cached_count = 0;
+    for (uint32_t row = 0; row < rect.height; ++row) {
+        const float y = map.offset_y + map.scale_y * (static_cast<float>(row) + 0.5f);
+        const uint32_t band = FontAsset::band_of(glyph, y);
+        if (band != cached_band) {
+            cached_band = band;
+            cached_count = 0;
+            const size_t first = size_t{glyph.band_offset} + size_t{band} * glyph.band_words;
+            for (size_t w = 0; w < glyph.band_words; ++w)
+                cached_count += static_cast<uint64_t>(std::popcount(asset.band_words[first + w]));
+        }
+        tests += cached_count * rect.width;
+    }
+    return tests;
 }
 
 }  // namespace crisp

@@ -363,8 +363,8 @@ private:
             }
             ++pos_;
             skip_space();
-            value.object.emplace_back(std::move(key), Value{});
-            if (!parse_value(value.object.back().second, depth + 1)) return false;
+            value.object.push_back(Member{std::move(key), Value{}});
+            if (!parse_value(value.object.back().value, depth + 1)) return false;
             skip_space();
             if (peek() == ',') {
                 ++pos_;

@@ -17,8 +17,9 @@
 namespace crisp::json {
 
 struct Value;
+struct Member;
 using Array = std::vector<Value>;
-using Object = std::vector<std::pair<std::string, Value>>;  // in file order; duplicate keys are an error
+using Object = std::vector<Member>;  // in file order; duplicate names are an error
 
 struct Value {
     enum class Type { null, boolean, number, string, array, object };
@@ -32,6 +33,11 @@ struct Value {
     // The member named `key`, or nullptr (also when this is not an object).
     const Value* find(std::string_view key) const;
     const char* type_name() const;
+};
+
+struct Member {
+    std::string name;
+    Value value;
 };
 
 inline constexpr size_t kMaxDepth = 64;

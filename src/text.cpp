@@ -1,4 +1,6 @@
 // Small text parsers shared by the baker and the tools: UTF-8, code point ranges, axis values.
+#include "utf8.hpp"
+
 #include <crisp/bake.hpp>
 
 #include <algorithm>
@@ -7,18 +9,19 @@
 
 namespace crisp {
 
-std::vector<uint32_t> decode_utf8(std::string_view text) {
-    // Invalid input becomes U+FFFD, one per maximal ill-formed subpart (Unicode 15, 3.9 U+FFFD
-    // substitution), so a truncated sequence costs one replacement, not one per byte.
-    std::vector<uint32_t> out;
-    out.reserve(text.size());
+namespace {
+
+// Invalid input becomes U+FFFD, one per maximal ill-formed subpart (Unicode 15, 3.9 U+FFFD
+// substitution), so a truncated sequence costs one replacement, not one per byte.
+void decode(std::string_view text, std::vector<uint32_t>& codepoints, std::vector<uint32_t>* offsets) {
     const auto* s = reinterpret_cast<const unsigned char*>(text.data());
     const size_t n = text.size();
     size_t i = 0;
     while (i < n) {
         const unsigned char b = s[i];
+        if (offsets) offsets->push_back(static_cast<uint32_t>(i));
         if (b < 0x80) {
-            out.push_back(b);
+            codepoints.push_back(b);
             ++i;
             continue;
         }
@@ -38,7 +41,7 @@ std::vector<uint32_t> decode_utf8(std::string_view text) {
             if (b == 0xF0) lo = 0x90;
             if (b == 0xF4) hi = 0x8F;
         } else {
-            out.push_back(0xFFFD);
+            codepoints.push_back(0xFFFD);
             ++i;
             continue;
         }
@@ -53,10 +56,28 @@ std::vector<uint32_t> decode_utf8(std::string_view text) {
             lo = 0x80;
             hi = 0xBF;
         }
-        out.push_back(good ? cp : 0xFFFDu);
+        codepoints.push_back(good ? cp : 0xFFFDu);
         i = j;
     }
+    if (offsets) offsets->push_back(static_cast<uint32_t>(n));
+}
+
+}  // namespace
+
+std::vector<uint32_t> decode_utf8(std::string_view text) {
+    std::vector<uint32_t> out;
+    out.reserve(text.size());
+    decode(text, out, nullptr);
     return out;
+}
+
+void decode_utf8_with_offsets(std::string_view text, std::vector<uint32_t>& codepoints,
+                              std::vector<uint32_t>& offsets) {
+    codepoints.clear();
+    offsets.clear();
+    codepoints.reserve(text.size());
+    offsets.reserve(text.size() + 1);
+    decode(text, codepoints, &offsets);
 }
 
 namespace {

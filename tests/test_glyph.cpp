@@ -59,6 +59,24 @@ TEST(Glyph, TexelToEmMapsTheRectOntoTheOutline) {
     }
 }
 
+TEST(Glyph, CurveTestsPerSampleCountsEachRowsBand) {
+    FontAsset asset;
+    GlyphRecord glyph = box(0.0f, 0.0f, 1.0f, 1.0f);
+    glyph.curve_count = 40;  // two words per band
+    glyph.band_count = 2;
+    glyph.band_words = 2;
+    asset.band_words = {0x0000000Fu, 0x1u, 0xFFFFFFFFu, 0x0u};  // band 0: 5 curves, band 1: 32
+    const GlyphKey key = key_at(10.0f, 0.0f, 0.0f);
+    const GlyphRect rect = glyph_rect(glyph, key);  // 12 x 12 with padding: rows above y=0.5 in band 1
+    uint64_t expected = 0;
+    for (uint32_t row = 0; row < rect.height; ++row) {
+        const float y = texel_to_em(rect, key).offset_y - (static_cast<float>(row) + 0.5f) / 10.0f;
+        expected += (y >= 0.5f ? 32u : 5u) * rect.width;
+    }
+    EXPECT_EQ(curve_tests_per_sample(asset, glyph, key), expected);
+    EXPECT_EQ(curve_tests_per_sample(asset, GlyphRecord{}, key), 0u);
+}
+
 TEST(Glyph, KeysHashAndCompareByEveryField) {
     std::unordered_set<GlyphKey, GlyphKeyHash> keys;
     GlyphKey key = key_at(16.0f, 0.5f, 0.0f);

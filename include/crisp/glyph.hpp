@@ -63,6 +63,11 @@ struct TexelToEm {
 };
 TexelToEm texel_to_em(const GlyphRect& rect, const GlyphKey& key);
 
+// What one sample of every texel of the glyph's rect costs the rasterizer, in curve tests: the
+// sum over the rect's rows of its width times the curves listed in the band of the row's centre.
+// The atlas budgets its samples in these units. 0 for a glyph without curves.
+uint64_t curve_tests_per_sample(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key);
+
 inline float size_to_float(uint32_t fixed) {
     return static_cast<float>(fixed) / static_cast<float>(kSizeOne);
 }
