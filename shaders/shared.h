@@ -13,6 +13,9 @@
 namespace crisp::gpu {
 
 using uint = std::uint32_t;
+struct vec4 {
+    float x, y, z, w;
+};
 
 #define CRISP_CONSTANT(type, name, value) inline constexpr type name = value
 #else
@@ -40,7 +43,55 @@ struct SelftestResult {
     uint subgroup_size;  // gl_SubgroupSize
 };
 
+// ---- raster.comp: adds point samples of glyph outlines into the atlas accumulators.
+
+// Invocations per workgroup; a workgroup rasterizes 64 texels of one glyph, row-major, so the
+// bands a subgroup touches stay few.
+CRISP_CONSTANT(uint, kRasterWorkgroupSize, 64u);
+// One covered sample adds this to its channel's accumulator (fixed point, so that fractional
+// coverage from row spans fits later); alpha counts samples. 1023 samples fill 16 bits.
+CRISP_CONSTANT(uint, kRasterCoverageOne, 64u);
+// Storage buffers of curve points and of band bitsets, one each per font: with the work items
+// 17 storage buffers, within the 32 per stage that lavapipe and desktop drivers offer.
+CRISP_CONSTANT(uint, kRasterMaxFonts, 8u);
+// Workgroups per row of the 2D dispatch (maxComputeWorkGroupCount[0] is at least 65535).
+CRISP_CONSTANT(uint, kRasterDispatchWidth, 65535u);
+
+// One glyph's work this frame, in a std430 storage buffer.
+struct RasterItem {
+    uint atlas_x;  // texel of the glyph rect's top-left corner in the atlas
+    uint atlas_y;
+    uint width;  // the rect, texels
+    uint height;
+    float offset_x;  // texel_to_em: em = offset + scale * (texel position in the rect)
+    float offset_y;
+    float scale_x;
+    float scale_y;
+    float bbox_min_y;  // the glyph's em bbox in y, for its bands
+    float bbox_max_y;
+    uint point_offset;  // first point of the glyph in its font's point buffer
+    uint band_offset;   // first word of its bands in its font's band buffer
+    uint band_count;
+    uint band_words;       // words per band
+    uint font;             // index into the per-font buffer arrays
+    uint first_sample;     // index of the first sample to add; 0: start from empty accumulators
+    uint sample_count;     // samples to add
+    uint first_workgroup;  // this item's first workgroup; the items' ranges tile the dispatch
+};
+
+struct RasterPushConstants {
+    vec4 channel_rects[3];  // subpixel layout: x0, y0, x1, y1 of red, green, blue, pixel units, y down
+    uint item_count;
+    uint workgroup_count;  // workgroups that have work (the dispatch may round up)
+    uint shared_rows;      // 1: the three rects share their rows, one set of roots serves all
+    uint padding;
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(RasterItem) == 72);
+static_assert(offsetof(RasterItem, first_workgroup) == 68);
+static_assert(sizeof(RasterPushConstants) == 64);
+static_assert(offsetof(RasterPushConstants, item_count) == 48);
 static_assert(sizeof(SelftestPushConstants) == 8);
 static_assert(offsetof(SelftestPushConstants, seed) == 4);
 static_assert(sizeof(SelftestResult) == 24);  // std430 array stride: 6 uints, 4-byte aligned

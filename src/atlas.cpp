@@ -267,9 +267,7 @@ AtlasLookup GlyphAtlas::acquire(const GlyphKey& key, uint32_t width, uint32_t he
     uint32_t id = kNoAtlasEntry;
     if (const auto found = ids_by_key_.find(key); found != ids_by_key_.end()) {
         id = found->second;
-        Slot& slot = slots_[id];
-        assert(slot.entry.width == width && slot.entry.height == height && "equal keys need equal rects");
-        slot.entry.curve_tests_per_sample = curve_tests_per_sample;
+        assert(slots_[id].entry.width == width && slots_[id].entry.height == height && "equal keys need equal rects");
         pin(id);
         ++frame_counters_.hits;
         ++total_counters_.hits;

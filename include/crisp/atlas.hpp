@@ -166,7 +166,9 @@ public:
     //   tall) is wider or taller than the atlas. Such a glyph never fits; skip it.
     // Failures are counted in stats(). Equal keys must come with equal width and height (the
     // key determines the rect); a mismatch is a programmer error and asserts, and release builds
-    // keep the first size. The latest curve_tests_per_sample is kept. May be called after
+    // keep the first size. curve_tests_per_sample is read when the glyph is placed and ignored for a
+    // resident one (the key determines the cost too), so callers may compute it only on a miss
+    // (find() first). May be called after
     // schedule(): the glyph is pinned but gets samples from the next frame on.
     AtlasLookup acquire(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample);
 

@@ -1,0 +1,144 @@
+// crisp: the GPU renderer. It rasterizes glyph outlines into the atlas image with a compute shader,
+// adding R2-distributed point samples per subpixel channel for as long as a glyph stays on screen.
+//
+// A Renderer is created from the caller's Vulkan objects and records its work into command buffers
+// the caller gives; it never submits on its own. A frame:
+//
+//     renderer.begin_frame();
+//     renderer.draw(layout.glyphs);             // any number of times: acquires atlas entries
+//     renderer.record(command_buffer);          // uploads, then one compute dispatch
+//     ... the caller submits; the atlas image is ready for shaders (or copies) after it ...
+//
+// The caller must not have more than RendererCreateInfo::frames_in_flight recorded command buffers
+// pending on the GPU at once: the renderer reuses its per-frame resources after that many frames.
+//
+// The atlas image (RendererCreateInfo::atlas sets its size) is VK_FORMAT_R16G16B16A16_UINT, kept in
+// VK_IMAGE_LAYOUT_GENERAL. Each texel holds the hits of its red, green and blue samples in units of
+// kCoverageOne per hit, and its sample count in alpha: a channel's coverage is
+// value / (kCoverageOne * alpha). After record() the image is made visible to fragment and compute
+// shader reads and to transfer reads.
+#pragma once
+
+#include <crisp/atlas.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/result.hpp>
+#include <crisp/subpixel.hpp>
+
+#include <vulkan/vulkan.h>
+
+#include <memory>
+#include <span>
+
+namespace crisp {
+
+// Fixed-point units of one covered sample in the atlas accumulators.
+inline constexpr uint32_t kCoverageOne = 64;
+// The most samples a texel can hold: 65535 / kCoverageOne.
+inline constexpr uint32_t kMaxRendererSamples = 1023;
+// Fonts one renderer can hold at once.
+inline constexpr uint32_t kMaxRendererFonts = 8;
+
+struct RendererCreateInfo {
+    VkInstance instance = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    VkDevice device = VK_NULL_HANDLE;
+    uint32_t queue_family = 0;  // the family of the queue the caller submits crisp's work on
+    const VkAllocationCallbacks* allocator = nullptr;
+    uint32_t frames_in_flight = 2;  // 1 to 8
+    AtlasConfig atlas;              // max_samples at most kMaxRendererSamples
+    SubpixelLayout layout;          // default: rgb
+    // Where the three channels sample the same rows (stripe layouts), solve each curve's roots
+    // once for all three. Off only to measure what it saves.
+    bool shared_row_roots = true;
+};
+
+// A glyph drawn this frame whose rect holds samples: where its texels are in the atlas.
+struct DrawnGlyph {
+    GlyphInstance instance;
+    uint32_t atlas_x = 0;  // texel of the rect's top-left corner in the atlas image
+    uint32_t atlas_y = 0;
+    uint32_t samples = 0;  // samples its texels hold once this frame's work has run
+};
+
+struct RendererStats {
+    uint32_t drawn_glyphs = 0;    // draw()n glyphs with outlines this frame
+    uint32_t skipped_glyphs = 0;  // not drawable this frame: no samples yet, atlas full or too large
+    uint32_t failed_glyphs = 0;   // atlas_full or too_large this frame (also in atlas().stats())
+    uint32_t unknown_fonts = 0;   // instances whose FontId was never added
+    uint32_t work_items = 0;      // glyphs given samples this frame
+    uint32_t workgroups = 0;      // compute workgroups dispatched
+    uint64_t samples = 0;         // samples scheduled this frame (all channels count once)
+    uint64_t curve_tests = 0;     // the atlas's estimate of this frame's curve tests
+    uint64_t upload_bytes = 0;    // bytes copied into GPU buffers while recording this frame
+};
+
+class Renderer {
+public:
+    // Creates the atlas image, buffers and the compute pipeline. Fails with ErrorCode::vulkan when
+    // the device is below Vulkan 1.2 or lacks what the rasterizer needs (named in the message:
+    // shaderStorageBufferArrayDynamicIndexing, storage images of R16G16B16A16_UINT, subgroup
+    // arithmetic in compute shaders, 1 + 2 * kMaxRendererFonts storage buffers per stage), and with ErrorCode::invalid_argument for a bad atlas config
+    // (see GlyphAtlas::create), max_samples above kMaxRendererSamples, frames_in_flight outside
+    // 1..8, or an invalid layout.
+    static Result<Renderer> create(const RendererCreateInfo& info);
+
+    Renderer(Renderer&&) noexcept;
+    Renderer& operator=(Renderer&&) noexcept;
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+    // Destroys every object the renderer made. The caller makes sure the GPU is done with them
+    // (e.g. vkDeviceWaitIdle) first.
+    ~Renderer();
+
+    // Makes a font drawable. The renderer keeps a pointer: the Font must outlive it. Its curves and
+    // bands are copied to the GPU by the next record(). Errors: invalid_argument when a font with
+    // the same id was added, or kMaxRendererFonts are already held; vulkan when its buffers cannot
+    // be made or exceed maxStorageBufferRange (the message says which).
+    Status add_font(const Font& font);
+
+    // Replaces the subpixel layout. Every accumulated sample is invalidated: glyphs restart their
+    // sample schedule. An invalid layout is refused (invalid_argument) and the old one stays.
+    Status set_subpixel_layout(const SubpixelLayout& layout);
+    const SubpixelLayout& subpixel_layout() const;
+
+    // Starts a frame: unpins the atlas and forgets last frame's drawn glyphs.
+    void begin_frame();
+
+    // Draws glyph instances this frame: finds or places each in the atlas and pins it. Instances
+    // of unknown fonts and glyphs the atlas cannot hold are counted in stats() and skipped, never
+    // a crash.
+    void draw(std::span<const GlyphInstance> glyphs);
+
+    // Records this frame's work into `command_buffer` (which must be recording, outside a render
+    // pass, on a queue of RendererCreateInfo::queue_family): pending font uploads, the work list,
+    // one compute dispatch, and a barrier that makes the atlas readable. Call once per frame after
+    // the draws. Errors (ErrorCode::vulkan) leave the command buffer without crisp's commands.
+    Status record(VkCommandBuffer command_buffer);
+
+    // The glyphs draw()n this frame that hold samples once this frame's work has run, with their
+    // atlas positions (valid after record()).
+    std::span<const DrawnGlyph> drawn() const;
+
+    // True when every glyph drawn this frame holds max_samples: static text has converged and
+    // record() schedules no work.
+    bool converged() const;
+
+    // Records a copy of the whole atlas image into `buffer` (at offset 0; width * height texels of
+    // 4 uint16 each, row-major: red, green, blue hits in kCoverageOne units, then the sample
+    // count), with the barriers and layout changes around it. For tools and tests that read the
+    // accumulators back; call after record() in the same command buffer or a later one.
+    void record_atlas_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const;
+
+    const RendererStats& stats() const;
+    const GlyphAtlas& atlas() const;
+    VkImage atlas_image() const;
+    VkImageView atlas_view() const;
+
+private:
+    struct State;
+    explicit Renderer(std::unique_ptr<State> state);
+    std::unique_ptr<State> state_;
+};
+
+}  // namespace crisp

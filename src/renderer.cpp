@@ -1,0 +1,689 @@
+#include "embedded_shaders.hpp"
+#include "shared.h"
+#include "vk_resources.hpp"
+
+#include <crisp/renderer.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace crisp {
+
+namespace {
+
+constexpr VkFormat kAtlasFormat = VK_FORMAT_R16G16B16A16_UINT;
+static_assert(kCoverageOne == gpu::kRasterCoverageOne);
+static_assert(kMaxRendererFonts == gpu::kRasterMaxFonts);
+// vkCmdUpdateBuffer takes at most this many bytes a call.
+constexpr VkDeviceSize kUpdateChunk = 65536;
+
+// A buffer with its own memory; host-visible ones stay mapped.
+struct GpuBuffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkDeviceSize size = 0;
+};
+
+struct GpuFont {
+    const Font* font = nullptr;
+    GpuBuffer points;   // device-local
+    GpuBuffer bands;    // device-local
+    GpuBuffer staging;  // host-visible, points then bands; freed once copied and done
+    VkDeviceSize points_bytes = 0;
+    bool uploaded = false;
+};
+
+struct Retired {
+    GpuBuffer buffer;
+    uint64_t frame = 0;  // free once frames_in_flight frames have been recorded after this one
+};
+
+}  // namespace
+
+struct Renderer::State {
+    VkDevice device = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    const VkAllocationCallbacks* allocator = nullptr;
+    VkPhysicalDeviceMemoryProperties memory_properties{};
+    VkDeviceSize max_storage_buffer_range = 0;
+    uint32_t frames_in_flight = 2;
+    bool shared_row_roots = true;
+
+    GlyphAtlas atlas;
+    SubpixelLayout layout;
+
+    VkImage atlas_image = VK_NULL_HANDLE;
+    VkDeviceMemory atlas_memory = VK_NULL_HANDLE;
+    VkImageView atlas_view = VK_NULL_HANDLE;
+    bool atlas_initialized = false;
+
+    GpuBuffer items;  // device-local, RasterItem[usable cells]
+    uint32_t item_capacity = 0;
+    GpuBuffer dummy;  // bound to the font slots no font uses
+
+    std::vector<GpuFont> fonts;                      // slot order
+    std::unordered_map<FontId, uint32_t> font_slot;  // FontId -> index in fonts
+    std::vector<Retired> retired;
+
+    VkShaderModule shader = VK_NULL_HANDLE;
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
+    std::vector<VkDescriptorSet> sets;
+
+    uint64_t frame = 0;
+    struct Pending {
+        DrawnGlyph glyph;
+        uint32_t entry = kNoAtlasEntry;
+    };
+    std::vector<Pending> pending;  // draw()n this frame, before record() knows their samples
+    std::vector<DrawnGlyph> drawn;
+    std::vector<gpu::RasterItem> item_data;
+    RendererStats stats;
+    bool converged = true;
+
+    explicit State(GlyphAtlas glyph_atlas) : atlas(std::move(glyph_atlas)) {}
+    ~State();
+    Status make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, GpuBuffer& out);
+    void free_buffer(GpuBuffer& buffer);
+    Status create_objects();
+    void write_descriptors(VkDescriptorSet set);
+};
+
+Renderer::State::~State() {
+    if (!device) return;
+    for (Retired& r : retired) free_buffer(r.buffer);
+    for (GpuFont& font : fonts) {
+        free_buffer(font.points);
+        free_buffer(font.bands);
+        free_buffer(font.staging);
+    }
+    free_buffer(items);
+    free_buffer(dummy);
+    if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, allocator);
+    if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
+    if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, allocator);
+    if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, allocator);
+    if (shader) vkDestroyShaderModule(device, shader, allocator);
+    if (atlas_view) vkDestroyImageView(device, atlas_view, allocator);
+    if (atlas_image) vkDestroyImage(device, atlas_image, allocator);
+    if (atlas_memory) vkFreeMemory(device, atlas_memory, allocator);
+}
+
+Status Renderer::State::make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, GpuBuffer& out) {
+    VkBufferCreateInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    info.size = std::max<VkDeviceSize>(size, 16);
+    info.usage = usage;
+    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    if (VkResult r = vkCreateBuffer(device, &info, allocator, &out.buffer); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateBuffer", r);
+    }
+    out.size = info.size;
+    VkMemoryRequirements requirements{};
+    vkGetBufferMemoryRequirements(device, out.buffer, &requirements);
+    const VkMemoryPropertyFlags required =
+        host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                     : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+    const auto type = vk::find_memory_type(memory_properties, requirements.memoryTypeBits, required, 0);
+    if (!type) {
+        free_buffer(out);
+        return Error{ErrorCode::vulkan, "no memory type for a buffer of " + std::to_string(size) + " bytes"};
+    }
+    VkMemoryAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    allocate.allocationSize = requirements.size;
+    allocate.memoryTypeIndex = *type;
+    if (VkResult r = vkAllocateMemory(device, &allocate, allocator, &out.memory); r != VK_SUCCESS) {
+        free_buffer(out);
+        return vk::vulkan_error("vkAllocateMemory", r);
+    }
+    vkBindBufferMemory(device, out.buffer, out.memory, 0);
+    if (host_visible) {
+        if (VkResult r = vkMapMemory(device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped); r != VK_SUCCESS) {
+            free_buffer(out);
+            return vk::vulkan_error("vkMapMemory", r);
+        }
+    }
+    return {};
+}
+
+void Renderer::State::free_buffer(GpuBuffer& buffer) {
+    if (buffer.buffer) vkDestroyBuffer(device, buffer.buffer, allocator);
+    if (buffer.memory) vkFreeMemory(device, buffer.memory, allocator);
+    buffer = {};
+}
+
+Status Renderer::State::create_objects() {
+    // The atlas image.
+    const AtlasConfig& config = atlas.config();
+    VkImageCreateInfo image{};
+    image.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+    image.imageType = VK_IMAGE_TYPE_2D;
+    image.format = kAtlasFormat;
+    image.extent = {config.width, config.height, 1};
+    image.mipLevels = 1;
+    image.arrayLayers = 1;
+    image.samples = VK_SAMPLE_COUNT_1_BIT;
+    image.tiling = VK_IMAGE_TILING_OPTIMAL;
+    image.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                  VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    image.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    image.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    if (VkResult r = vkCreateImage(device, &image, allocator, &atlas_image); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateImage (atlas)", r);
+    }
+    VkMemoryRequirements requirements{};
+    vkGetImageMemoryRequirements(device, atlas_image, &requirements);
+    const auto type =
+        vk::find_memory_type(memory_properties, requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
+    if (!type) return Error{ErrorCode::vulkan, "no device-local memory type for the atlas image"};
+    VkMemoryAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    allocate.allocationSize = requirements.size;
+    allocate.memoryTypeIndex = *type;
+    if (VkResult r = vkAllocateMemory(device, &allocate, allocator, &atlas_memory); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkAllocateMemory (atlas)", r);
+    }
+    vkBindImageMemory(device, atlas_image, atlas_memory, 0);
+    VkImageViewCreateInfo view{};
+    view.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+    view.image = atlas_image;
+    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view.format = kAtlasFormat;
+    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    if (VkResult r = vkCreateImageView(device, &view, allocator, &atlas_view); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateImageView (atlas)", r);
+    }
+
+    // Work items: an entry takes at least one cell, so a frame never has more items than cells.
+    item_capacity = atlas.stats().usable_cells;
+    if (Status s = make_buffer(VkDeviceSize{item_capacity} * sizeof(gpu::RasterItem),
+                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, items);
+        !s) {
+        return s;
+    }
+    if (Status s = make_buffer(16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, dummy); !s) return s;
+
+    // The pipeline.
+    const shaders::EmbeddedShader* code = shaders::find_embedded_shader("raster.comp");
+    if (!code) return Error{ErrorCode::vulkan, "the raster shader is not embedded in this build"};
+    VkShaderModuleCreateInfo module{};
+    module.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+    module.codeSize = code->size;
+    module.pCode = code->code;
+    if (VkResult r = vkCreateShaderModule(device, &module, allocator, &shader); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateShaderModule", r);
+    }
+    const VkDescriptorSetLayoutBinding bindings[] = {
+        {0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kMaxRendererFonts, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kMaxRendererFonts, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+    };
+    VkDescriptorSetLayoutCreateInfo set_info{};
+    set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+    set_info.bindingCount = static_cast<uint32_t>(std::size(bindings));
+    set_info.pBindings = bindings;
+    if (VkResult r = vkCreateDescriptorSetLayout(device, &set_info, allocator, &set_layout); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateDescriptorSetLayout", r);
+    }
+    VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::RasterPushConstants)};
+    VkPipelineLayoutCreateInfo layout_info{};
+    layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+    layout_info.setLayoutCount = 1;
+    layout_info.pSetLayouts = &set_layout;
+    layout_info.pushConstantRangeCount = 1;
+    layout_info.pPushConstantRanges = &push;
+    if (VkResult r = vkCreatePipelineLayout(device, &layout_info, allocator, &pipeline_layout); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreatePipelineLayout", r);
+    }
+    VkComputePipelineCreateInfo pipeline_info{};
+    pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+    pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    pipeline_info.stage.module = shader;
+    pipeline_info.stage.pName = "main";
+    pipeline_info.layout = pipeline_layout;
+    if (VkResult r = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipeline_info, allocator, &pipeline);
+        r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateComputePipelines", r);
+    }
+
+    // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
+    const VkDescriptorPoolSize sizes[] = {
+        {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, frames_in_flight},
+        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, frames_in_flight * (1 + 2 * kMaxRendererFonts)},
+    };
+    VkDescriptorPoolCreateInfo pool{};
+    pool.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+    pool.maxSets = frames_in_flight;
+    pool.poolSizeCount = static_cast<uint32_t>(std::size(sizes));
+    pool.pPoolSizes = sizes;
+    if (VkResult r = vkCreateDescriptorPool(device, &pool, allocator, &descriptor_pool); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateDescriptorPool", r);
+    }
+    sets.resize(frames_in_flight);
+    std::vector<VkDescriptorSetLayout> layouts(frames_in_flight, set_layout);
+    VkDescriptorSetAllocateInfo set_allocate{};
+    set_allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    set_allocate.descriptorPool = descriptor_pool;
+    set_allocate.descriptorSetCount = frames_in_flight;
+    set_allocate.pSetLayouts = layouts.data();
+    if (VkResult r = vkAllocateDescriptorSets(device, &set_allocate, sets.data()); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkAllocateDescriptorSets", r);
+    }
+    return {};
+}
+
+void Renderer::State::write_descriptors(VkDescriptorSet set) {
+    VkDescriptorImageInfo image{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
+    VkDescriptorBufferInfo item_info{items.buffer, 0, VK_WHOLE_SIZE};
+    std::array<VkDescriptorBufferInfo, kMaxRendererFonts> point_infos{}, band_infos{};
+    for (uint32_t slot = 0; slot < kMaxRendererFonts; ++slot) {
+        const bool used = slot < fonts.size() && fonts[slot].uploaded;
+        point_infos[slot] = {used ? fonts[slot].points.buffer : dummy.buffer, 0, VK_WHOLE_SIZE};
+        band_infos[slot] = {used ? fonts[slot].bands.buffer : dummy.buffer, 0, VK_WHOLE_SIZE};
+    }
+    VkWriteDescriptorSet writes[4]{};
+    for (VkWriteDescriptorSet& write : writes) {
+        write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        write.dstSet = set;
+        write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        write.descriptorCount = 1;
+    }
+    writes[0].dstBinding = 0;
+    writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    writes[0].pImageInfo = &image;
+    writes[1].dstBinding = 1;
+    writes[1].pBufferInfo = &item_info;
+    writes[2].dstBinding = 2;
+    writes[2].descriptorCount = kMaxRendererFonts;
+    writes[2].pBufferInfo = point_infos.data();
+    writes[3].dstBinding = 3;
+    writes[3].descriptorCount = kMaxRendererFonts;
+    writes[3].pBufferInfo = band_infos.data();
+    vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
+}
+
+Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
+    if (!info.device || !info.physical_device) {
+        return Error{ErrorCode::invalid_argument, "renderer: a physical device and a device are required"};
+    }
+    if (info.frames_in_flight < 1 || info.frames_in_flight > 8) {
+        return Error{ErrorCode::invalid_argument, "renderer: frames_in_flight must be 1 to 8"};
+    }
+    if (info.atlas.max_samples > kMaxRendererSamples) {
+        return Error{ErrorCode::invalid_argument, "renderer: max_samples " + std::to_string(info.atlas.max_samples) +
+                                                      " is above the " + std::to_string(kMaxRendererSamples) +
+                                                      " the 16-bit accumulators hold"};
+    }
+    SubpixelLayout layout = info.layout;
+    if (layout.name.empty() && layout == SubpixelLayout{}) layout = *subpixel_preset("rgb");
+    if (Status s = validate_subpixel_layout(layout); !s) return s.error();
+    auto atlas = GlyphAtlas::create(info.atlas);
+    if (!atlas) return atlas.error();
+
+    VkPhysicalDeviceProperties properties{};
+    vkGetPhysicalDeviceProperties(info.physical_device, &properties);
+    if (properties.apiVersion < VK_API_VERSION_1_2) {
+        return Error{ErrorCode::vulkan, std::string("renderer: ") + properties.deviceName + " offers Vulkan " +
+                                            vk::version_string(properties.apiVersion) + "; crisp needs 1.2"};
+    }
+    VkPhysicalDeviceFeatures features{};
+    vkGetPhysicalDeviceFeatures(info.physical_device, &features);
+    if (!features.shaderStorageBufferArrayDynamicIndexing) {
+        return Error{ErrorCode::vulkan, "renderer: the device lacks shaderStorageBufferArrayDynamicIndexing"};
+    }
+    VkPhysicalDeviceSubgroupProperties subgroup{};
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    VkPhysicalDeviceProperties2 properties2{};
+    properties2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    properties2.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(info.physical_device, &properties2);
+    if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
+        !(subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT)) {
+        return Error{ErrorCode::vulkan, "renderer: the device lacks subgroup arithmetic in compute shaders"};
+    }
+    const uint32_t buffers_needed = 1 + 2 * kMaxRendererFonts;
+    if (properties.limits.maxPerStageDescriptorStorageBuffers < buffers_needed) {
+        return Error{ErrorCode::vulkan, "renderer: the device offers " +
+                                            std::to_string(properties.limits.maxPerStageDescriptorStorageBuffers) +
+                                            " storage buffers per shader stage (maxPerStageDescriptorStorageBuffers); "
+                                            "crisp needs " +
+                                            std::to_string(buffers_needed)};
+    }
+    VkFormatProperties format{};
+    vkGetPhysicalDeviceFormatProperties(info.physical_device, kAtlasFormat, &format);
+    if (!(format.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT)) {
+        return Error{ErrorCode::vulkan, "renderer: the device lacks storage images of R16G16B16A16_UINT"};
+    }
+
+    auto state = std::make_unique<State>(std::move(*atlas));
+    state->device = info.device;
+    state->physical_device = info.physical_device;
+    state->allocator = info.allocator;
+    state->frames_in_flight = info.frames_in_flight;
+    state->shared_row_roots = info.shared_row_roots;
+    state->max_storage_buffer_range = properties.limits.maxStorageBufferRange;
+    vkGetPhysicalDeviceMemoryProperties(info.physical_device, &state->memory_properties);
+    state->layout = std::move(layout);
+    if (Status s = state->create_objects(); !s) return s.error();
+    return Renderer(std::move(state));
+}
+
+Renderer::Renderer(std::unique_ptr<State> state) : state_(std::move(state)) {}
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+Renderer::~Renderer() = default;
+
+Status Renderer::add_font(const Font& font) {
+    State& s = *state_;
+    if (s.font_slot.count(font.id())) {
+        return Error{ErrorCode::invalid_argument,
+                     "renderer: a font with id " + std::to_string(font.id()) + " was added already"};
+    }
+    if (s.fonts.size() >= kMaxRendererFonts) {
+        return Error{ErrorCode::invalid_argument,
+                     "renderer: it holds " + std::to_string(kMaxRendererFonts) + " fonts already"};
+    }
+    const FontAsset& asset = font.asset();
+    const VkDeviceSize points_bytes = asset.points.size() * sizeof(Point);
+    const VkDeviceSize bands_bytes = asset.band_words.size() * sizeof(uint32_t);
+    if (std::max(points_bytes, bands_bytes) > s.max_storage_buffer_range) {
+        return Error{ErrorCode::vulkan, "renderer: the font's " +
+                                            std::string(points_bytes > bands_bytes ? "curve points" : "band bitsets") +
+                                            " (" + std::to_string(std::max(points_bytes, bands_bytes)) +
+                                            " bytes) pass the device's maxStorageBufferRange of " +
+                                            std::to_string(s.max_storage_buffer_range)};
+    }
+    GpuFont gpu;
+    gpu.font = &font;
+    gpu.points_bytes = points_bytes;
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    Status status = s.make_buffer(points_bytes, usage, false, gpu.points);
+    if (status) status = s.make_buffer(bands_bytes, usage, false, gpu.bands);
+    if (status) status = s.make_buffer(points_bytes + bands_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, gpu.staging);
+    if (!status) {
+        s.free_buffer(gpu.points);
+        s.free_buffer(gpu.bands);
+        s.free_buffer(gpu.staging);
+        return status;
+    }
+    auto* bytes = static_cast<std::byte*>(gpu.staging.mapped);
+    if (points_bytes) std::memcpy(bytes, asset.points.data(), points_bytes);
+    if (bands_bytes) std::memcpy(bytes + points_bytes, asset.band_words.data(), bands_bytes);
+    s.font_slot[font.id()] = static_cast<uint32_t>(s.fonts.size());
+    s.fonts.push_back(gpu);
+    return {};
+}
+
+Status Renderer::set_subpixel_layout(const SubpixelLayout& layout) {
+    if (Status s = validate_subpixel_layout(layout); !s) return s;
+    state_->layout = layout;
+    state_->atlas.invalidate_samples();
+    return {};
+}
+
+const SubpixelLayout& Renderer::subpixel_layout() const {
+    return state_->layout;
+}
+
+void Renderer::begin_frame() {
+    State& s = *state_;
+    s.atlas.begin_frame();
+    s.pending.clear();
+    s.drawn.clear();
+    s.stats = {};
+    s.converged = true;
+}
+
+void Renderer::draw(std::span<const GlyphInstance> glyphs) {
+    State& s = *state_;
+    for (const GlyphInstance& glyph : glyphs) {
+        if (glyph.width == 0 || glyph.height == 0) continue;
+        const auto slot = s.font_slot.find(glyph.key.font);
+        if (slot == s.font_slot.end()) {
+            ++s.stats.unknown_fonts;
+            ++s.stats.skipped_glyphs;
+            continue;
+        }
+        const FontAsset& asset = s.fonts[slot->second].font->asset();
+        if (glyph.key.glyph >= asset.glyphs.size()) {
+            ++s.stats.skipped_glyphs;
+            continue;
+        }
+        uint64_t cost = 0;
+        if (s.atlas.find(glyph.key) == kNoAtlasEntry) {  // only a new glyph needs its cost
+            cost = curve_tests_per_sample(asset, asset.glyphs[glyph.key.glyph], glyph.key);
+        }
+        const AtlasLookup lookup = s.atlas.acquire(glyph.key, glyph.width, glyph.height, cost);
+        if (lookup.status == AtlasStatus::placed) {
+            s.pending.push_back({DrawnGlyph{glyph, lookup.x, lookup.y, 0}, lookup.entry});
+        } else if (lookup.status == AtlasStatus::atlas_full || lookup.status == AtlasStatus::too_large) {
+            ++s.stats.failed_glyphs;
+            ++s.stats.skipped_glyphs;
+        }
+    }
+}
+
+Status Renderer::record(VkCommandBuffer command_buffer) {
+    State& s = *state_;
+    const std::span<const RasterWork> work = s.atlas.schedule();
+
+    // Drawn glyphs: those whose texels hold samples once this frame's work has run.
+    for (State::Pending& p : s.pending) {
+        DrawnGlyph& d = p.glyph;
+        const AtlasEntry* entry = s.atlas.entry(p.entry);
+        d.samples = entry ? entry->samples : 0;
+        if (entry && entry->samples < s.atlas.config().max_samples) s.converged = false;
+        if (d.samples > 0) {
+            s.drawn.push_back(d);
+            ++s.stats.drawn_glyphs;
+        } else {
+            ++s.stats.skipped_glyphs;
+        }
+    }
+
+    // Free what the GPU is done with, upload new fonts.
+    const uint64_t frame = s.frame++;
+    std::erase_if(s.retired, [&](Retired& r) {
+        if (r.frame + s.frames_in_flight > frame) return false;
+        s.free_buffer(r.buffer);
+        return true;
+    });
+    bool uploaded = false;
+    for (GpuFont& font : s.fonts) {
+        if (font.uploaded) continue;
+        if (font.points_bytes) {
+            const VkBufferCopy copy{0, 0, font.points_bytes};
+            vkCmdCopyBuffer(command_buffer, font.staging.buffer, font.points.buffer, 1, &copy);
+        }
+        const VkDeviceSize real_bands = font.font->asset().band_words.size() * sizeof(uint32_t);
+        if (real_bands) {
+            const VkBufferCopy copy{font.points_bytes, 0, real_bands};
+            vkCmdCopyBuffer(command_buffer, font.staging.buffer, font.bands.buffer, 1, &copy);
+        }
+        s.stats.upload_bytes += font.points_bytes + real_bands;
+        font.uploaded = true;
+        s.retired.push_back({font.staging, frame});
+        font.staging = {};
+        uploaded = true;
+    }
+
+    if (!s.atlas_initialized) {
+        VkImageMemoryBarrier to_general{};
+        to_general.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+        to_general.srcAccessMask = 0;
+        to_general.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+        to_general.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        to_general.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+        to_general.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_general.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_general.image = s.atlas_image;
+        to_general.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
+                             0, nullptr, 0, nullptr, 1, &to_general);
+        s.atlas_initialized = true;
+    }
+
+    // The work list. Items are written with vkCmdUpdateBuffer, so they live in the command buffer
+    // and no host memory needs fencing; a barrier first keeps last frame's reads before the writes.
+    s.item_data.clear();
+    uint32_t workgroups = 0;
+    for (const RasterWork& w : work) {
+        const auto slot = s.font_slot.find(w.key.font);
+        if (slot == s.font_slot.end() || w.sample_count == 0) continue;
+        const GlyphRecord& glyph = s.fonts[slot->second].font->asset().glyphs[w.key.glyph];
+        const GlyphRect rect = glyph_rect(glyph, w.key);
+        const TexelToEm map = texel_to_em(rect, w.key);
+        gpu::RasterItem item{};
+        item.atlas_x = w.x;
+        item.atlas_y = w.y;
+        item.width = w.width;
+        item.height = w.height;
+        item.offset_x = map.offset_x;
+        item.offset_y = map.offset_y;
+        item.scale_x = map.scale_x;
+        item.scale_y = map.scale_y;
+        item.bbox_min_y = glyph.bbox_min_y;
+        item.bbox_max_y = glyph.bbox_max_y;
+        item.point_offset = glyph.point_offset;
+        item.band_offset = glyph.band_offset;
+        item.band_count = glyph.band_count;
+        item.band_words = glyph.band_words;
+        item.font = slot->second;
+        item.first_sample = w.first_sample;
+        item.sample_count = w.sample_count;
+        item.first_workgroup = workgroups;
+        workgroups += (w.width * w.height + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
+        s.item_data.push_back(item);
+        s.stats.samples += w.sample_count;
+    }
+    s.stats.work_items = static_cast<uint32_t>(s.item_data.size());
+    s.stats.workgroups = workgroups;
+    s.stats.curve_tests = s.atlas.stats().frame.curve_tests;
+
+    VkMemoryBarrier before{};
+    before.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    before.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    before.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    if (!s.item_data.empty()) {
+        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, nullptr, 0, nullptr);
+        const auto* bytes = reinterpret_cast<const std::byte*>(s.item_data.data());
+        const VkDeviceSize total = s.item_data.size() * sizeof(gpu::RasterItem);
+        for (VkDeviceSize offset = 0; offset < total; offset += kUpdateChunk) {
+            const VkDeviceSize size = std::min(kUpdateChunk, total - offset);
+            vkCmdUpdateBuffer(command_buffer, s.items.buffer, offset, size, bytes + offset);
+        }
+        s.stats.upload_bytes += total;
+    }
+    if (uploaded || !s.item_data.empty()) {
+        VkMemoryBarrier after{};
+        after.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+        after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        after.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                             &after, 0, nullptr, 0, nullptr);
+    }
+
+    if (!s.item_data.empty()) {
+        // Last frame's readers (composite shaders, copies) finish before the atlas is written.
+        VkMemoryBarrier readers{};
+        readers.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+        readers.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+        readers.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+        vkCmdPipelineBarrier(command_buffer,
+                             VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+                                 VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &readers, 0, nullptr, 0, nullptr);
+
+        const VkDescriptorSet set = s.sets[frame % s.frames_in_flight];
+        s.write_descriptors(set);
+        vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline);
+        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline_layout, 0, 1, &set, 0,
+                                nullptr);
+        gpu::RasterPushConstants push{};
+        for (size_t c = 0; c < 3; ++c) {
+            const SampleRect& r = s.layout.channels[c];
+            push.channel_rects[c] = {r.x0, r.y0, r.x1, r.y1};
+        }
+        push.item_count = static_cast<uint32_t>(s.item_data.size());
+        push.workgroup_count = workgroups;
+        push.shared_rows = s.shared_row_roots && shares_sample_rows(s.layout) ? 1u : 0u;
+        vkCmdPushConstants(command_buffer, s.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);
+        const uint32_t height = (workgroups + gpu::kRasterDispatchWidth - 1) / gpu::kRasterDispatchWidth;
+        vkCmdDispatch(command_buffer, width, height, 1);
+
+        VkMemoryBarrier done{};
+        done.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+        done.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+        done.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                             VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+                                 VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             0, 1, &done, 0, nullptr, 0, nullptr);
+    }
+    return {};
+}
+
+void Renderer::record_atlas_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const {
+    const State& s = *state_;
+    VkImageMemoryBarrier barrier{};
+    barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+    barrier.oldLayout = s.atlas_initialized ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_UNDEFINED;
+    barrier.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.image = s.atlas_image;
+    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                         nullptr, 0, nullptr, 1, &barrier);
+    VkBufferImageCopy copy{};
+    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    copy.imageExtent = {s.atlas.config().width, s.atlas.config().height, 1};
+    vkCmdCopyImageToBuffer(command_buffer, s.atlas_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &copy);
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+    barrier.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    barrier.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
+                         nullptr, 0, nullptr, 1, &barrier);
+    VkMemoryBarrier to_host{};
+    to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                         nullptr, 0, nullptr);
+}
+
+std::span<const DrawnGlyph> Renderer::drawn() const {
+    return state_->drawn;
+}
+bool Renderer::converged() const {
+    return state_->converged;
+}
+const RendererStats& Renderer::stats() const {
+    return state_->stats;
+}
+const GlyphAtlas& Renderer::atlas() const {
+    return state_->atlas;
+}
+VkImage Renderer::atlas_image() const {
+    return state_->atlas_image;
+}
+VkImageView Renderer::atlas_view() const {
+    return state_->atlas_view;
+}
+
+}  // namespace crisp

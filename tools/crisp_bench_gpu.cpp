@@ -1,0 +1,211 @@
+// crisp-bench-gpu: GPU time of the rasterizer for a screen of text, from its first frame (new
+// glyphs, 8 samples each) through the converging frames to converged static text. Measures with
+// Vulkan timestamp queries around the recorded work; prints Markdown (or JSON with --json).
+#include <crisp/bake.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/renderer.hpp>
+#include <crisp/vulkan_context.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Args {
+    std::string font = "fonts/DejaVuSans.ttf";
+    std::string layout = "rgb";
+    std::string device;
+    float size = 16.0f;
+    uint32_t width = 1920, height = 1080;
+    uint32_t samples = 512;
+    uint32_t max_frames = 1000;
+    bool no_shared_rows = false;
+    bool validate = false;
+};
+
+[[noreturn]] void usage(int code) {
+    std::fprintf(code ? stderr : stdout,
+                 "usage: crisp-bench-gpu [options]\n"
+                 "Fills a canvas with text and measures the rasterizer's GPU time per frame, from new text\n"
+                 "(8 samples per glyph) to converged static text, with timestamp queries.\n\n"
+                 "  --font PATH        a font file, baked at start (default fonts/DejaVuSans.ttf)\n"
+                 "  --size PX          pixels per em (default 16)\n"
+                 "  --canvas WxH       canvas filled with lines of text (default 1920x1080)\n"
+                 "  --layout NAME      subpixel layout preset or file (default rgb)\n"
+                 "  --samples N        samples per glyph to converge to (default 512)\n"
+                 "  --frames N         stop after N frames even if not converged (default 1000)\n"
+                 "  --no-shared-rows   solve roots per channel even where channels share rows\n"
+                 "  --device TEXT      pick a device whose name contains TEXT\n"
+                 "  --validate         turn the validation layer on\n"
+                 "  --help             this text\n");
+    std::exit(code);
+}
+
+Args parse(int argc, char** argv) {
+    Args args;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) usage(2);
+            return argv[++i];
+        };
+        if (arg == "--help" || arg == "-h")
+            usage(0);
+        else if (arg == "--font")
+            args.font = value();
+        else if (arg == "--size")
+            args.size = std::stof(value());
+        else if (arg == "--layout")
+            args.layout = value();
+        else if (arg == "--samples")
+            args.samples = static_cast<uint32_t>(std::stoul(value()));
+        else if (arg == "--frames")
+            args.max_frames = static_cast<uint32_t>(std::stoul(value()));
+        else if (arg == "--device")
+            args.device = value();
+        else if (arg == "--no-shared-rows")
+            args.no_shared_rows = true;
+        else if (arg == "--validate")
+            args.validate = true;
+        else if (arg == "--canvas") {
+            const std::string v = value();
+            if (std::sscanf(v.c_str(), "%ux%u", &args.width, &args.height) != 2) usage(2);
+        } else {
+            std::fprintf(stderr, "crisp-bench-gpu: unknown argument %s\n", arg.c_str());
+            usage(2);
+        }
+    }
+    return args;
+}
+
+[[noreturn]] void fail(const std::string& message) {
+    std::fprintf(stderr, "crisp-bench-gpu: %s\n", message.c_str());
+    std::exit(1);
+}
+
+struct Frame {
+    uint32_t index = 0;
+    uint64_t samples = 0;
+    uint32_t items = 0;
+    uint64_t curve_tests = 0;
+    double gpu_ms = 0.0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Args args = parse(argc, argv);
+    crisp::HeadlessContextOptions options;
+    options.validation = args.validate;
+    options.device_name_contains = args.device;
+    auto context = crisp::HeadlessContext::create(options);
+    if (!context) fail(context.error().message);
+
+    auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});
+    if (!baked) fail(baked.error().message);
+    auto font = crisp::Font::create(std::move(baked->asset), 1);
+    if (!font) fail(font.error().message);
+    auto layout = crisp::resolve_subpixel_layout(args.layout);
+    if (!layout) fail(layout.error().message);
+
+    crisp::RendererCreateInfo info;
+    info.instance = context->instance();
+    info.physical_device = context->physical_device();
+    info.device = context->device();
+    info.queue_family = context->queue_family();
+    info.atlas.max_samples = args.samples;
+    info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: the benchmark measures raw throughput
+    info.layout = *layout;
+    info.shared_row_roots = !args.no_shared_rows;
+    auto renderer = crisp::Renderer::create(info);
+    if (!renderer) fail(renderer.error().message);
+    if (auto s = renderer->add_font(*font); !s) fail(s.error().message);
+
+    // A screen of prose: lines of text at the given size until the canvas is full.
+    const std::string prose =
+        "It was the best of times, it was the worst of times, it was the age of wisdom, it was the age of "
+        "foolishness, it was the epoch of belief, it was the epoch of incredulity, it was the season of Light, "
+        "it was the season of Darkness, it was the spring of hope, it was the winter of despair. ";
+    std::string text;
+    while (text.size() < 400000) text += prose;
+    const crisp::Font* fonts[] = {&*font};
+    crisp::TextStyle style;
+    style.size = args.size;
+    crisp::LayoutOptions layout_options;
+    layout_options.origin_x = 4.25f;
+    layout_options.origin_y = args.size;
+    layout_options.wrap_width = static_cast<float>(args.width) - 8.0f;
+    auto laid = crisp::layout_text(fonts, text, style, layout_options);
+    if (!laid) fail(laid.error().message);
+    std::vector<crisp::GlyphInstance> screen;
+    for (const crisp::GlyphInstance& g : laid->glyphs) {
+        if (g.y + static_cast<int32_t>(g.height) <= static_cast<int32_t>(args.height)) screen.push_back(g);
+    }
+
+    VkQueryPoolCreateInfo query_info{};
+    query_info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    query_info.queryCount = 2;
+    VkQueryPool queries = VK_NULL_HANDLE;
+    if (vkCreateQueryPool(context->device(), &query_info, nullptr, &queries) != VK_SUCCESS) fail("no query pool");
+    const double period_ns = static_cast<double>(context->properties().limits.timestampPeriod);
+
+    std::vector<Frame> frames;
+    for (uint32_t f = 0; f < args.max_frames; ++f) {
+        renderer->begin_frame();
+        renderer->draw(screen);
+        const auto status = context->submit_and_wait([&](VkCommandBuffer cb) {
+            vkCmdResetQueryPool(cb, queries, 0, 2);
+            vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
+            if (auto s = renderer->record(cb); !s) fail(s.error().message);
+            vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
+        });
+        if (!status) fail(status.error().message);
+        uint64_t stamps[2] = {};
+        vkGetQueryPoolResults(context->device(), queries, 0, 2, sizeof stamps, stamps, sizeof(uint64_t),
+                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+        Frame frame;
+        frame.index = f;
+        frame.samples = renderer->stats().samples;
+        frame.items = renderer->stats().work_items;
+        frame.curve_tests = renderer->stats().curve_tests;
+        frame.gpu_ms = static_cast<double>(stamps[1] - stamps[0]) * period_ns * 1e-6;
+        frames.push_back(frame);
+        if (renderer->converged() && frame.items == 0) break;
+    }
+    vkDestroyQueryPool(context->device(), queries, nullptr);
+
+    const crisp::AtlasStats& atlas = renderer->atlas().stats();
+    std::printf(
+        "Device: %s, driver %s (%s). Canvas %ux%u, %s at %.4g px, layout %s%s, %zu glyphs on screen, "
+        "%u atlas entries.\n\n",
+        context->device_name().c_str(), context->driver_name().c_str(), context->driver_info().c_str(), args.width,
+        args.height, args.font.c_str(), static_cast<double>(args.size), layout->name.c_str(),
+        args.no_shared_rows ? " (roots per channel)" : "", screen.size(), atlas.resident_glyphs);
+    std::printf(
+        "| frame | samples per glyph added | glyphs refined | curve tests (estimate) | GPU ms | "
+        "curve tests per second |\n|---:|---:|---:|---:|---:|---:|\n");
+    double total_ms = 0.0;
+    for (const Frame& f : frames) {
+        total_ms += f.gpu_ms;
+        const bool show = f.index < 6 || f.index + 1 == frames.size() || (f.index & (f.index - 1)) == 0;
+        if (!show) continue;
+        std::printf("| %u | %.3g | %u | %.3g | %.3f | %.3g |\n", f.index + 1,
+                    f.items ? static_cast<double>(f.samples) / f.items : 0.0, f.items,
+                    static_cast<double>(f.curve_tests), f.gpu_ms,
+                    f.gpu_ms > 0 ? static_cast<double>(f.curve_tests) / (f.gpu_ms * 1e-3) : 0.0);
+    }
+    std::printf("\n%zu frames, %.1f ms of GPU time in all; converged: %s.\n", frames.size(), total_ms,
+                renderer->converged() ? "yes" : "no");
+    const auto messages = context->validation_messages();
+    if (messages.errors + messages.warnings > 0) {
+        for (const auto& m : messages.recent) std::fprintf(stderr, "%s\n", m.c_str());
+        return 1;
+    }
+    return 0;
+}
