@@ -1,0 +1,354 @@
+// The GPU rasterizer's accuracy against exact area coverage, and the hard cases of DESIGN.md, on
+// lavapipe with validation on. Each texel channel's coverage (hits / samples) is compared with the
+// exact area fraction of that channel's sample rectangle covered by the glyph (nonzero rule).
+#include "bands.hpp"
+#include "coverage.hpp"
+#include "test_support.hpp"
+
+#include <crisp/bake.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/renderer.hpp>
+#include <crisp/vulkan_context.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+namespace crisp {
+namespace {
+
+HeadlessContext* context() {
+    static std::unique_ptr<HeadlessContext> made = [] {
+        HeadlessContextOptions options;
+        options.validation = true;
+        auto created = HeadlessContext::create(options);
+        return created ? std::make_unique<HeadlessContext>(std::move(*created)) : nullptr;
+    }();
+    return made.get();
+}
+
+std::unique_ptr<Font> bake(const std::string& path, std::string_view text, uint32_t face = 0) {
+    BakeOptions options;
+    options.all_glyphs = false;
+    options.codepoints = decode_utf8(text);
+    options.face_index = face;
+    auto baked = bake_font_file(path, options);
+    if (!baked) return nullptr;
+    auto font = Font::create(std::move(baked->asset), 1);
+    return font ? std::make_unique<Font>(std::move(*font)) : nullptr;
+}
+
+struct Accuracy {
+    double mean = 0.0;  // mean absolute error over texel channels the glyph touches
+    double p99 = 0.0;
+    double max = 0.0;
+    uint64_t channels = 0;
+    bool in_range = true;  // every coverage finite and within [0, 1]
+};
+
+struct Texel {
+    uint16_t r, g, b, count;
+};
+
+// Renders the glyph instances with `samples` samples per glyph and measures the error.
+Accuracy render_and_measure(const Font& font, std::span<const GlyphInstance> glyphs, const SubpixelLayout& layout,
+                            uint32_t samples, uint32_t atlas_size = 512) {
+    HeadlessContext& ctx = *context();
+    RendererCreateInfo info;
+    info.instance = ctx.instance();
+    info.physical_device = ctx.physical_device();
+    info.device = ctx.device();
+    info.queue_family = ctx.queue_family();
+    info.atlas.width = info.atlas.height = atlas_size;
+    info.atlas.max_samples = samples;
+    info.atlas.frame_budget = uint64_t{1} << 40;
+    info.layout = layout;
+    auto renderer = Renderer::create(info);
+    EXPECT_TRUE(renderer) << renderer.error().message;
+    if (!renderer) return {};
+    EXPECT_TRUE(renderer->add_font(font));
+    uint32_t frames = 0;
+    do {
+        renderer->begin_frame();
+        renderer->draw(glyphs);
+        EXPECT_TRUE(ctx.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
+    } while (!renderer->converged() && ++frames < 2000);
+    const VkDeviceSize bytes = VkDeviceSize{atlas_size} * atlas_size * sizeof(Texel);
+    auto readback = ctx.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
+    EXPECT_TRUE(readback);
+    EXPECT_TRUE(
+        ctx.submit_and_wait([&](VkCommandBuffer cb) { renderer->record_atlas_readback(cb, readback->handle()); }));
+    auto data = ctx.read_buffer(*readback, 0, bytes);
+    std::vector<Texel> texels(size_t{atlas_size} * atlas_size);
+    std::memcpy(texels.data(), data->data(), bytes);
+
+    std::vector<double> errors;
+    Accuracy result;
+    EXPECT_EQ(renderer->drawn().size(), glyphs.size());
+    for (const DrawnGlyph& d : renderer->drawn()) {
+        const GlyphRecord& glyph = font.asset().glyphs[d.instance.key.glyph];
+        const ExactCoverage exact(font.asset(), glyph);
+        const TexelToEm map = texel_to_em(glyph_rect(glyph, d.instance.key), d.instance.key);
+        for (uint32_t ty = 0; ty < d.instance.height; ++ty) {
+            for (uint32_t tx = 0; tx < d.instance.width; ++tx) {
+                const Texel& t = texels[size_t{d.atlas_y + ty} * atlas_size + d.atlas_x + tx];
+                EXPECT_EQ(t.count, samples);
+                const uint16_t sums[3] = {t.r, t.g, t.b};
+                for (size_t c = 0; c < 3; ++c) {
+                    const SampleRect& r = layout.channels[c];
+                    const double ox = map.offset_x, oy = map.offset_y, sx = map.scale_x, sy = map.scale_y;
+                    const double px = tx, py = ty;
+                    const double x0 = ox + sx * (px + static_cast<double>(r.x0));
+                    const double x1 = ox + sx * (px + static_cast<double>(r.x1));
+                    const double ya = oy + sy * (py + static_cast<double>(r.y0));
+                    const double yb = oy + sy * (py + static_cast<double>(r.y1));
+                    const double truth = exact.coverage(x0, std::min(ya, yb), x1, std::max(ya, yb));
+                    const double got = static_cast<double>(sums[c]) / (kCoverageOne * std::max<uint32_t>(t.count, 1));
+                    if (!std::isfinite(got) || got < 0.0 || got > 1.0) result.in_range = false;
+                    if (truth == 0.0 && got == 0.0) continue;
+                    errors.push_back(std::fabs(got - truth));
+                }
+            }
+        }
+    }
+    const ValidationMessages messages = ctx.validation_messages();
+    EXPECT_EQ(messages.errors + messages.warnings, 0u);
+    if (errors.empty()) return result;
+    std::sort(errors.begin(), errors.end());
+    double sum = 0.0;
+    for (double e : errors) sum += e;
+    result.mean = sum / static_cast<double>(errors.size());
+    result.p99 = errors[std::min(errors.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(errors.size())))];
+    result.max = errors.back();
+    result.channels = errors.size();
+    return result;
+}
+
+std::vector<GlyphInstance> lay_out(const Font& font, std::string_view text, float size, float x, float y) {
+    const Font* fonts[] = {&font};
+    TextStyle style;
+    style.size = size;
+    LayoutOptions options;
+    options.origin_x = x;
+    options.origin_y = y;
+    auto layout = layout_text(fonts, text, style, options);
+    EXPECT_TRUE(layout);
+    return layout ? layout->glyphs : std::vector<GlyphInstance>{};
+}
+
+void report(const char* what, const Accuracy& a) {
+    std::printf("[ accuracy ] %s: mean %.4f, p99 %.4f, max %.4f over %llu channels\n", what, a.mean, a.p99, a.max,
+                static_cast<unsigned long long>(a.channels));
+}
+
+#define REQUIRE_GPU() \
+    if (!context()) GTEST_FAIL() << "no Vulkan device (lavapipe is installed by scripts/setup.sh)"
+
+TEST(Accuracy, ErrorFallsAsSamplesGrow) {
+    REQUIRE_GPU();
+    auto font = bake(test::kDejaVuSans, "g@");
+    ASSERT_TRUE(font);
+    const auto glyphs = lay_out(*font, "g@", 16.0f, 2.3f, 17.6f);
+    for (const char* layout : {"gray", "rgb"}) {
+        const Accuracy at16 = render_and_measure(*font, glyphs, *subpixel_preset(layout), 16);
+        const Accuracy at512 = render_and_measure(*font, glyphs, *subpixel_preset(layout), 512);
+        report(layout, at16);
+        report(layout, at512);
+        EXPECT_TRUE(at512.in_range);
+        EXPECT_LT(at512.mean, at16.mean / 4);  // points converge about as 1/sqrt(N) or better
+        EXPECT_LT(at512.mean, 0.01);
+        EXPECT_LT(at512.p99, 0.05);
+        EXPECT_LT(at512.max, 0.1);
+    }
+}
+
+TEST(Accuracy, SizesFromSixToTwoHundredPixelsAndFractionalOffsets) {
+    REQUIRE_GPU();
+    auto font = bake(test::kInterCff, "aS");
+    ASSERT_TRUE(font);
+    for (const float size : {6.0f, 13.0f, 50.0f, 200.0f}) {
+        const auto glyphs = lay_out(*font, size >= 100.0f ? "S" : "aS", size, 1.37f, 0.71f + size);
+        const Accuracy a = render_and_measure(*font, glyphs, *subpixel_preset("rgb"), 128);
+        report(("Inter rgb " + std::to_string(static_cast<int>(size)) + " px, 128 samples").c_str(), a);
+        EXPECT_TRUE(a.in_range);
+        EXPECT_LT(a.mean, 0.02);
+        EXPECT_LT(a.max, 0.2);
+    }
+}
+
+TEST(HardCase, CjkGlyphWithHundredsOfCurves) {
+    REQUIRE_GPU();
+    auto font = bake(test::kNotoCjk, "龘");
+    ASSERT_TRUE(font);
+    const auto glyphs = lay_out(*font, "龘", 24.0f, 1.5f, 23.25f);
+    ASSERT_EQ(glyphs.size(), 1u);
+    EXPECT_GT(font->asset().glyphs[glyphs[0].key.glyph].curve_count, 200u);
+    const Accuracy a = render_and_measure(*font, glyphs, *subpixel_preset("gray"), 128);
+    report("Noto Sans CJK 龘 24 px", a);
+    EXPECT_TRUE(a.in_range);
+    EXPECT_LT(a.mean, 0.03);
+}
+
+TEST(HardCase, FourPixelsAndOneThousandPixels) {
+    REQUIRE_GPU();
+    auto font = bake(test::kDejaVuSans, "e");
+    ASSERT_TRUE(font);
+    const Accuracy tiny =
+        render_and_measure(*font, lay_out(*font, "e", 4.0f, 0.6f, 3.3f), *subpixel_preset("rgb"), 128);
+    report("DejaVu e 4 px", tiny);
+    EXPECT_TRUE(tiny.in_range);
+    EXPECT_LT(tiny.mean, 0.03);
+    // 1000 px: a 600x800 texel rect; few samples keep lavapipe quick, the error bound follows.
+    const Accuracy huge =
+        render_and_measure(*font, lay_out(*font, "e", 1000.0f, 0.25f, 760.5f), *subpixel_preset("gray"), 8, 1024);
+    report("DejaVu e 1000 px, 8 samples", huge);
+    EXPECT_TRUE(huge.in_range);
+    EXPECT_LT(huge.mean, 0.1);  // interior texels are exact; only the edge texels carry error
+}
+
+TEST(HardCase, UnitsPerEmOf1000And2048) {
+    REQUIRE_GPU();
+    for (const std::string& path : {test::kCantarell, test::kDejaVuSans}) {
+        auto font = bake(path, "Ra");
+        ASSERT_TRUE(font);
+        const Accuracy a =
+            render_and_measure(*font, lay_out(*font, "Ra", 20.0f, 0.8f, 20.4f), *subpixel_preset("gray"), 128);
+        report(path.c_str(), a);
+        EXPECT_TRUE(a.in_range);
+        EXPECT_LT(a.mean, 0.02);
+    }
+}
+
+// Replaces the last outlined glyph of a subset asset with hand-made contours, so the rasterizer
+// meets shapes no font in the repository has.
+std::unique_ptr<Font> with_shape(const std::vector<Contour>& contours, uint32_t& glyph_index) {
+    BakeOptions options;
+    options.all_glyphs = false;
+    options.codepoints = decode_utf8("o");
+    auto baked = bake_font_file(test::kDejaVuSans, options);
+    if (!baked) return nullptr;
+    FontAsset asset = std::move(baked->asset);
+    glyph_index = 0;
+    for (uint32_t g = 0; g < asset.glyphs.size(); ++g) {
+        if (asset.glyphs[g].curve_count > 0) glyph_index = g;
+    }
+    GlyphRecord& record = asset.glyphs[glyph_index];
+    asset.points.resize(record.point_offset);
+    asset.band_words.resize(record.band_offset);
+    const PackedGlyph packed = pack_contours(contours);
+    const GlyphBands bands = build_bands(packed, kTargetCurvesPerBand, kMaxBands, kBandOverlap);
+    record.bbox_min_x = packed.min_x;
+    record.bbox_min_y = packed.min_y;
+    record.bbox_max_x = packed.max_x;
+    record.bbox_max_y = packed.max_y;
+    record.curve_count = packed.curve_count;
+    record.band_count = bands.band_count;
+    record.band_words = bands.band_words;
+    asset.points.insert(asset.points.end(), packed.points.begin(), packed.points.end());
+    asset.band_words.insert(asset.band_words.end(), bands.words.begin(), bands.words.end());
+    if (!validate_asset(asset)) return nullptr;
+    auto font = Font::create(std::move(asset), 1);
+    return font ? std::make_unique<Font>(std::move(*font)) : nullptr;
+}
+
+Contour polygon(std::initializer_list<Vec2> corners) {
+    Contour contour;
+    const std::vector<Vec2> points(corners);
+    for (size_t i = 0; i < points.size(); ++i)
+        contour.push_back(line_to_quad(points[i], points[(i + 1) % points.size()]));
+    return contour;
+}
+
+Contour circle(double cx, double cy, double r, bool clockwise) {
+    // Eight quadratic arcs, control points on the tangents.
+    Contour contour;
+    const double pi = 3.14159265358979323846;
+    for (int i = 0; i < 8; ++i) {
+        const double a0 = (clockwise ? -1 : 1) * i * pi / 4, a1 = (clockwise ? -1 : 1) * (i + 1) * pi / 4;
+        const double am = 0.5 * (a0 + a1), k = r / std::cos(pi / 8);
+        contour.push_back({{cx + r * std::cos(a0), cy + r * std::sin(a0)},
+                           {cx + k * std::cos(am), cy + k * std::sin(am)},
+                           {cx + r * std::cos(a1), cy + r * std::sin(a1)}});
+    }
+    return contour;
+}
+
+GlyphInstance place(const Font& font, uint32_t glyph_index, float size, float x, float y) {
+    GlyphInstance g;
+    g.key.font = font.id();
+    g.key.glyph = glyph_index;
+    g.key.size_x = g.key.size_y = static_cast<uint32_t>(std::lround(size * kSizeOne));
+    const double xd = x, yd = y, fx = std::floor(xd), fy = std::floor(yd);
+    g.key.subpixel_x = static_cast<uint8_t>(std::lround((xd - fx) * kSubpixelSteps) % kSubpixelSteps);
+    g.key.subpixel_y = static_cast<uint8_t>(std::lround((yd - fy) * kSubpixelSteps) % kSubpixelSteps);
+    const GlyphRect rect = glyph_rect(font.asset().glyphs[glyph_index], g.key);
+    g.x = static_cast<int32_t>(fx) + rect.x;
+    g.y = static_cast<int32_t>(fy) + rect.y;
+    g.width = rect.width;
+    g.height = rect.height;
+    return g;
+}
+
+void expect_shape_accurate(const char* what, const std::vector<Contour>& contours, double bound) {
+    uint32_t glyph = 0;
+    auto font = with_shape(contours, glyph);
+    ASSERT_TRUE(font) << what;
+    const GlyphInstance instance = place(*font, glyph, 20.0f, 1.25f, 20.0f);
+    for (const char* layout : {"gray", "vrgb"}) {
+        const Accuracy a = render_and_measure(*font, std::span(&instance, 1), *subpixel_preset(layout), 256);
+        report(what, a);
+        EXPECT_TRUE(a.in_range) << what;
+        EXPECT_LT(a.mean, bound) << what << " " << layout;
+    }
+}
+
+TEST(HardCase, OverlappingSameDirectionContoursNeverExceedOne) {
+    REQUIRE_GPU();
+    expect_shape_accurate(
+        "overlapping squares",
+        {polygon({{0, 0}, {0.6, 0}, {0.6, 0.6}, {0, 0.6}}), polygon({{0.3, 0.3}, {0.9, 0.3}, {0.9, 0.9}, {0.3, 0.9}})},
+        0.02);
+    expect_shape_accurate("overlapping circles", {circle(0.4, 0.4, 0.3, false), circle(0.55, 0.45, 0.3, false)}, 0.02);
+}
+
+TEST(HardCase, HolesAndSelfIntersection) {
+    REQUIRE_GPU();
+    expect_shape_accurate("ring", {circle(0.5, 0.5, 0.45, false), circle(0.5, 0.5, 0.25, true)}, 0.02);
+    expect_shape_accurate("bow tie", {polygon({{0, 0}, {0.8, 0.8}, {0.8, 0}, {0, 0.8}})}, 0.02);
+    expect_shape_accurate("pentagram", {polygon({{0.5, 0.95}, {0.79, 0.05}, {0.02, 0.61}, {0.98, 0.61}, {0.21, 0.05}})},
+                          0.02);
+}
+
+TEST(HardCase, HairlinesFarThinnerThanAPixel) {
+    REQUIRE_GPU();
+    // 1/200 em wide: a tenth of a pixel at 20 px.
+    expect_shape_accurate("hairlines",
+                          {polygon({{0.1, 0}, {0.105, 0}, {0.105, 0.9}, {0.1, 0.9}}),
+                           polygon({{0, 0.4}, {0.8, 0.4}, {0.8, 0.405}, {0, 0.405}}),
+                           polygon({{0.2, 0.0}, {0.805, 0.9}, {0.8, 0.9}, {0.195, 0.0}})},
+                          0.02);
+}
+
+TEST(HardCase, RaysThroughEndPointsHorizontalSegmentsAndTangents) {
+    REQUIRE_GPU();
+    // At 20 px every 1/20 em is a texel edge; with R2 samples many rows land on or within float
+    // rounding of these vertices, horizontal edges and the circles' extrema.
+    expect_shape_accurate(
+        "grid-aligned staircase",
+        {polygon({{0, 0}, {0.5, 0}, {0.5, 0.25}, {0.75, 0.25}, {0.75, 0.5}, {0.25, 0.5}, {0.25, 0.75}, {0, 0.75}})},
+        0.02);
+    expect_shape_accurate("tangent circles", {circle(0.25, 0.5, 0.25, false), circle(0.75, 0.5, 0.25, false)}, 0.02);
+    // Collinear and zero-length quadratics inside a contour.
+    Contour degenerate = polygon({{0, 0}, {0.8, 0}, {0.8, 0.8}, {0, 0.8}});
+    degenerate.insert(degenerate.begin() + 1, Quad{{0.8, 0}, {0.8, 0}, {0.8, 0}});        // zero length
+    degenerate.insert(degenerate.begin() + 2, Quad{{0.8, 0}, {0.8, -0.0001}, {0.8, 0}});  // a spike
+    degenerate.insert(degenerate.begin() + 3, Quad{{0.8, 0}, {0.8, 0.3}, {0.8, 0}});      // collinear, doubling back
+    expect_shape_accurate("degenerate curves", {degenerate}, 0.02);
+}
+
+}  // namespace
+}  // namespace crisp
