@@ -5,6 +5,7 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 // The float instantiation must round exactly where the shader rounds: no fused multiply-adds.
@@ -32,26 +33,29 @@ namespace crisp {
 // shift = below(y1) | below(y2) << 1 | below(y3) << 2 and the two bits of (0x2E74 >> shift) & 0x0101
 // say whether root 1 (bit 0) and root 2 (bit 8) count:
 //
-//   shift  y1 y2 y3   curve                                        root 1  root 2
-//     0    +  +  +    never reaches below the ray                    -       -
-//     1    -  +  +    starts below, ends above: one upward crossing  -       x
-//     2    +  -  +    ends above; dips below twice or not at all      x       x
-//     3    -  -  +    starts below, ends above: one upward crossing  -       x
-//     4    +  +  -    starts above, ends below: one downward         x       -
-//     5    -  +  -    ends below; rises above twice or not at all     x       x
-//     6    +  -  -    starts above, ends below: one downward         x       -
-//     7    -  -  -    never reaches above the ray                    -       -
+//   shift  y1 y2 y3   curve                                             root 1  root 2
+//     0    +  +  +    never reaches below the ray                         -       -
+//     1    -  +  +    starts below, ends above: one upward crossing       -       x
+//     2    +  -  +    starts and ends above: dips below twice, or not     x       x
+//     3    -  -  +    starts below, ends above: one upward crossing       -       x
+//     4    +  +  -    starts above, ends below: one downward crossing     x       -
+//     5    -  +  -    starts and ends below: rises above twice, or not    x       x
+//     6    +  -  -    starts above, ends below: one downward crossing     x       -
+//     7    -  -  -    never reaches above the ray                         -       -
 //
 // (0x2E74 has bits 2, 4, 5, 6 set for root 1 and bits 9, 10, 11, 13 for root 2, which is this
 // table.) In rows 2 and 5 a curve that does not reach the ray has b^2 - a c < 0, so d is clamped to
 // 0, t1 == t2, both roots give the same x and cancel. Treating 0 as "above" is the same as moving
 // the ray an infinitesimal distance down: an end point on the ray is counted once, by the curve
-// that arrives from or leaves downwards, and a curve touching the ray from above or below adds 0.
-// A curve flat in y has three equal signs (row 0 or 7) and never counts.
+// that arrives from below or leaves downwards, and a curve touching the ray from above or below
+// adds 0. A curve flat in y has three equal signs (row 0 or 7) and never counts.
+//
+// Slug's linear case solves the tangent at t = 0 rather than the curve: its crossing is off by up
+// to |a| < kLinearEpsilon in y, and a curve that starts flat (b == 0) divides by zero and loses
+// its crossing. RootSolver::stable avoids both; docs/coverage.md measures the difference.
 template <class Real>
 int curve_winding(Real x1, Real y1, Real x2, Real y2, Real x3, Real y3, RootSolver solver) {
-    const unsigned shift =
-        (std::signbit(y1) ? 1u : 0u) | (std::signbit(y2) ? 2u : 0u) | (std::signbit(y3) ? 4u : 0u);
+    const unsigned shift = (std::signbit(y1) ? 1u : 0u) | (std::signbit(y2) ? 2u : 0u) | (std::signbit(y3) ? 4u : 0u);
     const unsigned code = (0x2E74u >> shift) & 0x0101u;
     if (code == 0u) return 0;
 
@@ -144,8 +148,7 @@ int winding_number(std::span<const Point> glyph_points, std::span<const uint8_t>
 // no curve straddles its height. tests/test_coverage.cpp checks banded == all-real-curves on
 // grids over real glyphs.
 template <class Real>
-int winding_number_banded(const FontAsset& asset, const GlyphRecord& glyph, Real x_em, Real y_em,
-                          RootSolver solver) {
+int winding_number_banded(const FontAsset& asset, const GlyphRecord& glyph, Real x_em, Real y_em, RootSolver solver) {
     if (glyph.band_count == 0 || glyph.band_words == 0) return 0;
     const uint32_t band = FontAsset::band_of(glyph, static_cast<float>(y_em));
     const uint32_t* words = &asset.band_words[glyph.band_offset + size_t{band} * glyph.band_words];
@@ -360,7 +363,7 @@ double ExactCoverage::crossing_x(const Piece& piece, double y) const {
     double roots[2];
     const int count = solve_quadratic(A, B, C, roots);
     // y is monotonic on [t0, t1], so one root lies there (up to rounding): take the nearest.
-    double best = 0.5 * (piece.t0 + piece.t1), best_distance = INFINITY;
+    double best = 0.5 * (piece.t0 + piece.t1), best_distance = std::numeric_limits<double>::infinity();
     for (int i = 0; i < count; ++i) {
         const double clamped = std::clamp(roots[i], piece.t0, piece.t1);
         const double distance = std::fabs(clamped - roots[i]);
@@ -468,8 +471,8 @@ double ExactCoverage::area(double x0, double y0, double x1, double y1) const {
         for (const double side : {x0, x1}) {
             if (!(piece.x_lo <= side && side <= piece.x_hi)) continue;
             double roots[2];
-            const int count = solve_quadratic(q.p0.x - 2.0 * q.p1.x + q.p2.x, 2.0 * (q.p1.x - q.p0.x), q.p0.x - side,
-                                              roots);
+            const int count =
+                solve_quadratic(q.p0.x - 2.0 * q.p1.x + q.p2.x, 2.0 * (q.p1.x - q.p0.x), q.p0.x - side, roots);
             for (int i = 0; i < count; ++i) {
                 if (roots[i] >= piece.t0 && roots[i] <= piece.t1) events.push_back(y_at(q, roots[i]));
             }

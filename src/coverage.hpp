@@ -11,6 +11,9 @@
 // Windings follow Slug's sign: a crossing where the curve runs downwards (y falling as t grows)
 // adds +1, upwards -1. An outline that runs clockwise in y-up (TrueType outer contours) winds +1,
 // counter-clockwise (CFF outer contours) -1; the nonzero rule fills both.
+//
+// Functions taking a FontAsset expect a valid one (load_asset or validate_asset passed it): they
+// index its points and band words without further checks.
 #pragma once
 
 #include "curves.hpp"

@@ -1,5 +1,7 @@
 #include "json.hpp"
 
+#include <crisp/bake.hpp>
+
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +34,24 @@ const char* Value::type_name() const {
 }
 
 namespace {
+
+void append_utf8(std::string& out, uint32_t cp) {
+    if (cp < 0x80) {
+        out += static_cast<char>(cp);
+    } else if (cp < 0x800) {
+        out += static_cast<char>(0xC0 | (cp >> 6));
+        out += static_cast<char>(0x80 | (cp & 0x3F));
+    } else if (cp < 0x10000) {
+        out += static_cast<char>(0xE0 | (cp >> 12));
+        out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (cp & 0x3F));
+    } else {
+        out += static_cast<char>(0xF0 | (cp >> 18));
+        out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
+        out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (cp & 0x3F));
+    }
+}
 
 class Parser {
 public:
@@ -150,24 +170,6 @@ private:
         value.type = Value::Type::number;
         value.number = number;
         return true;
-    }
-
-    static void append_utf8(std::string& out, uint32_t cp) {
-        if (cp < 0x80) {
-            out += static_cast<char>(cp);
-        } else if (cp < 0x800) {
-            out += static_cast<char>(0xC0 | (cp >> 6));
-            out += static_cast<char>(0x80 | (cp & 0x3F));
-        } else if (cp < 0x10000) {
-            out += static_cast<char>(0xE0 | (cp >> 12));
-            out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-            out += static_cast<char>(0x80 | (cp & 0x3F));
-        } else {
-            out += static_cast<char>(0xF0 | (cp >> 18));
-            out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
-            out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-            out += static_cast<char>(0x80 | (cp & 0x3F));
-        }
     }
 
     bool hex4(uint32_t& value) {
@@ -391,18 +393,19 @@ Result<Value> parse(std::string_view text) {
 }
 
 void append_string(std::string& out, std::string_view text) {
+    // Decoded first, so ill-formed UTF-8 (a file name, say) becomes U+FFFD and the output stays
+    // valid JSON.
     out += '"';
-    for (const char c : text) {
-        const auto u = static_cast<unsigned char>(c);
+    for (const uint32_t c : decode_utf8(text)) {
         if (c == '"' || c == '\\') {
             out += '\\';
-            out += c;
-        } else if (u < 0x20) {
+            out += static_cast<char>(c);
+        } else if (c < 0x20 || c == 0x7F) {
             char buffer[8];
-            std::snprintf(buffer, sizeof buffer, "\\u%04x", u);
+            std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
             out += buffer;
         } else {
-            out += c;
+            append_utf8(out, c);
         }
     }
     out += '"';

@@ -45,7 +45,7 @@ inline constexpr size_t kMaxDepth = 64;
 // Parses a whole document. Errors are ErrorCode::invalid_argument: "line 3, column 14: ...".
 Result<Value> parse(std::string_view text);
 
-// Appends `text` as a JSON string literal (quoted and escaped).
+// Appends `text` as a JSON string literal, quoted and escaped; ill-formed UTF-8 becomes U+FFFD.
 void append_string(std::string& out, std::string_view text);
 
 // Appends a number in the shortest form that reads back to the same double.

@@ -67,6 +67,11 @@ TEST(Json, WritesWhatItReads) {
     ASSERT_TRUE(value) << out;
     EXPECT_EQ(value->array[0].string, "a\"b\\c\n\x01");
     EXPECT_EQ(value->array[1].number, 0.1);
+    // Ill-formed UTF-8 becomes U+FFFD, so the output is still valid JSON.
+    std::string bad;
+    json::append_string(bad, "a\xFF" "b\xC3\xA9");
+    EXPECT_EQ(bad, "\"a\xEF\xBF\xBD" "b\xC3\xA9\"");
+    EXPECT_TRUE(json::parse(bad));
 }
 
 }  // namespace
