@@ -223,6 +223,18 @@ TEST(HardCase, UnitsPerEmOf1000And2048) {
     }
 }
 
+TEST(HardCase, UnitsPerEmOf16384) {
+    REQUIRE_GPU();
+    auto font = bake(CRISP_UPEM_16384_FONT, "Ra");
+    ASSERT_TRUE(font);
+    ASSERT_EQ(font->asset().info.units_per_em, 16384u);
+    const Accuracy a =
+        render_and_measure(*font, lay_out(*font, "Ra", 20.0f, 0.8f, 20.4f), *subpixel_preset("gray"), 128);
+    report("DejaVu Sans \"Ra\" 20 px, gray, scaled to 16384 units per em", a);
+    EXPECT_TRUE(a.in_range);
+    EXPECT_LT(a.mean, 0.02);
+}
+
 // Replaces the last outlined glyph of a subset asset with hand-made contours, so the rasterizer
 // meets shapes no font in the repository has.
 std::unique_ptr<Font> with_shape(const std::vector<Contour>& contours, uint32_t& glyph_index) {

@@ -245,3 +245,48 @@ TEST(Raster, BadConfigurationsAreRefused) {
 
 }  // namespace
 }  // namespace crisp
+
+namespace crisp {
+namespace {
+
+TEST(Raster, TwoRenderersOnTwoContextsWorkSideBySide) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    HeadlessContextOptions options;
+    options.validation = true;
+    auto second = HeadlessContext::create(options);
+    ASSERT_TRUE(second) << second.error().message;
+    RendererCreateInfo info;
+    info.instance = second->instance();
+    info.physical_device = second->physical_device();
+    info.device = second->device();
+    info.queue_family = second->queue_family();
+    info.atlas.width = info.atlas.height = 256;
+    info.atlas.max_samples = 8;
+    auto other = Renderer::create(info);
+    ASSERT_TRUE(other) << other.error().message;
+    auto mine = make_renderer(*subpixel_preset("rgb"), 8);
+    ASSERT_TRUE(mine);
+    ASSERT_TRUE(mine->add_font(*f.font));
+    ASSERT_TRUE(other->add_font(*f.font));
+    const Font* fonts[] = {f.font.get()};
+    auto layout = layout_text(fonts, "Hg", TextStyle{}, LayoutOptions{.origin_x = 2.5f, .origin_y = 20.0f});
+    ASSERT_TRUE(layout);
+    // Interleaved frames: each renderer's state and each context's queue stay its own.
+    for (int frame = 0; frame < 2; ++frame) {
+        for (auto [renderer, context] : {std::pair{&*mine, f.context.get()}, std::pair{&*other, &*second}}) {
+            renderer->begin_frame();
+            renderer->draw(layout->glyphs);
+            ASSERT_TRUE(context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+        }
+    }
+    EXPECT_TRUE(mine->converged());
+    EXPECT_TRUE(other->converged());
+    EXPECT_EQ(mine->drawn().size(), other->drawn().size());
+    const ValidationMessages messages = second->validation_messages();
+    EXPECT_EQ(messages.errors + messages.warnings, 0u);
+    expect_no_validation_messages();
+}
+
+}  // namespace
+}  // namespace crisp

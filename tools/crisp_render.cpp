@@ -79,8 +79,8 @@ options:
                            has an alpha channel
   --coverage-out OUT.pfm   the text's linear coverage per channel as a PFM image
   --json                   print the report as one JSON object on stdout
-  --validate               turn on the Vulkan validation layer; any warning or error it
-                           reports fails the run (exit 5)
+  --validate               turn on the Vulkan validation layer (always on in debug builds); any
+                           warning or error it reports fails the run (exit 5)
   --device NAME            use the Vulkan device whose name contains NAME
   -h, --help               this text
 
@@ -102,7 +102,11 @@ struct Arguments {
     std::string output;
     std::string coverage_output;
     bool json = false;
+#ifdef NDEBUG
     bool validate = false;
+#else
+    bool validate = true;  // debug builds run with the validation layer on
+#endif
     std::string device;
 };
 
