@@ -193,7 +193,7 @@ TEST(HardCase, CjkGlyphWithHundredsOfCurves) {
     EXPECT_LT(a.mean, 0.03);
 }
 
-TEST(HardCase, FourPixelsAndOneThousandPixels) {
+TEST(HardCase, FourPixels) {
     REQUIRE_GPU();
     auto font = bake(test::kDejaVuSans, "e");
     ASSERT_TRUE(font);
@@ -202,6 +202,12 @@ TEST(HardCase, FourPixelsAndOneThousandPixels) {
     report("DejaVu e 4 px", tiny);
     EXPECT_TRUE(tiny.in_range);
     EXPECT_LT(tiny.mean, 0.03);
+}
+
+TEST(HardCase, OneThousandPixels) {
+    REQUIRE_GPU();
+    auto font = bake(test::kDejaVuSans, "e");
+    ASSERT_TRUE(font);
     // 1000 px: a 600x800 texel rect; few samples keep lavapipe quick, the error bound follows.
     const Accuracy huge =
         render_and_measure(*font, lay_out(*font, "e", 1000.0f, 0.25f, 760.5f), *subpixel_preset("gray"), 8, 1024);
@@ -327,9 +333,13 @@ TEST(HardCase, OverlappingSameDirectionContoursNeverExceedOne) {
     expect_shape_accurate("overlapping circles", {circle(0.4, 0.4, 0.3, false), circle(0.55, 0.45, 0.3, false)}, 0.02);
 }
 
-TEST(HardCase, HolesAndSelfIntersection) {
+TEST(HardCase, Holes) {
     REQUIRE_GPU();
     expect_shape_accurate("ring", {circle(0.5, 0.5, 0.45, false), circle(0.5, 0.5, 0.25, true)}, 0.02);
+}
+
+TEST(HardCase, SelfIntersectingContours) {
+    REQUIRE_GPU();
     expect_shape_accurate("bow tie", {polygon({{0, 0}, {0.8, 0.8}, {0.8, 0}, {0, 0.8}})}, 0.02);
     expect_shape_accurate("pentagram", {polygon({{0.5, 0.95}, {0.79, 0.05}, {0.02, 0.61}, {0.98, 0.61}, {0.21, 0.05}})},
                           0.02);
@@ -345,16 +355,24 @@ TEST(HardCase, HairlinesFarThinnerThanAPixel) {
                           0.02);
 }
 
-TEST(HardCase, RaysThroughEndPointsHorizontalSegmentsAndTangents) {
+TEST(HardCase, RaysThroughEndPointsAndHorizontalSegments) {
     REQUIRE_GPU();
     // At 20 px every 1/20 em is a texel edge; with R2 samples many rows land on or within float
-    // rounding of these vertices, horizontal edges and the circles' extrema.
+    // rounding of these vertices and horizontal edges.
     expect_shape_accurate(
         "grid-aligned staircase",
         {polygon({{0, 0}, {0.5, 0}, {0.5, 0.25}, {0.75, 0.25}, {0.75, 0.5}, {0.25, 0.5}, {0.25, 0.75}, {0, 0.75}})},
         0.02);
+}
+
+TEST(HardCase, CurvesTangentToTheRay) {
+    REQUIRE_GPU();
+    // Circles touching each other, their tops and bottoms horizontal tangents to sample rows.
     expect_shape_accurate("tangent circles", {circle(0.25, 0.5, 0.25, false), circle(0.75, 0.5, 0.25, false)}, 0.02);
-    // Collinear and zero-length quadratics inside a contour.
+}
+
+TEST(HardCase, CollinearAndZeroLengthQuadratics) {
+    REQUIRE_GPU();
     Contour degenerate = polygon({{0, 0}, {0.8, 0}, {0.8, 0.8}, {0, 0.8}});
     degenerate.insert(degenerate.begin() + 1, Quad{{0.8, 0}, {0.8, 0}, {0.8, 0}});        // zero length
     degenerate.insert(degenerate.begin() + 2, Quad{{0.8, 0}, {0.8, -0.0001}, {0.8, 0}});  // a spike
