@@ -46,6 +46,17 @@ struct Args {
     std::exit(code);
 }
 
+template <class T>
+T number(const std::string& text) {
+    T value{};
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (text.empty() || ec != std::errc() || end != text.data() + text.size()) {
+        std::fprintf(stderr, "crisp-bench-gpu: '%s' is not a valid number\n", text.c_str());
+        usage(2);
+    }
+    return value;
+}
+
 Args parse(int argc, char** argv) {
     Args args;
     for (int i = 1; i < argc; ++i) {
@@ -59,13 +70,13 @@ Args parse(int argc, char** argv) {
         else if (arg == "--font")
             args.font = value();
         else if (arg == "--size")
-            args.size = std::stof(value());
+            args.size = number<float>(value());
         else if (arg == "--layout")
             args.layout = value();
         else if (arg == "--samples")
-            args.samples = static_cast<uint32_t>(std::stoul(value()));
+            args.samples = number<uint32_t>(value());
         else if (arg == "--frames")
-            args.max_frames = static_cast<uint32_t>(std::stoul(value()));
+            args.max_frames = number<uint32_t>(value());
         else if (arg == "--device")
             args.device = value();
         else if (arg == "--no-shared-rows")
