@@ -1,0 +1,219 @@
+#include "scene.hpp"
+
+#include "file_io.hpp"
+#include "json.hpp"
+
+#include <crisp/renderer.hpp>
+
+#include <cfloat>
+#include <cmath>
+#include <optional>
+
+namespace crisp {
+
+static_assert(kMaxSceneFonts == kMaxRendererFonts, "a scene holds what one renderer holds");
+
+namespace {
+
+using Type = json::Value::Type;
+
+constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "runs"};
+constexpr std::string_view kRunMembers[] = {"font", "text", "size", "origin", "color", "depth"};
+
+Error fault(const std::string& path, const std::string& what) {
+    return Error{ErrorCode::invalid_argument, "scene: " + path + ": " + what};
+}
+
+std::string element(const std::string& path, size_t index) {
+    return path + "[" + std::to_string(index) + "]";
+}
+
+// The first member of `object` whose name is not in `known`, as an error naming the known ones.
+template <size_t N>
+std::optional<Error> unknown_member(const json::Value& object, const std::string& path,
+                                    const std::string_view (&known)[N]) {
+    for (const json::Member& member : object.object) {
+        bool found = false;
+        for (const std::string_view name : known) found = found || member.name == name;
+        if (found) continue;
+        std::string list;
+        for (const std::string_view name : known) list += (list.empty() ? "" : ", ") + std::string(name);
+        std::string what = "unknown member \"" + member.name + "\" (known: " + list + ")";
+        if (path.empty()) return Error{ErrorCode::invalid_argument, "scene: " + what};
+        return fault(path, what);
+    }
+    return std::nullopt;
+}
+
+// A path or preset name the operating system can take: non-empty, no NUL (which would cut it).
+bool is_usable_name(const json::Value& value) {
+    return value.type == Type::string && !value.string.empty() && value.string.find('\0') == std::string::npos;
+}
+
+std::optional<Error> read_fonts(const json::Value& value, Scene& scene) {
+    if (value.type != Type::array || value.array.empty()) {
+        return fault("fonts", "expected a non-empty array of font asset paths");
+    }
+    if (value.array.size() > kMaxSceneFonts) {
+        return fault("fonts", "at most " + std::to_string(kMaxSceneFonts) + " fonts (what one renderer holds), got " +
+                                  std::to_string(value.array.size()));
+    }
+    for (size_t i = 0; i < value.array.size(); ++i) {
+        if (!is_usable_name(value.array[i])) {
+            return fault(element("fonts", i), "expected a non-empty path string without U+0000");
+        }
+        scene.fonts.push_back(value.array[i].string);
+    }
+    return std::nullopt;
+}
+
+std::optional<Error> read_canvas(const json::Value& value, Scene& scene) {
+    const auto side = [](const json::Value& number) {
+        return number.type == Type::number && number.number >= 1.0 &&
+               number.number <= static_cast<double>(kMaxSceneCanvas) && number.number == std::floor(number.number);
+    };
+    if (value.type != Type::array || value.array.size() != 2 || !side(value.array[0]) || !side(value.array[1])) {
+        return fault("canvas", "expected [width, height] integers from 1 to " + std::to_string(kMaxSceneCanvas));
+    }
+    scene.width = static_cast<uint32_t>(value.array[0].number);
+    scene.height = static_cast<uint32_t>(value.array[1].number);
+    return std::nullopt;
+}
+
+// [r, g, b] or [r, g, b, a], each in [0, 1]; a missing alpha is 1.
+std::optional<Error> read_color(const json::Value& value, const std::string& path, float (&color)[4]) {
+    if (value.type != Type::array || (value.array.size() != 3 && value.array.size() != 4)) {
+        return fault(path, "expected [r, g, b] or [r, g, b, a], sRGB numbers from 0 to 1");
+    }
+    for (size_t i = 0; i < value.array.size(); ++i) {
+        const json::Value& component = value.array[i];
+        if (component.type != Type::number || !(component.number >= 0.0 && component.number <= 1.0)) {
+            return fault(element(path, i), "expected a number from 0 to 1");
+        }
+        color[i] = static_cast<float>(component.number);
+    }
+    if (value.array.size() == 3) color[3] = 1.0f;
+    return std::nullopt;
+}
+
+std::optional<Error> read_run(const json::Value& value, const std::string& path, size_t font_count, SceneRun& run) {
+    if (value.type != Type::object) return fault(path, "expected an object, got " + std::string(value.type_name()));
+    if (auto error = unknown_member(value, path, kRunMembers)) return error;
+
+    if (const json::Value* font = value.find("font")) {
+        if (font->type != Type::number || font->number < 0.0 || font->number != std::floor(font->number)) {
+            return fault(path + ".font", "expected an index into fonts (an integer from 0)");
+        }
+        if (font->number >= static_cast<double>(font_count)) {
+            std::string index;
+            json::append_number(index, font->number);
+            return fault(path + ".font", "index " + index + " is out of range (the scene has " +
+                                             std::to_string(font_count) + (font_count == 1 ? " font)" : " fonts)"));
+        }
+        run.font = static_cast<uint32_t>(font->number);
+    }
+
+    const json::Value* text = value.find("text");
+    if (!text) return fault(path, "the \"text\" member is missing");
+    if (text->type != Type::string)
+        return fault(path + ".text", "expected a string, got " + std::string(text->type_name()));
+    run.text = text->string;
+
+    const json::Value* size = value.find("size");
+    if (!size) return fault(path, "the \"size\" member is missing");
+    if (size->type != Type::number) return fault(path + ".size", "expected a number (pixels per em)");
+    if (!(size->number > 0.0 && size->number <= static_cast<double>(kMaxSceneTextSize))) {
+        return fault(path + ".size", "must be in (0, 4096]");
+    }
+    run.size = static_cast<float>(size->number);
+    // A size below the smallest float rounds to 0, which the renderer cannot scale by.
+    if (!(run.size > 0.0f)) return fault(path + ".size", "must be in (0, 4096]");
+
+    const json::Value* origin = value.find("origin");
+    if (!origin) return fault(path, "the \"origin\" member is missing");
+    const auto coordinate = [](const json::Value& number) {
+        return number.type == Type::number && std::fabs(number.number) <= static_cast<double>(FLT_MAX);
+    };
+    if (origin->type != Type::array || origin->array.size() != 2 || !coordinate(origin->array[0]) ||
+        !coordinate(origin->array[1])) {
+        return fault(path + ".origin", "expected [x, y], finite numbers (canvas pixels)");
+    }
+    run.origin_x = static_cast<float>(origin->array[0].number);
+    run.origin_y = static_cast<float>(origin->array[1].number);
+
+    if (const json::Value* color = value.find("color")) {
+        if (auto error = read_color(*color, path + ".color", run.color)) return error;
+    }
+
+    if (const json::Value* depth = value.find("depth")) {
+        if (depth->type != Type::number || !(depth->number >= 0.0 && depth->number <= 1.0)) {
+            return fault(path + ".depth", "expected a number from 0 (nearest) to 1 (farthest)");
+        }
+        run.depth = static_cast<float>(depth->number);
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
+Result<Scene> parse_scene(std::string_view json) {
+    auto document = json::parse(json);
+    if (!document) return Error{ErrorCode::invalid_argument, "scene: " + document.error().message};
+    const json::Value& root = *document;
+    if (root.type != Type::object) {
+        return Error{ErrorCode::invalid_argument, "scene: expected an object, got " + std::string(root.type_name())};
+    }
+    if (auto error = unknown_member(root, "", kSceneMembers)) return *error;
+
+    // Members are read in a fixed order, whatever the file's order, so a file with several faults
+    // always reports the same one, and runs can check their font index against the font count.
+    Scene scene;
+    const json::Value* fonts = root.find("fonts");
+    if (!fonts) return Error{ErrorCode::invalid_argument, "scene: the \"fonts\" member is missing"};
+    if (auto error = read_fonts(*fonts, scene)) return *error;
+
+    const json::Value* canvas = root.find("canvas");
+    if (!canvas) return Error{ErrorCode::invalid_argument, "scene: the \"canvas\" member is missing"};
+    if (auto error = read_canvas(*canvas, scene)) return *error;
+
+    if (const json::Value* background = root.find("background")) {
+        if (auto error = read_color(*background, "background", scene.background)) return *error;
+    }
+
+    if (const json::Value* layout = root.find("layout")) {
+        if (!is_usable_name(*layout)) {
+            return fault("layout", "expected a subpixel preset name or a layout file path (a non-empty string)");
+        }
+        scene.layout = layout->string;
+    }
+
+    const json::Value* runs = root.find("runs");
+    if (!runs) return Error{ErrorCode::invalid_argument, "scene: the \"runs\" member is missing"};
+    if (runs->type != Type::array) {
+        return fault("runs", "expected an array of run objects, got " + std::string(runs->type_name()));
+    }
+    scene.runs.resize(runs->array.size());
+    for (size_t i = 0; i < runs->array.size(); ++i) {
+        if (auto error = read_run(runs->array[i], element("runs", i), scene.fonts.size(), scene.runs[i])) {
+            return *error;
+        }
+    }
+    return scene;
+}
+
+Result<Scene> load_scene_file(const std::filesystem::path& path) {
+    auto bytes = read_file(path);
+    if (!bytes) return bytes.error();
+    const std::string_view text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
+    auto scene = parse_scene(text);
+    if (!scene) return Error{scene.error().code, path.string() + ": " + scene.error().message};
+    // Fonts sit beside the scene, wherever it is run from; an empty parent is the working directory.
+    const std::filesystem::path directory = path.parent_path();
+    for (std::string& font : scene->fonts) {
+        const std::filesystem::path font_path(font);
+        if (font_path.is_relative() && !directory.empty()) font = (directory / font_path).string();
+    }
+    return scene;
+}
+
+}  // namespace crisp

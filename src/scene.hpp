@@ -1,0 +1,54 @@
+// Scene files: what crisp-render's --scene draws, many runs of text in several fonts on one canvas.
+//
+//     {"fonts": ["a.crisp"], "canvas": [640, 200], "background": [1, 1, 1],
+//      "runs": [{"text": "Hello", "size": 48, "origin": [20, 80], "color": [0, 0, 0, 1]}]}
+//
+// docs/scene-format.md describes every member, its default and its limits. Safe for untrusted
+// input: every fault is ErrorCode::invalid_argument with a message that names the member's path
+// ("scene: runs[2].size: must be in (0, 4096]"); a parsed Scene always satisfies the limits.
+#pragma once
+
+#include <crisp/result.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace crisp {
+
+// Limits a parsed scene keeps; docs/scene-format.md explains each.
+inline constexpr uint32_t kMaxSceneFonts = 8;        // the renderer's kMaxRendererFonts
+inline constexpr uint32_t kMaxSceneCanvas = 16384;   // crisp-render's --canvas limit, per side
+inline constexpr float kMaxSceneTextSize = 4096.0f;  // pixels per em, crisp-render's --size limit
+
+struct SceneRun {
+    uint32_t font = 0;                          // index into Scene::fonts
+    std::string text;                           // UTF-8, valid (the JSON reader checks it); may be empty
+    float size = 0.0f;                          // pixels per em, in (0, kMaxSceneTextSize]
+    float origin_x = 0.0f, origin_y = 0.0f;     // pen position on the baseline, canvas pixels, y down
+    float color[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // sRGB-encoded, straight alpha, each in [0, 1]
+    float depth = 0.5f;                         // in [0, 1]; smaller is nearer, as Vulkan's depth
+    friend bool operator==(const SceneRun&, const SceneRun&) = default;
+};
+
+struct Scene {
+    std::vector<std::string> fonts;                  // 1..kMaxSceneFonts asset paths, none empty
+    uint32_t width = 0, height = 0;                  // each in 1..kMaxSceneCanvas
+    float background[4] = {1.0f, 1.0f, 1.0f, 1.0f};  // sRGB-encoded, straight alpha, each in [0, 1]
+    std::string layout = "rgb";                      // a subpixel preset name or a layout file path
+    std::vector<SceneRun> runs;                      // drawn in this (file) order
+    friend bool operator==(const Scene&, const Scene&) = default;
+};
+
+// Parses a scene. Font and layout paths are kept as written. Syntax errors name their line and
+// column; all faults are ErrorCode::invalid_argument with a message starting "scene: ".
+Result<Scene> parse_scene(std::string_view json);
+
+// Reads and parses a scene file; relative font paths become paths relative to the scene file's
+// directory (absolute ones are kept; the layout string is kept as written). An unreadable file is
+// ErrorCode::io; every message names the path.
+Result<Scene> load_scene_file(const std::filesystem::path& path);
+
+}  // namespace crisp

@@ -1,0 +1,272 @@
+#include "scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace crisp {
+namespace {
+
+// A valid scene whose one run is `run`.
+std::string with_run(const std::string& run) {
+    return R"({"fonts": ["a.crisp"], "canvas": [64, 32], "runs": [)" + run + "]}";
+}
+
+TEST(Scene, ParsesEveryMember) {
+    auto scene = parse_scene(R"({
+        "fonts": ["fonts/a.crisp", "/abs/b.crisp"],
+        "canvas": [640, 200],
+        "background": [0.1, 0.2, 0.3, 0.5],
+        "layout": "qd-oled",
+        "runs": [
+            {"font": 1, "text": "Héllo, 世界", "size": 48.5, "origin": [10.25, -20], "color": [1, 0.5, 0, 0.75],
+             "depth": 0.125},
+            {"text": "", "size": 4096, "origin": [0, 0], "depth": 1},
+            {"size": 0.5, "origin": [3e38, -3e38], "text": "x", "font": 0, "depth": 0, "color": [0, 0, 1]}
+        ]
+    })");
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_EQ(scene->fonts, (std::vector<std::string>{"fonts/a.crisp", "/abs/b.crisp"}));
+    EXPECT_EQ(scene->width, 640u);
+    EXPECT_EQ(scene->height, 200u);
+    EXPECT_EQ(scene->background[0], 0.1f);
+    EXPECT_EQ(scene->background[1], 0.2f);
+    EXPECT_EQ(scene->background[2], 0.3f);
+    EXPECT_EQ(scene->background[3], 0.5f);
+    EXPECT_EQ(scene->layout, "qd-oled");
+    ASSERT_EQ(scene->runs.size(), 3u);
+    const SceneRun& first = scene->runs[0];
+    EXPECT_EQ(first.font, 1u);
+    EXPECT_EQ(first.text, "H\xC3\xA9llo, \xE4\xB8\x96\xE7\x95\x8C");
+    EXPECT_EQ(first.size, 48.5f);
+    EXPECT_EQ(first.origin_x, 10.25f);
+    EXPECT_EQ(first.origin_y, -20.0f);
+    EXPECT_EQ(first.color[0], 1.0f);
+    EXPECT_EQ(first.color[1], 0.5f);
+    EXPECT_EQ(first.color[2], 0.0f);
+    EXPECT_EQ(first.color[3], 0.75f);
+    EXPECT_EQ(first.depth, 0.125f);
+    EXPECT_EQ(scene->runs[1].text, "");
+    EXPECT_EQ(scene->runs[1].size, 4096.0f);
+    EXPECT_EQ(scene->runs[1].depth, 1.0f);
+    const SceneRun& third = scene->runs[2];
+    EXPECT_EQ(third.size, 0.5f);
+    EXPECT_EQ(third.origin_x, 3e38f);
+    EXPECT_EQ(third.origin_y, -3e38f);
+    EXPECT_EQ(third.depth, 0.0f);
+    EXPECT_EQ(third.color[2], 1.0f);
+    EXPECT_EQ(third.color[3], 1.0f);  // three components: opaque
+}
+
+TEST(Scene, DefaultsFillWhatIsLeftOut) {
+    auto scene = parse_scene(R"({"fonts": ["a.crisp"], "canvas": [1, 16384],
+                                 "runs": [{"text": "a", "size": 12, "origin": [1, 2]}]})");
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_EQ(scene->width, 1u);
+    EXPECT_EQ(scene->height, 16384u);
+    for (const float c : scene->background) EXPECT_EQ(c, 1.0f);  // opaque white
+    EXPECT_EQ(scene->layout, "rgb");
+    ASSERT_EQ(scene->runs.size(), 1u);
+    const SceneRun& run = scene->runs[0];
+    EXPECT_EQ(run.font, 0u);
+    EXPECT_EQ(run.color[0], 0.0f);  // opaque black
+    EXPECT_EQ(run.color[1], 0.0f);
+    EXPECT_EQ(run.color[2], 0.0f);
+    EXPECT_EQ(run.color[3], 1.0f);
+    EXPECT_EQ(run.depth, 0.5f);
+    EXPECT_EQ(parse_scene(R"({"fonts": ["a"], "canvas": [8, 8], "runs": []})")->runs.size(), 0u);
+}
+
+TEST(Scene, MemberOrderDoesNotMatter) {
+    auto a = parse_scene(R"({"fonts": ["a", "b"], "canvas": [9, 7], "layout": "bgr", "runs": [
+        {"font": 1, "text": "t", "size": 3, "origin": [1, 2], "depth": 0.25}]})");
+    auto b = parse_scene(R"({"runs": [{"depth": 0.25, "origin": [1, 2], "size": 3, "text": "t", "font": 1}],
+        "layout": "bgr", "canvas": [9, 7], "fonts": ["a", "b"]})");
+    ASSERT_TRUE(a) << a.error().message;
+    ASSERT_TRUE(b) << b.error().message;
+    EXPECT_EQ(*a, *b);
+}
+
+TEST(Scene, BadScenesNameTheirFault) {
+    const std::string nine_fonts = R"({"fonts": ["1","2","3","4","5","6","7","8","9"], "canvas": [8, 8], "runs": []})";
+    const struct {
+        std::string text;
+        const char* fragment;
+    } cases[] = {
+        // The document.
+        {"", "scene: line 1, column"},
+        {"{\"fonts\": [\"a\"],\n \"canvas\": [1, 1]", "scene: line 2, column"},
+        {R"({"fonts": ["a"], "fonts": ["b"], "canvas": [1, 1], "runs": []})", "scene: line 1"},  // duplicate
+        {"[]", "scene: expected an object, got an array"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "runs": [], "colour": 1})",
+         "scene: unknown member \"colour\" (known: fonts, canvas, background, layout, runs)"},
+        // fonts
+        {R"({"canvas": [8, 8], "runs": []})", "scene: the \"fonts\" member is missing"},
+        {R"({"fonts": "a.crisp", "canvas": [8, 8], "runs": []})", "scene: fonts: expected a non-empty array"},
+        {R"({"fonts": [], "canvas": [8, 8], "runs": []})", "scene: fonts: expected a non-empty array"},
+        {nine_fonts, "scene: fonts: at most 8 fonts (what one renderer holds), got 9"},
+        {R"({"fonts": ["a", ""], "canvas": [8, 8], "runs": []})", "scene: fonts[1]: expected a non-empty path string"},
+        {R"({"fonts": [1], "canvas": [8, 8], "runs": []})", "scene: fonts[0]: expected a non-empty path string"},
+        {R"({"fonts": ["a\u0000b"], "canvas": [8, 8], "runs": []})", "scene: fonts[0]: expected a non-empty path"},
+        // canvas
+        {R"({"fonts": ["a"], "runs": []})", "scene: the \"canvas\" member is missing"},
+        {R"({"fonts": ["a"], "canvas": [0, 8], "runs": []})",
+         "scene: canvas: expected [width, height] integers from 1 to 16384"},
+        {R"({"fonts": ["a"], "canvas": [8, 16385], "runs": []})", "scene: canvas: expected [width, height]"},
+        {R"({"fonts": ["a"], "canvas": [8.5, 8], "runs": []})", "scene: canvas: expected [width, height]"},
+        {R"({"fonts": ["a"], "canvas": [8], "runs": []})", "scene: canvas: expected [width, height]"},
+        {R"({"fonts": ["a"], "canvas": [8, 8, 8], "runs": []})", "scene: canvas: expected [width, height]"},
+        {R"({"fonts": ["a"], "canvas": ["8", 8], "runs": []})", "scene: canvas: expected [width, height]"},
+        {R"({"fonts": ["a"], "canvas": "640x480", "runs": []})", "scene: canvas: expected [width, height]"},
+        // background
+        {R"({"fonts": ["a"], "canvas": [8, 8], "background": [1, 1], "runs": []})",
+         "scene: background: expected [r, g, b] or [r, g, b, a]"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "background": [1, 1, 1, 1, 1], "runs": []})",
+         "scene: background: expected [r, g, b] or [r, g, b, a]"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "background": [1, 1, 1, 2], "runs": []})",
+         "scene: background[3]: expected a number from 0 to 1"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "background": [1, -0.01, 1], "runs": []})",
+         "scene: background[1]: expected a number from 0 to 1"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "background": "white", "runs": []})",
+         "scene: background: expected [r, g, b]"},
+        // layout
+        {R"({"fonts": ["a"], "canvas": [8, 8], "layout": 3, "runs": []})",
+         "scene: layout: expected a subpixel preset name or a layout file path"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "layout": "", "runs": []})", "scene: layout: expected a subpixel"},
+        // runs
+        {R"({"fonts": ["a"], "canvas": [8, 8]})", "scene: the \"runs\" member is missing"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "runs": {}})",
+         "scene: runs: expected an array of run objects, got an object"},
+        {with_run("5"), "scene: runs[0]: expected an object, got a number"},
+        {with_run(
+             R"({"text": "a", "size": 9, "origin": [0, 0]}, {"text": "a", "size": 9, "origin": [0, 0], "colour": [0, 0, 0]})"),
+         "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth)"},
+        // runs[].font
+        {with_run(R"({"font": -1, "text": "a", "size": 9, "origin": [0, 0]})"),
+         "scene: runs[0].font: expected an index into fonts (an integer from 0)"},
+        {with_run(R"({"font": 0.5, "text": "a", "size": 9, "origin": [0, 0]})"),
+         "scene: runs[0].font: expected an index"},
+        {with_run(R"({"font": "0", "text": "a", "size": 9, "origin": [0, 0]})"),
+         "scene: runs[0].font: expected an index"},
+        {with_run(R"({"font": 1, "text": "a", "size": 9, "origin": [0, 0]})"),
+         "scene: runs[0].font: index 1 is out of range (the scene has 1 font)"},
+        {with_run(R"({"font": 1e300, "text": "a", "size": 9, "origin": [0, 0]})"), "scene: runs[0].font: index 1e+300"},
+        // runs[].text
+        {with_run(R"({"size": 9, "origin": [0, 0]})"), "scene: runs[0]: the \"text\" member is missing"},
+        {with_run(R"({"text": 5, "size": 9, "origin": [0, 0]})"),
+         "scene: runs[0].text: expected a string, got a number"},
+        // runs[].size
+        {with_run(R"({"text": "a", "origin": [0, 0]})"), "scene: runs[0]: the \"size\" member is missing"},
+        {with_run(R"({"text": "a", "size": "9", "origin": [0, 0]})"), "scene: runs[0].size: expected a number"},
+        {with_run(R"({"text": "a", "size": 0, "origin": [0, 0]})"), "scene: runs[0].size: must be in (0, 4096]"},
+        {with_run(R"({"text": "a", "size": -1, "origin": [0, 0]})"), "scene: runs[0].size: must be in (0, 4096]"},
+        {with_run(R"({"text": "a", "size": 4096.001, "origin": [0, 0]})"), "scene: runs[0].size: must be in (0, 4096]"},
+        {with_run(R"({"text": "a", "size": 1e-50, "origin": [0, 0]})"), "scene: runs[0].size: must be in (0, 4096]"},
+        // runs[].origin
+        {with_run(R"({"text": "a", "size": 9})"), "scene: runs[0]: the \"origin\" member is missing"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0]})"),
+         "scene: runs[0].origin: expected [x, y], finite numbers"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, "1"]})"), "scene: runs[0].origin: expected [x, y]"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [1e39, 0]})"), "scene: runs[0].origin: expected [x, y]"},
+        {with_run(R"({"text": "a", "size": 9, "origin": {"x": 0, "y": 0}})"), "scene: runs[0].origin: expected [x, y]"},
+        // runs[].color
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "color": [0, 0]})"),
+         "scene: runs[0].color: expected [r, g, b] or [r, g, b, a]"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "color": [0, 0, 255]})"),
+         "scene: runs[0].color[2]: expected a number from 0 to 1"},
+        // runs[].depth
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "depth": 1.5})"),
+         "scene: runs[0].depth: expected a number from 0 (nearest) to 1 (farthest)"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "depth": -0.1})"), "scene: runs[0].depth: expected"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "depth": "near"})"), "scene: runs[0].depth: expected"},
+    };
+    for (const auto& c : cases) {
+        auto scene = parse_scene(c.text);
+        ASSERT_FALSE(scene) << c.text;
+        EXPECT_EQ(scene.error().code, ErrorCode::invalid_argument);
+        EXPECT_NE(scene.error().message.find(c.fragment), std::string::npos)
+            << "message: " << scene.error().message << "\nexpected: " << c.fragment;
+    }
+}
+
+TEST(Scene, TheThirdRunsFaultNamesItsIndex) {
+    auto scene = parse_scene(R"({"fonts": ["a"], "canvas": [8, 8], "runs": [
+        {"text": "a", "size": 9, "origin": [0, 0]}, {"text": "b", "size": 9, "origin": [0, 0]},
+        {"text": "c", "size": 5000, "origin": [0, 0]}]})");
+    ASSERT_FALSE(scene);
+    EXPECT_EQ(scene.error().message, "scene: runs[2].size: must be in (0, 4096]");
+}
+
+class SceneFile : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = std::filesystem::temp_directory_path() /
+               ("crisp_scene_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        std::filesystem::remove_all(dir_);
+        std::filesystem::create_directories(dir_ / "scenes");
+    }
+    void TearDown() override { std::filesystem::remove_all(dir_); }
+    std::filesystem::path dir_;
+};
+
+TEST_F(SceneFile, RelativeFontPathsAreResolvedAgainstTheScenesDirectory) {
+    const std::filesystem::path absolute = dir_ / "elsewhere" / "c.crisp";
+    std::ofstream(dir_ / "scenes" / "scene.json") << R"({"fonts": ["a.crisp", "sub/b.crisp", "../up.crisp", )"
+                                                  << "\"" << absolute.generic_string() << "\""
+                                                  << R"(], "canvas": [8, 8], "layout": "my-layout.json", "runs": []})";
+    auto scene = load_scene_file(dir_ / "scenes" / "scene.json");
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_EQ(scene->fonts.size(), 4u);
+    EXPECT_EQ(scene->fonts[0], (dir_ / "scenes" / "a.crisp").string());
+    EXPECT_EQ(scene->fonts[1], (dir_ / "scenes" / "sub/b.crisp").string());
+    EXPECT_EQ(scene->fonts[2], (dir_ / "scenes" / "../up.crisp").string());
+    EXPECT_EQ(scene->fonts[3], absolute.generic_string());  // absolute: kept
+    EXPECT_EQ(scene->layout, "my-layout.json");             // kept as written
+    // parse_scene alone keeps every path as written.
+    EXPECT_EQ(parse_scene(R"({"fonts": ["a.crisp"], "canvas": [8, 8], "runs": []})")->fonts[0], "a.crisp");
+}
+
+TEST_F(SceneFile, UnreadableAndBadFilesNameThePath) {
+    auto missing = load_scene_file(dir_ / "missing.json");
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().code, ErrorCode::io);
+    EXPECT_NE(missing.error().message.find("missing.json"), std::string::npos) << missing.error().message;
+    auto directory = load_scene_file(dir_ / "scenes");
+    ASSERT_FALSE(directory);
+    EXPECT_EQ(directory.error().code, ErrorCode::io);
+    std::ofstream(dir_ / "bad.json") << R"({"fonts": ["a"], "canvas": [0, 0], "runs": []})";
+    auto bad = load_scene_file(dir_ / "bad.json");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().code, ErrorCode::invalid_argument);
+    EXPECT_EQ(bad.error().message,
+              (dir_ / "bad.json").string() + ": scene: canvas: expected [width, height] integers from 1 to 16384");
+}
+
+TEST(Scene, TenThousandRunsParse) {
+    constexpr size_t kRuns = 10000;
+    std::string text = R"({"fonts": ["a", "b", "c"], "canvas": [1920, 1080], "runs": [)";
+    for (size_t i = 0; i < kRuns; ++i) {
+        if (i) text += ",\n";
+        text += R"({"font": )" + std::to_string(i % 3) + R"(, "text": "run )" + std::to_string(i) + R"(", "size": )" +
+                std::to_string(8 + i % 64) + R"(, "origin": [)" + std::to_string(i % 1920) + ", " +
+                std::to_string(i / 10) + R"(], "color": [0.5, 0.25, 1], "depth": 0.75})";
+    }
+    text += "]}";
+    auto scene = parse_scene(text);
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_EQ(scene->runs.size(), kRuns);
+    for (const size_t i : {size_t{0}, size_t{4321}, kRuns - 1}) {
+        const SceneRun& run = scene->runs[i];
+        EXPECT_EQ(run.font, i % 3);
+        EXPECT_EQ(run.text, "run " + std::to_string(i));
+        EXPECT_EQ(run.size, static_cast<float>(8 + i % 64));
+        EXPECT_EQ(run.origin_x, static_cast<float>(i % 1920));
+        EXPECT_EQ(run.origin_y, static_cast<float>(i / 10));
+        EXPECT_EQ(run.depth, 0.75f);
+    }
+}
+
+}  // namespace
+}  // namespace crisp
