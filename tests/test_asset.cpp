@@ -3,6 +3,8 @@
 // atomic file write and FontAsset::band_of.
 #include <crisp/asset.hpp>
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 #include <hb.h>
 
@@ -335,33 +337,7 @@ void expect_invalid(const std::function<void(FontAsset&)>& change, std::string_v
         << "message \"" << status.error().message << "\" lacks \"" << fragment << "\"";
 }
 
-// A fresh directory under the system temporary directory, removed with everything in it.
-class TemporaryDirectory {
-public:
-    TemporaryDirectory() {
-        std::string pattern = (fs::temp_directory_path() / "crisp-test-XXXXXX").string();
-        if (::mkdtemp(pattern.data()) != nullptr) path_ = pattern;
-    }
-    ~TemporaryDirectory() {
-        std::error_code ignored;
-        if (!path_.empty()) fs::remove_all(path_, ignored);
-    }
-    TemporaryDirectory(const TemporaryDirectory&) = delete;
-    TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
-
-    const fs::path& path() const { return path_; }
-
-    std::vector<std::string> entries() const {
-        std::vector<std::string> names;
-        for (const fs::directory_entry& entry : fs::directory_iterator(path_))
-            names.push_back(entry.path().filename().string());
-        std::sort(names.begin(), names.end());
-        return names;
-    }
-
-private:
-    fs::path path_;
-};
+using test::TemporaryDirectory;
 
 // ---------------------------------------------------------------------------------------------
 // CRC-32C

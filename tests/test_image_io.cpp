@@ -4,6 +4,8 @@
 
 #include <crisp/layout.hpp>
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 #include <png.h>
 
@@ -26,34 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh directory under the system temporary directory, removed with everything in it.
-class TemporaryDirectory {
-public:
-    TemporaryDirectory() {
-        std::string pattern = (fs::temp_directory_path() / "crisp-image-test-XXXXXX").string();
-        if (::mkdtemp(pattern.data()) != nullptr) path_ = pattern;
-    }
-    ~TemporaryDirectory() {
-        std::error_code ignored;
-        if (!path_.empty()) fs::remove_all(path_, ignored);
-    }
-    TemporaryDirectory(const TemporaryDirectory&) = delete;
-    TemporaryDirectory& operator=(const TemporaryDirectory&) = delete;
-
-    const fs::path& path() const { return path_; }
-
-    // Every name in the directory, hidden ones (temporaries) included.
-    std::vector<std::string> entries() const {
-        std::vector<std::string> names;
-        for (const fs::directory_entry& entry : fs::directory_iterator(path_))
-            names.push_back(entry.path().filename().string());
-        std::sort(names.begin(), names.end());
-        return names;
-    }
-
-private:
-    fs::path path_;
-};
+using test::TemporaryDirectory;
 
 std::vector<std::byte> file_bytes(const fs::path& path) {
     std::ifstream file(path, std::ios::binary);

@@ -1,4 +1,6 @@
 // crisp-bake: turns a font into a .crisp asset, or checks an asset.
+#include "cli.hpp"
+
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>
 
@@ -69,12 +71,9 @@ struct Arguments {
 
 template <class T>
 T parse_number(std::string_view option, std::string_view text) {
-    T value{};
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || ec != std::errc() || end != text.data() + text.size()) {
-        usage_error(std::string(option) + ": '" + std::string(text) + "' is not a valid number");
-    }
-    return value;
+    const std::optional<T> value = crisp::cli::parse_number<T>(text);
+    if (!value) usage_error(std::string(option) + ": '" + std::string(text) + "' is not a valid number");
+    return *value;
 }
 
 Arguments parse_arguments(int argc, char** argv) {

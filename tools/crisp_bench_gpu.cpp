@@ -1,6 +1,8 @@
 // crisp-bench-gpu: GPU time of the rasterizer for a screen of text, from its first frame (new
 // glyphs, 8 samples each) through the converging frames to converged static text. Measures with
 // Vulkan timestamp queries around the recorded work; prints Markdown (or JSON with --json).
+#include "cli.hpp"
+
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
@@ -48,13 +50,12 @@ struct Args {
 
 template <class T>
 T number(const std::string& text) {
-    T value{};
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || ec != std::errc() || end != text.data() + text.size()) {
+    const std::optional<T> value = crisp::cli::parse_number<T>(text);
+    if (!value) {
         std::fprintf(stderr, "crisp-bench-gpu: '%s' is not a valid number\n", text.c_str());
         usage(2);
     }
-    return value;
+    return *value;
 }
 
 Args parse(int argc, char** argv) {

@@ -1,5 +1,6 @@
 // crisp-render: renders text with the GPU renderer until it converges, reads the atlas back and
 // composites on the CPU into a PNG and, on request, a PFM of the text's coverage.
+#include "cli.hpp"
 #include "image_io.hpp"
 #include "json.hpp"
 
@@ -122,15 +123,9 @@ struct Arguments {
 
 template <class T>
 T parse_number(std::string_view option, std::string_view text) {
-    T value{};
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || ec != std::errc() || end != text.data() + text.size()) {
-        usage_error(std::string(option) + ": '" + std::string(text) + "' is not a valid number");
-    }
-    if constexpr (std::is_floating_point_v<T>) {
-        if (!std::isfinite(value)) usage_error(std::string(option) + ": '" + std::string(text) + "' is not finite");
-    }
-    return value;
+    const std::optional<T> value = crisp::cli::parse_number<T>(text);
+    if (!value) usage_error(std::string(option) + ": '" + std::string(text) + "' is not a finite number");
+    return *value;
 }
 
 template <class T>
