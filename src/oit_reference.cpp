@@ -241,10 +241,19 @@ LinearRgb resolve_layers(const LayeredPixel& pixel, std::span<const Fragment> fr
     };
     std::vector<Contribution> contributions;
     contributions.reserve(fragments.size());
+    // Equal keys straddling the K boundary (copies of the last slot's key, some in the slots and
+    // some in the tail): a group of M fragments whose places are the M after the slots in front.
+    uint32_t group_count = 0;
+    double group_light[3] = {};
     for (const Fragment& f : fragments) {
         if (is_neutral(f)) continue;
         const uint64_t key = pack_layer_key(f);
         Contribution contribution{key, {}};
+        if (has_tail && key == last_key) {
+            ++group_count;
+            for (int c = 0; c < 3; ++c) group_light[c] += double{f.light[c]};
+            continue;
+        }
         if (has_tail && key > last_key) {
             for (int c = 0; c < 3; ++c) {
                 contribution.light[c] = f.light[c] * layers_t[c] * tail_factor(mode, pixel.tail, key, c);
@@ -285,6 +294,22 @@ LinearRgb resolve_layers(const LayeredPixel& pixel, std::span<const Fragment> fr
     for (size_t c = 0; c < 3; ++c) {
         result[c] = background[c] * layers_t[c] * pixel.tail.transmittance[c];
         for (const Contribution& contribution : contributions) result[c] += contribution.light[c];
+    }
+    if (group_count > 0) {
+        // Their mean light times (1 + T + ... + T^(M-1)), behind the slots with smaller keys.
+        for (size_t c = 0; c < 3; ++c) {
+            float in_front = 1.0f;
+            for (uint32_t i = 0; i < filled && pixel.slots[i] < last_key; ++i) {
+                in_front *= transmittance_from_code(key_transmittance_code(pixel.slots[i], static_cast<int>(c)));
+            }
+            const float t = transmittance_from_code(key_transmittance_code(last_key, static_cast<int>(c)));
+            float places = 0.0f, power = 1.0f;
+            for (uint32_t m = 0; m < group_count; ++m) {
+                places += power;
+                power *= t;
+            }
+            result[c] += static_cast<float>(group_light[c] / group_count) * in_front * places;
+        }
     }
     return result;
 }

@@ -1,4 +1,3 @@
-#include "embedded_shaders.hpp"
 #include "shared.h"
 #include "vk_resources.hpp"
 
@@ -21,13 +20,7 @@ static_assert(kMaxRendererFonts == gpu::kRasterMaxFonts);
 // vkCmdUpdateBuffer takes at most this many bytes a call.
 constexpr VkDeviceSize kUpdateChunk = 65536;
 
-// A buffer with its own memory; host-visible ones stay mapped.
-struct GpuBuffer {
-    VkBuffer buffer = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-    void* mapped = nullptr;
-    VkDeviceSize size = 0;
-};
+using GpuBuffer = vk::DeviceBuffer;
 
 struct GpuFont {
     const Font* font = nullptr;
@@ -57,9 +50,7 @@ struct Renderer::State {
     GlyphAtlas atlas;
     SubpixelLayout layout;
 
-    VkImage atlas_image = VK_NULL_HANDLE;
-    VkDeviceMemory atlas_memory = VK_NULL_HANDLE;
-    VkImageView atlas_view = VK_NULL_HANDLE;
+    vk::DeviceImage atlas_image;
     bool atlas_initialized = false;
 
     GpuBuffer items;  // device-local, RasterItem[usable cells]
@@ -111,95 +102,26 @@ Renderer::State::~State() {
     if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, allocator);
     if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, allocator);
     if (shader) vkDestroyShaderModule(device, shader, allocator);
-    if (atlas_view) vkDestroyImageView(device, atlas_view, allocator);
-    if (atlas_image) vkDestroyImage(device, atlas_image, allocator);
-    if (atlas_memory) vkFreeMemory(device, atlas_memory, allocator);
+    vk::destroy_image({device, allocator, memory_properties}, atlas_image);
 }
 
 Status Renderer::State::make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, GpuBuffer& out) {
-    VkBufferCreateInfo info{};
-    info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
-    info.size = std::max<VkDeviceSize>(size, 16);
-    info.usage = usage;
-    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    if (VkResult r = vkCreateBuffer(device, &info, allocator, &out.buffer); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateBuffer", r);
-    }
-    out.size = info.size;
-    VkMemoryRequirements requirements{};
-    vkGetBufferMemoryRequirements(device, out.buffer, &requirements);
-    const VkMemoryPropertyFlags required =
-        host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-                     : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-    const auto type = vk::find_memory_type(memory_properties, requirements.memoryTypeBits, required, 0);
-    if (!type) {
-        free_buffer(out);
-        return Error{ErrorCode::vulkan, "no memory type for a buffer of " + std::to_string(size) + " bytes"};
-    }
-    VkMemoryAllocateInfo allocate{};
-    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-    allocate.allocationSize = requirements.size;
-    allocate.memoryTypeIndex = *type;
-    if (VkResult r = vkAllocateMemory(device, &allocate, allocator, &out.memory); r != VK_SUCCESS) {
-        free_buffer(out);
-        return vk::vulkan_error("vkAllocateMemory", r);
-    }
-    vkBindBufferMemory(device, out.buffer, out.memory, 0);
-    if (host_visible) {
-        if (VkResult r = vkMapMemory(device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped); r != VK_SUCCESS) {
-            free_buffer(out);
-            return vk::vulkan_error("vkMapMemory", r);
-        }
-    }
-    return {};
+    return vk::create_buffer({device, allocator, memory_properties}, size, usage, host_visible, out);
 }
 
 void Renderer::State::free_buffer(GpuBuffer& buffer) {
-    if (buffer.buffer) vkDestroyBuffer(device, buffer.buffer, allocator);
-    if (buffer.memory) vkFreeMemory(device, buffer.memory, allocator);
-    buffer = {};
+    vk::destroy_buffer({device, allocator, memory_properties}, buffer);
 }
 
 Status Renderer::State::create_objects() {
     // The atlas image.
     const AtlasConfig& config = atlas.config();
-    VkImageCreateInfo image{};
-    image.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
-    image.imageType = VK_IMAGE_TYPE_2D;
-    image.format = kAtlasFormat;
-    image.extent = {config.width, config.height, 1};
-    image.mipLevels = 1;
-    image.arrayLayers = 1;
-    image.samples = VK_SAMPLE_COUNT_1_BIT;
-    image.tiling = VK_IMAGE_TILING_OPTIMAL;
-    image.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                  VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    image.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    image.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    if (VkResult r = vkCreateImage(device, &image, allocator, &atlas_image); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateImage (atlas)", r);
-    }
-    VkMemoryRequirements requirements{};
-    vkGetImageMemoryRequirements(device, atlas_image, &requirements);
-    const auto type =
-        vk::find_memory_type(memory_properties, requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
-    if (!type) return Error{ErrorCode::vulkan, "no device-local memory type for the atlas image"};
-    VkMemoryAllocateInfo allocate{};
-    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-    allocate.allocationSize = requirements.size;
-    allocate.memoryTypeIndex = *type;
-    if (VkResult r = vkAllocateMemory(device, &allocate, allocator, &atlas_memory); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkAllocateMemory (atlas)", r);
-    }
-    vkBindImageMemory(device, atlas_image, atlas_memory, 0);
-    VkImageViewCreateInfo view{};
-    view.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
-    view.image = atlas_image;
-    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-    view.format = kAtlasFormat;
-    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    if (VkResult r = vkCreateImageView(device, &view, allocator, &atlas_view); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateImageView (atlas)", r);
+    if (Status s = vk::create_image({device, allocator, memory_properties}, kAtlasFormat, config.width, config.height,
+                                    VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                    "atlas", atlas_image);
+        !s) {
+        return s;
     }
 
     // Work items: an entry takes at least one cell, so a frame never has more items than cells.
@@ -212,15 +134,9 @@ Status Renderer::State::create_objects() {
     if (Status s = make_buffer(16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, dummy); !s) return s;
 
     // The pipeline.
-    const shaders::EmbeddedShader* code = shaders::find_embedded_shader("raster.comp");
-    if (!code) return Error{ErrorCode::vulkan, "the raster shader is not embedded in this build"};
-    VkShaderModuleCreateInfo module{};
-    module.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    module.codeSize = code->size;
-    module.pCode = code->code;
-    if (VkResult r = vkCreateShaderModule(device, &module, allocator, &shader); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateShaderModule", r);
-    }
+    Result<VkShaderModule> module = vk::create_embedded_shader({device, allocator, memory_properties}, "raster.comp");
+    if (!module) return module.error();
+    shader = *module;
     const VkDescriptorSetLayoutBinding bindings[] = {
         {0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
         {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
@@ -283,7 +199,7 @@ Status Renderer::State::create_objects() {
 }
 
 void Renderer::State::write_descriptors(VkDescriptorSet set) {
-    VkDescriptorImageInfo image{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
+    VkDescriptorImageInfo image{VK_NULL_HANDLE, atlas_image.view, VK_IMAGE_LAYOUT_GENERAL};
     VkDescriptorBufferInfo item_info{items.buffer, 0, VK_WHOLE_SIZE};
     std::array<VkDescriptorBufferInfo, kMaxRendererFonts> point_infos{}, band_infos{};
     for (uint32_t slot = 0; slot < kMaxRendererFonts; ++slot) {
@@ -526,7 +442,7 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         to_general.newLayout = VK_IMAGE_LAYOUT_GENERAL;
         to_general.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
         to_general.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_general.image = s.atlas_image;
+        to_general.image = s.atlas_image.image;
         to_general.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
         vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
                              0, nullptr, 0, nullptr, 1, &to_general);
@@ -645,14 +561,14 @@ void Renderer::record_atlas_readback(VkCommandBuffer command_buffer, VkBuffer bu
     barrier.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
     barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    barrier.image = s.atlas_image;
+    barrier.image = s.atlas_image.image;
     barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
                          nullptr, 0, nullptr, 1, &barrier);
     VkBufferImageCopy copy{};
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.imageExtent = {s.atlas.config().width, s.atlas.config().height, 1};
-    vkCmdCopyImageToBuffer(command_buffer, s.atlas_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &copy);
+    vkCmdCopyImageToBuffer(command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &copy);
     barrier.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
     barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
     barrier.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
@@ -680,10 +596,10 @@ const GlyphAtlas& Renderer::atlas() const {
     return state_->atlas;
 }
 VkImage Renderer::atlas_image() const {
-    return state_->atlas_image;
+    return state_->atlas_image.image;
 }
 VkImageView Renderer::atlas_view() const {
-    return state_->atlas_view;
+    return state_->atlas_image.view;
 }
 
 }  // namespace crisp

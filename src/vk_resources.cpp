@@ -2,7 +2,11 @@
 // between them and the host.
 #include "vk_resources.hpp"
 
+#include "embedded_shaders.hpp"
+
 #include <crisp/vulkan_context.hpp>
+
+#include <algorithm>
 
 #include <cassert>
 #include <cstring>
@@ -32,6 +36,122 @@ std::optional<uint32_t> find_memory_type(const VkPhysicalDeviceMemoryProperties&
 std::string version_string(uint32_t version) {
     return std::to_string(VK_API_VERSION_MAJOR(version)) + "." + std::to_string(VK_API_VERSION_MINOR(version)) + "." +
            std::to_string(VK_API_VERSION_PATCH(version));
+}
+
+Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
+                     DeviceBuffer& out) {
+    out = {};
+    VkBufferCreateInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    info.size = std::max<VkDeviceSize>(size, 16);
+    info.usage = usage;
+    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    if (VkResult r = vkCreateBuffer(device.device, &info, device.allocator, &out.buffer); r != VK_SUCCESS) {
+        return vulkan_error("vkCreateBuffer", r);
+    }
+    out.size = info.size;
+    VkMemoryRequirements requirements{};
+    vkGetBufferMemoryRequirements(device.device, out.buffer, &requirements);
+    const VkMemoryPropertyFlags required =
+        host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                     : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+    const auto type = find_memory_type(device.memory_properties, requirements.memoryTypeBits, required, 0);
+    if (!type) {
+        destroy_buffer(device, out);
+        return Error{ErrorCode::vulkan, "no memory type for a buffer of " + std::to_string(size) + " bytes"};
+    }
+    VkMemoryAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    allocate.allocationSize = requirements.size;
+    allocate.memoryTypeIndex = *type;
+    if (VkResult r = vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory); r != VK_SUCCESS) {
+        destroy_buffer(device, out);
+        return vulkan_error("vkAllocateMemory", r);
+    }
+    vkBindBufferMemory(device.device, out.buffer, out.memory, 0);
+    if (host_visible) {
+        if (VkResult r = vkMapMemory(device.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped); r != VK_SUCCESS) {
+            destroy_buffer(device, out);
+            return vulkan_error("vkMapMemory", r);
+        }
+    }
+    return {};
+}
+
+void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer) {
+    if (buffer.buffer) vkDestroyBuffer(device.device, buffer.buffer, device.allocator);
+    if (buffer.memory) vkFreeMemory(device.device, buffer.memory, device.allocator);
+    buffer = {};
+}
+
+Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height,
+                    VkImageUsageFlags usage, const char* what, DeviceImage& out) {
+    out = {};
+    VkImageCreateInfo image{};
+    image.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+    image.imageType = VK_IMAGE_TYPE_2D;
+    image.format = format;
+    image.extent = {width, height, 1};
+    image.mipLevels = 1;
+    image.arrayLayers = 1;
+    image.samples = VK_SAMPLE_COUNT_1_BIT;
+    image.tiling = VK_IMAGE_TILING_OPTIMAL;
+    image.usage = usage;
+    image.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    image.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    const std::string suffix = std::string(" (") + what + ")";
+    if (VkResult r = vkCreateImage(device.device, &image, device.allocator, &out.image); r != VK_SUCCESS) {
+        return vulkan_error("vkCreateImage" + suffix, r);
+    }
+    VkMemoryRequirements requirements{};
+    vkGetImageMemoryRequirements(device.device, out.image, &requirements);
+    const auto type = find_memory_type(device.memory_properties, requirements.memoryTypeBits,
+                                       VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
+    if (!type) {
+        destroy_image(device, out);
+        return Error{ErrorCode::vulkan, std::string("no device-local memory type for the ") + what + " image"};
+    }
+    VkMemoryAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    allocate.allocationSize = requirements.size;
+    allocate.memoryTypeIndex = *type;
+    if (VkResult r = vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory); r != VK_SUCCESS) {
+        destroy_image(device, out);
+        return vulkan_error("vkAllocateMemory" + suffix, r);
+    }
+    vkBindImageMemory(device.device, out.image, out.memory, 0);
+    VkImageViewCreateInfo view{};
+    view.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+    view.image = out.image;
+    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view.format = format;
+    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    if (VkResult r = vkCreateImageView(device.device, &view, device.allocator, &out.view); r != VK_SUCCESS) {
+        destroy_image(device, out);
+        return vulkan_error("vkCreateImageView" + suffix, r);
+    }
+    return {};
+}
+
+void destroy_image(const DeviceRef& device, DeviceImage& image) {
+    if (image.view) vkDestroyImageView(device.device, image.view, device.allocator);
+    if (image.image) vkDestroyImage(device.device, image.image, device.allocator);
+    if (image.memory) vkFreeMemory(device.device, image.memory, device.allocator);
+    image = {};
+}
+
+Result<VkShaderModule> create_embedded_shader(const DeviceRef& device, std::string_view name) {
+    const shaders::EmbeddedShader* code = shaders::find_embedded_shader(name);
+    if (!code) return Error{ErrorCode::vulkan, "the shader " + std::string(name) + " is not embedded in this build"};
+    VkShaderModuleCreateInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+    info.codeSize = code->size;
+    info.pCode = code->code;
+    VkShaderModule module = VK_NULL_HANDLE;
+    if (VkResult r = vkCreateShaderModule(device.device, &info, device.allocator, &module); r != VK_SUCCESS) {
+        return vulkan_error("vkCreateShaderModule (" + std::string(name) + ")", r);
+    }
+    return module;
 }
 
 }  // namespace vk

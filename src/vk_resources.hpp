@@ -23,4 +23,42 @@ std::optional<uint32_t> find_memory_type(const VkPhysicalDeviceMemoryProperties&
 // "1.3.230".
 std::string version_string(uint32_t version);
 
+// A buffer with its own memory; host-visible ones stay mapped (coherent).
+struct DeviceBuffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkDeviceSize size = 0;
+};
+
+// The device objects buffers and pipelines are made with.
+struct DeviceRef {
+    VkDevice device = VK_NULL_HANDLE;
+    const VkAllocationCallbacks* allocator = nullptr;
+    VkPhysicalDeviceMemoryProperties memory_properties{};
+};
+
+// Makes `out` (at least 16 bytes): device-local, or host-visible and coherent and mapped. On
+// failure `out` is left empty and the error names the call.
+Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
+                     DeviceBuffer& out);
+// Frees both objects (either may be null) and empties `buffer`.
+void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer);
+
+// A 2D colour image (one mip level, one layer, optimal tiling) in device-local memory, with a view.
+struct DeviceImage {
+    VkImage image = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+};
+
+// Makes `out` in VK_IMAGE_LAYOUT_UNDEFINED. On failure what was made is destroyed and the error
+// names the call and `what` ("atlas").
+Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height,
+                    VkImageUsageFlags usage, const char* what, DeviceImage& out);
+void destroy_image(const DeviceRef& device, DeviceImage& image);
+
+// A shader module from SPIR-V embedded in the library ("raster.comp"); `name` must be embedded.
+Result<VkShaderModule> create_embedded_shader(const DeviceRef& device, std::string_view name);
+
 }  // namespace crisp::vk

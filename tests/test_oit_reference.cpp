@@ -196,9 +196,11 @@ TEST(OitLayered, EqualKeysAreNotLost) {
     const crisp::oit::LayeredPixel one_slot = crisp::oit::build_layers(twice, 1);
     EXPECT_EQ(one_slot.layer_count, 1u);
     EXPECT_EQ(one_slot.tail.count, 1u);
+    // ... and the copies straddling the boundary are placed as a group: still exact.
+    expect_near(crisp::oit::composite_layered(twice, background, 1), exact, kQuantum);
     // Three copies beside a distinct fragment, in every slot count.
     std::vector<Fragment> many = {glyph, make(0.2f, 0, {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f}), glyph, glyph};
-    for (uint32_t k : {4u, 8u}) {
+    for (uint32_t k : {1u, 2u, 3u, 4u, 8u}) {
         expect_near(crisp::oit::composite_layered(many, background, k), crisp::oit::composite_exact(many, background),
                     kQuantum);
     }

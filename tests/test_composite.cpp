@@ -1,0 +1,557 @@
+// The GPU compositor on lavapipe with validation on: each mode against the CPU references of
+// oit_reference.hpp (built from the same atlas texels), order independence, the layered error
+// bound, coplanar paint order, per-channel subpixel compositing and opaque text.
+#include "oit_reference.hpp"
+#include "test_support.hpp"
+
+#include <crisp/bake.hpp>
+#include <crisp/compositor.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/renderer.hpp>
+#include <crisp/subpixel.hpp>
+#include <crisp/vulkan_context.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace crisp {
+namespace {
+
+constexpr uint32_t kWidth = 72;
+constexpr uint32_t kHeight = 40;
+constexpr uint32_t kSamples = 16;  // enough for coverage ramps; quick to converge on lavapipe
+
+struct Fixture {
+    std::unique_ptr<HeadlessContext> context;
+    std::unique_ptr<Font> font;
+    bool int64 = false;
+};
+
+// A context with what the compositor needs, 64-bit atomics included (lavapipe has them).
+Fixture& fixture() {
+    static Fixture f = [] {
+        Fixture made;
+        VkPhysicalDeviceVulkan12Features vulkan12{};
+        vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+        vulkan12.shaderBufferInt64Atomics = VK_TRUE;
+        VkPhysicalDeviceFeatures2 features{};
+        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+        features.pNext = &vulkan12;
+        features.features.fragmentStoresAndAtomics = VK_TRUE;
+        features.features.dualSrcBlend = VK_TRUE;
+        features.features.shaderInt64 = VK_TRUE;
+        HeadlessContextOptions options;
+        options.validation = true;
+        options.synchronization_validation = true;  // the compositor's barriers are what is tested too
+        options.required_features = &features;
+        options.required_compute_subgroup_operations =
+            VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+        auto context = HeadlessContext::create(options);
+        EXPECT_TRUE(context) << (context ? "" : context.error().message);
+        if (context) made.context = std::make_unique<HeadlessContext>(std::move(*context));
+        made.int64 = true;
+        BakeOptions bake;
+        bake.all_glyphs = false;
+        bake.codepoints = decode_utf8("Hamburgefonstiv@&1");
+        auto baked = bake_font_file(test::kDejaVuSans, bake);
+        if (baked) {
+            auto font = Font::create(std::move(baked->asset), 1);
+            if (font) made.font = std::make_unique<Font>(std::move(*font));
+        }
+        return made;
+    }();
+    return f;
+}
+
+struct TextRun {
+    const char* text;
+    float x, y;
+    float color[4];  // sRGB, straight alpha
+    float depth;
+};
+
+struct Texel {
+    uint16_t r, g, b, count;
+};
+
+// A scene rendered to convergence: its glyphs, the atlas texels, and the fragments of every pixel
+// (in draw order) as the compositor's shaders compute them.
+struct Scene {
+    std::unique_ptr<Renderer> renderer;
+    std::vector<DrawnGlyph> drawn;
+    std::vector<std::vector<oit::Fragment>> pixels;  // kWidth * kHeight lists
+};
+
+Scene render_scene(const std::vector<TextRun>& runs, const char* layout_name = "rgb", float size = 20.0f) {
+    Fixture& f = fixture();
+    HeadlessContext& context = *f.context;
+    Scene scene;
+    RendererCreateInfo info;
+    info.instance = context.instance();
+    info.physical_device = context.physical_device();
+    info.device = context.device();
+    info.queue_family = context.queue_family();
+    info.atlas.width = info.atlas.height = 256;
+    info.atlas.max_samples = kSamples;
+    info.layout = *subpixel_preset(layout_name);
+    auto renderer = Renderer::create(info);
+    EXPECT_TRUE(renderer) << (renderer ? "" : renderer.error().message);
+    scene.renderer = std::make_unique<Renderer>(std::move(*renderer));
+    EXPECT_TRUE(scene.renderer->add_font(*f.font));
+
+    std::vector<GlyphInstance> glyphs;
+    uint32_t paint_order = 0;
+    const Font* fonts[] = {f.font.get()};
+    for (const TextRun& run : runs) {
+        TextStyle style;
+        style.size = size;
+        std::copy(run.color, run.color + 4, style.color);
+        style.depth = run.depth;
+        LayoutOptions options;
+        options.origin_x = run.x;
+        options.origin_y = run.y;
+        options.first_paint_order = paint_order;
+        auto laid = layout_text(fonts, run.text, style, options);
+        EXPECT_TRUE(laid);
+        glyphs.insert(glyphs.end(), laid->glyphs.begin(), laid->glyphs.end());
+        paint_order = laid->next_paint_order;
+    }
+    Renderer& r = *scene.renderer;
+    for (int frame = 0; frame < 200; ++frame) {
+        r.begin_frame();
+        r.draw(glyphs);
+        EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(r.record(cb)); }));
+        if (r.converged()) break;
+    }
+    EXPECT_TRUE(r.converged());
+    scene.drawn.assign(r.drawn().begin(), r.drawn().end());
+
+    const uint32_t atlas_width = r.atlas().config().width;
+    const VkDeviceSize bytes = VkDeviceSize{atlas_width} * r.atlas().config().height * sizeof(Texel);
+    auto readback = context.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
+    EXPECT_TRUE(readback);
+    EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { r.record_atlas_readback(cb, readback->handle()); }));
+    std::vector<Texel> texels(bytes / sizeof(Texel));
+    std::memcpy(texels.data(), readback->mapped().data(), bytes);
+
+    scene.pixels.resize(size_t{kWidth} * kHeight);
+    for (const DrawnGlyph& d : scene.drawn) {
+        const GlyphInstance& g = d.instance;
+        for (uint32_t ty = 0; ty < g.height; ++ty) {
+            for (uint32_t tx = 0; tx < g.width; ++tx) {
+                const int64_t x = int64_t{g.x} + tx, y = int64_t{g.y} + ty;
+                if (x < 0 || y < 0 || x >= kWidth || y >= kHeight) continue;
+                const Texel& t = texels[size_t{d.atlas_y + ty} * atlas_width + d.atlas_x + tx];
+                if (t.count == 0) continue;
+                oit::Fragment fragment;
+                fragment.depth = g.depth;
+                fragment.paint_order = g.paint_order;
+                const uint16_t sums[3] = {t.r, t.g, t.b};
+                bool visible = false;
+                for (int c = 0; c < 3; ++c) {
+                    const float coverage =
+                        std::min(static_cast<float>(sums[c]) / (64.0f * static_cast<float>(t.count)), 1.0f);
+                    const float opacity = g.color[3] * coverage;
+                    fragment.transmittance[c] = 1.0f - opacity;
+                    fragment.light[c] = g.color[c] * opacity;
+                    visible = visible || opacity > 0.0f;
+                }
+                if (visible) scene.pixels[static_cast<size_t>(y) * kWidth + static_cast<size_t>(x)].push_back(fragment);
+            }
+        }
+    }
+    return scene;
+}
+
+CompositorCreateInfo compositor_info(KeyFormat keys = KeyFormat::automatic, bool gray = false) {
+    Fixture& f = fixture();
+    CompositorCreateInfo info;
+    info.physical_device = f.context->physical_device();
+    info.device = f.context->device();
+    info.int64_atomics = f.int64;
+    info.width = kWidth;
+    info.height = kHeight;
+    info.key_format = keys;
+    info.gray_layout = gray;
+    return info;
+}
+
+constexpr float kBackground[4] = {0.9f, 0.85f, 0.7f, 1.0f};  // linear
+
+// Composites the scene's glyphs (in the given order) and returns linear premultiplied RGBA.
+std::vector<float> composite(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs,
+                             CompositeMode mode, uint32_t layers = kAutoLayers) {
+    HeadlessContext& context = *fixture().context;
+    const VkDeviceSize bytes = VkDeviceSize{kWidth} * kHeight * 4 * sizeof(float);
+    auto readback = context.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
+    EXPECT_TRUE(readback);
+    CompositeParams params;
+    params.mode = mode;
+    params.layers = layers;
+    std::copy(kBackground, kBackground + 4, params.background);
+    EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) {
+        EXPECT_TRUE(compositor.record(cb, glyphs, scene.renderer->atlas_view(), params));
+        compositor.record_target_readback(cb, readback->handle());
+    }));
+    std::vector<float> image(size_t{kWidth} * kHeight * 4);
+    std::memcpy(image.data(), readback->mapped().data(), bytes);
+    return image;
+}
+
+std::vector<float> composite(Compositor& compositor, const Scene& scene, CompositeMode mode,
+                             uint32_t layers = kAutoLayers) {
+    return composite(compositor, scene, scene.drawn, mode, layers);
+}
+
+oit::LinearRgb background_rgb() {
+    return {kBackground[0], kBackground[1], kBackground[2]};
+}
+
+void expect_no_validation_messages() {
+    const ValidationMessages messages = fixture().context->validation_messages();
+    EXPECT_EQ(messages.errors + messages.warnings, 0u);
+    for (const std::string& text : messages.recent) ADD_FAILURE() << text;
+}
+
+// Overlapping runs at distinct depths whose paint order is not their depth order.
+std::vector<TextRun> overlapping_runs(float alpha) {
+    return {
+        {"Hamburg", 1.25f, 20.0f, {0.9f, 0.1f, 0.1f, alpha}, 0.6f},
+        {"efonts", 3.6f, 22.3f, {0.1f, 0.6f, 0.2f, alpha}, 0.2f},
+        {"Hamburg", 2.4f, 24.7f, {0.1f, 0.2f, 0.9f, alpha}, 0.4f},
+        {"stiv@&1", 0.7f, 34.1f, {0.2f, 0.2f, 0.2f, alpha}, 0.3f},
+    };
+}
+
+size_t max_overlap(const Scene& scene) {
+    size_t most = 0;
+    for (const auto& list : scene.pixels) most = std::max(most, list.size());
+    return most;
+}
+
+TEST(Compositor, RejectsBadCreateInfo) {
+    CompositorCreateInfo info = compositor_info();
+    info.width = 0;
+    EXPECT_EQ(Compositor::create(info).error().code, ErrorCode::invalid_argument);
+    info = compositor_info();
+    info.max_layers = 9;
+    EXPECT_EQ(Compositor::create(info).error().code, ErrorCode::invalid_argument);
+    info = compositor_info();
+    info.exact_nodes_per_pixel = 65;
+    EXPECT_EQ(Compositor::create(info).error().code, ErrorCode::invalid_argument);
+    info = compositor_info(KeyFormat::rgb);
+    info.int64_atomics = false;
+    EXPECT_EQ(Compositor::create(info).error().code, ErrorCode::invalid_argument);
+    info = compositor_info();
+    info.int64_atomics = false;
+    auto fallback = Compositor::create(info);
+    ASSERT_TRUE(fallback);
+    ASSERT_EQ(fallback->warnings().size(), 1u);  // mono keys, said so
+    EXPECT_NE(fallback->warnings()[0].find("mono"), std::string::npos);
+    EXPECT_EQ(parse_composite_mode("wboit"), CompositeMode::wboit);
+    EXPECT_FALSE(parse_composite_mode("sorted"));
+}
+
+TEST(Compositor, ExactMatchesTheCpuReference) {
+    const Scene scene = render_scene(overlapping_runs(0.7f));
+    auto compositor = Compositor::create(compositor_info());
+    ASSERT_TRUE(compositor) << compositor.error().message;
+    const std::vector<float> image = composite(*compositor, scene, CompositeMode::exact);
+    double worst = 0.0;
+    for (size_t p = 0; p < scene.pixels.size(); ++p) {
+        const oit::LinearRgb want = oit::composite_exact(scene.pixels[p], background_rgb());
+        for (size_t c = 0; c < 3; ++c) worst = std::max(worst, std::abs(double{image[p * 4 + c]} - double{want[c]}));
+        EXPECT_FLOAT_EQ(image[p * 4 + 3], 1.0f);
+    }
+    EXPECT_LT(worst, 2e-5);
+    EXPECT_GE(max_overlap(scene), 4u);  // the scene does overlap
+    expect_no_validation_messages();
+}
+
+TEST(Compositor, UnsortedAndWboitMatchTheCpuReferences) {
+    const Scene scene = render_scene(overlapping_runs(0.7f));
+    auto compositor = Compositor::create(compositor_info());
+    ASSERT_TRUE(compositor);
+    const std::vector<float> unsorted = composite(*compositor, scene, CompositeMode::unsorted);
+    const std::vector<float> wboit = composite(*compositor, scene, CompositeMode::wboit);
+    double worst_unsorted = 0.0, worst_wboit = 0.0;
+    for (size_t p = 0; p < scene.pixels.size(); ++p) {
+        // drawn() is in draw order, so the pixel lists are in submission order too.
+        const oit::LinearRgb want_unsorted = oit::composite_unsorted(scene.pixels[p], background_rgb());
+        const oit::LinearRgb want_wboit = oit::composite_wboit(scene.pixels[p], background_rgb());
+        for (size_t c = 0; c < 3; ++c) {
+            worst_unsorted = std::max(worst_unsorted, std::abs(double{unsorted[p * 4 + c]} - double{want_unsorted[c]}));
+            worst_wboit = std::max(worst_wboit, std::abs(double{wboit[p * 4 + c]} - double{want_wboit[c]}));
+        }
+    }
+    EXPECT_LT(worst_unsorted, 2e-5);
+    // Fixed-point sums (2^-24 per term, 2^-16 per absorbance) against float sums.
+    EXPECT_LT(worst_wboit, 2e-4);
+    expect_no_validation_messages();
+}
+
+TEST(Compositor, LayeredMatchesTheCpuReferenceForEveryK) {
+    const Scene scene = render_scene(overlapping_runs(0.5f));
+    auto compositor = Compositor::create(compositor_info());
+    ASSERT_TRUE(compositor);
+    for (uint32_t layers : {1u, 2u, 4u, 8u}) {
+        const std::vector<float> image = composite(*compositor, scene, CompositeMode::layered, layers);
+        EXPECT_EQ(compositor->stats().layers, layers);
+        EXPECT_FALSE(compositor->stats().mono_keys);
+        double worst = 0.0;
+        for (size_t p = 0; p < scene.pixels.size(); ++p) {
+            const oit::LinearRgb want = oit::composite_layered(scene.pixels[p], background_rgb(), layers);
+            for (size_t c = 0; c < 3; ++c) worst = std::max(worst, std::abs(double{image[p * 4 + c]} - double{want[c]}));
+        }
+        // The same keys and the same estimate; the GPU's tail transmittance is exp(-A) of fixed-point
+        // absorbance where the CPU multiplies codes, and its light sums are fixed point.
+        EXPECT_LT(worst, 1e-3) << "K = " << layers;
+    }
+    expect_no_validation_messages();
+}
+
+// Where a pixel's fragments all fit in the K layers, layered is exact up to the rounding of each
+// transmittance to 8 bits: within max(1, n / 2) / 255 for n fragments (docs/oit.md). Past K the
+// error falls as K grows.
+TEST(Compositor, LayeredIsExactWhereTheOverlapFitsAndDegradesSmoothlyPastIt) {
+    const Scene scene = render_scene(overlapping_runs(0.6f));
+    auto compositor = Compositor::create(compositor_info());
+    ASSERT_TRUE(compositor);
+    const std::vector<float> exact = composite(*compositor, scene, CompositeMode::exact);
+    double previous_rmse = 1e9;
+    for (uint32_t layers : {1u, 2u, 4u, 8u}) {
+        const std::vector<float> image = composite(*compositor, scene, CompositeMode::layered, layers);
+        double sum = 0.0;
+        size_t fitting = 0;
+        for (size_t p = 0; p < scene.pixels.size(); ++p) {
+            const size_t n = scene.pixels[p].size();
+            for (size_t c = 0; c < 3; ++c) {
+                const double error = std::abs(double{image[p * 4 + c]} - double{exact[p * 4 + c]});
+                sum += error * error;
+                if (n <= layers) {
+                    EXPECT_LE(error, std::max(1.0, static_cast<double>(n) / 2.0) / 255.0 + 1e-6)
+                        << "pixel " << p << ", " << n << " fragments, K = " << layers;
+                }
+            }
+            fitting += n <= layers;
+        }
+        EXPECT_GT(fitting, 0u);
+        const double rmse = std::sqrt(sum / (static_cast<double>(scene.pixels.size()) * 3.0));
+        EXPECT_LE(rmse, previous_rmse + 1e-6) << "K = " << layers;
+        previous_rmse = rmse;
+    }
+    EXPECT_LT(previous_rmse, 1.0 / 255.0);  // at K = 8 every pixel of this scene fits
+    expect_no_validation_messages();
+}
+
+TEST(Compositor, ShuffledRunsGiveBitIdenticalImages) {
+    std::vector<TextRun> runs = overlapping_runs(0.6f);
+    const Scene scene = render_scene(runs);
+    std::mt19937 random(7);
+    std::shuffle(runs.begin(), runs.end(), random);
+    const Scene shuffled = render_scene(runs);
+    // Submission order within the draw too.
+    std::vector<DrawnGlyph> reversed(shuffled.drawn.rbegin(), shuffled.drawn.rend());
+    auto compositor = Compositor::create(compositor_info());
+    ASSERT_TRUE(compositor);
+    for (CompositeMode mode : {CompositeMode::layered, CompositeMode::wboit, CompositeMode::exact}) {
+        for (uint32_t layers : {2u, 8u}) {
+            if (mode != CompositeMode::layered && layers != 8u) continue;
+            const std::vector<float> a = composite(*compositor, scene, mode, layers);
+            const std::vector<float> b = composite(*compositor, shuffled, reversed, mode, layers);
+            EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0)
+                << composite_mode_name(mode) << " K = " << layers;
+        }
+    }
+    // Unsorted is order-dependent, and shows it: the same fragments give another image.
+    const std::vector<float> a = composite(*compositor, scene, CompositeMode::unsorted);
+    const std::vector<float> b = composite(*compositor, shuffled, reversed, CompositeMode::unsorted);
+    EXPECT_NE(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+    expect_no_validation_messages();
+}
+
+// Two opaque runs at one depth: the later-drawn is in front wherever they overlap, in every frame.
+TEST(Compositor, CoplanarGlyphsResolveByPaintOrder) {
+    const std::vector<TextRun> runs = {
+        {"HHH", 1.0f, 28.0f, {1.0f, 0.0f, 0.0f, 1.0f}, 0.5f},
+        {"mmm", 4.5f, 30.0f, {0.0f, 0.0f, 1.0f, 1.0f}, 0.5f},
+    };
+    const Scene scene = render_scene(runs, "gray", 24.0f);
+    auto compositor = Compositor::create(compositor_info(KeyFormat::automatic, true));
+    ASSERT_TRUE(compositor);
+    for (uint32_t layers : {1u, 4u}) {
+        const std::vector<float> first = composite(*compositor, scene, CompositeMode::layered, layers);
+        const std::vector<float> second = composite(*compositor, scene, CompositeMode::layered, layers);
+        EXPECT_TRUE(compositor->stats().mono_keys);  // a gray layout
+        EXPECT_EQ(std::memcmp(first.data(), second.data(), first.size() * sizeof(float)), 0);
+        size_t both_opaque = 0;
+        for (size_t p = 0; p < scene.pixels.size(); ++p) {
+            const auto& list = scene.pixels[p];
+            if (list.size() < 2) continue;
+            // Both glyphs fully cover the pixel: only the blue (later) one may show.
+            bool all_opaque = true;
+            for (const oit::Fragment& f : list) all_opaque = all_opaque && f.transmittance[0] == 0.0f;
+            if (!all_opaque) continue;
+            ++both_opaque;
+            EXPECT_NEAR(first[p * 4 + 0], 0.0f, 1e-6) << "pixel " << p << " K = " << layers;
+            EXPECT_NEAR(first[p * 4 + 2], 1.0f, 1e-6) << "pixel " << p << " K = " << layers;
+        }
+        EXPECT_GT(both_opaque, 0u);
+        // And the whole image is exact's, within the 8-bit transmittance bound.
+        const std::vector<float> exact = composite(*compositor, scene, CompositeMode::exact);
+        for (size_t p = 0; p < scene.pixels.size(); ++p) {
+            const size_t n = scene.pixels[p].size();
+            if (n > layers) continue;
+            for (size_t c = 0; c < 3; ++c) {
+                EXPECT_NEAR(first[p * 4 + c], exact[p * 4 + c], std::max(1.0, static_cast<double>(n) / 2.0) / 255.0 + 1e-6);
+            }
+        }
+    }
+    expect_no_validation_messages();
+}
+
+// The same glyphs drawn twice (a caller emboldening text, say): identical keys. The seed drops the
+// second of two equal keys; crisp keeps both, so layered still matches exact.
+TEST(Compositor, EqualKeysAreNotLost) {
+    const Scene scene = render_scene({{"Hamburg", 1.3f, 24.0f, {0.8f, 0.1f, 0.3f, 0.5f}, 0.5f}});
+    std::vector<DrawnGlyph> twice = scene.drawn;
+    twice.insert(twice.end(), scene.drawn.begin(), scene.drawn.end());
+    auto compositor = Compositor::create(compositor_info());
+    ASSERT_TRUE(compositor);
+    const std::vector<float> exact = composite(*compositor, scene, twice, CompositeMode::exact);
+    const std::vector<float> once = composite(*compositor, scene, scene.drawn, CompositeMode::exact);
+    for (uint32_t layers : {1u, 2u, 8u}) {
+        const std::vector<float> layered = composite(*compositor, scene, twice, CompositeMode::layered, layers);
+        double worst = 0.0, darker = 0.0;
+        for (size_t p = 0; p < scene.pixels.size(); ++p) {
+            for (size_t c = 0; c < 3; ++c) {
+                worst = std::max(worst, std::abs(double{layered[p * 4 + c]} - double{exact[p * 4 + c]}));
+                darker = std::max(darker, std::abs(double{once[p * 4 + c]} - double{exact[p * 4 + c]}));
+            }
+        }
+        EXPECT_GT(darker, 0.05);  // the second copy matters
+        // Two fragments per pixel at most (glyphs of one run barely overlap): within one code at
+        // K >= 2; at K = 1 the copy goes to the tail, whose estimate is exact for one fragment.
+        EXPECT_LT(worst, 1.0 / 255.0) << "K = " << layers;
+    }
+    expect_no_validation_messages();
+}
+
+// Subpixel coverage differs per channel; two coloured runs over each other must composite each
+// channel with its own transmittance (64-bit keys), which mono keys cannot.
+TEST(Compositor, ColouredSubpixelTextCompositesPerChannel) {
+    const std::vector<TextRun> runs = {
+        {"Hamburg", 1.3f, 22.0f, {1.0f, 0.8f, 0.0f, 0.9f}, 0.7f},
+        {"Hamburg", 1.6f, 23.0f, {0.0f, 0.3f, 1.0f, 0.9f}, 0.3f},
+    };
+    const Scene scene = render_scene(runs, "rgb");
+    auto rgb = Compositor::create(compositor_info(KeyFormat::rgb));
+    auto mono = Compositor::create(compositor_info(KeyFormat::mono));
+    ASSERT_TRUE(rgb);
+    ASSERT_TRUE(mono);
+    const std::vector<float> exact = composite(*rgb, scene, CompositeMode::exact);
+    const std::vector<float> layered = composite(*rgb, scene, CompositeMode::layered, 4);
+    const std::vector<float> layered_mono = composite(*mono, scene, CompositeMode::layered, 4);
+    double worst_rgb = 0.0, worst_mono = 0.0;
+    size_t channels_differ = 0;
+    for (size_t p = 0; p < scene.pixels.size(); ++p) {
+        const auto& list = scene.pixels[p];
+        if (list.size() > 4) continue;
+        for (const oit::Fragment& f : list) {
+            channels_differ += f.transmittance[0] != f.transmittance[2];
+        }
+        for (size_t c = 0; c < 3; ++c) {
+            worst_rgb = std::max(worst_rgb, std::abs(double{layered[p * 4 + c]} - double{exact[p * 4 + c]}));
+            worst_mono = std::max(worst_mono, std::abs(double{layered_mono[p * 4 + c]} - double{exact[p * 4 + c]}));
+        }
+    }
+    EXPECT_GT(channels_differ, 0u);        // the text really is subpixel
+    EXPECT_LE(worst_rgb, 1.0 / 255.0);     // two fragments: within one code
+    EXPECT_GT(worst_mono, 4.0 / 255.0);    // one transmittance for three channels is visibly wrong
+    expect_no_validation_messages();
+}
+
+// Opaque text through the layered path: it hides what is behind it completely, and composited
+// back to front it looks as opaque rendering (unsorted "over" in depth order) does.
+TEST(Compositor, OpaqueTextHidesWhatIsBehind) {
+    const std::vector<TextRun> runs = {
+        {"HHH", 1.0f, 28.0f, {0.0f, 1.0f, 0.0f, 1.0f}, 0.8f},  // behind, drawn first
+        {"mmm", 4.5f, 30.0f, {0.2f, 0.1f, 0.6f, 1.0f}, 0.2f},  // in front, drawn last
+    };
+    const Scene scene = render_scene(runs, "rgb", 24.0f);
+    auto compositor = Compositor::create(compositor_info());
+    ASSERT_TRUE(compositor);
+    const std::vector<float> layered = composite(*compositor, scene, CompositeMode::layered, 8);
+    const std::vector<float> opaque = composite(*compositor, scene, CompositeMode::unsorted);
+    size_t hidden = 0;
+    for (size_t p = 0; p < scene.pixels.size(); ++p) {
+        const auto& list = scene.pixels[p];
+        for (size_t c = 0; c < 3; ++c) {
+            EXPECT_NEAR(layered[p * 4 + c], opaque[p * 4 + c], std::max(1.0, static_cast<double>(list.size()) / 2.0) / 255.0);
+        }
+        // The front glyph covers the pixel fully: exactly its colour, no green from behind.
+        const bool front_opaque = !list.empty() && list.back().depth == 0.2f && list.back().transmittance[0] == 0.0f &&
+                                  list.back().transmittance[1] == 0.0f && list.back().transmittance[2] == 0.0f;
+        if (!front_opaque || list.size() < 2) continue;
+        ++hidden;
+        // (Up to the 2^-24 steps of the fixed-point light sums.)
+        EXPECT_NEAR(layered[p * 4 + 0], srgb_to_linear(0.2f), 1e-7);
+        EXPECT_NEAR(layered[p * 4 + 1], srgb_to_linear(0.1f), 1e-7);
+        EXPECT_NEAR(layered[p * 4 + 2], srgb_to_linear(0.6f), 1e-7);
+    }
+    EXPECT_GT(hidden, 0u);
+    expect_no_validation_messages();
+}
+
+TEST(Compositor, AutoLayersFollowTheMeasuredOverlap) {
+    const Scene scene = render_scene(overlapping_runs(0.5f));
+    CompositorCreateInfo info = compositor_info();
+    info.frames_in_flight = 1;
+    auto compositor = Compositor::create(info);
+    ASSERT_TRUE(compositor);
+    composite(*compositor, scene, CompositeMode::layered, kAutoLayers);
+    EXPECT_EQ(compositor->stats().layers, kMaxCompositeLayers);  // nothing measured yet
+    EXPECT_FALSE(compositor->stats().measured);
+    composite(*compositor, scene, CompositeMode::layered, kAutoLayers);
+    ASSERT_TRUE(compositor->stats().measured);
+    const size_t overlap = max_overlap(scene);
+    EXPECT_EQ(compositor->stats().max_overlap, overlap);
+    EXPECT_EQ(compositor->stats().layers, std::min<size_t>(overlap, kMaxCompositeLayers));
+    expect_no_validation_messages();
+}
+
+TEST(Compositor, ExactCountsWhatItsPoolCannotHold) {
+    // Three copies of the overlapping runs: more fragments than pixels.
+    std::vector<TextRun> runs;
+    for (float shift : {0.0f, 5.3f, 10.6f}) {
+        for (TextRun run : overlapping_runs(0.5f)) {
+            run.y = run.y - 8.0f + shift;
+            runs.push_back(run);
+        }
+    }
+    const Scene scene = render_scene(runs);
+    CompositorCreateInfo info = compositor_info();
+    info.frames_in_flight = 1;
+    info.exact_nodes_per_pixel = 1;  // too few for this scene
+    auto compositor = Compositor::create(info);
+    ASSERT_TRUE(compositor);
+    size_t fragments = 0;
+    for (const auto& list : scene.pixels) fragments += list.size();
+    ASSERT_GT(fragments, size_t{kWidth} * kHeight);
+    composite(*compositor, scene, CompositeMode::exact);
+    composite(*compositor, scene, CompositeMode::exact);  // reads the first frame's counters
+    ASSERT_TRUE(compositor->stats().measured);
+    EXPECT_EQ(compositor->stats().exact_lost_nodes, fragments - size_t{kWidth} * kHeight);
+    expect_no_validation_messages();
+}
+
+}  // namespace
+}  // namespace crisp
