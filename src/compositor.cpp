@@ -92,6 +92,23 @@ std::optional<CompositeMode> parse_composite_mode(std::string_view name) {
     return std::nullopt;
 }
 
+std::optional<float> depth_from_view_projection(const float view_projection[16], const float position[3]) {
+    const float* m = view_projection;
+    for (int i = 0; i < 16; ++i) {
+        if (!std::isfinite(m[i])) return std::nullopt;
+    }
+    for (int i = 0; i < 3; ++i) {
+        if (!std::isfinite(position[i])) return std::nullopt;
+    }
+    // Rows 2 and 3 of the column-major matrix times (x, y, z, 1).
+    const float z = m[2] * position[0] + m[6] * position[1] + m[10] * position[2] + m[14];
+    const float w = m[3] * position[0] + m[7] * position[1] + m[11] * position[2] + m[15];
+    if (!(w > 0.0f)) return std::nullopt;
+    const float depth = z / w;
+    if (!(depth >= 0.0f && depth <= 1.0f)) return std::nullopt;
+    return depth;
+}
+
 struct Compositor::State {
     vk::DeviceRef ref;
     uint32_t width = 0, height = 0, pixels = 0;
@@ -321,6 +338,8 @@ Status Compositor::State::create(const CompositorCreateInfo& info) {
     }
     vkGetPhysicalDeviceMemoryProperties(info.physical_device, &ref.memory_properties);
     const VkDeviceSize range = properties.limits.maxStorageBufferRange;
+    const VkDeviceSize layer_range =
+        info.max_layer_buffer_bytes != 0 ? std::min<VkDeviceSize>(range, info.max_layer_buffer_bytes) : range;
     const VkDevice device = ref.device;
     const VkAllocationCallbacks* allocator = ref.allocator;
 
@@ -339,12 +358,13 @@ Status Compositor::State::create(const CompositorCreateInfo& info) {
     const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     const VkDeviceSize key_bytes = mono ? 4 : 8;
     const VkDeviceSize layer_bytes = VkDeviceSize{pixels} * key_bytes;
-    if (layer_bytes > range) {
+    if (layer_bytes > layer_range) {
         return Error{ErrorCode::vulkan, "compositor: one layer of " + std::to_string(width) + "x" +
                                             std::to_string(height) + " keys is " + std::to_string(layer_bytes) +
-                                            " bytes, above maxStorageBufferRange (" + std::to_string(range) + ")"};
+                                            " bytes, above maxStorageBufferRange (" + std::to_string(layer_range) +
+                                            ")"};
     }
-    layers_per_buffer = static_cast<uint32_t>(std::min<VkDeviceSize>(max_layers, range / layer_bytes));
+    layers_per_buffer = static_cast<uint32_t>(std::min<VkDeviceSize>(max_layers, layer_range / layer_bytes));
     for (uint32_t first = 0; first < max_layers; first += layers_per_buffer) {
         const uint32_t count = std::min(layers_per_buffer, max_layers - first);
         vk::DeviceBuffer buffer;

@@ -553,5 +553,52 @@ TEST(Compositor, ExactCountsWhatItsPoolCannotHold) {
     expect_no_validation_messages();
 }
 
+// Layer buffers split where one would pass the range: the image does not change.
+TEST(Compositor, LayerBuffersSplitPastTheBufferRange) {
+    const Scene scene = render_scene(overlapping_runs(0.5f));
+    auto whole = Compositor::create(compositor_info());
+    CompositorCreateInfo info = compositor_info();
+    info.max_layer_buffer_bytes = VkDeviceSize{kWidth} * kHeight * 8 * 3;  // three layers of 64-bit keys
+    info.exact_nodes_per_pixel = 1;
+    auto split = Compositor::create(info);
+    ASSERT_TRUE(whole);
+    ASSERT_TRUE(split) << split.error().message;
+    for (uint32_t layers : {3u, 4u, 8u}) {
+        const std::vector<float> a = composite(*whole, scene, CompositeMode::layered, layers);
+        const std::vector<float> b = composite(*split, scene, CompositeMode::layered, layers);
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << "K = " << layers;
+    }
+    // Below one layer of keys nothing fits: an error that names the range.
+    info.max_layer_buffer_bytes = VkDeviceSize{kWidth} * kHeight * 8 - 1;
+    auto too_small = Compositor::create(info);
+    ASSERT_FALSE(too_small);
+    EXPECT_EQ(too_small.error().code, ErrorCode::vulkan);
+    EXPECT_NE(too_small.error().message.find("maxStorageBufferRange"), std::string::npos);
+    expect_no_validation_messages();
+}
+
+TEST(Compositor, DepthFromViewProjection) {
+    // A Vulkan perspective (depth 0 at near = 1, 1 at far = 100), looking down -z, column-major.
+    const float near = 1.0f, far = 100.0f;
+    float m[16] = {};
+    m[0] = 1.0f;
+    m[5] = 1.0f;
+    m[10] = far / (near - far);
+    m[11] = -1.0f;
+    m[14] = far * near / (near - far);
+    const float at_near[3] = {0.0f, 0.0f, -1.0f};
+    const float at_far[3] = {0.3f, 0.1f, -100.0f};
+    const float between[3] = {0.0f, 0.0f, -10.0f};
+    const float behind[3] = {0.0f, 0.0f, 5.0f};
+    const float nan[3] = {0.0f, std::nanf(""), -10.0f};
+    EXPECT_NEAR(*depth_from_view_projection(m, at_near), 0.0f, 1e-6f);
+    EXPECT_NEAR(*depth_from_view_projection(m, at_far), 1.0f, 1e-6f);
+    const float d = *depth_from_view_projection(m, between);
+    EXPECT_GT(d, 0.9f);  // perspective depth crowds towards 1
+    EXPECT_LT(d, 1.0f);
+    EXPECT_FALSE(depth_from_view_projection(m, behind));
+    EXPECT_FALSE(depth_from_view_projection(m, nan));
+}
+
 }  // namespace
 }  // namespace crisp

@@ -74,6 +74,9 @@ struct CompositorCreateInfo {
     // The exact mode's node pool, in nodes per target pixel on average (each node 36 bytes);
     // 0 makes no pool and the exact mode unavailable. At most 64.
     uint32_t exact_nodes_per_pixel = 16;
+    // Caps the size of one layer buffer below the device's maxStorageBufferRange (0: no cap), so
+    // that tests can make the layer buffers split on a small target.
+    uint64_t max_layer_buffer_bytes = 0;
 };
 
 struct CompositeParams {
@@ -100,14 +103,23 @@ struct CompositorStats {
     uint64_t exact_dropped = 0;       // exact: fragments past kMaxExactFragmentsPerPixel
 };
 
+// The depth of a world-space label for CompositeParams/TextStyle::depth: the clip-space z / w of
+// `position` (x, y, z, in world units) under `view_projection` (column-major 4x4, Vulkan clip
+// space with depth in [0, 1], as glm::perspectiveRH_ZO makes). nullopt when the point is behind
+// the eye (w <= 0), outside the depth range, or any input is not finite.
+std::optional<float> depth_from_view_projection(const float view_projection[16], const float position[3]);
+
 class Compositor {
 public:
     // Creates the target image (VK_FORMAT_R32G32B32A32_SFLOAT, premultiplied linear colour, kept in
     // VK_IMAGE_LAYOUT_GENERAL), the per-pixel buffers and the pipelines. Errors: invalid_argument
     // for a size outside 1..16384, frames_in_flight outside 1..8, max_layers outside 1..8,
     // exact_nodes_per_pixel above 64, or key_format rgb without int64_atomics; vulkan when the
-    // device cannot blend or store to the target format, a buffer would pass
-    // maxStorageBufferRange (the message names it), or a Vulkan call fails.
+    // device lacks fragmentStoresAndAtomics or dualSrcBlend, cannot blend, store to and copy the
+    // target format, one layer of keys or the per-pixel accumulators (44 bytes a pixel) would pass
+    // maxStorageBufferRange (the message names it; layers are split across up to 8 buffers, the
+    // accumulators are not: 128 MiB on lavapipe holds 3 million pixels), or a Vulkan call fails.
+    // A node pool larger than the range is cut to it, with a warning.
     static Result<Compositor> create(const CompositorCreateInfo& info);
 
     Compositor(Compositor&&) noexcept;
