@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # render_cli_test.sh CRISP_RENDER CRISP_BAKE SOURCE_DIR WORK_DIR: crisp-render's exit codes and
-# its refusal of bad input (no GPU needed), then one end-to-end render on whatever Vulkan device
-# there is (lavapipe in CI): PNG, coverage PFM and --json.
+# its refusal of bad input (no GPU needed), then end-to-end renders on whatever Vulkan device there
+# is (lavapipe in CI): PNG, coverage PFM and --json, every --composite mode, and scene files.
 set -uo pipefail
 render=$1 bake=$2 source=$3 work=$4
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
@@ -56,6 +56,22 @@ seventeen=()
 for _ in $(seq 17); do seventeen+=(--font "$font"); done
 expect_exit 2 "17 fonts" -- "$render" "${seventeen[@]}" --text Hi --size 20 --origin 0,20 --canvas 48,32 -o x.png
 expect_exit 2 "one file for both outputs" -- "$render" "${base[@]}" -o same.out --coverage-out ./same.out
+expect_exit 2 "--composite bogus" -- "$render" "${base[@]}" --composite bogus -o x.png
+expect_stderr "bogus" "--composite bogus"
+for layers in 0 9 -1 1.5 x ""; do
+  expect_exit 2 "--layers '$layers'" -- "$render" "${base[@]}" --layers "$layers" -o x.png
+done
+expect_stderr "--layers" "--layers ''"
+expect_exit 2 "--layers with a mode that has none" -- "$render" "${base[@]}" --composite wboit --layers 2 -o x.png
+# --scene gives the text, fonts, canvas, colours and layout: none of those options may come with it.
+for option in "--font $font" "--text Hi" "--size 20" "--origin 0,20" "--canvas 48,32" "--color 0,0,0" \
+              "--background 1,1,1" "--layout gray"; do
+  # shellcheck disable=SC2086
+  expect_exit 2 "--scene with $option" -- "$render" --scene "$work/any.json" $option -o x.png
+  expect_stderr "${option%% *}" "--scene with $option"
+done
+expect_exit 2 "--scene without output" -- "$render" --scene "$work/any.json"
+expect_exit 2 "--scene with an empty name" -- "$render" --scene "" -o x.png
 
 # ---- Outputs that cannot be written: exit 4, checked before rendering.
 expect_exit 4 "output directory missing" -- "$render" "${base[@]}" -o "$work/no/such/dir/x.png"
@@ -83,6 +99,32 @@ printf '{"r": [0, 0' >"$work/broken.json"
 expect_exit 6 "broken layout JSON" -- "$render" "${base[@]}" --layout "$work/broken.json" -o x.png
 [ ! -e "$work/x.png" ] || fail "a failed run wrote an output"
 
+# ---- Bad scene files: exit 7, with the reader's message naming the fault, and no output.
+scene_run() {  # scene_run FILE RUN_JSON: a one-run scene using the baked font
+  printf '{"fonts": ["dejavu.crisp"], "canvas": [48, 32], "runs": [%s]}' "$2" >"$work/$1"
+}
+scene_run negative-size.json '{"text": "Hi", "size": -1, "origin": [4, 24]}'
+expect_exit 7 "scene run with size -1" -- "$render" --scene "$work/negative-size.json" -o "$work/scene-bad.png"
+expect_stderr "runs[0].size" "scene run with size -1"
+expect_stderr "negative-size.json" "scene run with size -1"
+scene_run bad-font-index.json '{"font": 1, "text": "Hi", "size": 20, "origin": [4, 24]}'
+expect_exit 7 "scene run with a font index out of range" -- \
+  "$render" --scene "$work/bad-font-index.json" -o "$work/scene-bad.png"
+expect_stderr "runs[0].font" "scene run with a font index out of range"
+printf '{"fonts": ["dejavu.crisp"], "canvas": [48, 32], "runs": [{"text": "Hi",' >"$work/malformed.json"
+expect_exit 7 "malformed scene JSON" -- "$render" --scene "$work/malformed.json" -o "$work/scene-bad.png"
+expect_stderr "malformed.json" "malformed scene JSON"
+expect_stderr "line 1, column" "malformed scene JSON"
+expect_exit 7 "missing scene file" -- "$render" --scene "$work/no-such-scene.json" -o "$work/scene-bad.png"
+expect_stderr "no-such-scene.json" "missing scene file"
+printf '{"fonts": ["missing.crisp"], "canvas": [48, 32], "runs": []}' >"$work/missing-font.json"
+expect_exit 3 "scene with a missing font" -- "$render" --scene "$work/missing-font.json" -o "$work/scene-bad.png"
+expect_stderr "missing.crisp" "scene with a missing font"
+printf '{"fonts": ["dejavu.crisp"], "canvas": [48, 32], "layout": "no-such-layout", "runs": []}' \
+  >"$work/bad-layout.json"
+expect_exit 6 "scene with an unknown layout" -- "$render" --scene "$work/bad-layout.json" -o "$work/scene-bad.png"
+[ ! -e "$work/scene-bad.png" ] || fail "a failed scene run wrote an output"
+
 # ---- No Vulkan driver, or no device of that name: exit 5 naming it.
 VK_ICD_FILENAMES=$work/none.json VK_DRIVER_FILES=$work/none.json \
   expect_exit 5 "no Vulkan driver" -- "$render" "${base[@]}" -o x.png
@@ -103,6 +145,11 @@ assert report["canvas"] == {"width": 48, "height": 32}, report["canvas"]
 assert len(report["timings"]["frame_ms"]) == report["frames"], report["timings"]
 assert report["total_samples"] >= 2 * 16 and report["layout"] == "rgb", report
 assert report["device"]["name"] and report["outputs"]["png"].endswith("hi.png"), report
+composite = report["composite"]
+assert composite["mode"] == "layered" and composite["layers_requested"] == "auto", composite
+assert composite["measured"] and composite["max_overlap"] == 1 and composite["layers"] == 1, composite
+assert composite["quads"] == 2 and composite["tail_pixels"] == 0, composite
+assert report["timings"]["composite_ms"] > 0 and report["scene"] is None and report["runs"] == 1, report
 
 png = open(work + "/hi.png", "rb").read()
 assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
@@ -134,6 +181,111 @@ expect_exit 0 "render without --json" -- "$render" "${base[@]}" -o "$work/hi2.pn
 grep -q "frames" "$work/out" || fail "no summary on stdout"
 [ ! -s "$work/err" ] || fail "a good run wrote to stderr: $(head -c 400 "$work/err")"
 
+# -q: nothing on stdout or stderr.
+expect_exit 0 "render -q" -- "$render" "${base[@]}" -o "$work/quiet.png" -q
+[ ! -s "$work/out" ] && [ ! -s "$work/err" ] || fail "-q printed: $(head -c 400 "$work/out" "$work/err")"
+[ -s "$work/quiet.png" ] || fail "-q wrote no PNG"
+
+# ---- Every --composite mode, on a scene of overlapping translucent runs at different depths: the
+# committed example, with its font baked beside it (scene font paths are relative to the scene).
+mkdir -p "$work/example" "$work/elsewhere"
+cp "$source/docs/examples/overlap.json" "$work/example/"
+"$bake" "$source/fonts/DejaVuSans.ttf" --text "crisptex" -o "$work/example/DejaVuSans.crisp" -q ||
+  fail "crisp-bake failed for the example scene"
+cd "$work/elsewhere"
+for mode in layered unsorted wboit exact; do
+  expect_exit 0 "--scene --composite $mode" -- "$render" --scene ../example/overlap.json --samples 16 \
+    --composite "$mode" -o "$work/scene-$mode.png" --json
+  cp "$work/out" "$work/scene-$mode.json"
+  [ ! -s "$work/err" ] || fail "--composite $mode wrote to stderr: $(head -c 400 "$work/err")"
+done
+cd "$work"
+expect_exit 0 "--scene --layers 1" -- "$render" --scene "$work/example/overlap.json" --samples 16 --layers 1 \
+  -o "$work/scene-layers1.png" --json
+cp "$work/out" "$work/scene-layers1.json"
+python3 - "$work" <<'PY' || fail "the composite modes' outputs are wrong"
+import json, struct, sys, zlib
+work = sys.argv[1]
+
+def read_png(path):  # 8-bit RGB or RGBA, non-interlaced, as libpng writes them
+    data = open(path, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", path + " is not a PNG"
+    pos, idat = 8, b""
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+        if kind == b"IHDR":
+            width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
+            assert depth == 8 and colour in (2, 6) and interlace == 0, (path, depth, colour, interlace)
+        elif kind == b"IDAT":
+            idat += body
+    channels = 3 if colour == 2 else 4
+    raw, stride = zlib.decompress(idat), width * channels
+    rows, previous = [], bytearray(stride)
+    for y in range(height):
+        kind, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for x in range(stride):
+            a = line[x - channels] if x >= channels else 0
+            b = previous[x]
+            c = previous[x - channels] if x >= channels else 0
+            if kind == 1: line[x] = (line[x] + a) & 255
+            elif kind == 2: line[x] = (line[x] + b) & 255
+            elif kind == 3: line[x] = (line[x] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(line)
+        previous = line
+    return width, height, channels, b"".join(rows)
+
+images = {}
+for mode in ("layered", "unsorted", "wboit", "exact"):
+    report = json.load(open("%s/scene-%s.json" % (work, mode)))
+    c = report["composite"]
+    assert c["mode"] == mode, (mode, c)
+    assert report["canvas"] == {"width": 180, "height": 64} and report["runs"] == 3, report
+    assert report["scene"].endswith("overlap.json") and report["size"] is None, report
+    assert report["glyphs"]["drawn"] == 14 and report["glyphs"]["missing"] == 0, report["glyphs"]
+    assert c["quads"] == 14 and c["warnings"] == [], c
+    if mode in ("layered", "exact"):
+        assert c["measured"] and c["max_overlap"] == 3, c
+    if mode == "layered":
+        assert c["layers"] == 3 and c["tail_pixels"] == 0, c  # auto: K from the measured overlap
+    if mode == "exact":
+        assert c["exact_lost_nodes"] == 0 and c["exact_dropped"] == 0, c
+    images[mode] = read_png("%s/scene-%s.png" % (work, mode))
+    assert images[mode][:3] == (180, 64, 3), (mode, images[mode][:3])
+
+def max_difference(a, b):
+    return max(abs(x - y) for x, y in zip(images[a][3], images[b][3]))
+# All the fragments fit K = 3 layers: layered is exact to rounding. Unsorted draws in file order, so
+# the green run (depth 0.5, drawn last) covers the blue one (depth 0.25, nearer): far from exact.
+assert max_difference("layered", "exact") <= 2, max_difference("layered", "exact")
+assert max_difference("unsorted", "exact") > 32, max_difference("unsorted", "exact")
+assert max_difference("wboit", "exact") > 0, "wboit is exact: suspicious"
+white = bytes([255, 255, 255])
+assert images["exact"][3][:3] == white, "the top-left pixel is not the background"
+assert min(images["exact"][3]) < 128, "no dark pixel: nothing was drawn"
+
+one = json.load(open(work + "/scene-layers1.json"))["composite"]
+assert one["layers_requested"] == 1 and one["layers"] == 1 and one["tail_pixels"] > 0, one
+PY
+
+# The exact mode keeps at most 64 fragments per pixel: 70 runs of one glyph over each other drop
+# some, and the run says so on stderr (and still succeeds).
+python3 - "$work/pile.json" <<'PY'
+import json, sys
+runs = [{"text": "H", "size": 20, "origin": [4, 24], "color": [0, 0, 0, 0.05]} for _ in range(70)]
+json.dump({"fonts": ["dejavu.crisp"], "canvas": [32, 32], "runs": runs}, open(sys.argv[1], "w"))
+PY
+expect_exit 0 "exact past 64 fragments a pixel" -- "$render" --scene "$work/pile.json" --samples 16 \
+  --composite exact -o "$work/pile.png" --json
+expect_stderr "dropped" "exact past 64 fragments a pixel"
+python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['composite']; assert c['exact_dropped'] > 0, c" \
+  "$work/out" || fail "the exact mode's dropped fragments are not reported"
+
 # With the validation layer (when installed), a clean run stays clean.
 if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.json' 2>/dev/null)" ]; then
   expect_exit 0 "render --validate" -- "$render" "${base[@]}" --layout gray --background 1,1,1,0.5 \
@@ -142,6 +294,10 @@ if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.
     "$work/out" || fail "--validate --json does not report zero messages"
   python3 -c "import sys,struct; d=open(sys.argv[1],'rb').read(); assert struct.unpack('>B',d[25:26])[0]==6" \
     "$work/validated.png" || fail "a translucent background did not give an RGBA PNG"
+  for mode in unsorted wboit exact; do
+    expect_exit 0 "render --validate --composite $mode" -- "$render" --scene "$work/example/overlap.json" \
+      --samples 16 --composite "$mode" -o "$work/validated-$mode.png" --validate -q
+  done
 fi
 
 if [ "$failures" -ne 0 ]; then

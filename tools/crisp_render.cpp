@@ -1,12 +1,15 @@
-// crisp-render: renders text with the GPU renderer until it converges, reads the atlas back and
-// composites on the CPU into a PNG and, on request, a PFM of the text's coverage.
+// crisp-render: renders text with the GPU renderer until it converges, composites the glyphs on the
+// GPU with crisp::Compositor into a PNG and, on request, reads the atlas back for a PFM of the
+// text's coverage. The text comes from the command line or from a scene file.
 #include "cli.hpp"
 #include "image_io.hpp"
 #include "json.hpp"
+#include "scene.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/atlas.hpp>
 #include <crisp/bake.hpp>
+#include <crisp/compositor.hpp>
 #include <crisp/font.hpp>
 #include <crisp/glyph.hpp>
 #include <crisp/layout.hpp>
@@ -24,6 +27,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <new>
 #include <optional>
@@ -44,7 +48,8 @@ enum ExitCode : int {
     kExitFont = 3,      // a font asset cannot be loaded
     kExitOutput = 4,    // an output file cannot be written
     kExitVulkan = 5,    // no usable Vulkan device, a Vulkan failure, or validation messages
-    kExitLayout = 6,    // --layout is neither a preset nor a valid layout file
+    kExitLayout = 6,    // --layout (or the scene's layout) is neither a preset nor a valid layout file
+    kExitScene = 7,     // --scene cannot be read, is not a valid scene, or a run cannot be laid out
 };
 
 constexpr uint32_t kDefaultSamples = 512;
@@ -54,21 +59,28 @@ constexpr uint32_t kMaxCanvas = 16384;
 constexpr uint64_t kMaxFrames = 100000;
 // Smallest atlas side the tool asks for; it grows to hold every glyph of the text at once.
 constexpr uint32_t kMinAtlasSide = 256;
-constexpr uint32_t kAtlasTexelBytes = 8;  // R16G16B16A16_UINT
+constexpr uint32_t kAtlasTexelBytes = 8;    // R16G16B16A16_UINT
+constexpr uint32_t kTargetTexelBytes = 16;  // the compositor's R32G32B32A32_SFLOAT
 
 constexpr const char* kUsage = R"(usage: crisp-render --font A.crisp [--font B.crisp ...] --text UTF8 --size PX
                     --origin X,Y --canvas W,H -o OUT.png [options]
+       crisp-render --scene SCENE.json -o OUT.png [options]
 
 Renders text with crisp's GPU rasterizer, frame after frame until every glyph holds its samples,
-then reads the glyph atlas back and composites the glyphs on the CPU, in linear light.
+then composites the glyphs over the background on the GPU (crisp::Compositor), in linear light.
 
-required:
+the text (all required, unless --scene gives it):
   --font FILE.crisp        a font asset (crisp-bake makes them); repeat for a fallback chain
   --text UTF8              the text; line breaks start new lines
   --size PX                pixels per em, in (0, 4096]
   --origin X,Y             pen position of the first glyph on its baseline, canvas pixels, y down;
                            fractional values are kept (quantized to 1/256 px), never rounded
   --canvas W,H             image size in pixels, each 1..16384
+  --scene SCENE.json       a scene file instead (docs/scene-format.md): fonts, canvas, background,
+                           layout and runs of text with colours and depths; none of --font, --text,
+                           --size, --origin, --canvas, --color, --background, --layout may be given
+
+required:
   -o, --output OUT.png     the composited image, 8-bit sRGB
 
 options:
@@ -78,8 +90,15 @@ options:
   --color R,G,B[,A]        text colour, sRGB components in [0, 1], straight alpha (default 0,0,0,1)
   --background R,G,B[,A]   background, the same way (default 1,1,1,1); with alpha below 1 the PNG
                            has an alpha channel
+  --composite MODE         how overlapping glyphs are blended: layered (order-independent, the K
+                           nearest per pixel sorted; the default), unsorted (paint order, no OIT),
+                           wboit (weighted blended OIT) or exact (per-pixel sorted lists)
+  --layers K|auto          layered only: layers kept per pixel, 1..8, or auto: as many as the most
+                           glyphs one pixel has (measured by a first composite; default auto)
   --coverage-out OUT.pfm   the text's linear coverage per channel as a PFM image
-  --json                   print the report as one JSON object on stdout
+  --json                   print the report as one JSON object on stdout (compositor notes go
+                           into it instead of stderr)
+  -q, --quiet              no report on stdout, no notes or warnings on stderr (errors still)
   --validate               turn on the Vulkan validation layer (always on in debug builds); any
                            warning or error it reports fails the run (exit 5)
   --device NAME            use the Vulkan device whose name contains NAME
@@ -87,7 +106,8 @@ options:
 
 exit codes:
   0 success   2 usage error   3 font asset cannot be loaded   4 output not writable
-  5 Vulkan unavailable or failed, or validation messages   6 bad --layout   1 internal error
+  5 Vulkan unavailable or failed, or validation messages   6 bad --layout or scene layout
+  7 bad --scene file (unreadable, invalid, or a run the layout refuses)   1 internal error
 )";
 
 struct Arguments {
@@ -96,13 +116,18 @@ struct Arguments {
     std::optional<float> size;
     std::optional<std::array<float, 2>> origin;
     std::optional<std::array<uint32_t, 2>> canvas;
-    std::string layout = "rgb";
+    std::optional<std::string> layout;
     uint32_t samples = kDefaultSamples;
-    std::array<float, 4> color = {0.0f, 0.0f, 0.0f, 1.0f};
-    std::array<float, 4> background = {1.0f, 1.0f, 1.0f, 1.0f};
+    std::optional<std::array<float, 4>> color;
+    std::optional<std::array<float, 4>> background;
+    std::string scene;
+    crisp::CompositeMode composite = crisp::CompositeMode::layered;
+    uint32_t layers = crisp::kAutoLayers;
+    bool layers_given = false;
     std::string output;
     std::string coverage_output;
     bool json = false;
+    bool quiet = false;
 #ifdef NDEBUG
     bool validate = false;
 #else
@@ -189,7 +214,7 @@ Arguments parse_arguments(int argc, char** argv) {
             }
             args.canvas = std::array<uint32_t, 2>{wh[0], wh[1]};
         } else if (arg == "--layout") {
-            args.layout = value();
+            args.layout = std::string(value());
         } else if (arg == "--samples") {
             args.samples = parse_number<uint32_t>(arg, value());
             if (args.samples < 1 || args.samples > crisp::kMaxRendererSamples) {
@@ -199,12 +224,37 @@ Arguments parse_arguments(int argc, char** argv) {
             args.color = parse_color(arg, value());
         } else if (arg == "--background") {
             args.background = parse_color(arg, value());
+        } else if (arg == "--scene") {
+            args.scene = value();
+            if (args.scene.empty()) usage_error("--scene needs a file name");
+        } else if (arg == "--composite") {
+            const std::string_view name = value();
+            const std::optional<crisp::CompositeMode> mode = crisp::parse_composite_mode(name);
+            if (!mode) {
+                usage_error("--composite takes layered, unsorted, wboit or exact, not '" + std::string(name) + "'");
+            }
+            args.composite = *mode;
+        } else if (arg == "--layers") {
+            const std::string_view text = value();
+            args.layers_given = true;
+            if (text == "auto") {
+                args.layers = crisp::kAutoLayers;
+            } else {
+                const std::optional<uint32_t> layers = crisp::cli::parse_number<uint32_t>(text);
+                if (!layers || *layers < 1 || *layers > crisp::kMaxCompositeLayers) {
+                    usage_error("--layers takes 1.." + std::to_string(crisp::kMaxCompositeLayers) + " or auto, not '" +
+                                std::string(text) + "'");
+                }
+                args.layers = *layers;
+            }
         } else if (arg == "-o" || arg == "--output") {
             args.output = value();
         } else if (arg == "--coverage-out") {
             args.coverage_output = value();
         } else if (arg == "--json") {
             args.json = true;
+        } else if (arg == "-q" || arg == "--quiet") {
+            args.quiet = true;
         } else if (arg == "--validate") {
             args.validate = true;
         } else if (arg == "--device") {
@@ -213,16 +263,41 @@ Arguments parse_arguments(int argc, char** argv) {
             usage_error("unexpected argument '" + std::string(arg) + "'");
         }
     }
-    if (args.fonts.empty()) usage_error("no --font given");
-    if (args.fonts.size() > crisp::kMaxRendererFonts) {
-        usage_error("at most " + std::to_string(crisp::kMaxRendererFonts) + " fonts, not " +
-                    std::to_string(args.fonts.size()));
+    if (!args.scene.empty()) {
+        // The scene says all of these; a second source would leave one of them ignored.
+        std::string given;
+        const std::pair<bool, const char*> options[] = {
+            {!args.fonts.empty(), "--font"},
+            {args.text.has_value(), "--text"},
+            {args.size.has_value(), "--size"},
+            {args.origin.has_value(), "--origin"},
+            {args.canvas.has_value(), "--canvas"},
+            {args.color.has_value(), "--color"},
+            {args.background.has_value(), "--background"},
+            {args.layout.has_value(), "--layout"},
+        };
+        for (const auto& [present, name] : options) {
+            if (present) given += std::string(given.empty() ? "" : ", ") + name;
+        }
+        if (!given.empty()) {
+            usage_error("--scene gives the text, fonts, canvas, colours and layout: " + given +
+                        " must not be given with it");
+        }
+    } else {
+        if (args.fonts.empty()) usage_error("no --font given (or --scene)");
+        if (args.fonts.size() > crisp::kMaxRendererFonts) {
+            usage_error("at most " + std::to_string(crisp::kMaxRendererFonts) + " fonts, not " +
+                        std::to_string(args.fonts.size()));
+        }
+        if (!args.text) usage_error("no --text given");
+        if (!args.size) usage_error("no --size given");
+        if (!args.origin) usage_error("no --origin given");
+        if (!args.canvas) usage_error("no --canvas given");
     }
-    if (!args.text) usage_error("no --text given");
-    if (!args.size) usage_error("no --size given");
-    if (!args.origin) usage_error("no --origin given");
-    if (!args.canvas) usage_error("no --canvas given");
     if (args.output.empty()) usage_error("no output given (-o OUT.png)");
+    if (args.layers_given && args.composite != crisp::CompositeMode::layered) {
+        usage_error("--layers applies to --composite layered only");
+    }
     if (!args.coverage_output.empty() && std::filesystem::path(args.coverage_output).lexically_normal() ==
                                              std::filesystem::path(args.output).lexically_normal()) {
         usage_error("-o and --coverage-out name the same file");
@@ -267,16 +342,47 @@ int exit_code_for_vulkan(const crisp::Error& error) {
     return error.code == crisp::ErrorCode::vulkan ? kExitVulkan : kExitInternal;
 }
 
-// What the renderer's compute shader needs enabled on the device (renderer.hpp: Renderer::create).
+// What the renderer's compute shader and the compositor need enabled on the device
+// (Renderer::create, CompositorCreateInfo). Holds the feature chain, so it stays where it is made.
 struct DeviceRequirements {
     VkPhysicalDeviceFeatures2 features{};
+    VkPhysicalDeviceVulkan12Features vulkan12{};
 };
 
-void require_renderer_features(DeviceRequirements& requirements, crisp::HeadlessContextOptions& options) {
+// With int64_atomics, also the 64-bit buffer atomics that give layered compositing RGB keys.
+void require_device_features(DeviceRequirements& requirements, crisp::HeadlessContextOptions& options,
+                             bool int64_atomics) {
     requirements.features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
     requirements.features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;
+    requirements.features.features.fragmentStoresAndAtomics = VK_TRUE;
+    requirements.features.features.dualSrcBlend = VK_TRUE;
+    if (int64_atomics) {
+        requirements.features.features.shaderInt64 = VK_TRUE;
+        requirements.vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+        requirements.vulkan12.shaderBufferInt64Atomics = VK_TRUE;
+        requirements.features.pNext = &requirements.vulkan12;
+    }
     options.required_features = &requirements.features;
     options.required_compute_subgroup_operations = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+}
+
+// A device with 64-bit buffer atomics if one qualifies, else one without them (int64_atomics
+// says which). When no device has them, the second attempt's error is the one reported: it names
+// what else is missing.
+crisp::Result<crisp::HeadlessContext> create_context(const Arguments& args, bool& int64_atomics) {
+    auto attempt = [&](bool int64) {
+        crisp::HeadlessContextOptions options;
+        options.validation = args.validate;
+        options.device_name_contains = args.device;
+        DeviceRequirements requirements;
+        require_device_features(requirements, options, int64);
+        return crisp::HeadlessContext::create(options);
+    };
+    int64_atomics = true;
+    crisp::Result<crisp::HeadlessContext> context = attempt(true);
+    if (context) return context;
+    int64_atomics = false;
+    return attempt(false);
 }
 
 // The atlas block a rect takes (see atlas.hpp): cells rounded up to powers of two per axis, then
@@ -322,6 +428,26 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+// What is drawn: the scene (from --scene, or the one run the command line describes), its
+// resolved layout and fonts, and the glyphs its runs laid out.
+struct Job {
+    crisp::Scene scene;
+    crisp::SubpixelLayout layout;
+    std::vector<crisp::Font> fonts;            // FontIds 1, 2, ... in scene order
+    std::vector<crisp::GlyphInstance> glyphs;  // every run's glyphs that touch the canvas, in paint order
+    size_t laid_out = 0;                       // instances the layout produced, culled ones included
+    uint32_t missing = 0, blank = 0, out_of_range = 0;
+};
+
+struct CompositeReport {
+    crisp::CompositorStats stats;  // the image's frame; its measurements are the first frame's
+    std::vector<std::string> warnings;
+    bool int64_atomics = false;
+    bool gray_layout = false;
+    std::vector<double> frame_ms;  // CPU wall time of each composite frame: record, submit and wait
+    std::vector<float> target;     // premultiplied linear RGBA, top row first
+};
+
 struct RenderReport {
     uint64_t frames = 0;
     bool converged = false;
@@ -336,22 +462,170 @@ struct RenderReport {
     crisp::AtlasStats atlas;
     uint32_t atlas_side = 0;
     std::vector<crisp::DrawnGlyph> drawn;  // the last frame's, in paint order
-    std::vector<uint16_t> texels;          // RGBA16 of every drawn glyph's rect, at texel_offset[i]
-    std::vector<size_t> texel_offset;      // per drawn glyph, in uint16_t units
+    // With --coverage-out only:
+    std::vector<uint16_t> texels;      // RGBA16 of every drawn glyph's rect, at texel_offset[i]
+    std::vector<size_t> texel_offset;  // per drawn glyph, in uint16_t units
+    CompositeReport composite;
 };
 
-int render(crisp::HeadlessContext& context, const Arguments& args, const crisp::SubpixelLayout& layout,
-           std::span<const crisp::Font> fonts, std::span<const crisp::GlyphInstance> glyphs, RenderReport& report) {
+// Composites the renderer's last frame twice, the same glyphs both times: the first frame
+// measures the overlap (what --layers auto sizes K from, and what the report gives; measurements
+// arrive one frame late), the second is the image, read back into report.composite.target.
+int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, const Arguments& args, const Job& job,
+              RenderReport& report) {
+    CompositeReport& out = report.composite;
+    const std::array<crisp::SampleRect, 3>& channels = job.layout.channels;
+    out.gray_layout = channels[0] == channels[1] && channels[1] == channels[2];
+
+    crisp::CompositorCreateInfo info;
+    info.physical_device = context.physical_device();
+    info.device = context.device();
+    info.allocator = context.allocation_callbacks();
+    info.int64_atomics = out.int64_atomics;
+    info.width = job.scene.width;
+    info.height = job.scene.height;
+    info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
+    info.gray_layout = out.gray_layout;
+    info.max_layers = args.layers == crisp::kAutoLayers ? crisp::kMaxCompositeLayers : args.layers;
+    if (args.composite != crisp::CompositeMode::exact) info.exact_nodes_per_pixel = 0;  // no node pool
+    crisp::Result<crisp::Compositor> created = crisp::Compositor::create(info);
+    if (!created) {
+        std::fprintf(stderr, "crisp-render: cannot create the compositor: %s\n", created.error().message.c_str());
+        return exit_code_for_vulkan(created.error());
+    }
+    crisp::Compositor& compositor = *created;
+    out.warnings = compositor.warnings();
+
+    crisp::CompositeParams params;
+    params.mode = args.composite;
+    params.layers = args.layers;
+    for (size_t c = 0; c < 3; ++c) params.background[c] = crisp::srgb_to_linear(job.scene.background[c]);
+    params.background[3] = job.scene.background[3];
+
+    const size_t pixels = size_t{job.scene.width} * job.scene.height;
+    crisp::Result<crisp::Buffer> buffer = context.create_buffer(
+        pixels * kTargetTexelBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
+    if (!buffer) {
+        std::fprintf(stderr, "crisp-render: cannot make the image's readback buffer: %s\n",
+                     buffer.error().message.c_str());
+        return exit_code_for_vulkan(buffer.error());
+    }
+    constexpr int kCompositeFrames = 2;
+    for (int frame = 1; frame <= kCompositeFrames; ++frame) {
+        const auto frame_start = std::chrono::steady_clock::now();
+        crisp::Status recorded;
+        const crisp::Status submitted = context.submit_and_wait([&](VkCommandBuffer command_buffer) {
+            recorded = compositor.record(command_buffer, renderer.drawn(), renderer.atlas_view(), params);
+            if (recorded && frame == kCompositeFrames)
+                compositor.record_target_readback(command_buffer, buffer->handle());
+        });
+        out.frame_ms.push_back(milliseconds_since(frame_start));
+        for (const crisp::Status& status : {std::cref(recorded), std::cref(submitted)}) {
+            if (!status) {
+                std::fprintf(stderr, "crisp-render: composite frame %d: %s\n", frame, status.error().message.c_str());
+                return exit_code_for_vulkan(status.error());
+            }
+        }
+    }
+    out.stats = compositor.stats();
+    out.target.resize(pixels * 4);
+    std::memcpy(out.target.data(), buffer->mapped().data(), pixels * kTargetTexelBytes);
+    return kExitOk;
+}
+
+// Reads back each drawn glyph's atlas rect (once per rect: glyphs with equal keys share one), for
+// the coverage image.
+int read_atlas_rects(crisp::HeadlessContext& context, const crisp::Renderer& renderer, RenderReport& report) {
+    const auto readback_start = std::chrono::steady_clock::now();
+    std::map<std::pair<uint32_t, uint32_t>, size_t> rect_offset;
+    std::vector<VkBufferImageCopy> regions;
+    size_t texel_count = 0;
+    report.texel_offset.resize(report.drawn.size());
+    for (size_t i = 0; i < report.drawn.size(); ++i) {
+        const crisp::DrawnGlyph& glyph = report.drawn[i];
+        const auto [it, inserted] = rect_offset.try_emplace({glyph.atlas_x, glyph.atlas_y}, texel_count);
+        report.texel_offset[i] = it->second * 4;
+        if (!inserted) continue;
+        VkBufferImageCopy region{};
+        region.bufferOffset = texel_count * kAtlasTexelBytes;
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageOffset = {static_cast<int32_t>(glyph.atlas_x), static_cast<int32_t>(glyph.atlas_y), 0};
+        region.imageExtent = {glyph.instance.width, glyph.instance.height, 1};
+        regions.push_back(region);
+        texel_count += size_t{glyph.instance.width} * glyph.instance.height;
+    }
+    crisp::Result<crisp::Buffer> buffer = context.create_buffer(
+        texel_count * kAtlasTexelBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
+    if (!buffer) {
+        std::fprintf(stderr, "crisp-render: cannot make the atlas readback buffer: %s\n",
+                     buffer.error().message.c_str());
+        return exit_code_for_vulkan(buffer.error());
+    }
+    const VkImage atlas_image = renderer.atlas_image();
+    const crisp::Status copied = context.submit_and_wait([&](VkCommandBuffer command_buffer) {
+        // record() made the atlas readable by transfers; this barrier also orders the copy after
+        // the last frame's dispatch and the compositor's reads (earlier submissions) and moves the
+        // atlas to the layout copies are fast in, and the next one returns it to GENERAL, where the
+        // renderer keeps it.
+        VkImageMemoryBarrier image_barriers[2]{};
+        for (VkImageMemoryBarrier& barrier : image_barriers) {
+            barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+            barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            barrier.image = atlas_image;
+            barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        }
+        VkImageMemoryBarrier& to_copy = image_barriers[0];
+        to_copy.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+        to_copy.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+        to_copy.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
+        to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        VkImageMemoryBarrier& to_general = image_barriers[1];
+        to_general.srcAccessMask = 0;  // the copy only read
+        to_general.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+        to_general.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        to_general.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+        vkCmdPipelineBarrier(command_buffer,
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT |
+                                 VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &to_copy);
+        vkCmdCopyImageToBuffer(command_buffer, atlas_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer->handle(),
+                               static_cast<uint32_t>(regions.size()), regions.data());
+        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
+                             nullptr, 0, nullptr, 1, &to_general);
+        VkBufferMemoryBarrier to_host{};
+        to_host.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
+        to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.buffer = buffer->handle();
+        to_host.offset = 0;
+        to_host.size = VK_WHOLE_SIZE;
+        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr,
+                             1, &to_host, 0, nullptr);
+    });
+    if (!copied) {
+        std::fprintf(stderr, "crisp-render: reading the atlas back: %s\n", copied.error().message.c_str());
+        return exit_code_for_vulkan(copied.error());
+    }
+    report.texels.resize(texel_count * 4);
+    std::memcpy(report.texels.data(), buffer->mapped().data(), texel_count * kAtlasTexelBytes);
+    report.readback_ms = milliseconds_since(readback_start);
+    return kExitOk;
+}
+
+int render(crisp::HeadlessContext& context, const Arguments& args, const Job& job, RenderReport& report) {
     crisp::RendererCreateInfo info;
     info.instance = context.instance();
     info.physical_device = context.physical_device();
     info.device = context.device();
     info.queue_family = context.queue_family();
     info.allocator = context.allocation_callbacks();
-    info.layout = layout;
+    info.layout = job.layout;
     info.atlas.max_samples = args.samples;
     for (uint32_t& samples : info.atlas.ramp) samples = std::min(samples, args.samples);
-    report.atlas_side = atlas_side_for(glyphs);
+    report.atlas_side = atlas_side_for(job.glyphs);
     info.atlas.width = info.atlas.height = report.atlas_side;
 
     crisp::Result<crisp::Renderer> created = crisp::Renderer::create(info);
@@ -360,10 +634,10 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const crisp::
         return exit_code_for_vulkan(created.error());
     }
     crisp::Renderer& renderer = *created;
-    for (const crisp::Font& font : fonts) {
+    for (const crisp::Font& font : job.fonts) {
         if (crisp::Status status = renderer.add_font(font); !status) {
             std::fprintf(stderr, "crisp-render: cannot add font %u (%s): %s\n", font.id(),
-                         args.fonts[font.id() - 1].c_str(), status.error().message.c_str());
+                         job.scene.fonts[font.id() - 1].c_str(), status.error().message.c_str());
             return exit_code_for_vulkan(status.error());
         }
     }
@@ -377,7 +651,7 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const crisp::
         }
         const auto frame_start = std::chrono::steady_clock::now();
         renderer.begin_frame();
-        renderer.draw(glyphs);
+        renderer.draw(job.glyphs);
         crisp::Status recorded;
         const crisp::Status submitted = context.submit_and_wait(
             [&](VkCommandBuffer command_buffer) { recorded = renderer.record(command_buffer); });
@@ -413,111 +687,20 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const crisp::
             report.max_samples = std::max(report.max_samples, glyph.samples);
         }
     }
-    if (report.drawn.empty()) return kExitOk;
 
-    // Read back each atlas rect once: glyphs with equal keys share one.
-    const auto readback_start = std::chrono::steady_clock::now();
-    std::map<std::pair<uint32_t, uint32_t>, size_t> rect_offset;
-    std::vector<VkBufferImageCopy> regions;
-    size_t texel_count = 0;
-    report.texel_offset.resize(report.drawn.size());
-    for (size_t i = 0; i < report.drawn.size(); ++i) {
-        const crisp::DrawnGlyph& glyph = report.drawn[i];
-        const auto [it, inserted] = rect_offset.try_emplace({glyph.atlas_x, glyph.atlas_y}, texel_count);
-        report.texel_offset[i] = it->second * 4;
-        if (!inserted) continue;
-        VkBufferImageCopy region{};
-        region.bufferOffset = texel_count * kAtlasTexelBytes;
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageOffset = {static_cast<int32_t>(glyph.atlas_x), static_cast<int32_t>(glyph.atlas_y), 0};
-        region.imageExtent = {glyph.instance.width, glyph.instance.height, 1};
-        regions.push_back(region);
-        texel_count += size_t{glyph.instance.width} * glyph.instance.height;
-    }
-    crisp::Result<crisp::Buffer> buffer = context.create_buffer(
-        texel_count * kAtlasTexelBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
-    if (!buffer) {
-        std::fprintf(stderr, "crisp-render: cannot make the readback buffer: %s\n", buffer.error().message.c_str());
-        return exit_code_for_vulkan(buffer.error());
-    }
-    const VkImage atlas_image = renderer.atlas_image();
-    const crisp::Status copied = context.submit_and_wait([&](VkCommandBuffer command_buffer) {
-        // record() made the atlas readable by transfers; this barrier also orders the copy after
-        // the last frame's dispatch (an earlier submission) and moves the atlas to the layout
-        // copies are fast in, and the next one returns it to GENERAL, where the renderer keeps it.
-        VkImageMemoryBarrier image_barriers[2]{};
-        for (VkImageMemoryBarrier& barrier : image_barriers) {
-            barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-            barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-            barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-            barrier.image = atlas_image;
-            barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        }
-        VkImageMemoryBarrier& to_copy = image_barriers[0];
-        to_copy.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-        to_copy.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-        to_copy.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
-        to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-        VkImageMemoryBarrier& to_general = image_barriers[1];
-        to_general.srcAccessMask = 0;  // the copy only read
-        to_general.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-        to_general.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-        to_general.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &to_copy);
-        vkCmdCopyImageToBuffer(command_buffer, atlas_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer->handle(),
-                               static_cast<uint32_t>(regions.size()), regions.data());
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                             nullptr, 0, nullptr, 1, &to_general);
-        VkBufferMemoryBarrier to_host{};
-        to_host.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
-        to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.buffer = buffer->handle();
-        to_host.offset = 0;
-        to_host.size = VK_WHOLE_SIZE;
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr,
-                             1, &to_host, 0, nullptr);
-    });
-    if (!copied) {
-        std::fprintf(stderr, "crisp-render: reading the atlas back: %s\n", copied.error().message.c_str());
-        return exit_code_for_vulkan(copied.error());
-    }
-    report.texels.resize(texel_count * 4);
-    std::memcpy(report.texels.data(), buffer->mapped().data(), texel_count * kAtlasTexelBytes);
-    report.readback_ms = milliseconds_since(readback_start);
-    return kExitOk;
+    if (const int code = composite(context, renderer, args, job, report); code != kExitOk) return code;
+    if (args.coverage_output.empty() || report.drawn.empty()) return kExitOk;
+    return read_atlas_rects(context, renderer, report);
 }
 
-// ---- Compositing
+// ---- Images
 
-struct Composite {
-    std::vector<float> image;  // linear, straight alpha; 3 or 4 channels
-    uint32_t channels = 3;
-    std::vector<float> coverage;  // linear per-channel coverage, RGB; empty unless asked for
-};
-
-Composite composite(const Arguments& args, const RenderReport& report) {
-    const uint32_t width = (*args.canvas)[0], height = (*args.canvas)[1];
-    const size_t pixels = size_t{width} * height;
-    const float background_alpha = args.background[3];
-    const bool opaque = background_alpha >= 1.0f;
-    const bool want_coverage = !args.coverage_output.empty();
-
-    // Premultiplied colour and one alpha per channel: subpixel coverage differs between channels.
-    std::vector<float> colour(pixels * 3), alpha;
-    float background[3];
-    for (size_t c = 0; c < 3; ++c) background[c] = crisp::srgb_to_linear(args.background[c]) * background_alpha;
-    for (size_t p = 0; p < pixels; ++p) std::copy(background, background + 3, &colour[p * 3]);
-    if (!opaque) alpha.assign(pixels * 3, background_alpha);
-    std::vector<float> uncovered;  // product of (1 - coverage) over the glyphs
-    if (want_coverage) uncovered.assign(pixels * 3, 1.0f);
-
-    for (size_t g = 0; g < report.drawn.size(); ++g) {
-        const crisp::DrawnGlyph& glyph = report.drawn[g];
-        const crisp::GlyphInstance& instance = glyph.instance;
+// The text's linear coverage per channel, ignoring colours and alphas: where glyphs overlap,
+// 1 - (1 - c1)(1 - c2)...
+std::vector<float> coverage_image(uint32_t width, uint32_t height, const RenderReport& report) {
+    std::vector<float> uncovered(size_t{width} * height * 3, 1.0f);
+    for (size_t g = 0; g < report.drawn.size() && !report.texels.empty(); ++g) {
+        const crisp::GlyphInstance& instance = report.drawn[g].instance;
         const uint16_t* texels = report.texels.data() + report.texel_offset[g];
         for (uint32_t j = 0; j < instance.height; ++j) {
             const int64_t y = int64_t{instance.y} + j;
@@ -529,34 +712,31 @@ Composite composite(const Arguments& args, const RenderReport& report) {
                 if (texel[3] == 0) continue;
                 const float full = static_cast<float>(crisp::kCoverageOne) * static_cast<float>(texel[3]);
                 const size_t p = (static_cast<size_t>(y) * width + static_cast<size_t>(x)) * 3;
-                for (size_t c = 0; c < 3; ++c) {
-                    const float covered = std::min(static_cast<float>(texel[c]) / full, 1.0f);
-                    const float opacity = instance.color[3] * covered;
-                    colour[p + c] = instance.color[c] * opacity + colour[p + c] * (1.0f - opacity);
-                    if (!opaque) alpha[p + c] = opacity + alpha[p + c] * (1.0f - opacity);
-                    if (want_coverage) uncovered[p + c] *= 1.0f - covered;
-                }
+                for (size_t c = 0; c < 3; ++c)
+                    uncovered[p + c] *= 1.0f - std::min(static_cast<float>(texel[c]) / full, 1.0f);
             }
         }
     }
+    for (float& value : uncovered) value = 1.0f - value;
+    return uncovered;
+}
 
-    Composite out;
-    if (opaque) {
-        out.image = std::move(colour);
-    } else {
-        // One alpha for the pixel: the largest of the channels', so no colour exceeds 1 when it
-        // is un-premultiplied. Exact for the gray layout, where the three are equal.
-        out.channels = 4;
-        out.image.resize(pixels * 4);
-        for (size_t p = 0; p < pixels; ++p) {
-            const float a = std::max({alpha[p * 3], alpha[p * 3 + 1], alpha[p * 3 + 2]});
-            for (size_t c = 0; c < 3; ++c) out.image[p * 4 + c] = a > 0.0f ? colour[p * 3 + c] / a : 0.0f;
-            out.image[p * 4 + 3] = a;
+// The PNG's pixels from the compositor's premultiplied RGBA: RGB over an opaque background (alpha
+// is 1 everywhere, so the colour is as it is), else RGBA with the colour divided by alpha.
+std::vector<float> png_pixels(std::span<const float> target, bool opaque) {
+    const size_t pixels = target.size() / 4;
+    const size_t channels = opaque ? 3 : 4;
+    std::vector<float> out(pixels * channels);
+    for (size_t p = 0; p < pixels; ++p) {
+        const float* rgba = &target[p * 4];
+        float* pixel = &out[p * channels];
+        if (opaque) {
+            std::copy(rgba, rgba + 3, pixel);
+            continue;
         }
-    }
-    if (want_coverage) {
-        out.coverage = std::move(uncovered);
-        for (float& value : out.coverage) value = 1.0f - value;
+        const float alpha = rgba[3];
+        for (size_t c = 0; c < 3; ++c) pixel[c] = alpha > 0.0f ? rgba[c] / alpha : 0.0f;
+        pixel[3] = alpha;
     }
     return out;
 }
@@ -566,19 +746,58 @@ Composite composite(const Arguments& args, const RenderReport& report) {
 struct Summary {
     const Arguments* args = nullptr;
     const crisp::HeadlessContext* context = nullptr;
-    const crisp::SubpixelLayout* layout = nullptr;
-    const crisp::TextLayout* text = nullptr;
+    const Job* job = nullptr;
     const RenderReport* render = nullptr;
     uint32_t culled_glyphs = 0;
-    double composite_ms = 0.0;
     double write_ms = 0.0;
     double total_ms = 0.0;
     crisp::ValidationMessages validation;
 };
 
+bool is_layered(const CompositeReport& c) {
+    return c.stats.mode == crisp::CompositeMode::layered;
+}
+bool is_exact(const CompositeReport& c) {
+    return c.stats.mode == crisp::CompositeMode::exact;
+}
+// The measured max overlap, for the modes that measure it.
+bool has_overlap(const CompositeReport& c) {
+    return c.stats.measured && (is_layered(c) || is_exact(c));
+}
+
+std::string json_composite(const Arguments& args, const CompositeReport& c) {
+    const crisp::CompositorStats& s = c.stats;
+    const bool layered = is_layered(c), exact = is_exact(c);
+    auto uint_or_null = [](bool present, uint64_t v) { return present ? json_uint(v) : std::string("null"); };
+    std::string out = "{\"mode\": " + json_string(crisp::composite_mode_name(s.mode));
+    out += ", \"layers_requested\": " + (!layered                            ? std::string("null")
+                                         : args.layers == crisp::kAutoLayers ? json_string("auto")
+                                                                             : json_uint(args.layers));
+    out += ", \"layers\": " + uint_or_null(layered, s.layers);
+    out += ", \"mono_keys\": " + (layered ? std::string(s.mono_keys ? "true" : "false") : std::string("null"));
+    out += ", \"int64_atomics\": " + std::string(c.int64_atomics ? "true" : "false");
+    out += ", \"gray_layout\": " + std::string(c.gray_layout ? "true" : "false");
+    out += ", \"quads\": " + json_uint(s.quads);
+    out += ", \"paint_order_blocks\": " + json_uint(s.paint_order_blocks);
+    out += ", \"buffer_bytes\": " + json_uint(s.buffer_bytes);
+    out += ", \"measured\": " + std::string(s.measured ? "true" : "false");
+    out += ", \"max_overlap\": " + uint_or_null(has_overlap(c), s.max_overlap);
+    out += ", \"tail_pixels\": " + uint_or_null(s.measured && layered, s.tail_pixels);
+    out += ", \"exact_lost_nodes\": " + uint_or_null(s.measured && exact, s.exact_lost_nodes);
+    out += ", \"exact_dropped\": " + uint_or_null(s.measured && exact, s.exact_dropped);
+    out += ", \"frame_ms\": [";
+    for (size_t i = 0; i < c.frame_ms.size(); ++i) out += (i ? ", " : "") + json_number(c.frame_ms[i]);
+    out += "], \"ms\": " + json_number(c.frame_ms.empty() ? 0.0 : c.frame_ms.back());
+    out += ", \"warnings\": [";
+    for (size_t i = 0; i < c.warnings.size(); ++i) out += (i ? ", " : "") + json_string(c.warnings[i]);
+    return out + "]}";
+}
+
 void print_json(const Summary& s) {
     const Arguments& args = *s.args;
+    const Job& job = *s.job;
     const RenderReport& r = *s.render;
+    const CompositeReport& c = r.composite;
     std::string frame_ms = "[";
     for (size_t i = 0; i < r.frame_ms.size(); ++i) frame_ms += (i ? ", " : "") + json_number(r.frame_ms[i]);
     frame_ms += "]";
@@ -590,18 +809,19 @@ void print_json(const Summary& s) {
     out += ", \"converged\": " + std::string(r.converged ? "true" : "false");
     out += ", \"samples\": {\"target\": " + json_uint(args.samples) + ", \"min\": " + json_uint(r.min_samples) +
            ", \"max\": " + json_uint(r.max_samples) + "}";
-    out += ", \"glyphs\": {\"laid_out\": " + json_uint(s.text->glyphs.size()) +
-           ", \"culled\": " + json_uint(s.culled_glyphs) + ", \"drawn\": " + json_uint(last.drawn_glyphs) +
-           ", \"skipped\": " + json_uint(last.skipped_glyphs) + ", \"failed\": " + json_uint(last.failed_glyphs) +
-           ", \"unknown_fonts\": " + json_uint(last.unknown_fonts) +
-           ", \"missing\": " + json_uint(s.text->missing_glyphs) + ", \"blank\": " + json_uint(s.text->blank_glyphs) +
-           ", \"out_of_range\": " + json_uint(s.text->out_of_range_glyphs) + "}";
+    out += ", \"glyphs\": {\"laid_out\": " + json_uint(job.laid_out) + ", \"culled\": " + json_uint(s.culled_glyphs) +
+           ", \"drawn\": " + json_uint(last.drawn_glyphs) + ", \"skipped\": " + json_uint(last.skipped_glyphs) +
+           ", \"failed\": " + json_uint(last.failed_glyphs) + ", \"unknown_fonts\": " + json_uint(last.unknown_fonts) +
+           ", \"missing\": " + json_uint(job.missing) + ", \"blank\": " + json_uint(job.blank) +
+           ", \"out_of_range\": " + json_uint(job.out_of_range) + "}";
     out += ", \"total_samples\": " + json_uint(r.total_samples);
     out += ", \"total_curve_tests\": " + json_uint(r.total_curve_tests);
+    out += ", \"composite\": " + json_composite(args, c);
     out += ", \"timings\": {\"frame_ms\": " + frame_ms + ", \"frames_ms\": " + json_number(frame_total) +
            ", \"mean_frame_ms\": " + json_number(r.frames ? frame_total / static_cast<double>(r.frames) : 0.0) +
-           ", \"readback_ms\": " + json_number(r.readback_ms) + ", \"composite_ms\": " + json_number(s.composite_ms) +
-           ", \"write_ms\": " + json_number(s.write_ms) + ", \"total_ms\": " + json_number(s.total_ms) + "}";
+           ", \"composite_ms\": " + json_number(c.frame_ms.empty() ? 0.0 : c.frame_ms.back()) +
+           ", \"readback_ms\": " + json_number(r.readback_ms) + ", \"write_ms\": " + json_number(s.write_ms) +
+           ", \"total_ms\": " + json_number(s.total_ms) + "}";
     out += ", \"atlas\": {\"width\": " + json_uint(r.atlas_side) + ", \"height\": " + json_uint(r.atlas_side) +
            ", \"occupancy\": " + json_number(static_cast<double>(r.atlas.occupancy)) +
            ", \"resident\": " + json_uint(r.atlas.resident_glyphs) +
@@ -613,12 +833,18 @@ void print_json(const Summary& s) {
     out += ", \"device\": {\"name\": " + json_string(s.context->device_name()) +
            ", \"driver\": " + json_string(s.context->driver_name()) +
            ", \"driver_info\": " + json_string(s.context->driver_info()) + "}";
-    out += ", \"layout\": " + json_string(s.layout->name);
-    out += ", \"size\": " + json_number(static_cast<double>(*args.size));
-    out += ", \"origin\": [" + json_number(static_cast<double>((*args.origin)[0])) + ", " +
-           json_number(static_cast<double>((*args.origin)[1])) + "]";
-    out += ", \"canvas\": {\"width\": " + json_uint((*args.canvas)[0]) +
-           ", \"height\": " + json_uint((*args.canvas)[1]) + "}";
+    out += ", \"layout\": " + json_string(job.layout.name);
+    out += ", \"scene\": " + (args.scene.empty() ? std::string("null") : json_string(args.scene));
+    out += ", \"runs\": " + json_uint(job.scene.runs.size());
+    if (args.scene.empty()) {
+        out += ", \"size\": " + json_number(static_cast<double>(*args.size));
+        out += ", \"origin\": [" + json_number(static_cast<double>((*args.origin)[0])) + ", " +
+               json_number(static_cast<double>((*args.origin)[1])) + "]";
+    } else {
+        out += ", \"size\": null, \"origin\": null";
+    }
+    out += ", \"canvas\": {\"width\": " + json_uint(job.scene.width) + ", \"height\": " + json_uint(job.scene.height) +
+           "}";
     out += ", \"outputs\": {\"png\": " + json_string(args.output) +
            ", \"coverage\": " + (args.coverage_output.empty() ? "null" : json_string(args.coverage_output)) + "}";
     if (args.validate) {
@@ -629,26 +855,105 @@ void print_json(const Summary& s) {
     std::fputs(out.c_str(), stdout);
 }
 
+// "layered, K 3 (auto), rgb keys, max overlap 3, 0 tail pixels, 1.2 ms"
+std::string human_composite(const Arguments& args, const CompositeReport& c) {
+    const crisp::CompositorStats& s = c.stats;
+    std::string out = crisp::composite_mode_name(s.mode);
+    if (is_layered(c)) {
+        out += ", K " + std::to_string(s.layers) + (args.layers == crisp::kAutoLayers ? " (auto)" : "") +
+               (s.mono_keys ? ", mono keys" : ", rgb keys");
+    }
+    if (has_overlap(c)) out += ", max overlap " + std::to_string(s.max_overlap);
+    if (s.measured && is_layered(c)) out += ", " + std::to_string(s.tail_pixels) + " tail pixels";
+    if (s.measured && is_exact(c)) {
+        out += ", " + std::to_string(s.exact_lost_nodes) + " lost, " + std::to_string(s.exact_dropped) + " dropped";
+    }
+    char ms[32];
+    std::snprintf(ms, sizeof ms, ", %.1f ms", c.frame_ms.empty() ? 0.0 : c.frame_ms.back());
+    return out + ms;
+}
+
 void print_human(const Summary& s) {
     const Arguments& args = *s.args;
+    const Job& job = *s.job;
     const RenderReport& r = *s.render;
     double frame_total = 0.0;
     for (const double ms : r.frame_ms) frame_total += ms;
-    std::printf("%s (%ux%u)%s%s\n", args.output.c_str(), (*args.canvas)[0], (*args.canvas)[1],
+    std::printf("%s (%ux%u)%s%s\n", args.output.c_str(), job.scene.width, job.scene.height,
                 args.coverage_output.empty() ? "" : ", coverage in ", args.coverage_output.c_str());
+    if (!args.scene.empty()) std::printf("  scene    %s, %zu runs\n", args.scene.c_str(), job.scene.runs.size());
     std::printf("  device   %s (%s, %s)\n", s.context->device_name().c_str(), s.context->driver_name().c_str(),
                 s.context->driver_info().c_str());
-    std::printf("  layout   %s, %u samples per texel and channel\n", s.layout->name.c_str(), args.samples);
+    std::printf("  layout   %s, %u samples per texel and channel\n", job.layout.name.c_str(), args.samples);
     std::printf("  glyphs   %u drawn, %zu laid out (%u outside the canvas), %u missing, %u failed\n",
-                r.last_frame.drawn_glyphs, s.text->glyphs.size(), s.culled_glyphs, s.text->missing_glyphs,
-                r.last_frame.failed_glyphs);
-    std::printf("  frames   %llu, %.1f ms (%.2f ms per frame); readback %.1f ms, composite %.1f ms\n",
-                static_cast<unsigned long long>(r.frames), frame_total,
-                r.frames ? frame_total / static_cast<double>(r.frames) : 0.0, r.readback_ms, s.composite_ms);
+                r.last_frame.drawn_glyphs, job.laid_out, s.culled_glyphs, job.missing, r.last_frame.failed_glyphs);
+    std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)\n", static_cast<unsigned long long>(r.frames),
+                frame_total, r.frames ? frame_total / static_cast<double>(r.frames) : 0.0);
+    std::printf("  blend    %s\n", human_composite(args, r.composite).c_str());
     std::printf("  atlas    %ux%u, %.1f%% occupied, %u resident, %llu allocations, %llu evictions\n", r.atlas_side,
                 r.atlas_side, 100.0 * static_cast<double>(r.atlas.occupancy), r.atlas.resident_glyphs,
                 static_cast<unsigned long long>(r.atlas.total.allocations),
                 static_cast<unsigned long long>(r.atlas.total.evictions));
+}
+
+// ---- The run
+
+// The one run the command line describes, as a scene.
+crisp::Scene scene_from_arguments(const Arguments& args) {
+    crisp::Scene scene;
+    scene.fonts = args.fonts;
+    scene.width = (*args.canvas)[0];
+    scene.height = (*args.canvas)[1];
+    if (args.background) std::copy(args.background->begin(), args.background->end(), scene.background);
+    scene.layout = args.layout.value_or("rgb");
+    crisp::SceneRun run;
+    run.text = *args.text;
+    run.size = *args.size;
+    run.origin_x = (*args.origin)[0];
+    run.origin_y = (*args.origin)[1];
+    if (args.color) std::copy(args.color->begin(), args.color->end(), run.color);
+    scene.runs.push_back(std::move(run));
+    return scene;
+}
+
+// Lays out every run in file order, paint order continuing from run to run so that later runs
+// are in front at equal depth. A run's font comes first in its chain, the scene's others follow
+// in order as fallbacks.
+void lay_out(const Arguments& args, Job& job) {
+    crisp::Layouter layouter;
+    crisp::TextLayout text;
+    uint32_t paint_order = 0;
+    for (size_t i = 0; i < job.scene.runs.size(); ++i) {
+        const crisp::SceneRun& run = job.scene.runs[i];
+        std::vector<const crisp::Font*> font_chain = {&job.fonts[run.font]};
+        for (size_t f = 0; f < job.fonts.size(); ++f) {
+            if (f != run.font) font_chain.push_back(&job.fonts[f]);
+        }
+        crisp::TextStyle style;
+        style.size = run.size;
+        std::copy(std::begin(run.color), std::end(run.color), style.color);  // sRGB: the layout linearizes it
+        style.depth = run.depth;
+        crisp::LayoutOptions options;
+        options.origin_x = run.origin_x;
+        options.origin_y = run.origin_y;
+        options.first_paint_order = paint_order;
+        if (crisp::Status status = layouter.layout(font_chain, run.text, style, options, text); !status) {
+            const bool input = status.error().code == crisp::ErrorCode::invalid_argument;
+            if (args.scene.empty()) {
+                fail(input ? kExitUsage : kExitInternal, "cannot lay out the text: " + status.error().message);
+            }
+            fail(input ? kExitScene : kExitInternal,
+                 args.scene + ": runs[" + std::to_string(i) + "]: cannot lay out the text: " + status.error().message);
+        }
+        paint_order = text.next_paint_order;
+        job.laid_out += text.glyphs.size();
+        job.missing += text.missing_glyphs;
+        job.blank += text.blank_glyphs;
+        job.out_of_range += text.out_of_range_glyphs;
+        for (const crisp::GlyphInstance& glyph : text.glyphs) {
+            if (touches_canvas(glyph, job.scene.width, job.scene.height)) job.glyphs.push_back(glyph);
+        }
+    }
 }
 
 int run(const Arguments& args) {
@@ -656,65 +961,56 @@ int run(const Arguments& args) {
     check_output_path(args.output);
     if (!args.coverage_output.empty()) check_output_path(args.coverage_output);
 
-    crisp::Result<crisp::SubpixelLayout> layout = crisp::resolve_subpixel_layout(args.layout);
-    if (!layout) fail(kExitLayout, "--layout " + args.layout + ": " + layout.error().message);
+    Job job;
+    if (args.scene.empty()) {
+        job.scene = scene_from_arguments(args);
+    } else {
+        crisp::Result<crisp::Scene> scene = crisp::load_scene_file(args.scene);
+        if (!scene) fail(kExitScene, scene.error().message);
+        job.scene = std::move(*scene);
+    }
 
-    std::vector<crisp::Font> fonts;
-    fonts.reserve(args.fonts.size());
-    for (size_t i = 0; i < args.fonts.size(); ++i) {
-        crisp::Result<crisp::FontAsset> asset = crisp::load_asset_file(args.fonts[i]);
-        if (!asset) fail(kExitFont, args.fonts[i] + ": " + asset.error().message);
+    crisp::Result<crisp::SubpixelLayout> layout = crisp::resolve_subpixel_layout(job.scene.layout);
+    if (!layout) {
+        fail(kExitLayout, (args.scene.empty() ? "--layout " : args.scene + ": layout ") + job.scene.layout + ": " +
+                              layout.error().message);
+    }
+    job.layout = std::move(*layout);
+
+    job.fonts.reserve(job.scene.fonts.size());
+    for (size_t i = 0; i < job.scene.fonts.size(); ++i) {
+        const std::string& path = job.scene.fonts[i];
+        crisp::Result<crisp::FontAsset> asset = crisp::load_asset_file(path);
+        if (!asset) fail(kExitFont, path + ": " + asset.error().message);
         crisp::Result<crisp::Font> font = crisp::Font::create(std::move(*asset), static_cast<crisp::FontId>(i + 1));
-        if (!font) fail(kExitFont, args.fonts[i] + ": " + font.error().message);
-        fonts.push_back(std::move(*font));
+        if (!font) fail(kExitFont, path + ": " + font.error().message);
+        job.fonts.push_back(std::move(*font));
     }
-    std::vector<const crisp::Font*> font_chain;
-    for (const crisp::Font& font : fonts) font_chain.push_back(&font);
-
-    crisp::TextStyle style;
-    style.size = *args.size;
-    std::copy(args.color.begin(), args.color.end(), style.color);
-    crisp::LayoutOptions options;
-    options.origin_x = (*args.origin)[0];
-    options.origin_y = (*args.origin)[1];
-    crisp::TextLayout text;
-    crisp::Layouter layouter;
-    if (crisp::Status status = layouter.layout(font_chain, *args.text, style, options, text); !status) {
-        fail(status.error().code == crisp::ErrorCode::invalid_argument ? kExitUsage : kExitInternal,
-             "cannot lay out the text: " + status.error().message);
-    }
-    const uint32_t width = (*args.canvas)[0], height = (*args.canvas)[1];
-    std::vector<crisp::GlyphInstance> glyphs;
-    for (const crisp::GlyphInstance& glyph : text.glyphs) {
-        if (touches_canvas(glyph, width, height)) glyphs.push_back(glyph);
-    }
-
-    crisp::HeadlessContextOptions context_options;
-    context_options.validation = args.validate;
-    context_options.device_name_contains = args.device;
-    DeviceRequirements requirements;
-    require_renderer_features(requirements, context_options);
-    crisp::Result<crisp::HeadlessContext> context = crisp::HeadlessContext::create(context_options);
-    if (!context) fail(exit_code_for_vulkan(context.error()), "Vulkan: " + context.error().message);
+    lay_out(args, job);
 
     RenderReport report;
-    if (const int code = render(*context, args, *layout, fonts, glyphs, report); code != kExitOk) return code;
-    // The renderer is gone: every message the validation layer had for it has arrived.
+    crisp::Result<crisp::HeadlessContext> context = create_context(args, report.composite.int64_atomics);
+    if (!context) fail(exit_code_for_vulkan(context.error()), "Vulkan: " + context.error().message);
+
+    if (const int code = render(*context, args, job, report); code != kExitOk) return code;
+    // The renderer and compositor are gone: every message the validation layer had for them has arrived.
     Summary summary;
     summary.validation = context->validation_messages();
 
-    const auto composite_start = std::chrono::steady_clock::now();
-    const Composite image = composite(args, report);
-    summary.composite_ms = milliseconds_since(composite_start);
-    report.texels = {};
-
+    const uint32_t width = job.scene.width, height = job.scene.height;
     const auto write_start = std::chrono::steady_clock::now();
-    if (crisp::Status status = crisp::write_png_srgb8(args.output, width, height, image.channels, image.image);
-        !status) {
-        fail(status.error().code == crisp::ErrorCode::io ? kExitOutput : kExitInternal, status.error().message);
+    {
+        const bool opaque = job.scene.background[3] >= 1.0f;
+        const std::vector<float> pixels = png_pixels(report.composite.target, opaque);
+        report.composite.target = {};
+        if (crisp::Status status = crisp::write_png_srgb8(args.output, width, height, opaque ? 3 : 4, pixels);
+            !status) {
+            fail(status.error().code == crisp::ErrorCode::io ? kExitOutput : kExitInternal, status.error().message);
+        }
     }
     if (!args.coverage_output.empty()) {
-        if (crisp::Status status = crisp::write_pfm(args.coverage_output, width, height, image.coverage); !status) {
+        const std::vector<float> coverage = coverage_image(width, height, report);
+        if (crisp::Status status = crisp::write_pfm(args.coverage_output, width, height, coverage); !status) {
             fail(status.error().code == crisp::ErrorCode::io ? kExitOutput : kExitInternal, status.error().message);
         }
     }
@@ -723,14 +1019,29 @@ int run(const Arguments& args) {
 
     summary.args = &args;
     summary.context = &*context;
-    summary.layout = &*layout;
-    summary.text = &text;
+    summary.job = &job;
     summary.render = &report;
-    summary.culled_glyphs = static_cast<uint32_t>(text.glyphs.size() - glyphs.size());
+    summary.culled_glyphs = static_cast<uint32_t>(job.laid_out - job.glyphs.size());
     if (args.json) {
         print_json(summary);
-    } else {
+    } else if (!args.quiet) {
         print_human(summary);
+    }
+
+    const CompositeReport& composite = report.composite;
+    if (!args.quiet && !args.json) {
+        for (const std::string& warning : composite.warnings) {
+            std::fprintf(stderr, "crisp-render: compositor: %s\n", warning.c_str());
+        }
+    }
+    const crisp::CompositorStats& stats = composite.stats;
+    if (!args.quiet && is_exact(composite) && stats.measured &&
+        (stats.exact_lost_nodes > 0 || stats.exact_dropped > 0)) {
+        std::fprintf(stderr,
+                     "crisp-render: warning: the exact compositor lost %llu fragments (its node pool was full) and "
+                     "dropped %llu (past %u per pixel); the image lacks them\n",
+                     static_cast<unsigned long long>(stats.exact_lost_nodes),
+                     static_cast<unsigned long long>(stats.exact_dropped), crisp::kMaxExactFragmentsPerPixel);
     }
 
     int code = kExitOk;
