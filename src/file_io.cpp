@@ -71,7 +71,11 @@ Status write_file_atomically(const std::filesystem::path& path, std::span<const 
     // The temporary lives beside the target so the rename stays within one file system. It is
     // opened with mode 0666 and O_EXCL rather than made by mkstemp, whose 0600 the rename would
     // carry over to the file: this way it gets the umask's usual permissions.
-    std::string temporary_prefix = (directory / ("." + file_name.string() + ".tmp-")).string();
+    // (Appended piece by piece: GCC 12 at -O3 warns falsely about "." + string + "..." (-Wrestrict).)
+    std::string hidden = ".";
+    hidden += file_name.string();
+    hidden += ".tmp-";
+    std::string temporary_prefix = (directory / hidden).string();
     auto seed = static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
                 (static_cast<uint64_t>(::getpid()) << 40);
     std::string temporary;

@@ -1,0 +1,867 @@
+// crisp-bench-composite: what each compositing mode costs and how far it is from exact, for scenes
+// of N overlapping layers of text at high and low alpha. Per mode (layered with K = 1, 2, 4, 8 and
+// auto, unsorted, wboit, exact): the GPU time of Compositor::record() on converged static text
+// (Vulkan timestamp queries), the error of its image against the exact mode's in 8-bit sRGB codes,
+// and its bytes per pixel. The exact mode is itself checked against the CPU reference
+// (src/oit_reference). Prints Markdown (or JSON with --json); docs/benchmarks-compositing.md.
+#include "cli.hpp"
+#include "image_io.hpp"
+#include "oit_reference.hpp"
+
+#include <crisp/bake.hpp>
+#include <crisp/compositor.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/renderer.hpp>
+#include <crisp/vulkan_context.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
+#include <random>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+constexpr uint32_t kFramesInFlight = 2;
+// Frames each mode runs before the timed ones (pipelines, caches and the auto K settle), at least
+// frames_in_flight: with one timed frame or more, the stats the last frame reports as measured
+// (and the auto K) then come from a frame of the same mode.
+constexpr uint32_t kDefaultWarmupFrames = 2;
+static_assert(kDefaultWarmupFrames >= kFramesInFlight);
+// ... and for at least this long (wall clock): a GPU that idled (while the CPU checked the last
+// scene) runs its first frames at low clocks: on an H200 the first modes of a scene measured up
+// to 5x slower with 2 warm-up frames alone.
+constexpr double kDefaultWarmupMs = 500.0;
+// Layer i is shifted by (i * kShiftStepX mod kShiftRangeX, i * kShiftStepY mod kShiftRangeY)
+// pixels: fractional steps, so that the layers' glyphs overlap partially and at many phases.
+constexpr float kShiftStepX = 1.37f, kShiftRangeX = 5.0f;
+constexpr float kShiftStepY = 0.61f, kShiftRangeY = 3.0f;
+constexpr float kMargin = 4.0f;
+// Mid grey (sRGB 0.5) behind the text: errors show in both directions.
+constexpr float kBackgroundSrgb = 0.5f;
+constexpr uint32_t kExactNodeBytes = 36;       // CompositorCreateInfo::exact_nodes_per_pixel
+constexpr uint32_t kTargetBytesPerPixel = 16;  // RGBA32F
+constexpr uint32_t kMaxConvergeFrames = 4096;
+
+struct Args {
+    std::string font = "fonts/DejaVuSans.ttf";
+    std::string device;
+    std::string layout = "rgb";
+    float size = 18.0f;
+    uint32_t width = 512, height = 256;
+    std::vector<uint32_t> layers = {1, 2, 4, 8, 16, 32};
+    std::vector<float> alphas = {0.9f, 0.3f};
+    uint32_t frames = 10;
+    uint32_t warmup = kDefaultWarmupFrames;
+    double warmup_ms = kDefaultWarmupMs;
+    uint32_t samples = 512;
+    uint32_t subpixel_steps = 4;
+    crisp::KeyFormat keys = crisp::KeyFormat::automatic;
+    bool cpu_check = true;
+    bool json = false;
+    bool validate = false;
+    bool validate_sync = false;
+};
+
+[[noreturn]] void usage(int code) {
+    std::fprintf(code ? stderr : stdout,
+                 "usage: crisp-bench-composite [options]\n"
+                 "For scenes of N overlapping layers of text, measures each compositing mode's GPU time\n"
+                 "(timestamp queries around Compositor::record), its error against the exact mode in 8-bit\n"
+                 "sRGB codes, and its bytes per pixel. Progress goes to stderr.\n\n"
+                 "  --layers LIST      layer counts, comma-separated (default 1,2,4,8,16,32)\n"
+                 "  --alphas LIST      text alphas, comma-separated, in (0, 1] (default 0.9,0.3)\n"
+                 "  --canvas W,H       target size, also WxH (default 512,256)\n"
+                 "  --frames N         timed frames per mode (default 10)\n"
+                 "  --warmup N         untimed frames per mode before them, at least %u (default %u)\n"
+                 "  --warmup-ms T      ... and more until T ms have passed (default %g)\n"
+                 "  --font PATH        a font file, baked at start (default fonts/DejaVuSans.ttf)\n"
+                 "  --size PX          pixels per em (default 18)\n"
+                 "  --samples N        samples per glyph the text converges to (default 512)\n"
+                 "  --subpixel-steps N subpixel positions per pixel in glyph keys (default 4)\n"
+                 "  --layout NAME      subpixel layout preset or file (default rgb)\n"
+                 "  --keys NAME        layered keys: auto, rgb or mono (default auto)\n"
+                 "  --no-cpu-check     skip checking the exact mode against the CPU reference\n"
+                 "  --device TEXT      pick a device whose name contains TEXT\n"
+                 "  --validate         turn the validation layer on\n"
+                 "  --validate-sync    the validation layer with synchronization validation\n"
+                 "  --json             print JSON instead of Markdown\n"
+                 "  -h, --help         this text\n",
+                 kFramesInFlight, kDefaultWarmupFrames, kDefaultWarmupMs);
+    std::exit(code);
+}
+
+[[noreturn]] void fail(const std::string& message) {
+    std::fprintf(stderr, "crisp-bench-composite: %s\n", message.c_str());
+    std::exit(1);
+}
+
+template <class T>
+T number(const std::string& text) {
+    const std::optional<T> value = crisp::cli::parse_number<T>(text);
+    if (!value) {
+        std::fprintf(stderr, "crisp-bench-composite: '%s' is not a valid number\n", text.c_str());
+        usage(2);
+    }
+    return *value;
+}
+
+template <class T>
+std::vector<T> number_list(const std::string& text, char separator = ',') {
+    std::vector<T> values;
+    size_t begin = 0;
+    while (true) {
+        const size_t end = text.find(separator, begin);
+        values.push_back(number<T>(text.substr(begin, end == std::string::npos ? std::string::npos : end - begin)));
+        if (end == std::string::npos) break;
+        begin = end + 1;
+    }
+    return values;
+}
+
+Args parse(int argc, char** argv) {
+    Args args;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) usage(2);
+            return argv[++i];
+        };
+        if (arg == "--help" || arg == "-h") {
+            usage(0);
+        } else if (arg == "--layers") {
+            args.layers = number_list<uint32_t>(value());
+            for (uint32_t n : args.layers) {
+                if (n < 1 || n > 1024) fail("--layers: each count must be in 1..1024");
+            }
+        } else if (arg == "--alphas") {
+            args.alphas = number_list<float>(value());
+            for (float a : args.alphas) {
+                if (!(a > 0.0f && a <= 1.0f)) fail("--alphas: each alpha must be in (0, 1]");
+            }
+        } else if (arg == "--canvas") {
+            const std::string v = value();
+            const std::vector<uint32_t> size = number_list<uint32_t>(v, v.find('x') != std::string::npos ? 'x' : ',');
+            if (size.size() != 2 || size[0] < 16 || size[1] < 16 || size[0] > 16384 || size[1] > 16384) {
+                fail("--canvas: W,H each in 16..16384");
+            }
+            args.width = size[0];
+            args.height = size[1];
+        } else if (arg == "--frames") {
+            args.frames = number<uint32_t>(value());
+            if (args.frames < 1) fail("--frames must be at least 1");
+        } else if (arg == "--warmup") {
+            args.warmup = number<uint32_t>(value());
+            if (args.warmup < kFramesInFlight) fail("--warmup must be at least " + std::to_string(kFramesInFlight));
+        } else if (arg == "--warmup-ms") {
+            args.warmup_ms = number<double>(value());
+            if (!(args.warmup_ms >= 0.0 && args.warmup_ms <= 600000.0)) fail("--warmup-ms must be in 0..600000");
+        } else if (arg == "--font") {
+            args.font = value();
+        } else if (arg == "--size") {
+            args.size = number<float>(value());
+            if (!(args.size >= 4.0f && args.size <= 256.0f)) fail("--size must be in 4..256");
+        } else if (arg == "--samples") {
+            args.samples = number<uint32_t>(value());
+        } else if (arg == "--subpixel-steps") {
+            args.subpixel_steps = number<uint32_t>(value());
+        } else if (arg == "--layout") {
+            args.layout = value();
+        } else if (arg == "--keys") {
+            const std::string v = value();
+            if (v == "auto")
+                args.keys = crisp::KeyFormat::automatic;
+            else if (v == "rgb")
+                args.keys = crisp::KeyFormat::rgb;
+            else if (v == "mono")
+                args.keys = crisp::KeyFormat::mono;
+            else
+                fail("--keys: auto, rgb or mono");
+        } else if (arg == "--no-cpu-check") {
+            args.cpu_check = false;
+        } else if (arg == "--device") {
+            args.device = value();
+        } else if (arg == "--validate") {
+            args.validate = true;
+        } else if (arg == "--validate-sync") {
+            args.validate = args.validate_sync = true;
+        } else if (arg == "--json") {
+            args.json = true;
+        } else {
+            std::fprintf(stderr, "crisp-bench-composite: unknown argument %s\n", arg.c_str());
+            usage(2);
+        }
+    }
+    return args;
+}
+
+// ---- Device
+
+// What the renderer (as crisp-render asks) and the compositor need; int64 atomics only when asked.
+struct DeviceRequirements {
+    VkPhysicalDeviceFeatures2 features{};
+    VkPhysicalDeviceVulkan12Features vulkan12{};
+};
+
+crisp::Result<crisp::HeadlessContext> create_context(const Args& args, bool int64_atomics) {
+    DeviceRequirements requirements;
+    requirements.features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    requirements.features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;
+    requirements.features.features.fragmentStoresAndAtomics = VK_TRUE;
+    requirements.features.features.dualSrcBlend = VK_TRUE;
+    if (int64_atomics) {
+        requirements.features.features.shaderInt64 = VK_TRUE;
+        requirements.vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+        requirements.vulkan12.shaderBufferInt64Atomics = VK_TRUE;
+        requirements.features.pNext = &requirements.vulkan12;
+    }
+    crisp::HeadlessContextOptions options;
+    options.validation = args.validate;
+    options.synchronization_validation = args.validate_sync;
+    options.device_name_contains = args.device;
+    options.required_features = &requirements.features;
+    options.required_compute_subgroup_operations = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+    return crisp::HeadlessContext::create(options);
+}
+
+std::string version_string(uint32_t version) {
+    return std::to_string(VK_API_VERSION_MAJOR(version)) + "." + std::to_string(VK_API_VERSION_MINOR(version)) + "." +
+           std::to_string(VK_API_VERSION_PATCH(version));
+}
+
+// ---- Scenes
+
+// A fixed-seed mt19937: its raw outputs are the same with every standard library (its
+// distributions are not).
+double unit(std::mt19937& rng) {
+    return static_cast<double>(rng()) / 4294967296.0;
+}
+
+struct Scene {
+    std::vector<crisp::GlyphInstance> glyphs;  // layer after layer: the submission order
+    uint64_t rect_texels = 0;                  // sum of the rects' areas: no more fragments than this
+};
+
+// N copies of a screen of prose, one per layer, each shifted by a fractional offset, with its own
+// colour and depth. Depths are evenly spaced in (0, 1) and shuffled, so depth order is not paint
+// order; each layer is one depth plane and numbers its paint orders from 0.
+Scene make_scene(const Args& args, const crisp::Font& font, const std::string& text, uint32_t layers, float alpha) {
+    Scene scene;
+    std::mt19937 rng(1000u + layers);
+    std::vector<uint32_t> depth_rank(layers);
+    for (uint32_t i = 0; i < layers; ++i) depth_rank[i] = i;
+    for (uint32_t i = layers; i > 1; --i) std::swap(depth_rank[i - 1], depth_rank[rng() % i]);
+
+    const crisp::Font* fonts[] = {&font};
+    crisp::Layouter layouter;
+    crisp::TextLayout laid;
+    for (uint32_t i = 0; i < layers; ++i) {
+        crisp::TextStyle style;
+        style.size = args.size;
+        for (int c = 0; c < 3; ++c) style.color[c] = static_cast<float>(0.05 + 0.9 * unit(rng));
+        style.color[3] = alpha;
+        style.depth = static_cast<float>(depth_rank[i] + 1) / static_cast<float>(layers + 1);
+        crisp::LayoutOptions options;
+        options.origin_x = kMargin + std::fmod(static_cast<float>(i) * kShiftStepX, kShiftRangeX);
+        options.origin_y = kMargin + args.size + std::fmod(static_cast<float>(i) * kShiftStepY, kShiftRangeY);
+        options.wrap_width = static_cast<float>(args.width) - 2.0f * kMargin - kShiftRangeX;
+        options.subpixel_steps = args.subpixel_steps;
+        if (crisp::Status s = layouter.layout(fonts, text, style, options, laid); !s) fail(s.error().message);
+        for (const crisp::GlyphInstance& g : laid.glyphs) {
+            if (g.x < 0 || g.y < 0 || g.x + static_cast<int64_t>(g.width) > args.width ||
+                g.y + static_cast<int64_t>(g.height) > args.height) {
+                continue;
+            }
+            scene.glyphs.push_back(g);
+            scene.rect_texels += uint64_t{g.width} * g.height;
+        }
+    }
+    return scene;
+}
+
+// Draws the scene until every glyph holds its samples; returns the frames it took.
+uint32_t converge(crisp::HeadlessContext& context, crisp::Renderer& renderer, const Scene& scene) {
+    for (uint32_t f = 0; f < kMaxConvergeFrames; ++f) {
+        renderer.begin_frame();
+        renderer.draw(scene.glyphs);
+        const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
+            if (crisp::Status s = renderer.record(cb); !s) fail(s.error().message);
+        });
+        if (!status) fail(status.error().message);
+        if (renderer.converged()) return f + 1;
+    }
+    return kMaxConvergeFrames;
+}
+
+// ---- Images and errors
+
+// 8-bit sRGB codes of the target's RGB (premultiplied over an opaque background: alpha is 1).
+std::vector<uint8_t> srgb_codes(std::span<const float> rgba, float& worst_alpha_error) {
+    std::vector<uint8_t> codes(rgba.size() / 4 * 3);
+    worst_alpha_error = 0.0f;
+    for (size_t p = 0; p < rgba.size() / 4; ++p) {
+        for (size_t c = 0; c < 3; ++c) codes[3 * p + c] = crisp::linear_to_srgb8(rgba[4 * p + c]);
+        worst_alpha_error = std::max(worst_alpha_error, std::abs(rgba[4 * p + 3] - 1.0f));
+    }
+    return codes;
+}
+
+struct ImageError {
+    double rmse = 0.0;
+    int max = 0;
+};
+
+ImageError compare(const std::vector<uint8_t>& got, const std::vector<uint8_t>& want) {
+    ImageError error;
+    double sum_squares = 0.0;
+    for (size_t i = 0; i < got.size(); ++i) {
+        const int d = std::abs(int{got[i]} - int{want[i]});
+        sum_squares += static_cast<double>(d * d);
+        error.max = std::max(error.max, d);
+    }
+    error.rmse = got.empty() ? 0.0 : std::sqrt(sum_squares / static_cast<double>(got.size()));
+    return error;
+}
+
+// Calls visit(pixel, fragment) for every fragment the GPU quads produce, in submission order:
+// pixel (x + i, y + j) of a glyph reads atlas texel (atlas_x + i, atlas_y + j), coverage
+// min(sum / (kCoverageOne * count), 1); skipped where the texel has no samples or every channel's
+// opacity is 0, as the exact shader does. Every rect lies inside the target (make_scene).
+template <class Visit>
+void for_each_fragment(std::span<const crisp::DrawnGlyph> drawn, std::span<const uint16_t> atlas, uint32_t atlas_width,
+                       uint32_t width, Visit&& visit) {
+    crisp::oit::Fragment f;
+    for (const crisp::DrawnGlyph& g : drawn) {
+        f.depth = g.instance.depth;
+        f.paint_order = g.instance.paint_order;
+        for (uint32_t j = 0; j < g.instance.height; ++j) {
+            for (uint32_t i = 0; i < g.instance.width; ++i) {
+                const uint16_t* texel = &atlas[4 * (size_t{g.atlas_y + j} * atlas_width + g.atlas_x + i)];
+                if (texel[3] == 0) continue;
+                const float scale = static_cast<float>(crisp::kCoverageOne) * static_cast<float>(texel[3]);
+                bool visible = false;
+                for (int c = 0; c < 3; ++c) {
+                    const float opacity = g.instance.color[3] * std::min(static_cast<float>(texel[c]) / scale, 1.0f);
+                    visible = visible || opacity != 0.0f;
+                    f.transmittance[c] = 1.0f - opacity;
+                    f.light[c] = g.instance.color[c] * opacity;
+                }
+                if (!visible) continue;
+                visit(static_cast<size_t>(g.instance.y + static_cast<int32_t>(j)) * width +
+                          static_cast<size_t>(g.instance.x + static_cast<int32_t>(i)),
+                      f);
+            }
+        }
+    }
+}
+
+struct CpuExact {
+    std::vector<uint8_t> codes;
+    uint64_t fragments = 0;
+    uint32_t max_overlap = 0;
+};
+
+// The exact composite on the CPU (oit::composite_exact, in double precision) of those fragments.
+CpuExact cpu_exact(std::span<const crisp::DrawnGlyph> drawn, std::span<const uint16_t> atlas, uint32_t atlas_width,
+                   uint32_t width, uint32_t height, const crisp::oit::LinearRgb& background) {
+    const size_t pixels = size_t{width} * height;
+    // Per-pixel lists in one array: count, prefix sum, fill.
+    std::vector<size_t> first(pixels + 1, 0);
+    for_each_fragment(drawn, atlas, atlas_width, width,
+                      [&](size_t pixel, const crisp::oit::Fragment&) { ++first[pixel + 1]; });
+    for (size_t p = 0; p < pixels; ++p) first[p + 1] += first[p];
+    std::vector<crisp::oit::Fragment> fragments(first[pixels]);
+    std::vector<size_t> next(first.begin(), first.end() - 1);
+    for_each_fragment(drawn, atlas, atlas_width, width,
+                      [&](size_t pixel, const crisp::oit::Fragment& f) { fragments[next[pixel]++] = f; });
+
+    CpuExact result;
+    result.codes.resize(pixels * 3);
+    result.fragments = fragments.size();
+    for (size_t p = 0; p < pixels; ++p) {
+        const std::span<const crisp::oit::Fragment> list(fragments.data() + first[p], first[p + 1] - first[p]);
+        result.max_overlap = std::max(result.max_overlap, static_cast<uint32_t>(list.size()));
+        const crisp::oit::LinearRgb rgb = crisp::oit::composite_exact(list, background);
+        for (size_t c = 0; c < 3; ++c) result.codes[3 * p + c] = crisp::linear_to_srgb8(rgb[c]);
+    }
+    return result;
+}
+
+// ---- Measuring
+
+struct ModeRun {
+    crisp::CompositeMode mode;
+    uint32_t layers;  // layered: K, or kAutoLayers
+};
+
+struct Measurement {
+    ModeRun run;
+    crisp::CompositorStats stats;  // after the last frame
+    uint32_t warmup_frames = 0;
+    std::vector<double> gpu_ms;  // the timed frames
+    double median_ms = 0.0;
+    ImageError error;  // against the exact mode
+    std::vector<uint8_t> codes;
+};
+
+struct SceneResult {
+    uint32_t layers = 0;
+    float alpha = 0.0f;
+    size_t glyphs = 0;
+    size_t drawn = 0;
+    uint32_t converge_frames = 0;
+    uint32_t exact_nodes_per_pixel = 0;
+    std::optional<CpuExact> cpu;  // codes dropped once compared
+    ImageError exact_vs_cpu;
+    std::vector<Measurement> modes;
+};
+
+std::string mode_label(const ModeRun& run) {
+    std::string label = crisp::composite_mode_name(run.mode);
+    if (run.mode == crisp::CompositeMode::layered) {
+        label += run.layers == crisp::kAutoLayers ? " auto" : " K=" + std::to_string(run.layers);
+    }
+    return label;
+}
+
+double median(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    const size_t n = values.size();
+    return n == 0 ? 0.0 : n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+struct Bench {
+    const Args& args;
+    crisp::HeadlessContext& context;
+    crisp::Renderer& renderer;
+    VkQueryPool queries = VK_NULL_HANDLE;
+    double period_ns = 1.0;
+    uint64_t timestamp_mask = ~uint64_t{0};
+    crisp::Buffer& target_readback;
+    std::vector<std::string>& warnings;
+
+    void warn(const std::string& text) {
+        std::fprintf(stderr, "warning: %s\n", text.c_str());
+        warnings.push_back(text);
+    }
+
+    Measurement measure(crisp::Compositor& compositor, const std::string& scene_name, const ModeRun& run) {
+        Measurement m;
+        m.run = run;
+        crisp::CompositeParams params;
+        params.mode = run.mode;
+        params.layers = run.layers;
+        const float grey = crisp::srgb_to_linear(kBackgroundSrgb);
+        params.background[0] = params.background[1] = params.background[2] = grey;
+        params.background[3] = 1.0f;
+        // One frame; its GPU time in ms.
+        auto frame = [&](bool last) {
+            // The text has converged: the renderer would record nothing but a barrier, and its
+            // drawn() list stays valid until its next begin_frame(). Leaving it out keeps the GPU's
+            // idle gaps between frames short.
+            const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
+                vkCmdResetQueryPool(cb, queries, 0, 2);
+                vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
+                if (crisp::Status s = compositor.record(cb, renderer.drawn(), renderer.atlas_view(), params); !s) {
+                    fail(mode_label(run) + ": " + s.error().message);
+                }
+                vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
+                if (last) compositor.record_target_readback(cb, target_readback.handle());
+            });
+            if (!status) fail(status.error().message);
+            uint64_t stamps[2] = {};
+            const VkResult got =
+                vkGetQueryPoolResults(context.device(), queries, 0, 2, sizeof stamps, stamps, sizeof(uint64_t),
+                                      VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+            if (got != VK_SUCCESS) fail("vkGetQueryPoolResults: " + crisp::vk_result_name(got));
+            return static_cast<double>((stamps[1] - stamps[0]) & timestamp_mask) * period_ns * 1e-6;
+        };
+        const auto start = std::chrono::steady_clock::now();
+        auto elapsed_ms = [&] {
+            return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        };
+        while (m.warmup_frames < args.warmup || elapsed_ms() < args.warmup_ms) {
+            frame(false);
+            ++m.warmup_frames;
+        }
+        for (uint32_t f = 0; f < args.frames; ++f) m.gpu_ms.push_back(frame(f + 1 == args.frames));
+        m.stats = compositor.stats();
+        m.median_ms = median(m.gpu_ms);
+        const size_t floats = size_t{args.width} * args.height * 4;
+        std::vector<float> rgba(floats);
+        std::memcpy(rgba.data(), target_readback.mapped().data(), floats * sizeof(float));
+        float alpha_error = 0.0f;
+        m.codes = srgb_codes(rgba, alpha_error);
+        if (alpha_error > 1e-3f) {
+            warn(scene_name + ", " + mode_label(run) + ": target alpha off 1 by up to " + std::to_string(alpha_error) +
+                 " over an opaque background");
+        }
+        return m;
+    }
+};
+
+// ---- Output
+
+std::string json_string(const std::string& text) {
+    std::string out = "\"";
+    for (const char ch : text) {
+        if (ch == '"' || ch == '\\') {
+            out += '\\';
+            out += ch;
+        } else if (static_cast<unsigned char>(ch) < 0x20) {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(ch));
+            out += escaped;
+        } else {
+            out += ch;
+        }
+    }
+    return out + "\"";
+}
+
+struct Header {
+    std::string device, driver_name, driver_info, api;
+    uint32_t driver_version = 0;
+    bool int64_atomics = false;
+    std::string layout;
+    std::string keys;  // what the layered frames used
+    std::vector<std::string> compositor_warnings;
+};
+
+double buffer_bytes_per_pixel(const Measurement& m, const Args& args) {
+    return static_cast<double>(m.stats.buffer_bytes) / (static_cast<double>(args.width) * args.height);
+}
+
+void print_json(const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
+                const std::vector<std::string>& warnings) {
+    std::printf("{\n  \"device\": %s,\n  \"driver_name\": %s,\n  \"driver_info\": %s,\n  \"driver_version\": %u,\n",
+                json_string(header.device).c_str(), json_string(header.driver_name).c_str(),
+                json_string(header.driver_info).c_str(), header.driver_version);
+    std::printf("  \"api_version\": %s,\n  \"int64_atomics\": %s,\n  \"layout\": %s,\n  \"layered_keys\": %s,\n",
+                json_string(header.api).c_str(), header.int64_atomics ? "true" : "false",
+                json_string(header.layout).c_str(), json_string(header.keys).c_str());
+    std::printf("  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
+                args.height, json_string(args.font).c_str(), static_cast<double>(args.size), args.samples);
+    std::printf("  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"timed_frames\": %u,\n",
+                args.subpixel_steps, args.warmup, args.warmup_ms, args.frames);
+    std::printf("  \"background_srgb\": %g,\n  \"target_bytes_per_pixel\": %u,\n  \"scenes\": [\n",
+                static_cast<double>(kBackgroundSrgb), kTargetBytesPerPixel);
+    for (size_t s = 0; s < scenes.size(); ++s) {
+        const SceneResult& r = scenes[s];
+        std::printf(
+            "    {\"layers\": %u, \"alpha\": %g, \"glyphs\": %zu, \"drawn_glyphs\": %zu, "
+            "\"converge_frames\": %u, \"exact_nodes_per_pixel\": %u,\n",
+            r.layers, static_cast<double>(r.alpha), r.glyphs, r.drawn, r.converge_frames, r.exact_nodes_per_pixel);
+        if (r.cpu) {
+            std::printf(
+                "     \"cpu_fragments\": %llu, \"cpu_max_overlap\": %u, "
+                "\"exact_vs_cpu\": {\"rmse\": %.6g, \"max\": %d},\n",
+                static_cast<unsigned long long>(r.cpu->fragments), r.cpu->max_overlap, r.exact_vs_cpu.rmse,
+                r.exact_vs_cpu.max);
+        }
+        std::printf("     \"modes\": [\n");
+        for (size_t i = 0; i < r.modes.size(); ++i) {
+            const Measurement& m = r.modes[i];
+            std::printf(
+                "       {\"mode\": %s, \"layers_requested\": %u, \"layers\": %u, \"mono_keys\": %s, "
+                "\"warmup_frames\": %u, \"gpu_ms_median\": %.6g, \"gpu_ms\": [",
+                json_string(crisp::composite_mode_name(m.run.mode)).c_str(), m.run.layers, m.stats.layers,
+                m.stats.mono_keys ? "true" : "false", m.warmup_frames, m.median_ms);
+            for (size_t f = 0; f < m.gpu_ms.size(); ++f) std::printf("%s%.6g", f ? ", " : "", m.gpu_ms[f]);
+            std::printf(
+                "], \"rmse\": %.6g, \"max\": %d, \"buffer_bytes\": %llu, \"buffer_bytes_per_pixel\": %.6g, "
+                "\"quads\": %u, \"paint_order_blocks\": %u, \"measured\": %s, \"max_overlap\": %u, "
+                "\"tail_pixels\": %u, \"exact_lost_nodes\": %llu, \"exact_dropped\": %llu}%s\n",
+                m.error.rmse, m.error.max, static_cast<unsigned long long>(m.stats.buffer_bytes),
+                buffer_bytes_per_pixel(m, args), m.stats.quads, m.stats.paint_order_blocks,
+                m.stats.measured ? "true" : "false", m.stats.max_overlap, m.stats.tail_pixels,
+                static_cast<unsigned long long>(m.stats.exact_lost_nodes),
+                static_cast<unsigned long long>(m.stats.exact_dropped), i + 1 < r.modes.size() ? "," : "");
+        }
+        std::printf("     ]}%s\n", s + 1 < scenes.size() ? "," : "");
+    }
+    std::printf("  ],\n  \"warnings\": [");
+    for (size_t i = 0; i < warnings.size(); ++i) std::printf("%s%s", i ? ", " : "", json_string(warnings[i]).c_str());
+    std::printf("]\n}\n");
+}
+
+void print_markdown(const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
+                    const std::vector<std::string>& warnings) {
+    std::printf("Device: %s, driver %s (%s); Vulkan %s in use.\n", header.device.c_str(), header.driver_name.c_str(),
+                header.driver_info.c_str(), header.api.c_str());
+    std::printf(
+        "64-bit buffer atomics: %s; layered keys: %s. Canvas %ux%u; %s at %g px, layout %s, %u subpixel "
+        "steps, %u samples per glyph; background sRGB %g grey.\n",
+        header.int64_atomics ? "enabled" : "not available", header.keys == "mono" ? "mono (32-bit)" : "rgb (64-bit)",
+        args.width, args.height, args.font.c_str(), static_cast<double>(args.size), header.layout.c_str(),
+        args.subpixel_steps, args.samples, static_cast<double>(kBackgroundSrgb));
+    for (const std::string& w : header.compositor_warnings) std::printf("Compositor: %s.\n", w.c_str());
+    std::printf(
+        "GPU ms: median of %u frames after at least %u warm-up frames and %g ms, timestamps around "
+        "Compositor::record() alone. "
+        "RMSE and max: 8-bit sRGB codes against the exact mode, over all pixels and channels. B/px: the "
+        "mode's per-pixel buffers (CompositorStats::buffer_bytes / pixels); the RGBA32F target adds %u B/px "
+        "to every mode.\n",
+        args.frames, args.warmup, args.warmup_ms, kTargetBytesPerPixel);
+    for (const float alpha : args.alphas) {
+        std::printf("\n### alpha %g\n\n", static_cast<double>(alpha));
+        std::printf(
+            "| layers | mode | K | GPU ms | RMSE | max | B/px | max overlap | tail pixels |\n"
+            "|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+        for (const SceneResult& r : scenes) {
+            if (r.alpha != alpha) continue;
+            for (const Measurement& m : r.modes) {
+                const bool layered = m.run.mode == crisp::CompositeMode::layered;
+                const bool exact = m.run.mode == crisp::CompositeMode::exact;
+                char k[32] = "";
+                if (layered) {
+                    std::snprintf(k, sizeof k, m.run.layers == crisp::kAutoLayers ? "auto: %u" : "%u", m.stats.layers);
+                }
+                char error[64] = "reference";
+                if (!exact) std::snprintf(error, sizeof error, "%.3f | %d", m.error.rmse, m.error.max);
+                char overlap[32] = "";
+                if ((layered || exact) && m.stats.measured)
+                    std::snprintf(overlap, sizeof overlap, "%u", m.stats.max_overlap);
+                char tail[32] = "";
+                if (layered && m.stats.measured) std::snprintf(tail, sizeof tail, "%u", m.stats.tail_pixels);
+                std::printf("| %u | %s | %s | %.4g | %s%s | %.1f | %s | %s |\n", r.layers,
+                            crisp::composite_mode_name(m.run.mode), k, m.median_ms, error, exact ? " | " : "",
+                            buffer_bytes_per_pixel(m, args), overlap, tail);
+            }
+        }
+    }
+    std::printf(
+        "\n### Scenes and the exact mode\n\n"
+        "| layers | alpha | glyphs | frames to converge | fragments / px | max overlap | exact nodes / px | "
+        "lost nodes | dropped | exact vs CPU: RMSE | max |\n"
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (const SceneResult& r : scenes) {
+        const Measurement* exact = nullptr;
+        for (const Measurement& m : r.modes) {
+            if (m.run.mode == crisp::CompositeMode::exact) exact = &m;
+        }
+        const double pixels = static_cast<double>(args.width) * args.height;
+        std::printf("| %u | %g | %zu | %u | ", r.layers, static_cast<double>(r.alpha), r.drawn, r.converge_frames);
+        if (r.cpu)
+            std::printf("%.2f | %u | ", static_cast<double>(r.cpu->fragments) / pixels, r.cpu->max_overlap);
+        else
+            std::printf(" | %u | ", exact ? exact->stats.max_overlap : 0u);
+        std::printf("%u | %llu | %llu | ", r.exact_nodes_per_pixel,
+                    static_cast<unsigned long long>(exact ? exact->stats.exact_lost_nodes : 0),
+                    static_cast<unsigned long long>(exact ? exact->stats.exact_dropped : 0));
+        if (r.cpu)
+            std::printf("%.3f | %d |\n", r.exact_vs_cpu.rmse, r.exact_vs_cpu.max);
+        else
+            std::printf("not checked | |\n");
+    }
+    if (!warnings.empty()) {
+        std::printf("\nWarnings:\n\n");
+        for (const std::string& w : warnings) std::printf("- %s\n", w.c_str());
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Args args = parse(argc, argv);
+
+    bool int64_atomics = true;
+    auto context = create_context(args, true);
+    if (!context) {
+        const std::string first_error = context.error().message;
+        int64_atomics = false;
+        context = create_context(args, false);
+        if (!context) fail(first_error + "; without 64-bit atomics: " + context.error().message);
+        std::fprintf(stderr, "no device with shaderInt64 and shaderBufferInt64Atomics (%s): layered keys are mono\n",
+                     first_error.c_str());
+    }
+
+    auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});
+    if (!baked) fail(baked.error().message);
+    auto font = crisp::Font::create(std::move(baked->asset), 1);
+    if (!font) fail(font.error().message);
+    auto layout = crisp::resolve_subpixel_layout(args.layout);
+    if (!layout) fail(layout.error().message);
+    const bool gray_layout = layout->channels[0] == layout->channels[1] && layout->channels[1] == layout->channels[2];
+
+    crisp::RendererCreateInfo info;
+    info.instance = context->instance();
+    info.physical_device = context->physical_device();
+    info.device = context->device();
+    info.queue_family = context->queue_family();
+    info.frames_in_flight = kFramesInFlight;
+    info.atlas.max_samples = args.samples;
+    info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: converge in as few frames as the ramp allows
+    info.layout = *layout;
+    auto renderer = crisp::Renderer::create(info);
+    if (!renderer) fail(renderer.error().message);
+    if (auto s = renderer->add_font(*font); !s) fail(s.error().message);
+
+    // Enough prose to fill the canvas: lines at the given size, generously estimated.
+    const std::string prose =
+        "The quick brown fox jumps over the lazy dog. Pack my box with five dozen liquor jugs. Sphinx of "
+        "black quartz, judge my vow! How vexingly quick daft zebras jump; 0123456789. ";
+    const double characters = (static_cast<double>(args.width) / (0.3 * static_cast<double>(args.size)) + 1.0) *
+                              (static_cast<double>(args.height) / static_cast<double>(args.size) + 1.0);
+    std::string text;
+    while (static_cast<double>(text.size()) < characters) text += prose;
+
+    VkQueryPoolCreateInfo query_info{};
+    query_info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    query_info.queryCount = 2;
+    VkQueryPool queries = VK_NULL_HANDLE;
+    if (vkCreateQueryPool(context->device(), &query_info, nullptr, &queries) != VK_SUCCESS) fail("no query pool");
+    uint32_t family_count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(context->physical_device(), &family_count, nullptr);
+    std::vector<VkQueueFamilyProperties> families(family_count);
+    vkGetPhysicalDeviceQueueFamilyProperties(context->physical_device(), &family_count, families.data());
+    const uint32_t valid_bits = families.at(context->queue_family()).timestampValidBits;
+    if (valid_bits == 0) fail("the queue has no timestamps");
+
+    const size_t pixels = size_t{args.width} * args.height;
+    auto target_readback = context->create_buffer(pixels * 4 * sizeof(float), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                  crisp::MemoryUsage::readback);
+    if (!target_readback) fail(target_readback.error().message);
+    const crisp::AtlasConfig& atlas_config = renderer->atlas().config();
+    std::optional<crisp::Buffer> atlas_readback;
+    if (args.cpu_check) {
+        auto buffer = context->create_buffer(size_t{atlas_config.width} * atlas_config.height * 4 * sizeof(uint16_t),
+                                             VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
+        if (!buffer) fail(buffer.error().message);
+        atlas_readback = std::move(*buffer);
+    }
+
+    std::vector<std::string> warnings;
+    Bench bench{args,
+                *context,
+                *renderer,
+                queries,
+                static_cast<double>(context->properties().limits.timestampPeriod),
+                valid_bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << valid_bits) - 1,
+                *target_readback,
+                warnings};
+
+    Header header;
+    header.device = context->device_name();
+    header.driver_name = context->driver_name();
+    header.driver_info = context->driver_info();
+    header.driver_version = context->driver_version();
+    header.api = version_string(context->api_version());
+    header.int64_atomics = int64_atomics;
+    header.layout = layout->name;
+
+    const uint64_t range = context->properties().limits.maxStorageBufferRange;
+    const uint64_t pool_cap =
+        std::min<uint64_t>(crisp::kMaxExactFragmentsPerPixel, range / (uint64_t{kExactNodeBytes} * pixels));
+    const crisp::oit::LinearRgb background = {crisp::srgb_to_linear(kBackgroundSrgb),
+                                              crisp::srgb_to_linear(kBackgroundSrgb),
+                                              crisp::srgb_to_linear(kBackgroundSrgb)};
+
+    std::vector<ModeRun> runs = {
+        {crisp::CompositeMode::exact, 0},   {crisp::CompositeMode::unsorted, 0},
+        {crisp::CompositeMode::wboit, 0},   {crisp::CompositeMode::layered, 1},
+        {crisp::CompositeMode::layered, 2}, {crisp::CompositeMode::layered, 4},
+        {crisp::CompositeMode::layered, 8}, {crisp::CompositeMode::layered, crisp::kAutoLayers}};
+
+    std::vector<SceneResult> results;
+    for (const uint32_t layers : args.layers) {
+        for (const float alpha : args.alphas) {
+            const std::string name = std::to_string(layers) + " layers, alpha " + std::to_string(alpha).substr(0, 4);
+            std::fprintf(stderr, "%s: laying out\n", name.c_str());
+            const Scene scene = make_scene(args, *font, text, layers, alpha);
+            SceneResult result;
+            result.layers = layers;
+            result.alpha = alpha;
+            result.glyphs = scene.glyphs.size();
+            std::fprintf(stderr, "%s: %zu glyphs, converging\n", name.c_str(), scene.glyphs.size());
+            result.converge_frames = converge(*context, *renderer, scene);
+            if (!renderer->converged()) bench.warn(name + ": the text did not converge");
+            result.drawn = renderer->drawn().size();
+            if (renderer->stats().failed_glyphs > 0) {
+                bench.warn(name + ": " + std::to_string(renderer->stats().failed_glyphs) +
+                           " glyphs did not fit the atlas and are not drawn");
+            }
+
+            // The pool holds every fragment when it has a node per texel of every rect.
+            const uint64_t wanted = std::max<uint64_t>(1, (scene.rect_texels + pixels - 1) / pixels);
+            result.exact_nodes_per_pixel = static_cast<uint32_t>(std::min(wanted, pool_cap));
+            if (wanted > pool_cap) {
+                bench.warn(name + ": the exact node pool is capped at " + std::to_string(pool_cap) +
+                           " nodes per pixel (64, or maxStorageBufferRange) below the " + std::to_string(wanted) +
+                           " the rects could need");
+            }
+            crisp::CompositorCreateInfo compositor_info;
+            compositor_info.physical_device = context->physical_device();
+            compositor_info.device = context->device();
+            compositor_info.int64_atomics = int64_atomics;
+            compositor_info.width = args.width;
+            compositor_info.height = args.height;
+            compositor_info.frames_in_flight = kFramesInFlight;
+            compositor_info.key_format = args.keys;
+            compositor_info.gray_layout = gray_layout;
+            compositor_info.exact_nodes_per_pixel = result.exact_nodes_per_pixel;
+            auto compositor = crisp::Compositor::create(compositor_info);
+            if (!compositor) fail(compositor.error().message);
+            for (const std::string& w : compositor->warnings()) {
+                if (std::find(header.compositor_warnings.begin(), header.compositor_warnings.end(), w) ==
+                    header.compositor_warnings.end()) {
+                    header.compositor_warnings.push_back(w);
+                }
+            }
+
+            for (const ModeRun& run : runs) {
+                std::fprintf(stderr, "%s: %s\n", name.c_str(), mode_label(run).c_str());
+                result.modes.push_back(bench.measure(*compositor, name, run));
+            }
+            const Measurement& exact = result.modes.front();
+            if (exact.stats.exact_lost_nodes > 0 || exact.stats.exact_dropped > 0) {
+                bench.warn(name + ": the exact mode lost " + std::to_string(exact.stats.exact_lost_nodes) +
+                           " fragments (node pool) and dropped " + std::to_string(exact.stats.exact_dropped) +
+                           " (past 64 per pixel): it is not exact here");
+            }
+            if (!exact.stats.measured) bench.warn(name + ": the exact mode's stats were not measured");
+            for (Measurement& m : result.modes) m.error = compare(m.codes, exact.codes);
+
+            if (args.cpu_check) {
+                std::fprintf(stderr, "%s: CPU reference\n", name.c_str());
+                const crisp::Status status = context->submit_and_wait(
+                    [&](VkCommandBuffer cb) { renderer->record_atlas_readback(cb, atlas_readback->handle()); });
+                if (!status) fail(status.error().message);
+                std::vector<uint16_t> atlas(size_t{atlas_config.width} * atlas_config.height * 4);
+                std::memcpy(atlas.data(), atlas_readback->mapped().data(), atlas.size() * sizeof(uint16_t));
+                result.cpu =
+                    cpu_exact(renderer->drawn(), atlas, atlas_config.width, args.width, args.height, background);
+                result.exact_vs_cpu = compare(exact.codes, result.cpu->codes);
+                result.cpu->codes = {};
+            }
+            for (Measurement& m : result.modes) {
+                m.codes = {};
+                if (m.run.mode == crisp::CompositeMode::layered) header.keys = m.stats.mono_keys ? "mono" : "rgb";
+            }
+            results.push_back(std::move(result));
+        }
+    }
+    vkDestroyQueryPool(context->device(), queries, nullptr);
+
+    if (args.json)
+        print_json(args, header, results, warnings);
+    else
+        print_markdown(args, header, results, warnings);
+    const auto messages = context->validation_messages();
+    if (messages.errors + messages.warnings > 0) {
+        std::fprintf(stderr, "validation: %u errors, %u warnings\n", messages.errors, messages.warnings);
+        for (const auto& m : messages.recent) std::fprintf(stderr, "%s\n", m.c_str());
+        return 1;
+    }
+    return 0;
+}
