@@ -1,8 +1,14 @@
-// What every compositing fragment shader starts from: its quad, its pixel and the glyph's
-// coverage there. Included by the *.frag shaders after #version and the include extension.
+// What every compositing quad pass starts from: its quad, its pixel and the glyph's coverage
+// there. Included after #version and the include extension by the *.frag shaders (a quad
+// rasterized: one fragment per pixel) and, with CRISP_COMPUTE defined, by the *_quads.comp shaders
+// (one invocation per pixel of an 8 x 8 tile of a quad, from the frame's tile list).
 #include "shared.h"
 
+#ifdef CRISP_COMPUTE
+layout(local_size_x = kCompositeTile * kCompositeTile) in;
+#else
 layout(early_fragment_tests) in;
+#endif
 
 layout(push_constant) uniform PushConstants {
     CompositePushConstants pc;
@@ -14,7 +20,14 @@ layout(std430, set = 0, binding = 1) readonly buffer Quads {
     CompositeQuad quads[];
 };
 
+#ifdef CRISP_COMPUTE
+// Per tile: the quad's index, and the tile's top-left texel in the quad's rect (x | y << 16).
+layout(std430, set = 0, binding = 7) readonly buffer Tiles {
+    uvec2 tiles[];
+};
+#else
 layout(location = 0) flat in uint v_quad;
+#endif
 
 // One glyph at one pixel, per channel: opacity o = a * coverage, T = 1 - o, L = c * o (linear).
 struct GlyphFragment {
@@ -27,8 +40,20 @@ struct GlyphFragment {
 
 // False where the texel holds no samples: the glyph does not draw there yet.
 bool load_fragment(out GlyphFragment f) {
+#ifdef CRISP_COMPUTE
+    const uint tile_index = gl_WorkGroupID.y * kRasterDispatchWidth + gl_WorkGroupID.x;
+    if (tile_index >= pc.tile_count) return false;
+    const uvec2 tile = tiles[tile_index];
+    f.quad = quads[tile.x];
+    const uvec2 texel_in_rect = uvec2(tile.y & 0xFFFFu, tile.y >> 16) +
+                                uvec2(gl_LocalInvocationIndex % kCompositeTile, gl_LocalInvocationIndex / kCompositeTile);
+    if (texel_in_rect.x >= f.quad.width || texel_in_rect.y >= f.quad.height) return false;
+    const ivec2 pixel = ivec2(f.quad.x, f.quad.y) + ivec2(texel_in_rect);
+    if (pixel.x < 0 || pixel.y < 0 || pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) return false;
+#else
     f.quad = quads[v_quad];
     const ivec2 pixel = ivec2(gl_FragCoord.xy);
+#endif
     f.pixel = uint(pixel.y) * pc.width + uint(pixel.x);
     const ivec2 texel = ivec2(f.quad.atlas_x, f.quad.atlas_y) + pixel - ivec2(f.quad.x, f.quad.y);
     const uvec4 sums = imageLoad(atlas, texel);

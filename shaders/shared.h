@@ -93,7 +93,8 @@ struct RasterPushConstants {
 // Layer buffers a layered pipeline binds: a layer never straddles two, so K <= 8 needs at most 8.
 CRISP_CONSTANT(uint, kCompositeMaxLayerBuffers, 8u);
 CRISP_CONSTANT(uint, kCompositeMaxLayers, 8u);
-// Threads per workgroup of the per-pixel resolve passes: 8 x 8 pixels.
+// Threads per workgroup of the per-pixel resolve passes, and of the compute quad passes (one
+// 8 x 8 tile of a quad each): 8 x 8 pixels.
 CRISP_CONSTANT(uint, kCompositeTile, 8u);
 // Light sums are u8.24 fixed point: integer addition is associative, so the sum of a pixel's
 // fragments is bit-identical whatever order they arrive in.
@@ -158,7 +159,7 @@ struct CompositePushConstants {
     uint pixels;            // width * height
     uint layers_per_buffer; // layered: whole layers per layer buffer
     uint node_capacity;     // exact: nodes in the pool
-    uint padding0;
+    uint tile_count;        // compute quad passes: tiles in the frame's tile list
     uint padding1;
     uint padding2;
 };

@@ -37,7 +37,9 @@ enum Binding : uint32_t {
     kBindNodes = 4,
     kBindStats = 5,
     kBindTarget = 6,
+    kBindTiles = 7,
 };
+constexpr uint32_t kBindingCount = 8;
 
 float clamp01(float value) {
     return value >= 0.0f ? std::min(value, 1.0f) : 0.0f;  // NaN -> 0
@@ -55,6 +57,8 @@ uint32_t depth_bits(float depth, int bits) {
 struct FrameSlot {
     vk::DeviceBuffer quads;  // host-visible CompositeQuad[]
     uint32_t quad_capacity = 0;
+    vk::DeviceBuffer tiles;  // host-visible uvec2[]: the compute path's tiles
+    uint32_t tile_capacity = 0;
     vk::DeviceBuffer stats;  // host-visible copy of the stats words
     VkDescriptorSet set = VK_NULL_HANDLE;
     bool pending = false;  // recorded, its stats not read yet
@@ -66,6 +70,8 @@ struct LayeredPipelines {
     VkPipeline build = VK_NULL_HANDLE;
     VkPipeline composite = VK_NULL_HANDLE;
     VkPipeline resolve = VK_NULL_HANDLE;
+    VkPipeline build_compute = VK_NULL_HANDLE;  // the quad passes as compute dispatches
+    VkPipeline composite_compute = VK_NULL_HANDLE;
 };
 
 }  // namespace
@@ -82,6 +88,16 @@ const char* composite_mode_name(CompositeMode mode) {
             return "exact";
     }
     return "?";
+}
+
+const char* quad_path_name(QuadPath path) {
+    return path == QuadPath::compute ? "compute" : "raster";
+}
+
+std::optional<QuadPath> parse_quad_path(std::string_view name) {
+    if (name == "raster") return QuadPath::raster;
+    if (name == "compute") return QuadPath::compute;
+    return std::nullopt;
 }
 
 std::optional<CompositeMode> parse_composite_mode(std::string_view name) {
@@ -136,6 +152,7 @@ struct Compositor::State {
     VkFramebuffer color_framebuffer = VK_NULL_HANDLE;
     VkPipeline unsorted = VK_NULL_HANDLE, wboit = VK_NULL_HANDLE, exact = VK_NULL_HANDLE;
     VkPipeline wboit_resolve = VK_NULL_HANDLE, exact_resolve = VK_NULL_HANDLE;
+    VkPipeline wboit_compute = VK_NULL_HANDLE, exact_compute = VK_NULL_HANDLE;  // made on first use
     std::array<LayeredPipelines, kMaxCompositeLayers + 1> layered{};  // by K, made on first use
 
     std::vector<FrameSlot> slots;
@@ -145,6 +162,7 @@ struct Compositor::State {
     CompositorStats stats;
     std::vector<std::string> warnings;
     std::vector<gpu::CompositeQuad> quad_data;
+    std::vector<uint32_t> tile_data;  // pairs: quad index, tile origin in its rect (x | y << 16)
 
     ~State();
     Status create(const CompositorCreateInfo& info);
@@ -152,10 +170,11 @@ struct Compositor::State {
     Result<VkPipeline> graphics_pipeline(const char* fragment, const VkSpecializationInfo* specialization,
                                          bool blend);
     Result<VkPipeline> compute_pipeline(const char* shader, const VkSpecializationInfo* specialization);
-    Result<LayeredPipelines*> layered_pipelines(uint32_t layers);
+    Result<LayeredPipelines*> layered_pipelines(uint32_t layers, bool compute);
     void read_back_stats(FrameSlot& slot);
     void build_quads(std::span<const DrawnGlyph> glyphs);
-    Status upload_quads(FrameSlot& slot);
+    void build_tiles();
+    Status upload(vk::DeviceBuffer& buffer, uint32_t& capacity, const void* data, uint32_t count, size_t size);
     void write_descriptors(const FrameSlot& slot, VkImageView atlas_view);
 };
 
@@ -164,11 +183,11 @@ Compositor::State::~State() {
     VkDevice device = ref.device;
     const VkAllocationCallbacks* allocator = ref.allocator;
     for (LayeredPipelines& p : layered) {
-        for (VkPipeline pipeline : {p.build, p.composite, p.resolve}) {
+        for (VkPipeline pipeline : {p.build, p.composite, p.resolve, p.build_compute, p.composite_compute}) {
             if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
         }
     }
-    for (VkPipeline pipeline : {unsorted, wboit, exact, wboit_resolve, exact_resolve}) {
+    for (VkPipeline pipeline : {unsorted, wboit, exact, wboit_resolve, exact_resolve, wboit_compute, exact_compute}) {
         if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
     }
     for (auto& [name, shader] : modules) vkDestroyShaderModule(device, shader, allocator);
@@ -181,6 +200,7 @@ Compositor::State::~State() {
     if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, allocator);
     for (FrameSlot& slot : slots) {
         vk::destroy_buffer(ref, slot.quads);
+        vk::destroy_buffer(ref, slot.tiles);
         vk::destroy_buffer(ref, slot.stats);
     }
     for (vk::DeviceBuffer& buffer : layer_buffers) vk::destroy_buffer(ref, buffer);
@@ -292,27 +312,37 @@ Result<VkPipeline> Compositor::State::compute_pipeline(const char* shader, const
     return pipeline;
 }
 
-Result<LayeredPipelines*> Compositor::State::layered_pipelines(uint32_t layers) {
+Result<LayeredPipelines*> Compositor::State::layered_pipelines(uint32_t layers, bool compute) {
     LayeredPipelines& p = layered[layers];
-    if (p.build && p.composite && p.resolve) return &p;
     // constant_id 0: K; 1: the pass (build, composite); 2: 64-bit keys (resolve).
     struct Constants {
         uint32_t layers, pass, key64;
     };
     const VkSpecializationMapEntry entries[3] = {
         {0, offsetof(Constants, layers), 4}, {1, offsetof(Constants, pass), 4}, {2, offsetof(Constants, key64), 4}};
-    const char* fragment = mono ? "layered32.frag" : "layered64.frag";
-    for (uint32_t pass = 0; pass < 3; ++pass) {
+    auto make = [&](VkPipeline& pipeline, uint32_t pass, const char* shader, bool graphics) -> Status {
+        if (pipeline) return {};
         const Constants constants{layers, pass, mono ? 0u : 1u};
         VkSpecializationInfo specialization{};
         specialization.mapEntryCount = 3;
         specialization.pMapEntries = entries;
         specialization.dataSize = sizeof(constants);
         specialization.pData = &constants;
-        Result<VkPipeline> made = pass < 2 ? graphics_pipeline(fragment, &specialization, false)
-                                           : compute_pipeline("layered_resolve.comp", &specialization);
+        Result<VkPipeline> made =
+            graphics ? graphics_pipeline(shader, &specialization, false) : compute_pipeline(shader, &specialization);
         if (!made) return made.error();
-        (pass == 0 ? p.build : pass == 1 ? p.composite : p.resolve) = *made;
+        pipeline = *made;
+        return {};
+    };
+    if (Status s = make(p.resolve, 2, "layered_resolve.comp", false); !s) return s.error();
+    if (compute) {
+        const char* shader = mono ? "layered32_quads.comp" : "layered64_quads.comp";
+        if (Status s = make(p.build_compute, 0, shader, false); !s) return s.error();
+        if (Status s = make(p.composite_compute, 1, shader, false); !s) return s.error();
+    } else {
+        const char* shader = mono ? "layered32.frag" : "layered64.frag";
+        if (Status s = make(p.build, 0, shader, true); !s) return s.error();
+        if (Status s = make(p.composite, 1, shader, true); !s) return s.error();
     }
     return &p;
 }
@@ -411,7 +441,9 @@ Status Compositor::State::create(const CompositorCreateInfo& info) {
         {kBindNodes, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
         {kBindStats, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
         {kBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stages, nullptr},
+        {kBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
     };
+    static_assert(std::size(bindings) == kBindingCount);
     VkDescriptorSetLayoutCreateInfo set_info{};
     set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
     set_info.bindingCount = static_cast<uint32_t>(std::size(bindings));
@@ -431,7 +463,7 @@ Status Compositor::State::create(const CompositorCreateInfo& info) {
     }
     const VkDescriptorPoolSize sizes[] = {
         {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2 * frames_in_flight},
-        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, (4 + gpu::kCompositeMaxLayerBuffers) * frames_in_flight},
+        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, (5 + gpu::kCompositeMaxLayerBuffers) * frames_in_flight},
     };
     VkDescriptorPoolCreateInfo pool_info{};
     pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
@@ -594,21 +626,34 @@ void Compositor::State::build_quads(std::span<const DrawnGlyph> glyphs) {
     stats.paint_order_blocks = blocks;
 }
 
-Status Compositor::State::upload_quads(FrameSlot& slot) {
-    const uint32_t count = static_cast<uint32_t>(quad_data.size());
-    if (count > slot.quad_capacity || !slot.quads.buffer) {
+void Compositor::State::build_tiles() {
+    tile_data.clear();
+    for (uint32_t i = 0; i < quad_data.size(); ++i) {
+        const gpu::CompositeQuad& q = quad_data[i];
+        for (uint32_t y = 0; y < q.height; y += gpu::kCompositeTile) {
+            for (uint32_t x = 0; x < q.width; x += gpu::kCompositeTile) {
+                tile_data.push_back(i);
+                tile_data.push_back(x | (y << 16));
+            }
+        }
+    }
+}
+
+Status Compositor::State::upload(vk::DeviceBuffer& buffer, uint32_t& capacity, const void* data, uint32_t count,
+                                 size_t size) {
+    if (count > capacity || !buffer.buffer) {
         // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
-        vk::destroy_buffer(ref, slot.quads);
-        slot.quad_capacity = 0;
-        const uint32_t capacity = std::max<uint32_t>(64, std::bit_ceil(std::max(count, 1u)));
-        if (Status s = vk::create_buffer(ref, VkDeviceSize{capacity} * sizeof(gpu::CompositeQuad),
-                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, slot.quads);
+        vk::destroy_buffer(ref, buffer);
+        capacity = 0;
+        const uint32_t grown = std::max<uint32_t>(64, std::bit_ceil(std::max(count, 1u)));
+        if (Status s = vk::create_buffer(ref, VkDeviceSize{grown} * size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
+                                         buffer);
             !s) {
             return s;
         }
-        slot.quad_capacity = capacity;
+        capacity = grown;
     }
-    if (count > 0) std::memcpy(slot.quads.mapped, quad_data.data(), count * sizeof(gpu::CompositeQuad));
+    if (count > 0) std::memcpy(buffer.mapped, data, count * size);
     return {};
 }
 
@@ -624,8 +669,9 @@ void Compositor::State::write_descriptors(const FrameSlot& slot, VkImageView atl
     const VkDescriptorBufferInfo accumulator_info{accumulators.buffer, 0, VK_WHOLE_SIZE};
     const VkDescriptorBufferInfo node_info{nodes.buffer, 0, VK_WHOLE_SIZE};
     const VkDescriptorBufferInfo stats_info{stats_words.buffer, 0, VK_WHOLE_SIZE};
-    VkWriteDescriptorSet writes[7]{};
-    for (uint32_t i = 0; i < 7; ++i) {
+    const VkDescriptorBufferInfo tiles_info{slot.tiles.buffer, 0, VK_WHOLE_SIZE};
+    VkWriteDescriptorSet writes[kBindingCount]{};
+    for (uint32_t i = 0; i < kBindingCount; ++i) {
         writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
         writes[i].dstSet = slot.set;
         writes[i].dstBinding = i;
@@ -642,7 +688,8 @@ void Compositor::State::write_descriptors(const FrameSlot& slot, VkImageView atl
     writes[kBindStats].pBufferInfo = &stats_info;
     writes[kBindTarget].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     writes[kBindTarget].pImageInfo = &target_info;
-    vkUpdateDescriptorSets(ref.device, 7, writes, 0, nullptr);
+    writes[kBindTiles].pBufferInfo = &tiles_info;
+    vkUpdateDescriptorSets(ref.device, kBindingCount, writes, 0, nullptr);
 }
 
 namespace {
@@ -730,18 +777,41 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     FrameSlot& slot = s.slots[s.frame % s.frames_in_flight];
     s.read_back_stats(slot);
 
+    const bool compute = params.path == QuadPath::compute && params.mode != CompositeMode::unsorted;
     uint32_t layers = 0;
     LayeredPipelines* layered = nullptr;
     if (params.mode == CompositeMode::layered) {
         layers = params.layers != kAutoLayers
                      ? params.layers
                      : (s.have_overlap ? std::clamp(s.last_overlap, 1u, s.max_layers) : s.max_layers);
-        Result<LayeredPipelines*> made = s.layered_pipelines(layers);
+        Result<LayeredPipelines*> made = s.layered_pipelines(layers, compute);
         if (!made) return made.error();
         layered = *made;
+    } else if (compute) {
+        const bool wboit = params.mode == CompositeMode::wboit;
+        VkPipeline& pipeline = wboit ? s.wboit_compute : s.exact_compute;
+        if (!pipeline) {
+            Result<VkPipeline> made = s.compute_pipeline(wboit ? "wboit_quads.comp" : "exact_quads.comp", nullptr);
+            if (!made) return made.error();
+            pipeline = *made;
+        }
     }
     s.build_quads(glyphs);
-    if (Status status = s.upload_quads(slot); !status) return status;
+    if (compute) {
+        s.build_tiles();
+    } else {
+        s.tile_data.clear();
+    }
+    const uint32_t tile_count = static_cast<uint32_t>(s.tile_data.size() / 2);
+    if (Status status = s.upload(slot.quads, slot.quad_capacity, s.quad_data.data(),
+                                 static_cast<uint32_t>(s.quad_data.size()), sizeof(gpu::CompositeQuad));
+        !status) {
+        return status;
+    }
+    if (Status status = s.upload(slot.tiles, slot.tile_capacity, s.tile_data.data(), tile_count, 2 * sizeof(uint32_t));
+        !status) {
+        return status;
+    }
     s.write_descriptors(slot, atlas_view);
 
     gpu::CompositePushConstants push{};
@@ -753,6 +823,7 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     push.pixels = s.pixels;
     push.layers_per_buffer = s.layers_per_buffer;
     push.node_capacity = s.node_capacity;
+    push.tile_count = tile_count;
 
     // Every earlier use of the buffers and the target (this compositor's last frames, the
     // caller's reads of the target) before this frame's clears and writes.
@@ -835,9 +906,27 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
         }
         vkCmdEndRenderPass(command_buffer);
     };
+    // The compute path: one workgroup per tile, in rows of kRasterDispatchWidth workgroups.
+    auto dispatch_tiles = [&](VkPipeline pipeline) {
+        if (tile_count == 0) return;
+        vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline_layout, 0, 1, &slot.set, 0,
+                                nullptr);
+        vkCmdPushConstants(command_buffer, s.pipeline_layout, push_stages, 0, sizeof(push), &push);
+        const uint32_t width = std::min(tile_count, gpu::kRasterDispatchWidth);
+        vkCmdDispatch(command_buffer, width, (tile_count + width - 1) / width, 1);
+    };
+    auto quads = [&](VkPipeline raster, VkPipeline computed) {
+        if (compute) {
+            dispatch_tiles(computed);
+        } else {
+            draw_quads(raster, false);
+        }
+    };
+    const VkPipelineStageFlags quad_stage =
+        compute ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
     auto fragment_to = [&](VkPipelineStageFlags stage) {
-        memory_barrier(command_buffer, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, stage,
-                       kShaderAccess);
+        memory_barrier(command_buffer, quad_stage, VK_ACCESS_SHADER_WRITE_BIT, stage, kShaderAccess);
     };
     auto resolve = [&](VkPipeline pipeline) {
         vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
@@ -851,19 +940,19 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     VkAccessFlags last_access = VK_ACCESS_SHADER_WRITE_BIT;
     switch (params.mode) {
         case CompositeMode::layered:
-            draw_quads(layered->build, false);
-            fragment_to(VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
-            draw_quads(layered->composite, false);
+            quads(layered->build, layered->build_compute);
+            fragment_to(quad_stage);
+            quads(layered->composite, layered->composite_compute);
             fragment_to(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
             resolve(layered->resolve);
             break;
         case CompositeMode::wboit:
-            draw_quads(s.wboit, false);
+            quads(s.wboit, s.wboit_compute);
             fragment_to(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
             resolve(s.wboit_resolve);
             break;
         case CompositeMode::exact:
-            draw_quads(s.exact, false);
+            quads(s.exact, s.exact_compute);
             fragment_to(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
             resolve(s.exact_resolve);
             break;
@@ -887,6 +976,8 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     slot.frame = s.frame;
     slot.mode = params.mode;
     s.stats.mode = params.mode;
+    s.stats.path = compute ? QuadPath::compute : QuadPath::raster;
+    s.stats.tiles = tile_count;
     s.stats.layers = layers;
     s.stats.mono_keys = params.mode == CompositeMode::layered && s.mono;
     s.stats.quads = quad_count;

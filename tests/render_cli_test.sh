@@ -56,6 +56,8 @@ seventeen=()
 for _ in $(seq 17); do seventeen+=(--font "$font"); done
 expect_exit 2 "17 fonts" -- "$render" "${seventeen[@]}" --text Hi --size 20 --origin 0,20 --canvas 48,32 -o x.png
 expect_exit 2 "one file for both outputs" -- "$render" "${base[@]}" -o same.out --coverage-out ./same.out
+expect_exit 2 "--path bogus" -- "$render" "${base[@]}" --path bogus -o x.png
+expect_stderr "bogus" "--path bogus"
 expect_exit 2 "--composite bogus" -- "$render" "${base[@]}" --composite bogus -o x.png
 expect_stderr "bogus" "--composite bogus"
 for layers in 0 9 -1 1.5 x ""; do
@@ -200,6 +202,12 @@ for mode in layered unsorted wboit exact; do
   [ ! -s "$work/err" ] || fail "--composite $mode wrote to stderr: $(head -c 400 "$work/err")"
 done
 cd "$work"
+# The compute path runs the same per-fragment code over tiles: the very same image.
+for mode in layered wboit exact; do
+  expect_exit 0 "--scene --composite $mode --path compute" -- "$render" --scene "$work/example/overlap.json" \
+    --samples 16 --composite "$mode" --path compute -o "$work/scene-$mode-compute.png"
+  cmp -s "$work/scene-$mode.png" "$work/scene-$mode-compute.png" || fail "--path compute changes the $mode image"
+done
 expect_exit 0 "--scene --layers 1" -- "$render" --scene "$work/example/overlap.json" --samples 16 --layers 1 \
   -o "$work/scene-layers1.png" --json
 cp "$work/out" "$work/scene-layers1.json"

@@ -188,7 +188,7 @@ constexpr float kBackground[4] = {0.9f, 0.85f, 0.7f, 1.0f};  // linear
 
 // Composites the scene's glyphs (in the given order) and returns linear premultiplied RGBA.
 std::vector<float> composite(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs,
-                             CompositeMode mode, uint32_t layers = kAutoLayers) {
+                             CompositeMode mode, uint32_t layers = kAutoLayers, QuadPath path = QuadPath::raster) {
     HeadlessContext& context = *fixture().context;
     const VkDeviceSize bytes = VkDeviceSize{kWidth} * kHeight * 4 * sizeof(float);
     auto readback = context.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
@@ -196,6 +196,7 @@ std::vector<float> composite(Compositor& compositor, const Scene& scene, std::sp
     CompositeParams params;
     params.mode = mode;
     params.layers = layers;
+    params.path = path;
     std::copy(kBackground, kBackground + 4, params.background);
     EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) {
         EXPECT_TRUE(compositor.record(cb, glyphs, scene.renderer->atlas_view(), params));
@@ -362,19 +363,50 @@ TEST(Compositor, ShuffledRunsGiveBitIdenticalImages) {
     std::vector<DrawnGlyph> reversed(shuffled.drawn.rbegin(), shuffled.drawn.rend());
     auto compositor = Compositor::create(compositor_info());
     ASSERT_TRUE(compositor);
-    for (CompositeMode mode : {CompositeMode::layered, CompositeMode::wboit, CompositeMode::exact}) {
-        for (uint32_t layers : {2u, 8u}) {
-            if (mode != CompositeMode::layered && layers != 8u) continue;
-            const std::vector<float> a = composite(*compositor, scene, mode, layers);
-            const std::vector<float> b = composite(*compositor, shuffled, reversed, mode, layers);
-            EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0)
-                << composite_mode_name(mode) << " K = " << layers;
+    for (QuadPath path : {QuadPath::raster, QuadPath::compute}) {
+        for (CompositeMode mode : {CompositeMode::layered, CompositeMode::wboit, CompositeMode::exact}) {
+            for (uint32_t layers : {2u, 8u}) {
+                if (mode != CompositeMode::layered && layers != 8u) continue;
+                const std::vector<float> a = composite(*compositor, scene, scene.drawn, mode, layers, path);
+                const std::vector<float> b = composite(*compositor, shuffled, reversed, mode, layers, path);
+                EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0)
+                    << composite_mode_name(mode) << " K = " << layers << ", " << quad_path_name(path);
+            }
         }
     }
     // Unsorted is order-dependent, and shows it: the same fragments give another image.
     const std::vector<float> a = composite(*compositor, scene, CompositeMode::unsorted);
     const std::vector<float> b = composite(*compositor, shuffled, reversed, CompositeMode::unsorted);
     EXPECT_NE(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+    expect_no_validation_messages();
+}
+
+// The compute path runs the same per-fragment code over tiles instead of rasterized quads: with
+// fixed-point sums and sorted lists the images are the same to the bit, for 64-bit and mono keys.
+TEST(Compositor, ComputeQuadPathMatchesTheRasterPathBitForBit) {
+    const Scene scene = render_scene(overlapping_runs(0.6f));
+    for (KeyFormat keys : {KeyFormat::rgb, KeyFormat::mono}) {
+        auto compositor = Compositor::create(compositor_info(keys));
+        ASSERT_TRUE(compositor);
+        for (CompositeMode mode : {CompositeMode::layered, CompositeMode::wboit, CompositeMode::exact}) {
+            for (uint32_t layers : {1u, 3u, 8u}) {
+                if (mode != CompositeMode::layered && layers != 8u) continue;
+                const std::vector<float> raster =
+                    composite(*compositor, scene, scene.drawn, mode, layers, QuadPath::raster);
+                const std::vector<float> computed =
+                    composite(*compositor, scene, scene.drawn, mode, layers, QuadPath::compute);
+                EXPECT_EQ(compositor->stats().path, QuadPath::compute);
+                EXPECT_GT(compositor->stats().tiles, 0u);
+                EXPECT_EQ(std::memcmp(raster.data(), computed.data(), raster.size() * sizeof(float)), 0)
+                    << composite_mode_name(mode) << " K = " << layers;
+            }
+        }
+        // Unsorted needs the blend unit's order: it stays rasterized.
+        composite(*compositor, scene, scene.drawn, CompositeMode::unsorted, kAutoLayers, QuadPath::compute);
+        EXPECT_EQ(compositor->stats().path, QuadPath::raster);
+    }
+    EXPECT_EQ(parse_quad_path("compute"), QuadPath::compute);
+    EXPECT_FALSE(parse_quad_path("mesh"));
     expect_no_validation_messages();
 }
 

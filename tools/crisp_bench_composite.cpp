@@ -66,6 +66,7 @@ struct Args {
     uint32_t samples = 512;
     uint32_t subpixel_steps = 4;
     crisp::KeyFormat keys = crisp::KeyFormat::automatic;
+    crisp::QuadPath path = crisp::QuadPath::raster;
     bool cpu_check = true;
     bool json = false;
     bool validate = false;
@@ -90,6 +91,8 @@ struct Args {
                  "  --subpixel-steps N subpixel positions per pixel in glyph keys (default 4)\n"
                  "  --layout NAME      subpixel layout preset or file (default rgb)\n"
                  "  --keys NAME        layered keys: auto, rgb or mono (default auto)\n"
+                 "  --path NAME        quad passes of layered, wboit and exact: raster or compute\n"
+                 "                     (default raster; unsorted is always rasterized)\n"
                  "  --no-cpu-check     skip checking the exact mode against the CPU reference\n"
                  "  --device TEXT      pick a device whose name contains TEXT\n"
                  "  --validate         turn the validation layer on\n"
@@ -186,6 +189,10 @@ Args parse(int argc, char** argv) {
                 args.keys = crisp::KeyFormat::mono;
             else
                 fail("--keys: auto, rgb or mono");
+        } else if (arg == "--path") {
+            const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(value());
+            if (!path) fail("--path: raster or compute");
+            args.path = *path;
         } else if (arg == "--no-cpu-check") {
             args.cpu_check = false;
         } else if (arg == "--device") {
@@ -460,6 +467,7 @@ struct Bench {
         crisp::CompositeParams params;
         params.mode = run.mode;
         params.layers = run.layers;
+        params.path = args.path;
         const float grey = crisp::srgb_to_linear(kBackgroundSrgb);
         params.background[0] = params.background[1] = params.background[2] = grey;
         params.background[3] = 1.0f;
@@ -549,6 +557,7 @@ void print_json(const Args& args, const Header& header, const std::vector<SceneR
     std::printf("  \"api_version\": %s,\n  \"int64_atomics\": %s,\n  \"layout\": %s,\n  \"layered_keys\": %s,\n",
                 json_string(header.api).c_str(), header.int64_atomics ? "true" : "false",
                 json_string(header.layout).c_str(), json_string(header.keys).c_str());
+    std::printf("  \"quad_path\": %s,\n", json_string(crisp::quad_path_name(args.path)).c_str());
     std::printf("  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
                 args.height, json_string(args.font).c_str(), static_cast<double>(args.size), args.samples);
     std::printf("  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"timed_frames\": %u,\n",
@@ -599,9 +608,10 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
     std::printf("Device: %s, driver %s (%s); Vulkan %s in use.\n", header.device.c_str(), header.driver_name.c_str(),
                 header.driver_info.c_str(), header.api.c_str());
     std::printf(
-        "64-bit buffer atomics: %s; layered keys: %s. Canvas %ux%u; %s at %g px, layout %s, %u subpixel "
-        "steps, %u samples per glyph; background sRGB %g grey.\n",
+        "64-bit buffer atomics: %s; layered keys: %s; quad passes: %s. Canvas %ux%u; %s at %g px, layout %s, %u "
+        "subpixel steps, %u samples per glyph; background sRGB %g grey.\n",
         header.int64_atomics ? "enabled" : "not available", header.keys == "mono" ? "mono (32-bit)" : "rgb (64-bit)",
+        crisp::quad_path_name(args.path),
         args.width, args.height, args.font.c_str(), static_cast<double>(args.size), header.layout.c_str(),
         args.subpixel_steps, args.samples, static_cast<double>(kBackgroundSrgb));
     for (const std::string& w : header.compositor_warnings) std::printf("Compositor: %s.\n", w.c_str());

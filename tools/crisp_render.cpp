@@ -95,6 +95,8 @@ options:
                            wboit (weighted blended OIT) or exact (per-pixel sorted lists)
   --layers K|auto          layered only: layers kept per pixel, 1..8, or auto: as many as the most
                            glyphs one pixel has (measured by a first composite; default auto)
+  --path raster|compute    how layered, wboit and exact run their glyph passes: rasterized quads
+                           (default) or compute over 8x8 tiles of each quad; the same image
   --coverage-out OUT.pfm   the text's linear coverage per channel as a PFM image
   --json                   print the report as one JSON object on stdout (compositor notes go
                            into it instead of stderr)
@@ -124,6 +126,7 @@ struct Arguments {
     crisp::CompositeMode composite = crisp::CompositeMode::layered;
     uint32_t layers = crisp::kAutoLayers;
     bool layers_given = false;
+    crisp::QuadPath path = crisp::QuadPath::raster;
     std::string output;
     std::string coverage_output;
     bool json = false;
@@ -234,6 +237,11 @@ Arguments parse_arguments(int argc, char** argv) {
                 usage_error("--composite takes layered, unsorted, wboit or exact, not '" + std::string(name) + "'");
             }
             args.composite = *mode;
+        } else if (arg == "--path") {
+            const std::string_view name = value();
+            const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(name);
+            if (!path) usage_error("--path takes raster or compute, not '" + std::string(name) + "'");
+            args.path = *path;
         } else if (arg == "--layers") {
             const std::string_view text = value();
             args.layers_given = true;
@@ -499,6 +507,7 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
     crisp::CompositeParams params;
     params.mode = args.composite;
     params.layers = args.layers;
+    params.path = args.path;
     for (size_t c = 0; c < 3; ++c) params.background[c] = crisp::srgb_to_linear(job.scene.background[c]);
     params.background[3] = job.scene.background[3];
 
@@ -773,6 +782,7 @@ std::string json_composite(const Arguments& args, const CompositeReport& c) {
     out += ", \"layers_requested\": " + (!layered                            ? std::string("null")
                                          : args.layers == crisp::kAutoLayers ? json_string("auto")
                                                                              : json_uint(args.layers));
+    out += ", \"path\": " + json_string(crisp::quad_path_name(s.path));
     out += ", \"layers\": " + uint_or_null(layered, s.layers);
     out += ", \"mono_keys\": " + (layered ? std::string(s.mono_keys ? "true" : "false") : std::string("null"));
     out += ", \"int64_atomics\": " + std::string(c.int64_atomics ? "true" : "false");
@@ -863,6 +873,7 @@ std::string human_composite(const Arguments& args, const CompositeReport& c) {
         out += ", K " + std::to_string(s.layers) + (args.layers == crisp::kAutoLayers ? " (auto)" : "") +
                (s.mono_keys ? ", mono keys" : ", rgb keys");
     }
+    if (s.path == crisp::QuadPath::compute) out += ", compute path";
     if (has_overlap(c)) out += ", max overlap " + std::to_string(s.max_overlap);
     if (s.measured && is_layered(c)) out += ", " + std::to_string(s.tail_pixels) + " tail pixels";
     if (s.measured && is_exact(c)) {

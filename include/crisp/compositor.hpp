@@ -79,8 +79,20 @@ struct CompositorCreateInfo {
     uint64_t max_layer_buffer_bytes = 0;
 };
 
+// How the quad passes of the layered, wboit and exact modes run (unsorted is always rasterized:
+// it needs the blend unit's submission order).
+enum class QuadPath {
+    raster,   // quads drawn, one fragment per pixel, early fragment tests (the seed's way)
+    compute,  // one compute invocation per pixel of each 8 x 8 tile of each quad: no rasterizer
+};
+// "raster", "compute".
+const char* quad_path_name(QuadPath path);
+// The path of that name; nullopt for any other string.
+std::optional<QuadPath> parse_quad_path(std::string_view name);
+
 struct CompositeParams {
     CompositeMode mode = CompositeMode::layered;
+    QuadPath path = QuadPath::raster;
     uint32_t layers = kAutoLayers;  // layered: 1..max_layers, or kAutoLayers
     // Linear colour and straight alpha of the background behind all glyphs.
     float background[4] = {1.0f, 1.0f, 1.0f, 1.0f};
@@ -89,6 +101,8 @@ struct CompositeParams {
 struct CompositorStats {
     // This frame (known when record() returns):
     CompositeMode mode = CompositeMode::layered;
+    QuadPath path = QuadPath::raster;  // the path this frame's quad passes took
+    uint32_t tiles = 0;                // compute path: 8 x 8 tiles dispatched
     uint32_t layers = 0;           // layered: the K this frame used
     bool mono_keys = false;        // layered: 32-bit keys
     uint32_t quads = 0;            // glyph quads drawn
