@@ -320,8 +320,9 @@ TEST(Compositor, LayeredMatchesTheCpuReferenceForEveryK) {
 }
 
 // Where a pixel's fragments all fit in the K layers, layered is exact up to the rounding of each
-// transmittance to 8 bits: within max(1, n / 2) / 255 for n fragments (docs/oit.md). Past K the
-// error falls as K grows.
+// transmittance to 8 bits. The rounding bound is max(1, n / 2) / 255 for n fragments (docs/oit.md);
+// the issue asks for 1/255, and these scenes (up to 6 fragments a pixel) keep to it. Past K the error
+// falls as K grows.
 TEST(Compositor, LayeredIsExactWhereTheOverlapFitsAndDegradesSmoothlyPastIt) {
     const Scene scene = render_scene(overlapping_runs(0.6f));
     auto compositor = Compositor::create(compositor_info());
@@ -338,7 +339,7 @@ TEST(Compositor, LayeredIsExactWhereTheOverlapFitsAndDegradesSmoothlyPastIt) {
                 const double error = std::abs(double{image[p * 4 + c]} - double{exact[p * 4 + c]});
                 sum += error * error;
                 if (n <= layers) {
-                    EXPECT_LE(error, std::max(1.0, static_cast<double>(n) / 2.0) / 255.0 + 1e-6)
+                    EXPECT_LE(error, 1.0 / 255.0 + 1e-6)
                         << "pixel " << p << ", " << n << " fragments, K = " << layers;
                 }
             }
@@ -443,7 +444,7 @@ TEST(Compositor, CoplanarGlyphsResolveByPaintOrder) {
             const size_t n = scene.pixels[p].size();
             if (n > layers) continue;
             for (size_t c = 0; c < 3; ++c) {
-                EXPECT_NEAR(first[p * 4 + c], exact[p * 4 + c], std::max(1.0, static_cast<double>(n) / 2.0) / 255.0 + 1e-6);
+                EXPECT_NEAR(first[p * 4 + c], exact[p * 4 + c], 1.0 / 255.0 + 1e-6);
             }
         }
     }
@@ -527,7 +528,7 @@ TEST(Compositor, OpaqueTextHidesWhatIsBehind) {
     for (size_t p = 0; p < scene.pixels.size(); ++p) {
         const auto& list = scene.pixels[p];
         for (size_t c = 0; c < 3; ++c) {
-            EXPECT_NEAR(layered[p * 4 + c], opaque[p * 4 + c], std::max(1.0, static_cast<double>(list.size()) / 2.0) / 255.0);
+            EXPECT_NEAR(layered[p * 4 + c], opaque[p * 4 + c], 1.0 / 255.0);
         }
         // The front glyph covers the pixel fully: exactly its colour, no green from behind.
         const bool front_opaque = !list.empty() && list.back().depth == 0.2f && list.back().transmittance[0] == 0.0f &&
