@@ -1,7 +1,7 @@
 // What every compositing quad pass starts from: its quad, its pixel and the glyph's coverage
 // there. Included after #version and the include extension by the *.frag shaders (a quad
 // rasterized: one fragment per pixel) and, with CRISP_COMPUTE defined, by the *_quads.comp shaders
-// (one invocation per pixel of an 8 x 8 tile of a quad, from the frame's tile list).
+// (one invocation per pixel of an 8 x 8 tile of a quad's rect, from the frame's tile list).
 #include "shared.h"
 
 #ifdef CRISP_COMPUTE
@@ -56,6 +56,8 @@ bool load_fragment(out GlyphFragment f) {
 #endif
     f.pixel = uint(pixel.y) * pc.width + uint(pixel.x);
     const ivec2 texel = ivec2(f.quad.atlas_x, f.quad.atlas_y) + pixel - ivec2(f.quad.x, f.quad.y);
+    // A rect that does not lie in the atlas (not from Renderer::drawn()) draws nothing there.
+    if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, imageSize(atlas)))) return false;
     const uvec4 sums = imageLoad(atlas, texel);
     if (sums.a == 0u) return false;
     const vec3 coverage = min(vec3(sums.rgb) / (float(kRasterCoverageOne) * float(sums.a)), vec3(1.0));

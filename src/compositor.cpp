@@ -628,12 +628,20 @@ void Compositor::State::build_quads(std::span<const DrawnGlyph> glyphs) {
 
 void Compositor::State::build_tiles() {
     tile_data.clear();
+    const int64_t tile = gpu::kCompositeTile;
     for (uint32_t i = 0; i < quad_data.size(); ++i) {
         const gpu::CompositeQuad& q = quad_data[i];
-        for (uint32_t y = 0; y < q.height; y += gpu::kCompositeTile) {
-            for (uint32_t x = 0; x < q.width; x += gpu::kCompositeTile) {
+        // Tiles are 8 x 8 blocks of the rect from its corner, their origins in the rect 16 bits
+        // each: a rect past 65536 texels a side (the renderer's are at most a few thousand) is
+        // not drawn. Only the tiles that reach the target are listed.
+        if (q.width > 0xFFFFu || q.height > 0xFFFFu) continue;
+        const int64_t x0 = std::max<int64_t>(0, -int64_t{q.x}), y0 = std::max<int64_t>(0, -int64_t{q.y});
+        const int64_t x1 = std::min<int64_t>(q.width, int64_t{width} - q.x);
+        const int64_t y1 = std::min<int64_t>(q.height, int64_t{height} - q.y);
+        for (int64_t y = y0 / tile * tile; y < y1; y += tile) {
+            for (int64_t x = x0 / tile * tile; x < x1; x += tile) {
                 tile_data.push_back(i);
-                tile_data.push_back(x | (y << 16));
+                tile_data.push_back(static_cast<uint32_t>(x | (y << 16)));
             }
         }
     }

@@ -385,7 +385,9 @@ TEST(Compositor, ShuffledRunsGiveBitIdenticalImages) {
 // The compute path runs the same per-fragment code over tiles instead of rasterized quads: with
 // fixed-point sums and sorted lists the images are the same to the bit, for 64-bit and mono keys.
 TEST(Compositor, ComputeQuadPathMatchesTheRasterPathBitForBit) {
-    const Scene scene = render_scene(overlapping_runs(0.6f));
+    std::vector<TextRun> runs = overlapping_runs(0.6f);
+    runs.push_back({"efonts", -9.3f, 8.0f, {0.5f, 0.5f, 0.1f, 0.8f}, 0.25f});  // off the left and top edges
+    const Scene scene = render_scene(runs);
     for (KeyFormat keys : {KeyFormat::rgb, KeyFormat::mono}) {
         auto compositor = Compositor::create(compositor_info(keys));
         ASSERT_TRUE(compositor);
@@ -408,6 +410,23 @@ TEST(Compositor, ComputeQuadPathMatchesTheRasterPathBitForBit) {
     }
     EXPECT_EQ(parse_quad_path("compute"), QuadPath::compute);
     EXPECT_FALSE(parse_quad_path("mesh"));
+    expect_no_validation_messages();
+}
+
+// Glyphs whose rect is not in the atlas (a caller's mistake) draw nothing where they miss it; the
+// rest of the frame is untouched and nothing reads outside the image.
+TEST(Compositor, RectsOutsideTheAtlasDrawNothing) {
+    const Scene scene = render_scene(overlapping_runs(0.6f));
+    auto compositor = Compositor::create(compositor_info());
+    ASSERT_TRUE(compositor);
+    std::vector<DrawnGlyph> broken = scene.drawn;
+    std::vector<DrawnGlyph> kept(scene.drawn.begin() + 1, scene.drawn.end());
+    broken[0].atlas_x = 1u << 20;
+    for (QuadPath path : {QuadPath::raster, QuadPath::compute}) {
+        const std::vector<float> a = composite(*compositor, scene, broken, CompositeMode::exact, kAutoLayers, path);
+        const std::vector<float> b = composite(*compositor, scene, kept, CompositeMode::exact, kAutoLayers, path);
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << quad_path_name(path);
+    }
     expect_no_validation_messages();
 }
 

@@ -150,7 +150,9 @@ public:
     // recording, outside a render pass. After it the target is readable by fragment and compute
     // shaders and transfers. Errors: invalid_argument for layers above max_layers, or exact with
     // no node pool; vulkan for a failed Vulkan call; either leaves no commands recorded.
-    // Non-finite colours or depths are clamped into range, never undefined behaviour.
+    // Non-finite colours or depths are clamped into range, never undefined behaviour; a glyph whose
+    // rect does not lie in the atlas draws nothing where it misses it, and on the compute path a
+    // rect over 65535 texels a side draws nothing (the renderer's are at most a few thousand).
     Status record(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
                   const CompositeParams& params);
 
