@@ -143,9 +143,7 @@ struct Compositor::State {
     vk::DeviceBuffer stats_words;   // device-local kStatWords
 
     std::map<std::string, VkShaderModule> modules;
-    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-    VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
-    VkDescriptorPool pool = VK_NULL_HANDLE;
+    vk::DescriptorSets descriptors;            // one set per frame in flight
     VkRenderPass empty_pass = VK_NULL_HANDLE;  // no attachments: the storage-only passes
     VkRenderPass color_pass = VK_NULL_HANDLE;  // the target as colour attachment: unsorted
     VkFramebuffer empty_framebuffer = VK_NULL_HANDLE;
@@ -153,7 +151,7 @@ struct Compositor::State {
     VkPipeline unsorted = VK_NULL_HANDLE, wboit = VK_NULL_HANDLE, exact = VK_NULL_HANDLE;
     VkPipeline wboit_resolve = VK_NULL_HANDLE, exact_resolve = VK_NULL_HANDLE;
     VkPipeline wboit_compute = VK_NULL_HANDLE, exact_compute = VK_NULL_HANDLE;  // made on first use
-    std::array<LayeredPipelines, kMaxCompositeLayers + 1> layered{};  // by K, made on first use
+    std::array<LayeredPipelines, kMaxCompositeLayers + 1> layered{};            // by K, made on first use
 
     std::vector<FrameSlot> slots;
     uint64_t frame = 0;
@@ -167,8 +165,7 @@ struct Compositor::State {
     ~State();
     Status create(const CompositorCreateInfo& info);
     Result<VkShaderModule> module(const char* name);
-    Result<VkPipeline> graphics_pipeline(const char* fragment, const VkSpecializationInfo* specialization,
-                                         bool blend);
+    Result<VkPipeline> graphics_pipeline(const char* fragment, const VkSpecializationInfo* specialization, bool blend);
     Result<VkPipeline> compute_pipeline(const char* shader, const VkSpecializationInfo* specialization);
     Result<LayeredPipelines*> layered_pipelines(uint32_t layers, bool compute);
     void read_back_stats(FrameSlot& slot);
@@ -195,9 +192,7 @@ Compositor::State::~State() {
     if (color_framebuffer) vkDestroyFramebuffer(device, color_framebuffer, allocator);
     if (empty_pass) vkDestroyRenderPass(device, empty_pass, allocator);
     if (color_pass) vkDestroyRenderPass(device, color_pass, allocator);
-    if (pool) vkDestroyDescriptorPool(device, pool, allocator);
-    if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, allocator);
-    if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, allocator);
+    vk::destroy_descriptor_sets(ref, descriptors);
     for (FrameSlot& slot : slots) {
         vk::destroy_buffer(ref, slot.quads);
         vk::destroy_buffer(ref, slot.tiles);
@@ -283,7 +278,7 @@ Result<VkPipeline> Compositor::State::graphics_pipeline(const char* fragment,
     info.pRasterizationState = &raster;
     info.pMultisampleState = &multisample;
     info.pColorBlendState = &color_blend;
-    info.layout = pipeline_layout;
+    info.layout = descriptors.pipeline_layout;
     info.renderPass = blend ? color_pass : empty_pass;
     VkPipeline pipeline = VK_NULL_HANDLE;
     if (VkResult r = vkCreateGraphicsPipelines(ref.device, VK_NULL_HANDLE, 1, &info, ref.allocator, &pipeline);
@@ -296,20 +291,7 @@ Result<VkPipeline> Compositor::State::graphics_pipeline(const char* fragment,
 Result<VkPipeline> Compositor::State::compute_pipeline(const char* shader, const VkSpecializationInfo* specialization) {
     Result<VkShaderModule> compute_module = module(shader);
     if (!compute_module) return compute_module.error();
-    VkComputePipelineCreateInfo info{};
-    info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    info.stage.module = *compute_module;
-    info.stage.pName = "main";
-    info.stage.pSpecializationInfo = specialization;
-    info.layout = pipeline_layout;
-    VkPipeline pipeline = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateComputePipelines(ref.device, VK_NULL_HANDLE, 1, &info, ref.allocator, &pipeline);
-        r != VK_SUCCESS) {
-        return vk::vulkan_error(std::string("vkCreateComputePipelines (") + shader + ")", r);
-    }
-    return pipeline;
+    return vk::create_compute_pipeline(ref, *compute_module, descriptors.pipeline_layout, specialization, shader);
 }
 
 Result<LayeredPipelines*> Compositor::State::layered_pipelines(uint32_t layers, bool compute) {
@@ -353,9 +335,9 @@ Status Compositor::State::create(const CompositorCreateInfo& info) {
     VkPhysicalDeviceFeatures features{};
     vkGetPhysicalDeviceFeatures(info.physical_device, &features);
     if (!features.fragmentStoresAndAtomics || !features.dualSrcBlend) {
-        return Error{ErrorCode::vulkan, std::string("compositor: ") + properties.deviceName + " lacks " +
-                                            (!features.fragmentStoresAndAtomics ? "fragmentStoresAndAtomics"
-                                                                                : "dualSrcBlend")};
+        return Error{ErrorCode::vulkan,
+                     std::string("compositor: ") + properties.deviceName + " lacks " +
+                         (!features.fragmentStoresAndAtomics ? "fragmentStoresAndAtomics" : "dualSrcBlend")};
     }
     VkFormatProperties format{};
     vkGetPhysicalDeviceFormatProperties(info.physical_device, kTargetFormat, &format);
@@ -444,47 +426,17 @@ Status Compositor::State::create(const CompositorCreateInfo& info) {
         {kBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
     };
     static_assert(std::size(bindings) == kBindingCount);
-    VkDescriptorSetLayoutCreateInfo set_info{};
-    set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    set_info.bindingCount = static_cast<uint32_t>(std::size(bindings));
-    set_info.pBindings = bindings;
-    if (VkResult r = vkCreateDescriptorSetLayout(device, &set_info, allocator, &set_layout); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateDescriptorSetLayout (compositor)", r);
-    }
-    const VkPushConstantRange push{stages, 0, sizeof(gpu::CompositePushConstants)};
-    VkPipelineLayoutCreateInfo layout_info{};
-    layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-    layout_info.setLayoutCount = 1;
-    layout_info.pSetLayouts = &set_layout;
-    layout_info.pushConstantRangeCount = 1;
-    layout_info.pPushConstantRanges = &push;
-    if (VkResult r = vkCreatePipelineLayout(device, &layout_info, allocator, &pipeline_layout); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreatePipelineLayout (compositor)", r);
-    }
-    const VkDescriptorPoolSize sizes[] = {
-        {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2 * frames_in_flight},
-        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, (5 + gpu::kCompositeMaxLayerBuffers) * frames_in_flight},
-    };
-    VkDescriptorPoolCreateInfo pool_info{};
-    pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-    pool_info.maxSets = frames_in_flight;
-    pool_info.poolSizeCount = static_cast<uint32_t>(std::size(sizes));
-    pool_info.pPoolSizes = sizes;
-    if (VkResult r = vkCreateDescriptorPool(device, &pool_info, allocator, &pool); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateDescriptorPool (compositor)", r);
+    if (Status s = vk::create_descriptor_sets(ref, bindings, stages, sizeof(gpu::CompositePushConstants),
+                                              frames_in_flight, "compositor", descriptors);
+        !s) {
+        return s;
     }
     slots.resize(frames_in_flight);
-    for (FrameSlot& slot : slots) {
-        VkDescriptorSetAllocateInfo set_allocate{};
-        set_allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-        set_allocate.descriptorPool = pool;
-        set_allocate.descriptorSetCount = 1;
-        set_allocate.pSetLayouts = &set_layout;
-        if (VkResult r = vkAllocateDescriptorSets(device, &set_allocate, &slot.set); r != VK_SUCCESS) {
-            return vk::vulkan_error("vkAllocateDescriptorSets (compositor)", r);
-        }
-        if (Status s = vk::create_buffer(ref, gpu::kStatWords * kWord, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true,
-                                         slot.stats);
+    for (uint32_t i = 0; i < frames_in_flight; ++i) {
+        FrameSlot& slot = slots[i];
+        slot.set = descriptors.sets[i];
+        if (Status s =
+                vk::create_buffer(ref, gpu::kStatWords * kWord, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, slot.stats);
             !s) {
             return s;
         }
@@ -564,10 +516,9 @@ void Compositor::State::read_back_stats(FrameSlot& slot) {
     stats.measured_frame = slot.frame;
     stats.max_overlap = words[gpu::kStatMaxOverlap];
     stats.tail_pixels = words[gpu::kStatTailPixels];
-    stats.exact_lost_nodes =
-        slot.mode == CompositeMode::exact && words[gpu::kStatNodesUsed] > node_capacity
-            ? words[gpu::kStatNodesUsed] - node_capacity
-            : 0;
+    stats.exact_lost_nodes = slot.mode == CompositeMode::exact && words[gpu::kStatNodesUsed] > node_capacity
+                                 ? words[gpu::kStatNodesUsed] - node_capacity
+                                 : 0;
     stats.exact_dropped = words[gpu::kStatListOverflow];
     if (slot.mode == CompositeMode::layered || slot.mode == CompositeMode::exact) {
         have_overlap = true;
@@ -597,7 +548,8 @@ void Compositor::State::build_quads(std::span<const DrawnGlyph> glyphs) {
         q.depth = clamp01(instance.depth);
         q.color = {clamp01(instance.color[0]), clamp01(instance.color[1]), clamp01(instance.color[2]),
                    clamp01(instance.color[3])};
-        orders.push_back({depth_bits(instance.depth, 32), instance.paint_order, static_cast<uint32_t>(quad_data.size())});
+        orders.push_back(
+            {depth_bits(instance.depth, 32), instance.paint_order, static_cast<uint32_t>(quad_data.size())});
         quad_data.push_back(q);
     }
     // Paint orders become dense ranks within each depth plane, so that the key's 8 bits of paint
@@ -654,8 +606,8 @@ Status Compositor::State::upload(vk::DeviceBuffer& buffer, uint32_t& capacity, c
         vk::destroy_buffer(ref, buffer);
         capacity = 0;
         const uint32_t grown = std::max<uint32_t>(64, std::bit_ceil(std::max(count, 1u)));
-        if (Status s = vk::create_buffer(ref, VkDeviceSize{grown} * size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
-                                         buffer);
+        if (Status s =
+                vk::create_buffer(ref, VkDeviceSize{grown} * size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, buffer);
             !s) {
             return s;
         }
@@ -780,7 +732,8 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
                                                       std::to_string(s.max_layers)};
     }
     if (params.mode == CompositeMode::exact && s.node_capacity == 0) {
-        return Error{ErrorCode::invalid_argument, "compositor: the exact mode needs a node pool (exact_nodes_per_pixel)"};
+        return Error{ErrorCode::invalid_argument,
+                     "compositor: the exact mode needs a node pool (exact_nodes_per_pixel)"};
     }
     FrameSlot& slot = s.slots[s.frame % s.frames_in_flight];
     s.read_back_stats(slot);
@@ -883,7 +836,8 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
         case CompositeMode::exact:
             vkCmdFillBuffer(command_buffer, s.accumulators.buffer, 0, pixel_words * gpu::kExactWords,
                             gpu::kCompositeNoNode);
-            buffer_bytes = pixel_words * gpu::kExactWords + VkDeviceSize{s.node_capacity} * gpu::kCompositeNodeWords * kWord;
+            buffer_bytes =
+                pixel_words * gpu::kExactWords + VkDeviceSize{s.node_capacity} * gpu::kCompositeNodeWords * kWord;
             break;
         case CompositeMode::unsorted:
             break;  // the colour pass clears the target to the background
@@ -907,9 +861,9 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
         vkCmdBeginRenderPass(command_buffer, &begin, VK_SUBPASS_CONTENTS_INLINE);
         if (quad_count > 0) {
             vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-            vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, s.pipeline_layout, 0, 1, &slot.set,
-                                    0, nullptr);
-            vkCmdPushConstants(command_buffer, s.pipeline_layout, push_stages, 0, sizeof(push), &push);
+            vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, s.descriptors.pipeline_layout, 0,
+                                    1, &slot.set, 0, nullptr);
+            vkCmdPushConstants(command_buffer, s.descriptors.pipeline_layout, push_stages, 0, sizeof(push), &push);
             vkCmdDraw(command_buffer, 4, quad_count, 0, 0);
         }
         vkCmdEndRenderPass(command_buffer);
@@ -918,9 +872,9 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     auto dispatch_tiles = [&](VkPipeline pipeline) {
         if (tile_count == 0) return;
         vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline_layout, 0, 1, &slot.set, 0,
-                                nullptr);
-        vkCmdPushConstants(command_buffer, s.pipeline_layout, push_stages, 0, sizeof(push), &push);
+        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.descriptors.pipeline_layout, 0, 1,
+                                &slot.set, 0, nullptr);
+        vkCmdPushConstants(command_buffer, s.descriptors.pipeline_layout, push_stages, 0, sizeof(push), &push);
         const uint32_t width = std::min(tile_count, gpu::kRasterDispatchWidth);
         vkCmdDispatch(command_buffer, width, (tile_count + width - 1) / width, 1);
     };
@@ -938,9 +892,9 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     };
     auto resolve = [&](VkPipeline pipeline) {
         vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline_layout, 0, 1, &slot.set, 0,
-                                nullptr);
-        vkCmdPushConstants(command_buffer, s.pipeline_layout, push_stages, 0, sizeof(push), &push);
+        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.descriptors.pipeline_layout, 0, 1,
+                                &slot.set, 0, nullptr);
+        vkCmdPushConstants(command_buffer, s.descriptors.pipeline_layout, push_stages, 0, sizeof(push), &push);
         vkCmdDispatch(command_buffer, (s.width + gpu::kCompositeTile - 1) / gpu::kCompositeTile,
                       (s.height + gpu::kCompositeTile - 1) / gpu::kCompositeTile, 1);
     };
@@ -971,8 +925,7 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
             break;
     }
     // The target for the caller; the stats words for the host.
-    memory_barrier(command_buffer, last_stage, last_access,
-                   kShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT,
+    memory_barrier(command_buffer, last_stage, last_access, kShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
     const VkBufferCopy copy{0, 0, gpu::kStatWords * kWord};
     vkCmdCopyBuffer(command_buffer, s.stats_words.buffer, slot.stats.buffer, 1, &copy);

@@ -62,11 +62,8 @@ struct Renderer::State {
     std::vector<Retired> retired;
 
     VkShaderModule shader = VK_NULL_HANDLE;
-    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-    VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+    vk::DescriptorSets descriptors;  // one set per frame in flight
     VkPipeline pipeline = VK_NULL_HANDLE;
-    VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
-    std::vector<VkDescriptorSet> sets;
 
     uint64_t frame = 0;
     struct Pending {
@@ -97,10 +94,8 @@ Renderer::State::~State() {
     }
     free_buffer(items);
     free_buffer(dummy);
-    if (descriptor_pool) vkDestroyDescriptorPool(device, descriptor_pool, allocator);
     if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
-    if (pipeline_layout) vkDestroyPipelineLayout(device, pipeline_layout, allocator);
-    if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, allocator);
+    vk::destroy_descriptor_sets({device, allocator, memory_properties}, descriptors);
     if (shader) vkDestroyShaderModule(device, shader, allocator);
     vk::destroy_image({device, allocator, memory_properties}, atlas_image);
 }
@@ -143,58 +138,18 @@ Status Renderer::State::create_objects() {
         {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kMaxRendererFonts, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
         {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kMaxRendererFonts, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
     };
-    VkDescriptorSetLayoutCreateInfo set_info{};
-    set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    set_info.bindingCount = static_cast<uint32_t>(std::size(bindings));
-    set_info.pBindings = bindings;
-    if (VkResult r = vkCreateDescriptorSetLayout(device, &set_info, allocator, &set_layout); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateDescriptorSetLayout", r);
-    }
-    VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::RasterPushConstants)};
-    VkPipelineLayoutCreateInfo layout_info{};
-    layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-    layout_info.setLayoutCount = 1;
-    layout_info.pSetLayouts = &set_layout;
-    layout_info.pushConstantRangeCount = 1;
-    layout_info.pPushConstantRanges = &push;
-    if (VkResult r = vkCreatePipelineLayout(device, &layout_info, allocator, &pipeline_layout); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreatePipelineLayout", r);
-    }
-    VkComputePipelineCreateInfo pipeline_info{};
-    pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipeline_info.stage.module = shader;
-    pipeline_info.stage.pName = "main";
-    pipeline_info.layout = pipeline_layout;
-    if (VkResult r = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipeline_info, allocator, &pipeline);
-        r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateComputePipelines", r);
-    }
-
     // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
-    const VkDescriptorPoolSize sizes[] = {
-        {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, frames_in_flight},
-        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, frames_in_flight * (1 + 2 * kMaxRendererFonts)},
-    };
-    VkDescriptorPoolCreateInfo pool{};
-    pool.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-    pool.maxSets = frames_in_flight;
-    pool.poolSizeCount = static_cast<uint32_t>(std::size(sizes));
-    pool.pPoolSizes = sizes;
-    if (VkResult r = vkCreateDescriptorPool(device, &pool, allocator, &descriptor_pool); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateDescriptorPool", r);
+    const vk::DeviceRef ref{device, allocator, memory_properties};
+    if (Status s =
+            vk::create_descriptor_sets(ref, bindings, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(gpu::RasterPushConstants),
+                                       frames_in_flight, "renderer", descriptors);
+        !s) {
+        return s;
     }
-    sets.resize(frames_in_flight);
-    std::vector<VkDescriptorSetLayout> layouts(frames_in_flight, set_layout);
-    VkDescriptorSetAllocateInfo set_allocate{};
-    set_allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-    set_allocate.descriptorPool = descriptor_pool;
-    set_allocate.descriptorSetCount = frames_in_flight;
-    set_allocate.pSetLayouts = layouts.data();
-    if (VkResult r = vkAllocateDescriptorSets(device, &set_allocate, sets.data()); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkAllocateDescriptorSets", r);
-    }
+    Result<VkPipeline> made =
+        vk::create_compute_pipeline(ref, shader, descriptors.pipeline_layout, nullptr, "raster.comp");
+    if (!made) return made.error();
+    pipeline = *made;
     return {};
 }
 
@@ -521,11 +476,11 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
                                  VK_PIPELINE_STAGE_TRANSFER_BIT,
                              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &readers, 0, nullptr, 0, nullptr);
 
-        const VkDescriptorSet set = s.sets[frame % s.frames_in_flight];
+        const VkDescriptorSet set = s.descriptors.sets[frame % s.frames_in_flight];
         s.write_descriptors(set);
         vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline);
-        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline_layout, 0, 1, &set, 0,
-                                nullptr);
+        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.descriptors.pipeline_layout, 0, 1,
+                                &set, 0, nullptr);
         gpu::RasterPushConstants push{};
         for (size_t c = 0; c < 3; ++c) {
             const SampleRect& r = s.layout.channels[c];
@@ -534,7 +489,8 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         push.item_count = static_cast<uint32_t>(s.item_data.size());
         push.workgroup_count = workgroups;
         push.shared_rows = s.shared_row_roots && shares_sample_rows(s.layout) ? 1u : 0u;
-        vkCmdPushConstants(command_buffer, s.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdPushConstants(command_buffer, s.descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
+                           &push);
         const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);
         const uint32_t height = (workgroups + gpu::kRasterDispatchWidth - 1) / gpu::kRasterDispatchWidth;
         vkCmdDispatch(command_buffer, width, height, 1);

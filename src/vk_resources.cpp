@@ -84,8 +84,8 @@ void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer) {
     buffer = {};
 }
 
-Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height,
-                    VkImageUsageFlags usage, const char* what, DeviceImage& out) {
+Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height, VkImageUsageFlags usage,
+                    const char* what, DeviceImage& out) {
     out = {};
     VkImageCreateInfo image{};
     image.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
@@ -105,8 +105,8 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     }
     VkMemoryRequirements requirements{};
     vkGetImageMemoryRequirements(device.device, out.image, &requirements);
-    const auto type = find_memory_type(device.memory_properties, requirements.memoryTypeBits,
-                                       VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
+    const auto type =
+        find_memory_type(device.memory_properties, requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
     if (!type) {
         destroy_image(device, out);
         return Error{ErrorCode::vulkan, std::string("no device-local memory type for the ") + what + " image"};
@@ -138,6 +138,88 @@ void destroy_image(const DeviceRef& device, DeviceImage& image) {
     if (image.image) vkDestroyImage(device.device, image.image, device.allocator);
     if (image.memory) vkFreeMemory(device.device, image.memory, device.allocator);
     image = {};
+}
+
+Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescriptorSetLayoutBinding> bindings,
+                              VkShaderStageFlags push_stages, uint32_t push_bytes, uint32_t set_count, const char* what,
+                              DescriptorSets& out) {
+    out = {};
+    const std::string suffix = std::string(" (") + what + ")";
+    auto failed = [&](const char* call, VkResult r) {
+        destroy_descriptor_sets(device, out);
+        return vulkan_error(call + suffix, r);
+    };
+    VkDescriptorSetLayoutCreateInfo set_info{};
+    set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+    set_info.bindingCount = static_cast<uint32_t>(bindings.size());
+    set_info.pBindings = bindings.data();
+    if (VkResult r = vkCreateDescriptorSetLayout(device.device, &set_info, device.allocator, &out.set_layout);
+        r != VK_SUCCESS) {
+        return failed("vkCreateDescriptorSetLayout", r);
+    }
+    const VkPushConstantRange push{push_stages, 0, push_bytes};
+    VkPipelineLayoutCreateInfo layout_info{};
+    layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+    layout_info.setLayoutCount = 1;
+    layout_info.pSetLayouts = &out.set_layout;
+    layout_info.pushConstantRangeCount = push_bytes > 0 ? 1 : 0;
+    layout_info.pPushConstantRanges = &push;
+    if (VkResult r = vkCreatePipelineLayout(device.device, &layout_info, device.allocator, &out.pipeline_layout);
+        r != VK_SUCCESS) {
+        return failed("vkCreatePipelineLayout", r);
+    }
+    // The pool holds exactly the descriptors of set_count sets.
+    std::vector<VkDescriptorPoolSize> sizes;
+    for (const VkDescriptorSetLayoutBinding& binding : bindings) {
+        auto it = std::find_if(sizes.begin(), sizes.end(),
+                               [&](const VkDescriptorPoolSize& size) { return size.type == binding.descriptorType; });
+        if (it == sizes.end()) it = sizes.insert(sizes.end(), {binding.descriptorType, 0});
+        it->descriptorCount += binding.descriptorCount * set_count;
+    }
+    VkDescriptorPoolCreateInfo pool_info{};
+    pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+    pool_info.maxSets = set_count;
+    pool_info.poolSizeCount = static_cast<uint32_t>(sizes.size());
+    pool_info.pPoolSizes = sizes.data();
+    if (VkResult r = vkCreateDescriptorPool(device.device, &pool_info, device.allocator, &out.pool); r != VK_SUCCESS) {
+        return failed("vkCreateDescriptorPool", r);
+    }
+    const std::vector<VkDescriptorSetLayout> layouts(set_count, out.set_layout);
+    out.sets.resize(set_count);
+    VkDescriptorSetAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    allocate.descriptorPool = out.pool;
+    allocate.descriptorSetCount = set_count;
+    allocate.pSetLayouts = layouts.data();
+    if (VkResult r = vkAllocateDescriptorSets(device.device, &allocate, out.sets.data()); r != VK_SUCCESS) {
+        return failed("vkAllocateDescriptorSets", r);
+    }
+    return {};
+}
+
+void destroy_descriptor_sets(const DeviceRef& device, DescriptorSets& sets) {
+    if (sets.pool) vkDestroyDescriptorPool(device.device, sets.pool, device.allocator);  // frees the sets
+    if (sets.pipeline_layout) vkDestroyPipelineLayout(device.device, sets.pipeline_layout, device.allocator);
+    if (sets.set_layout) vkDestroyDescriptorSetLayout(device.device, sets.set_layout, device.allocator);
+    sets = {};
+}
+
+Result<VkPipeline> create_compute_pipeline(const DeviceRef& device, VkShaderModule module, VkPipelineLayout layout,
+                                           const VkSpecializationInfo* specialization, const char* what) {
+    VkComputePipelineCreateInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+    info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = module;
+    info.stage.pName = "main";
+    info.stage.pSpecializationInfo = specialization;
+    info.layout = layout;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    if (VkResult r = vkCreateComputePipelines(device.device, VK_NULL_HANDLE, 1, &info, device.allocator, &pipeline);
+        r != VK_SUCCESS) {
+        return vulkan_error(std::string("vkCreateComputePipelines (") + what + ")", r);
+    }
+    return pipeline;
 }
 
 Result<VkShaderModule> create_embedded_shader(const DeviceRef& device, std::string_view name) {

@@ -7,6 +7,8 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
+#include <vector>
 #include <string>
 #include <string_view>
 
@@ -54,9 +56,28 @@ struct DeviceImage {
 
 // Makes `out` in VK_IMAGE_LAYOUT_UNDEFINED. On failure what was made is destroyed and the error
 // names the call and `what` ("atlas").
-Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height,
-                    VkImageUsageFlags usage, const char* what, DeviceImage& out);
+Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height, VkImageUsageFlags usage,
+                    const char* what, DeviceImage& out);
 void destroy_image(const DeviceRef& device, DeviceImage& image);
+
+// One descriptor set layout, a pipeline layout over it with one push-constant range at offset 0,
+// and a pool holding `sets.size()` sets of it (one per frame in flight, typically).
+struct DescriptorSets {
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    std::vector<VkDescriptorSet> sets;
+};
+
+// Makes `out`; on failure what was made is destroyed and the error names the call and `what`.
+Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescriptorSetLayoutBinding> bindings,
+                              VkShaderStageFlags push_stages, uint32_t push_bytes, uint32_t set_count, const char* what,
+                              DescriptorSets& out);
+void destroy_descriptor_sets(const DeviceRef& device, DescriptorSets& sets);
+
+// A compute pipeline of `module`'s "main" with `layout`.
+Result<VkPipeline> create_compute_pipeline(const DeviceRef& device, VkShaderModule module, VkPipelineLayout layout,
+                                           const VkSpecializationInfo* specialization, const char* what);
 
 // A shader module from SPIR-V embedded in the library ("raster.comp"); `name` must be embedded.
 Result<VkShaderModule> create_embedded_shader(const DeviceRef& device, std::string_view name);
