@@ -251,7 +251,7 @@ LinearRgb resolve_layers(const LayeredPixel& pixel, std::span<const Fragment> fr
         Contribution contribution{key, {}};
         if (has_tail && key == last_key) {
             ++group_count;
-            for (int c = 0; c < 3; ++c) group_light[c] += double{f.light[c]};
+            for (int c = 0; c < 3; ++c) group_light[c] += static_cast<double>(f.light[c]);
             continue;
         }
         if (has_tail && key > last_key) {
