@@ -946,6 +946,14 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     return {};
 }
 
+Status Compositor::prepare_layered(QuadPath path) {
+    for (uint32_t layers = 1; layers <= state_->max_layers; ++layers) {
+        Result<LayeredPipelines*> made = state_->layered_pipelines(layers, path == QuadPath::compute);
+        if (!made) return made.error();
+    }
+    return {};
+}
+
 void Compositor::record_target_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const {
     const State& s = *state_;
     // To the layout copies are fast in and back to GENERAL, where the compositor keeps the target.

@@ -569,6 +569,7 @@ TEST(Compositor, AutoLayersFollowTheMeasuredOverlap) {
     info.frames_in_flight = 1;
     auto compositor = Compositor::create(info);
     ASSERT_TRUE(compositor);
+    EXPECT_TRUE(compositor->prepare_layered(QuadPath::raster));  // no pipeline built mid-frame below
     composite(*compositor, scene, CompositeMode::layered, kAutoLayers);
     EXPECT_EQ(compositor->stats().layers, kMaxCompositeLayers);  // nothing measured yet
     EXPECT_FALSE(compositor->stats().measured);

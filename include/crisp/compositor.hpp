@@ -156,6 +156,11 @@ public:
     Status record(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
                   const CompositeParams& params);
 
+    // Builds every pipeline the layered mode can use on `path` (K = 1 to max_layers), so that a
+    // frame whose K changes (kAutoLayers follows the overlap) does not compile one mid-frame. Without
+    // it each K's pipelines are built by the first record() that uses them. Errors: vulkan.
+    Status prepare_layered(QuadPath path);
+
     // Records a copy of the target into `buffer` (offset 0, width * height * 4 floats, row-major,
     // premultiplied linear RGBA), with barriers; the buffer is ready for host reads once the
     // command buffer completes.
