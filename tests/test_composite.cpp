@@ -58,14 +58,7 @@ Fixture& fixture() {
         EXPECT_TRUE(context) << (context ? "" : context.error().message);
         if (context) made.context = std::make_unique<HeadlessContext>(std::move(*context));
         made.int64 = true;
-        BakeOptions bake;
-        bake.all_glyphs = false;
-        bake.codepoints = decode_utf8("Hamburgefonstiv@&1");
-        auto baked = bake_font_file(test::kDejaVuSans, bake);
-        if (baked) {
-            auto font = Font::create(std::move(baked->asset), 1);
-            if (font) made.font = std::make_unique<Font>(std::move(*font));
-        }
+        made.font = test::bake_test_font("Hamburgefonstiv@&1");
         return made;
     }();
     return f;

@@ -29,14 +29,7 @@ Fixture& fixture() {
         options.validation = true;
         auto context = HeadlessContext::create(options);
         if (context) made.context = std::make_unique<HeadlessContext>(std::move(*context));
-        BakeOptions bake;
-        bake.all_glyphs = false;
-        bake.codepoints = decode_utf8("Hg@&1");
-        auto baked = bake_font_file(test::kDejaVuSans, bake);
-        if (baked) {
-            auto font = Font::create(std::move(baked->asset), 1);
-            if (font) made.font = std::make_unique<Font>(std::move(*font));
-        }
+        made.font = test::bake_test_font("Hg@&1");
         return made;
     }();
     return f;

@@ -1,12 +1,17 @@
 // Shared by the tests: where the fonts are, and reading files.
 #pragma once
 
+#include <crisp/bake.hpp>
+#include <crisp/font.hpp>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -22,6 +27,18 @@ inline const std::string kInterVariable = source_path("fonts/Inter-roman.var.ttf
 // From Debian packages that scripts/setup.sh installs.
 inline const std::string kNotoCjk = "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc";       // CFF collection
 inline const std::string kCantarell = "/usr/share/fonts/opentype/cantarell/Cantarell-Regular.otf";  // CFF, 1000 upem
+
+// DejaVu Sans baked with only the glyphs of `text`, as FontId `id`; null when baking fails (the
+// test's own checks then fail).
+inline std::unique_ptr<Font> bake_test_font(std::string_view text, FontId id = 1) {
+    BakeOptions bake;
+    bake.all_glyphs = false;
+    bake.codepoints = decode_utf8(text);
+    auto baked = bake_font_file(kDejaVuSans, bake);
+    if (!baked) return nullptr;
+    auto font = Font::create(std::move(baked->asset), id);
+    return font ? std::make_unique<Font>(std::move(*font)) : nullptr;
+}
 
 inline std::vector<std::byte> read_file(const std::string& path) {
     std::ifstream file(path, std::ios::binary);

@@ -5,6 +5,7 @@
 
 #include "embedded_shaders.hpp"
 #include "shared.h"
+#include "vk_resources.hpp"
 
 #include <gtest/gtest.h>
 
@@ -103,109 +104,62 @@ uint32_t lowbias32(uint32_t x) {
 }
 
 // The objects of one compute pipeline with one storage buffer at binding 0 and push constants,
-// destroyed in reverse order of creation.
+// made with the library's own helpers (vk_resources.hpp), destroyed in reverse order of creation.
 struct ComputeKernel {
-    VkDevice device = VK_NULL_HANDLE;
+    vk::DeviceRef device;
     VkShaderModule module = VK_NULL_HANDLE;
-    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-    VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+    vk::DescriptorSets descriptors;  // one set
     VkPipeline pipeline = VK_NULL_HANDLE;
-    VkDescriptorPool pool = VK_NULL_HANDLE;
-    VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
 
     ComputeKernel() = default;
     ComputeKernel(const ComputeKernel&) = delete;
     ComputeKernel& operator=(const ComputeKernel&) = delete;
     ~ComputeKernel() {
-        if (device == VK_NULL_HANDLE) return;
-        vkDestroyDescriptorPool(device, pool, nullptr);
-        vkDestroyPipeline(device, pipeline, nullptr);
-        vkDestroyPipelineLayout(device, pipeline_layout, nullptr);
-        vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
-        vkDestroyShaderModule(device, module, nullptr);
+        if (device.device == VK_NULL_HANDLE) return;
+        vkDestroyPipeline(device.device, pipeline, nullptr);
+        vk::destroy_descriptor_sets(device, descriptors);
+        vkDestroyShaderModule(device.device, module, nullptr);
     }
 };
 
-// Builds `kernel` for the embedded shader `name`, bound to `storage`; the first failure's VkResult.
-VkResult create_kernel(ComputeKernel& kernel, VkDevice device, const char* name, uint32_t push_constant_size,
-                       const Buffer& storage) {
+// Builds `kernel` for the test shader `name`, bound to `storage`.
+Status create_kernel(ComputeKernel& kernel, VkDevice device, const char* name, uint32_t push_constant_size,
+                     const Buffer& storage) {
     const test_shaders::EmbeddedShader* shader = test_shaders::find_embedded_shader(name);
-    if (shader == nullptr) return VK_ERROR_INITIALIZATION_FAILED;
-    kernel.device = device;
+    if (shader == nullptr) return Error{ErrorCode::vulkan, std::string(name) + " is not embedded"};
+    kernel.device.device = device;
 
     VkShaderModuleCreateInfo module_info{};
     module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
     module_info.codeSize = shader->size;
     module_info.pCode = shader->code;
-    if (VkResult r = vkCreateShaderModule(device, &module_info, nullptr, &kernel.module); r != VK_SUCCESS) return r;
-
-    VkDescriptorSetLayoutBinding binding{};
-    binding.binding = 0;
-    binding.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    binding.descriptorCount = 1;
-    binding.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    VkDescriptorSetLayoutCreateInfo set_layout_info{};
-    set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    set_layout_info.bindingCount = 1;
-    set_layout_info.pBindings = &binding;
-    if (VkResult r = vkCreateDescriptorSetLayout(device, &set_layout_info, nullptr, &kernel.set_layout);
-        r != VK_SUCCESS) {
-        return r;
+    if (VkResult r = vkCreateShaderModule(device, &module_info, nullptr, &kernel.module); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateShaderModule", r);
     }
-
-    VkPushConstantRange push_range{};
-    push_range.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    push_range.size = push_constant_size;
-    VkPipelineLayoutCreateInfo layout_info{};
-    layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-    layout_info.setLayoutCount = 1;
-    layout_info.pSetLayouts = &kernel.set_layout;
-    layout_info.pushConstantRangeCount = 1;
-    layout_info.pPushConstantRanges = &push_range;
-    if (VkResult r = vkCreatePipelineLayout(device, &layout_info, nullptr, &kernel.pipeline_layout); r != VK_SUCCESS) {
-        return r;
+    const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT,
+                                               nullptr};
+    if (Status s = vk::create_descriptor_sets(kernel.device, std::span(&binding, 1), VK_SHADER_STAGE_COMPUTE_BIT,
+                                              push_constant_size, 1, name, kernel.descriptors);
+        !s) {
+        return s;
     }
-
-    VkComputePipelineCreateInfo pipeline_info{};
-    pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipeline_info.stage.module = kernel.module;
-    pipeline_info.stage.pName = "main";
-    pipeline_info.layout = kernel.pipeline_layout;
-    if (VkResult r = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &kernel.pipeline);
-        r != VK_SUCCESS) {
-        return r;
-    }
-
-    VkDescriptorPoolSize pool_size{};
-    pool_size.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    pool_size.descriptorCount = 1;
-    VkDescriptorPoolCreateInfo pool_info{};
-    pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-    pool_info.maxSets = 1;
-    pool_info.poolSizeCount = 1;
-    pool_info.pPoolSizes = &pool_size;
-    if (VkResult r = vkCreateDescriptorPool(device, &pool_info, nullptr, &kernel.pool); r != VK_SUCCESS) return r;
-    VkDescriptorSetAllocateInfo set_info{};
-    set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-    set_info.descriptorPool = kernel.pool;
-    set_info.descriptorSetCount = 1;
-    set_info.pSetLayouts = &kernel.set_layout;
-    if (VkResult r = vkAllocateDescriptorSets(device, &set_info, &kernel.set); r != VK_SUCCESS) return r;
+    Result<VkPipeline> pipeline =
+        vk::create_compute_pipeline(kernel.device, kernel.module, kernel.descriptors.pipeline_layout, nullptr, name);
+    if (!pipeline) return pipeline.error();
+    kernel.pipeline = *pipeline;
 
     VkDescriptorBufferInfo buffer_info{};
     buffer_info.buffer = storage.handle();
     buffer_info.range = VK_WHOLE_SIZE;
     VkWriteDescriptorSet write{};
     write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    write.dstSet = kernel.set;
+    write.dstSet = kernel.descriptors.sets[0];
     write.dstBinding = 0;
     write.descriptorCount = 1;
     write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     write.pBufferInfo = &buffer_info;
     vkUpdateDescriptorSets(device, 1, &write, 0, nullptr);
-    return VK_SUCCESS;
+    return {};
 }
 
 // Runs selftest.comp over `count` invocations and returns what it wrote (empty after a failure,
@@ -219,17 +173,19 @@ std::vector<SelftestResult> run_selftest(HeadlessContext& context, uint32_t coun
         return {};
     }
     ComputeKernel kernel;
-    if (VkResult r = create_kernel(kernel, context.device(), "selftest.comp", sizeof(SelftestPushConstants), *results);
-        r != VK_SUCCESS) {
-        ADD_FAILURE() << "creating the selftest pipeline: " << vk_result_name(r);
+    if (Status s = create_kernel(kernel, context.device(), "selftest.comp", sizeof(SelftestPushConstants), *results);
+        !s) {
+        ADD_FAILURE() << "creating the selftest pipeline: " << s.error().message;
         return {};
     }
     const SelftestPushConstants push{count, seed};
     Status ran = context.submit_and_wait([&](VkCommandBuffer commands) {
         vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.pipeline);
-        vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.pipeline_layout, 0, 1, &kernel.set, 0,
+        vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.descriptors.pipeline_layout, 0, 1,
+                                &kernel.descriptors.sets[0], 0,
                                 nullptr);
-        vkCmdPushConstants(commands, kernel.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+        vkCmdPushConstants(commands, kernel.descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
+                           &push);
         vkCmdDispatch(commands, (count + gpu::kSelftestWorkgroupSize - 1) / gpu::kSelftestWorkgroupSize, 1, 1);
     });
     if (!ran) {

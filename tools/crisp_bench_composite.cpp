@@ -5,6 +5,8 @@
 // and its bytes per pixel. The exact mode is itself checked against the CPU reference
 // (src/oit_reference). Prints Markdown (or JSON with --json); docs/benchmarks-compositing.md.
 #include "cli.hpp"
+#include "gpu_tools.hpp"
+#include "vk_resources.hpp"
 #include "image_io.hpp"
 #include "oit_reference.hpp"
 
@@ -213,38 +215,6 @@ Args parse(int argc, char** argv) {
 
 // ---- Device
 
-// What the renderer (as crisp-render asks) and the compositor need; int64 atomics only when asked.
-struct DeviceRequirements {
-    VkPhysicalDeviceFeatures2 features{};
-    VkPhysicalDeviceVulkan12Features vulkan12{};
-};
-
-crisp::Result<crisp::HeadlessContext> create_context(const Args& args, bool int64_atomics) {
-    DeviceRequirements requirements;
-    requirements.features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    requirements.features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;
-    requirements.features.features.fragmentStoresAndAtomics = VK_TRUE;
-    requirements.features.features.dualSrcBlend = VK_TRUE;
-    if (int64_atomics) {
-        requirements.features.features.shaderInt64 = VK_TRUE;
-        requirements.vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
-        requirements.vulkan12.shaderBufferInt64Atomics = VK_TRUE;
-        requirements.features.pNext = &requirements.vulkan12;
-    }
-    crisp::HeadlessContextOptions options;
-    options.validation = args.validate;
-    options.synchronization_validation = args.validate_sync;
-    options.device_name_contains = args.device;
-    options.required_features = &requirements.features;
-    options.required_compute_subgroup_operations = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
-    return crisp::HeadlessContext::create(options);
-}
-
-std::string version_string(uint32_t version) {
-    return std::to_string(VK_API_VERSION_MAJOR(version)) + "." + std::to_string(VK_API_VERSION_MINOR(version)) + "." +
-           std::to_string(VK_API_VERSION_PATCH(version));
-}
-
 // ---- Scenes
 
 // A fixed-seed mt19937: its raw outputs are the same with every standard library (its
@@ -450,9 +420,7 @@ struct Bench {
     const Args& args;
     crisp::HeadlessContext& context;
     crisp::Renderer& renderer;
-    VkQueryPool queries = VK_NULL_HANDLE;
-    double period_ns = 1.0;
-    uint64_t timestamp_mask = ~uint64_t{0};
+    const crisp::tools::GpuTimer& timer;
     crisp::Buffer& target_readback;
     std::vector<std::string>& warnings;
 
@@ -477,21 +445,17 @@ struct Bench {
             // drawn() list stays valid until its next begin_frame(). Leaving it out keeps the GPU's
             // idle gaps between frames short.
             const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
-                vkCmdResetQueryPool(cb, queries, 0, 2);
-                vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
+                timer.begin(cb);
                 if (crisp::Status s = compositor.record(cb, renderer.drawn(), renderer.atlas_view(), params); !s) {
                     fail(mode_label(run) + ": " + s.error().message);
                 }
-                vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
+                timer.end(cb);
                 if (last) compositor.record_target_readback(cb, target_readback.handle());
             });
             if (!status) fail(status.error().message);
-            uint64_t stamps[2] = {};
-            const VkResult got =
-                vkGetQueryPoolResults(context.device(), queries, 0, 2, sizeof stamps, stamps, sizeof(uint64_t),
-                                      VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
-            if (got != VK_SUCCESS) fail("vkGetQueryPoolResults: " + crisp::vk_result_name(got));
-            return static_cast<double>((stamps[1] - stamps[0]) & timestamp_mask) * period_ns * 1e-6;
+            const crisp::Result<double> ms = timer.milliseconds();
+            if (!ms) fail(ms.error().message);
+            return *ms;
         };
         const auto start = std::chrono::steady_clock::now();
         auto elapsed_ms = [&] {
@@ -684,15 +648,15 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
 int main(int argc, char** argv) {
     const Args args = parse(argc, argv);
 
-    bool int64_atomics = true;
-    auto context = create_context(args, true);
-    if (!context) {
-        const std::string first_error = context.error().message;
-        int64_atomics = false;
-        context = create_context(args, false);
-        if (!context) fail(first_error + "; without 64-bit atomics: " + context.error().message);
-        std::fprintf(stderr, "no device with shaderInt64 and shaderBufferInt64Atomics (%s): layered keys are mono\n",
-                     first_error.c_str());
+    crisp::HeadlessContextOptions options;
+    options.validation = args.validate;
+    options.synchronization_validation = args.validate_sync;
+    options.device_name_contains = args.device;
+    bool int64_atomics = false;
+    auto context = crisp::tools::create_context(options, int64_atomics);
+    if (!context) fail(context.error().message);
+    if (!int64_atomics) {
+        std::fprintf(stderr, "no device with shaderInt64 and shaderBufferInt64Atomics: layered keys are mono\n");
     }
 
     auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});
@@ -725,18 +689,8 @@ int main(int argc, char** argv) {
     std::string text;
     while (static_cast<double>(text.size()) < characters) text += prose;
 
-    VkQueryPoolCreateInfo query_info{};
-    query_info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
-    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    query_info.queryCount = 2;
-    VkQueryPool queries = VK_NULL_HANDLE;
-    if (vkCreateQueryPool(context->device(), &query_info, nullptr, &queries) != VK_SUCCESS) fail("no query pool");
-    uint32_t family_count = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(context->physical_device(), &family_count, nullptr);
-    std::vector<VkQueueFamilyProperties> families(family_count);
-    vkGetPhysicalDeviceQueueFamilyProperties(context->physical_device(), &family_count, families.data());
-    const uint32_t valid_bits = families.at(context->queue_family()).timestampValidBits;
-    if (valid_bits == 0) fail("the queue has no timestamps");
+    auto timer = crisp::tools::GpuTimer::create(*context);
+    if (!timer) fail(timer.error().message);
 
     const size_t pixels = size_t{args.width} * args.height;
     auto target_readback = context->create_buffer(pixels * 4 * sizeof(float), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -755,9 +709,7 @@ int main(int argc, char** argv) {
     Bench bench{args,
                 *context,
                 *renderer,
-                queries,
-                static_cast<double>(context->properties().limits.timestampPeriod),
-                valid_bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << valid_bits) - 1,
+                *timer,
                 *target_readback,
                 warnings};
 
@@ -766,7 +718,7 @@ int main(int argc, char** argv) {
     header.driver_name = context->driver_name();
     header.driver_info = context->driver_info();
     header.driver_version = context->driver_version();
-    header.api = version_string(context->api_version());
+    header.api = crisp::vk::version_string(context->api_version());
     header.int64_atomics = int64_atomics;
     header.layout = layout->name;
 
@@ -861,7 +813,6 @@ int main(int argc, char** argv) {
             results.push_back(std::move(result));
         }
     }
-    vkDestroyQueryPool(context->device(), queries, nullptr);
 
     if (args.json)
         print_json(args, header, results, warnings);

@@ -2,6 +2,7 @@
 // glyphs, 8 samples each) through the converging frames to converged static text. Measures with
 // Vulkan timestamp queries around the recorded work; prints Markdown (or JSON with --json).
 #include "cli.hpp"
+#include "gpu_tools.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
@@ -115,7 +116,8 @@ int main(int argc, char** argv) {
     crisp::HeadlessContextOptions options;
     options.validation = args.validate;
     options.device_name_contains = args.device;
-    auto context = crisp::HeadlessContext::create(options);
+    bool int64_atomics = false;  // the rasterizer does not use them
+    auto context = crisp::tools::create_context(options, int64_atomics);
     if (!context) fail(context.error().message);
 
     auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});
@@ -159,38 +161,30 @@ int main(int argc, char** argv) {
         if (g.y + static_cast<int32_t>(g.height) <= static_cast<int32_t>(args.height)) screen.push_back(g);
     }
 
-    VkQueryPoolCreateInfo query_info{};
-    query_info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
-    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    query_info.queryCount = 2;
-    VkQueryPool queries = VK_NULL_HANDLE;
-    if (vkCreateQueryPool(context->device(), &query_info, nullptr, &queries) != VK_SUCCESS) fail("no query pool");
-    const double period_ns = static_cast<double>(context->properties().limits.timestampPeriod);
+    auto timer = crisp::tools::GpuTimer::create(*context);
+    if (!timer) fail(timer.error().message);
 
     std::vector<Frame> frames;
     for (uint32_t f = 0; f < args.max_frames; ++f) {
         renderer->begin_frame();
         renderer->draw(screen);
         const auto status = context->submit_and_wait([&](VkCommandBuffer cb) {
-            vkCmdResetQueryPool(cb, queries, 0, 2);
-            vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
+            timer->begin(cb);
             if (auto s = renderer->record(cb); !s) fail(s.error().message);
-            vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
+            timer->end(cb);
         });
         if (!status) fail(status.error().message);
-        uint64_t stamps[2] = {};
-        vkGetQueryPoolResults(context->device(), queries, 0, 2, sizeof stamps, stamps, sizeof(uint64_t),
-                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+        const crisp::Result<double> gpu_ms = timer->milliseconds();
+        if (!gpu_ms) fail(gpu_ms.error().message);
         Frame frame;
         frame.index = f;
         frame.samples = renderer->stats().samples;
         frame.items = renderer->stats().work_items;
         frame.curve_tests = renderer->stats().curve_tests;
-        frame.gpu_ms = static_cast<double>(stamps[1] - stamps[0]) * period_ns * 1e-6;
+        frame.gpu_ms = *gpu_ms;
         frames.push_back(frame);
         if (renderer->converged() && frame.items == 0) break;
     }
-    vkDestroyQueryPool(context->device(), queries, nullptr);
 
     const crisp::AtlasStats& atlas = renderer->atlas().stats();
     std::printf(

@@ -2,6 +2,7 @@
 // GPU with crisp::Compositor into a PNG and, on request, reads the atlas back for a PFM of the
 // text's coverage. The text comes from the command line or from a scene file.
 #include "cli.hpp"
+#include "gpu_tools.hpp"
 #include "image_io.hpp"
 #include "json.hpp"
 #include "scene.hpp"
@@ -348,49 +349,6 @@ std::string json_uint(uint64_t v) {
 
 int exit_code_for_vulkan(const crisp::Error& error) {
     return error.code == crisp::ErrorCode::vulkan ? kExitVulkan : kExitInternal;
-}
-
-// What the renderer's compute shader and the compositor need enabled on the device
-// (Renderer::create, CompositorCreateInfo). Holds the feature chain, so it stays where it is made.
-struct DeviceRequirements {
-    VkPhysicalDeviceFeatures2 features{};
-    VkPhysicalDeviceVulkan12Features vulkan12{};
-};
-
-// With int64_atomics, also the 64-bit buffer atomics that give layered compositing RGB keys.
-void require_device_features(DeviceRequirements& requirements, crisp::HeadlessContextOptions& options,
-                             bool int64_atomics) {
-    requirements.features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    requirements.features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;
-    requirements.features.features.fragmentStoresAndAtomics = VK_TRUE;
-    requirements.features.features.dualSrcBlend = VK_TRUE;
-    if (int64_atomics) {
-        requirements.features.features.shaderInt64 = VK_TRUE;
-        requirements.vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
-        requirements.vulkan12.shaderBufferInt64Atomics = VK_TRUE;
-        requirements.features.pNext = &requirements.vulkan12;
-    }
-    options.required_features = &requirements.features;
-    options.required_compute_subgroup_operations = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
-}
-
-// A device with 64-bit buffer atomics if one qualifies, else one without them (int64_atomics
-// says which). When no device has them, the second attempt's error is the one reported: it names
-// what else is missing.
-crisp::Result<crisp::HeadlessContext> create_context(const Arguments& args, bool& int64_atomics) {
-    auto attempt = [&](bool int64) {
-        crisp::HeadlessContextOptions options;
-        options.validation = args.validate;
-        options.device_name_contains = args.device;
-        DeviceRequirements requirements;
-        require_device_features(requirements, options, int64);
-        return crisp::HeadlessContext::create(options);
-    };
-    int64_atomics = true;
-    crisp::Result<crisp::HeadlessContext> context = attempt(true);
-    if (context) return context;
-    int64_atomics = false;
-    return attempt(false);
 }
 
 // The atlas block a rect takes (see atlas.hpp): cells rounded up to powers of two per axis, then
@@ -1000,7 +958,11 @@ int run(const Arguments& args) {
     lay_out(args, job);
 
     RenderReport report;
-    crisp::Result<crisp::HeadlessContext> context = create_context(args, report.composite.int64_atomics);
+    crisp::HeadlessContextOptions options;
+    options.validation = args.validate;
+    options.device_name_contains = args.device;
+    crisp::Result<crisp::HeadlessContext> context =
+        crisp::tools::create_context(options, report.composite.int64_atomics);
     if (!context) fail(exit_code_for_vulkan(context.error()), "Vulkan: " + context.error().message);
 
     if (const int code = render(*context, args, job, report); code != kExitOk) return code;

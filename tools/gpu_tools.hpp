@@ -1,0 +1,113 @@
+// Shared by crisp's GPU tools: a headless context with what the renderer and the compositor need
+// (docs/vulkan.md), and a GPU timer from timestamp queries.
+#pragma once
+
+#include <crisp/result.hpp>
+#include <crisp/vulkan_context.hpp>
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace crisp::tools {
+
+// A context from `options` (validation, device name) plus the features crisp's renderer and
+// compositor need, with shaderInt64 and shaderBufferInt64Atomics where a device qualifies and
+// without them otherwise; `int64_atomics` says which. When neither attempt finds a device, the
+// error is the second attempt's (it names what else is missing), prefixed by the first's.
+inline Result<HeadlessContext> create_context(HeadlessContextOptions options, bool& int64_atomics) {
+    auto attempt = [&](bool int64) {
+        VkPhysicalDeviceVulkan12Features vulkan12{};
+        vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+        vulkan12.shaderBufferInt64Atomics = VK_TRUE;
+        VkPhysicalDeviceFeatures2 features{};
+        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+        features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;  // the renderer
+        features.features.fragmentStoresAndAtomics = VK_TRUE;                // the compositor
+        features.features.dualSrcBlend = VK_TRUE;
+        if (int64) {
+            features.features.shaderInt64 = VK_TRUE;  // the compositor's 64-bit keys
+            features.pNext = &vulkan12;
+        }
+        HeadlessContextOptions with = options;
+        with.required_features = &features;  // read during create() only
+        with.required_compute_subgroup_operations = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+        return HeadlessContext::create(with);
+    };
+    int64_atomics = true;
+    Result<HeadlessContext> context = attempt(true);
+    if (context) return context;
+    const std::string first = context.error().message;
+    int64_atomics = false;
+    context = attempt(false);
+    if (context) return context;
+    return Error{context.error().code, first + "; without 64-bit atomics: " + context.error().message};
+}
+
+// The GPU time between two points of a command buffer, from a pool of two timestamp queries.
+// Move-only; destroy it before its context.
+class GpuTimer {
+public:
+    static Result<GpuTimer> create(const HeadlessContext& context) {
+        uint32_t family_count = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(context.physical_device(), &family_count, nullptr);
+        std::vector<VkQueueFamilyProperties> families(family_count);
+        vkGetPhysicalDeviceQueueFamilyProperties(context.physical_device(), &family_count, families.data());
+        const uint32_t bits = families.at(context.queue_family()).timestampValidBits;
+        if (bits == 0) return Error{ErrorCode::vulkan, "the queue has no timestamps"};
+        GpuTimer timer;
+        timer.device_ = context.device();
+        timer.period_ns_ = static_cast<double>(context.properties().limits.timestampPeriod);
+        timer.mask_ = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
+        VkQueryPoolCreateInfo info{};
+        info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+        info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+        info.queryCount = 2;
+        if (VkResult r = vkCreateQueryPool(timer.device_, &info, nullptr, &timer.pool_); r != VK_SUCCESS) {
+            return Error{ErrorCode::vulkan, "vkCreateQueryPool failed: " + vk_result_name(r)};
+        }
+        return timer;
+    }
+    GpuTimer(GpuTimer&& other) noexcept { *this = std::move(other); }
+    GpuTimer& operator=(GpuTimer&& other) noexcept {
+        std::swap(device_, other.device_);
+        std::swap(pool_, other.pool_);
+        period_ns_ = other.period_ns_;
+        mask_ = other.mask_;
+        return *this;
+    }
+    GpuTimer(const GpuTimer&) = delete;
+    GpuTimer& operator=(const GpuTimer&) = delete;
+    ~GpuTimer() {
+        if (pool_) vkDestroyQueryPool(device_, pool_, nullptr);
+    }
+
+    // Around the work to time, in one command buffer.
+    void begin(VkCommandBuffer command_buffer) const {
+        vkCmdResetQueryPool(command_buffer, pool_, 0, 2);
+        vkCmdWriteTimestamp(command_buffer, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, pool_, 0);
+    }
+    void end(VkCommandBuffer command_buffer) const {
+        vkCmdWriteTimestamp(command_buffer, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, 1);
+    }
+    // Once that command buffer has completed: the milliseconds between begin and end.
+    Result<double> milliseconds() const {
+        uint64_t stamps[2] = {};
+        const VkResult r = vkGetQueryPoolResults(device_, pool_, 0, 2, sizeof stamps, stamps, sizeof(uint64_t),
+                                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+        if (r != VK_SUCCESS) return Error{ErrorCode::vulkan, "vkGetQueryPoolResults failed: " + vk_result_name(r)};
+        return static_cast<double>((stamps[1] - stamps[0]) & mask_) * period_ns_ * 1e-6;
+    }
+
+private:
+    GpuTimer() = default;
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueryPool pool_ = VK_NULL_HANDLE;
+    double period_ns_ = 1.0;
+    uint64_t mask_ = ~uint64_t{0};
+};
+
+}  // namespace crisp::tools
