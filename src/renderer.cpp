@@ -2,6 +2,7 @@
 #include "vk_resources.hpp"
 
 #include <crisp/renderer.hpp>
+#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <array>
@@ -181,6 +182,16 @@ void Renderer::State::write_descriptors(VkDescriptorSet set) {
     writes[3].descriptorCount = kMaxRendererFonts;
     writes[3].pBufferInfo = band_infos.data();
     vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
+}
+
+RendererCreateInfo renderer_create_info(const HeadlessContext& context) {
+    RendererCreateInfo info;
+    info.instance = context.instance();
+    info.physical_device = context.physical_device();
+    info.device = context.device();
+    info.queue_family = context.queue_family();
+    info.allocator = context.allocation_callbacks();
+    return info;
 }
 
 Result<Renderer> Renderer::create(const RendererCreateInfo& info) {

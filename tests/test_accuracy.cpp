@@ -58,11 +58,7 @@ struct Texel {
 Accuracy render_and_measure(const Font& font, std::span<const GlyphInstance> glyphs, const SubpixelLayout& layout,
                             uint32_t samples, uint32_t atlas_size = 512) {
     HeadlessContext& ctx = *context();
-    RendererCreateInfo info;
-    info.instance = ctx.instance();
-    info.physical_device = ctx.physical_device();
-    info.device = ctx.device();
-    info.queue_family = ctx.queue_family();
+    RendererCreateInfo info = renderer_create_info(ctx);
     info.atlas.width = info.atlas.height = atlas_size;
     info.atlas.max_samples = samples;
     info.atlas.frame_budget = uint64_t{1} << 40;

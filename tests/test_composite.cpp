@@ -87,11 +87,7 @@ Scene render_scene(const std::vector<TextRun>& runs, const char* layout_name = "
     Fixture& f = fixture();
     HeadlessContext& context = *f.context;
     Scene scene;
-    RendererCreateInfo info;
-    info.instance = context.instance();
-    info.physical_device = context.physical_device();
-    info.device = context.device();
-    info.queue_family = context.queue_family();
+    RendererCreateInfo info = renderer_create_info(context);
     info.atlas.width = info.atlas.height = 256;
     info.atlas.max_samples = kSamples;
     info.layout = *subpixel_preset(layout_name);

@@ -130,11 +130,7 @@ Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, u
 
 Result<Renderer> make_renderer(const SubpixelLayout& layout, uint32_t samples) {
     const HeadlessContext& context = *fixture().context;
-    RendererCreateInfo info;
-    info.instance = context.instance();
-    info.physical_device = context.physical_device();
-    info.device = context.device();
-    info.queue_family = context.queue_family();
+    RendererCreateInfo info = renderer_create_info(context);
     info.atlas.width = info.atlas.height = 256;
     info.atlas.max_samples = samples;
     info.layout = layout;
@@ -249,11 +245,7 @@ TEST(Raster, TwoRenderersOnTwoContextsWorkSideBySide) {
     options.validation = true;
     auto second = HeadlessContext::create(options);
     ASSERT_TRUE(second) << second.error().message;
-    RendererCreateInfo info;
-    info.instance = second->instance();
-    info.physical_device = second->physical_device();
-    info.device = second->device();
-    info.queue_family = second->queue_family();
+    RendererCreateInfo info = renderer_create_info(*second);
     info.atlas.width = info.atlas.height = 256;
     info.atlas.max_samples = 8;
     auto other = Renderer::create(info);

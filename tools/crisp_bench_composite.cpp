@@ -667,11 +667,7 @@ int main(int argc, char** argv) {
     if (!layout) fail(layout.error().message);
     const bool gray_layout = layout->channels[0] == layout->channels[1] && layout->channels[1] == layout->channels[2];
 
-    crisp::RendererCreateInfo info;
-    info.instance = context->instance();
-    info.physical_device = context->physical_device();
-    info.device = context->device();
-    info.queue_family = context->queue_family();
+    crisp::RendererCreateInfo info = crisp::renderer_create_info(*context);
     info.frames_in_flight = kFramesInFlight;
     info.atlas.max_samples = args.samples;
     info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: converge in as few frames as the ramp allows

@@ -127,11 +127,7 @@ int main(int argc, char** argv) {
     auto layout = crisp::resolve_subpixel_layout(args.layout);
     if (!layout) fail(layout.error().message);
 
-    crisp::RendererCreateInfo info;
-    info.instance = context->instance();
-    info.physical_device = context->physical_device();
-    info.device = context->device();
-    info.queue_family = context->queue_family();
+    crisp::RendererCreateInfo info = crisp::renderer_create_info(*context);
     info.atlas.max_samples = args.samples;
     info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: the benchmark measures raw throughput
     info.layout = *layout;

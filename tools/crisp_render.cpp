@@ -583,12 +583,7 @@ int read_atlas_rects(crisp::HeadlessContext& context, const crisp::Renderer& ren
 }
 
 int render(crisp::HeadlessContext& context, const Arguments& args, const Job& job, RenderReport& report) {
-    crisp::RendererCreateInfo info;
-    info.instance = context.instance();
-    info.physical_device = context.physical_device();
-    info.device = context.device();
-    info.queue_family = context.queue_family();
-    info.allocator = context.allocation_callbacks();
+    crisp::RendererCreateInfo info = crisp::renderer_create_info(context);
     info.layout = job.layout;
     info.atlas.max_samples = args.samples;
     for (uint32_t& samples : info.atlas.ramp) samples = std::min(samples, args.samples);

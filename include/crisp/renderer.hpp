@@ -53,6 +53,12 @@ struct RendererCreateInfo {
     bool shared_row_roots = true;
 };
 
+class HeadlessContext;
+
+// A RendererCreateInfo for the objects `context` made (instance, devices, queue family,
+// allocator), the rest at its defaults. For tools and tests; an engine fills in its own objects.
+RendererCreateInfo renderer_create_info(const HeadlessContext& context);
+
 // A glyph drawn this frame whose rect holds samples: where its texels are in the atlas.
 struct DrawnGlyph {
     GlyphInstance instance;
