@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The demo: installs what is missing, builds crisp, bakes the bundled fonts (showing each bake's
 # report), renders a paragraph with subpixel anti-aliasing into a PNG on the GPU (lavapipe when
-# there is no GPU), composites a scene of overlapping translucent text with layered
+# there is no GPU), composites it over a photo-like backdrop and a gradient with the tile path,
+# composites a scene of overlapping translucent text with the tiled
 # order-independent transparency and, to compare, unsorted, and prints where the images are.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -31,9 +32,20 @@ build/tools/crisp-render --font "$out/DejaVuSans.crisp" --text "$paragraph" --si
 build/tools/crisp-render --font "$out/DejaVuSans.crisp" --text "$paragraph" --size 17 --origin 12.3,26.6 \
   --canvas 560,110 --layout gray -o "$out/paragraph-gray.png" >/dev/null
 echo
-echo "== crisp-render --scene: overlapping translucent runs at three depths, layered OIT and unsorted"
+echo "== crisp-render: the same paragraph composited by the tile path over a photo-like backdrop and a"
+echo "   gradient, with rgb, bgr and vrgb subpixel layouts (coverage stays per channel over any scene)"
+for layout in rgb bgr vrgb; do
+  build/tools/crisp-render --font "$out/DejaVuSans.crisp" --text "$paragraph" --size 17 --origin 12.3,26.6 \
+    --canvas 560,110 --layout "$layout" --color 1,1,1,1 --background 0.1,0.2,0.4 --backdrop photo \
+    -o "$out/paragraph-photo-$layout.png" >/dev/null
+done
+build/tools/crisp-render --font "$out/DejaVuSans.crisp" --text "$paragraph" --size 17 --origin 12.3,26.6 \
+  --canvas 560,110 --layout rgb --color 0.05,0.05,0.1 --background 0.95,0.8,0.5 --backdrop gradient \
+  -o "$out/paragraph-gradient-rgb.png"
+echo
+echo "== crisp-render --scene: overlapping translucent runs at three depths, tiled (exact order) and unsorted"
 cp docs/examples/overlap.json "$out/overlap.json"  # its font path is relative to the scene file
-build/tools/crisp-render --scene "$out/overlap.json" --composite layered -o "$out/overlap-layered.png"
+build/tools/crisp-render --scene "$out/overlap.json" --composite tiled -o "$out/overlap-tiled.png"
 build/tools/crisp-render --scene "$out/overlap.json" --composite unsorted -o "$out/overlap-unsorted.png" >/dev/null
 echo
 echo "The assets are in $(pwd)/$out:"
@@ -41,6 +53,9 @@ ls -1 "$(pwd)/$out"/*.crisp
 echo "The rendered paragraph (subpixel rgb, and grayscale to compare):"
 echo "$(pwd)/$out/paragraph-rgb.png"
 echo "$(pwd)/$out/paragraph-gray.png"
-echo "The scene, composited in depth order (layered) and in draw order (unsorted):"
-echo "$(pwd)/$out/overlap-layered.png"
+echo "Over a photo-like backdrop (rgb, bgr, vrgb) and a gradient (rgb):"
+for layout in rgb bgr vrgb; do echo "$(pwd)/$out/paragraph-photo-$layout.png"; done
+echo "$(pwd)/$out/paragraph-gradient-rgb.png"
+echo "The scene, composited in depth order (tiled) and in draw order (unsorted):"
+echo "$(pwd)/$out/overlap-tiled.png"
 echo "$(pwd)/$out/overlap-unsorted.png"

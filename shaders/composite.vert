@@ -17,9 +17,11 @@ layout(std430, set = 0, binding = 1) readonly buffer Quads {
 layout(location = 0) flat out uint v_quad;
 
 void main() {
-    const CompositeQuad q = quads[gl_InstanceIndex];
+    // The draw path's quads are sorted front to back: drawn in reverse, "over" is exact.
+    const uint index = pc.back_to_front != 0u ? pc.quad_count - 1u - uint(gl_InstanceIndex) : uint(gl_InstanceIndex);
+    const CompositeQuad q = quads[index];
     const vec2 corner = vec2(float(gl_VertexIndex & 1), float(gl_VertexIndex >> 1));
     const vec2 p = vec2(q.x, q.y) + corner * vec2(q.width, q.height);
     gl_Position = vec4(p / vec2(pc.width, pc.height) * 2.0 - 1.0, 0.0, 1.0);
-    v_quad = gl_InstanceIndex;
+    v_quad = index;
 }

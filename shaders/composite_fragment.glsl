@@ -20,6 +20,8 @@ layout(std430, set = 0, binding = 1) readonly buffer Quads {
     CompositeQuad quads[];
 };
 
+#include "glyph_texel.glsl"
+
 #ifdef CRISP_COMPUTE
 // Per tile: the quad's index, and the tile's top-left texel in the quad's rect (x | y << 16).
 layout(std430, set = 0, binding = 7) readonly buffer Tiles {
@@ -52,16 +54,12 @@ bool load_fragment(out GlyphFragment f) {
     if (pixel.x < 0 || pixel.y < 0 || pixel.x >= int(pc.width) || pixel.y >= int(pc.height)) return false;
 #else
     f.quad = quads[v_quad];
-    const ivec2 pixel = ivec2(gl_FragCoord.xy);
+    // The draw path's viewport is the caller's rect; glyph positions are relative to its corner.
+    const ivec2 pixel = ivec2(gl_FragCoord.xy) - ivec2(pc.origin_x, pc.origin_y);
 #endif
     f.pixel = uint(pixel.y) * pc.width + uint(pixel.x);
-    const ivec2 texel = ivec2(f.quad.atlas_x, f.quad.atlas_y) + pixel - ivec2(f.quad.x, f.quad.y);
     // A rect that does not lie in the atlas (not from Renderer::drawn()) draws nothing there.
-    if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, imageSize(atlas)))) return false;
-    const uvec4 sums = imageLoad(atlas, texel);
-    if (sums.a == 0u) return false;
-    const vec3 coverage = min(vec3(sums.rgb) / (float(kRasterCoverageOne) * float(sums.a)), vec3(1.0));
-    f.opacity = f.quad.color.a * coverage;
+    if (!glyph_texel_opacity(f.quad, pixel, f.opacity)) return false;
     f.transmittance = 1.0 - f.opacity;
     f.light = f.quad.color.rgb * f.opacity;
     return true;

@@ -160,15 +160,84 @@ struct CompositePushConstants {
     uint layers_per_buffer; // layered: whole layers per layer buffer
     uint node_capacity;     // exact: nodes in the pool
     uint tile_count;        // compute quad passes: tiles in the frame's tile list
+    uint quad_count;        // quads in the quad buffer
+    uint back_to_front;     // 1: instance i draws quad quad_count - 1 - i (the draw path)
+    int origin_x;           // the draw path: the caller's rect, whose corner is glyph pixel (0, 0)
+    int origin_y;
+    uint padding0;
     uint padding1;
-    uint padding2;
+};
+
+
+// ---- The tile compositor (tile_bin.comp, tile_scan.comp, tile_composite*.comp): the frame's quads,
+// sorted front to back on the CPU (so a quad's index is its key), binned into screen tiles on the
+// GPU and composited per tile into the caller's image (docs/compositing.md).
+
+// A screen tile is kTileSide x kTileSide pixels; one workgroup of kTileSide^2 invocations
+// composites one tile, an invocation per pixel.
+CRISP_CONSTANT(uint, kTileSide, 16u);
+CRISP_CONSTANT(uint, kTileInvocations, 256u);
+// Invocations of the one workgroup that scans the tile counts.
+CRISP_CONSTANT(uint, kTileScanInvocations, 1024u);
+// Invocations per workgroup of the binning passes (one quad each).
+CRISP_CONSTANT(uint, kTileBinInvocations, 64u);
+// Quad indices a tile's list holds in workgroup memory by default; a longer list takes the
+// layered way (the K nearest per pixel, the rest estimated).
+CRISP_CONSTANT(uint, kTileDefaultCapacity, 1024u);
+CRISP_CONSTANT(uint, kTileMaxCapacity, 2048u);  // 8 KiB of the 16 KiB every device offers
+CRISP_CONSTANT(uint, kTileNoQuad, 0xFFFFFFFFu);
+// Below this in every channel the transmittance left hides whatever lies behind (less than a
+// 16-bit code): a pixel's walk stops there.
+CRISP_CONSTANT(float, kTileOpaque, 1.0f / 65536.0f);
+
+// Bindings of the tile compositor's descriptor set (tile_common.glsl declares the same).
+CRISP_CONSTANT(uint, kTileBindAtlas, 0u);    // the atlas, storage image
+CRISP_CONSTANT(uint, kTileBindQuads, 1u);    // CompositeQuad[], front to back
+CRISP_CONSTANT(uint, kTileBindTiles, 2u);    // per tile: count, start, cursor (plane-major)
+CRISP_CONSTANT(uint, kTileBindBins, 3u);     // quad indices, each tile's at its start
+CRISP_CONSTANT(uint, kTileBindHeader, 4u);   // TileHeader, then the non-empty tiles' indices
+CRISP_CONSTANT(uint, kTileBindTarget, 5u);   // the caller's image, storage image
+CRISP_CONSTANT(uint, kTileBindingCount, 6u);
+
+// Target encodings of the tile pass (specialization constant 1).
+CRISP_CONSTANT(uint, kTileEncodeLinear, 0u);  // float formats: the image holds linear colour
+CRISP_CONSTANT(uint, kTileEncodeSrgb, 1u);    // 8-bit UNORM formats: sRGB-encoded in the shader
+
+// The start of the header buffer; the list of non-empty tiles follows it.
+struct TileHeader {
+    uint dispatch_x;  // VkDispatchIndirectCommand of the tile pass
+    uint dispatch_y;
+    uint dispatch_z;
+    uint busy_tiles;    // tiles with at least one quad
+    uint pairs;         // (quad, tile) pairs binned
+    uint lost_pairs;    // pairs past the bins' capacity (never, when the CPU sized them)
+    uint exact_tiles;   // tiles composited exactly (their list fit in workgroup memory)
+    uint layered_tiles; // tiles that took the layered way
+    uint max_overlap;   // most fragments one pixel had
+    uint tail_pixels;   // layered tiles: pixels with fragments past K
+    uint padding0;
+    uint padding1;
+};
+CRISP_CONSTANT(uint, kTileHeaderWords, 12u);
+
+struct TilePushConstants {
+    int origin_x;  // the caller's rect: its top-left pixel in the image, and its size
+    int origin_y;
+    uint width;
+    uint height;
+    uint tiles_x;  // tiles across and down the rect
+    uint tiles_y;
+    uint quad_count;
+    uint bin_capacity;  // quad indices the bins buffer holds
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(RasterItem) == 72);
+static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
+static_assert(sizeof(TilePushConstants) == 32);
 static_assert(sizeof(CompositeQuad) == 64);
 static_assert(offsetof(CompositeQuad, color) == 48);
-static_assert(sizeof(CompositePushConstants) == 48);
+static_assert(sizeof(CompositePushConstants) == 64);
 static_assert(offsetof(CompositePushConstants, width) == 16);
 static_assert(offsetof(RasterItem, first_workgroup) == 68);
 static_assert(sizeof(RasterPushConstants) == 64);

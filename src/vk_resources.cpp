@@ -550,9 +550,12 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
     if (is_depth_or_stencil(desc.format)) {
         return Error{ErrorCode::invalid_argument, "create_image: depth and stencil formats are not supported"};
     }
+    const VkFormat view_format = desc.view_format != VK_FORMAT_UNDEFINED ? desc.view_format : desc.format;
+    const VkImageCreateFlags flags =
+        view_format != desc.format ? VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT | VK_IMAGE_CREATE_EXTENDED_USAGE_BIT : 0;
     VkImageFormatProperties limits{};
     VkResult supported = vkGetPhysicalDeviceImageFormatProperties(physical_device(), desc.format, VK_IMAGE_TYPE_2D,
-                                                                  VK_IMAGE_TILING_OPTIMAL, desc.usage, 0, &limits);
+                                                                  VK_IMAGE_TILING_OPTIMAL, desc.usage, flags, &limits);
     if (supported == VK_ERROR_FORMAT_NOT_SUPPORTED ||
         (supported == VK_SUCCESS && (desc.width > limits.maxExtent.width || desc.height > limits.maxExtent.height))) {
         return Error{ErrorCode::vulkan, "create_image: the device does not support a " + std::to_string(desc.width) +
@@ -570,6 +573,7 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
     image.usage_ = desc.usage;
     VkImageCreateInfo info{};
     info.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+    info.flags = flags;
     info.imageType = VK_IMAGE_TYPE_2D;
     info.format = desc.format;
     info.extent = {desc.width, desc.height, 1};
@@ -603,7 +607,7 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
         view_info.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
         view_info.image = image.image_;
         view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
-        view_info.format = desc.format;
+        view_info.format = view_format;
         view_info.subresourceRange = color_range();
         if (VkResult result = vkCreateImageView(vk_device, &view_info, nullptr, &image.view_); result != VK_SUCCESS) {
             return vk::vulkan_error("vkCreateImageView", result);

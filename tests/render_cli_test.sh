@@ -148,9 +148,11 @@ assert len(report["timings"]["frame_ms"]) == report["frames"], report["timings"]
 assert report["total_samples"] >= 2 * 16 and report["layout"] == "rgb", report
 assert report["device"]["name"] and report["outputs"]["png"].endswith("hi.png"), report
 composite = report["composite"]
-assert composite["mode"] == "layered" and composite["layers_requested"] == "auto", composite
-assert composite["measured"] and composite["max_overlap"] == 1 and composite["layers"] == 1, composite
+assert composite["mode"] == "tiled" and composite["layers_requested"] is None, composite
+assert composite["measured"] and composite["max_overlap"] == 1 and composite["backdrop"] == "flat", composite
 assert composite["quads"] == 2 and composite["tail_pixels"] == 0, composite
+tiles = composite["tiles"]
+assert tiles["busy"] > 0 and tiles["exact"] == tiles["busy"] and tiles["layered"] == 0, tiles
 assert report["timings"]["composite_ms"] > 0 and report["scene"] is None and report["runs"] == 1, report
 
 png = open(work + "/hi.png", "rb").read()
@@ -195,7 +197,7 @@ cp "$source/docs/examples/overlap.json" "$work/example/"
 "$bake" "$source/fonts/DejaVuSans.ttf" --text "crisptex" -o "$work/example/DejaVuSans.crisp" -q ||
   fail "crisp-bake failed for the example scene"
 cd "$work/elsewhere"
-for mode in layered unsorted wboit exact; do
+for mode in tiled draw layered unsorted wboit exact; do
   expect_exit 0 "--scene --composite $mode" -- "$render" --scene ../example/overlap.json --samples 16 \
     --composite "$mode" -o "$work/scene-$mode.png" --json
   cp "$work/out" "$work/scene-$mode.json"
@@ -209,7 +211,7 @@ for mode in layered wboit exact; do
   cmp -s "$work/scene-$mode.png" "$work/scene-$mode-compute.png" || fail "--path compute changes the $mode image"
 done
 expect_exit 0 "--scene --layers 1" -- "$render" --scene "$work/example/overlap.json" --samples 16 --layers 1 \
-  -o "$work/scene-layers1.png" --json
+  --composite layered -o "$work/scene-layers1.png" --json
 cp "$work/out" "$work/scene-layers1.json"
 python3 - "$work" <<'PY' || fail "the composite modes' outputs are wrong"
 import json, struct, sys, zlib
@@ -249,7 +251,7 @@ def read_png(path):  # 8-bit RGB or RGBA, non-interlaced, as libpng writes them
     return width, height, channels, b"".join(rows)
 
 images = {}
-for mode in ("layered", "unsorted", "wboit", "exact"):
+for mode in ("tiled", "draw", "layered", "unsorted", "wboit", "exact"):
     report = json.load(open("%s/scene-%s.json" % (work, mode)))
     c = report["composite"]
     assert c["mode"] == mode, (mode, c)
@@ -257,8 +259,10 @@ for mode in ("layered", "unsorted", "wboit", "exact"):
     assert report["scene"].endswith("overlap.json") and report["size"] is None, report
     assert report["glyphs"]["drawn"] == 14 and report["glyphs"]["missing"] == 0, report["glyphs"]
     assert c["quads"] == 14 and c["warnings"] == [], c
-    if mode in ("layered", "exact"):
+    if mode in ("tiled", "layered", "exact"):
         assert c["measured"] and c["max_overlap"] == 3, c
+    if mode == "tiled":
+        assert c["tiles"]["busy"] == c["tiles"]["exact"] > 0 and c["tiles"]["pairs"] >= c["quads"], c
     if mode == "layered":
         assert c["layers"] == 3 and c["tail_pixels"] == 0, c  # auto: K from the measured overlap
     if mode == "exact":
@@ -271,6 +275,9 @@ def max_difference(a, b):
 # All the fragments fit K = 3 layers: layered is exact to rounding. Unsorted draws in file order, so
 # the green run (depth 0.5, drawn last) covers the blue one (depth 0.25, nearer): far from exact.
 assert max_difference("layered", "exact") <= 2, max_difference("layered", "exact")
+# The tile and draw paths are exact front to back over the same flat background.
+assert max_difference("tiled", "exact") <= 1, max_difference("tiled", "exact")
+assert max_difference("draw", "exact") <= 1, max_difference("draw", "exact")
 assert max_difference("unsorted", "exact") > 32, max_difference("unsorted", "exact")
 assert max_difference("wboit", "exact") > 0, "wboit is exact: suspicious"
 white = bytes([255, 255, 255])
@@ -280,6 +287,35 @@ assert min(images["exact"][3]) < 128, "no dark pixel: nothing was drawn"
 one = json.load(open(work + "/scene-layers1.json"))["composite"]
 assert one["layers_requested"] == 1 and one["layers"] == 1 and one["tail_pixels"] > 0, one
 PY
+
+# A backdrop: the tile and draw paths put the same text over the same gradient; the reference
+# modes draw over a flat background only.
+for mode in tiled draw; do
+  expect_exit 0 "--backdrop gradient --composite $mode" -- "$render" --scene "$work/example/overlap.json" \
+    --samples 16 --composite "$mode" --backdrop gradient -o "$work/gradient-$mode.png"
+done
+python3 - "$work" <<'PY' || fail "the backdrop images are wrong"
+import sys, zlib, struct
+work = sys.argv[1]
+def pixels(path):
+    data = open(path, "rb").read()
+    pos, idat, width = 8, b"", 0
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IHDR": width = struct.unpack(">I", data[pos + 8:pos + 12])[0]
+        if kind == b"IDAT": idat += data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+    return zlib.decompress(idat), width
+tiled, width = pixels(work + "/gradient-tiled.png")
+drawn, _ = pixels(work + "/gradient-draw.png")
+flat, _ = pixels(work + "/scene-tiled.png")
+assert len(tiled) == len(drawn) == len(flat)
+assert tiled != flat, "the gradient backdrop looks like the flat background"
+PY
+expect_exit 2 "--backdrop with a reference mode" -- "$render" --scene "$work/example/overlap.json" \
+  --composite exact --backdrop photo -o x.png
+expect_stderr "--backdrop" "--backdrop with a reference mode"
+expect_exit 2 "--backdrop bogus" -- "$render" "${base[@]}" --backdrop bogus -o x.png
 
 # The exact mode keeps at most 64 fragments per pixel: 70 runs of one glyph over each other drop
 # some, and the run says so on stderr (and still succeeds).
@@ -302,7 +338,7 @@ if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.
     "$work/out" || fail "--validate --json does not report zero messages"
   python3 -c "import sys,struct; d=open(sys.argv[1],'rb').read(); assert struct.unpack('>B',d[25:26])[0]==6" \
     "$work/validated.png" || fail "a translucent background did not give an RGBA PNG"
-  for mode in unsorted wboit exact; do
+  for mode in tiled draw unsorted wboit exact; do
     expect_exit 0 "render --validate --composite $mode" -- "$render" --scene "$work/example/overlap.json" \
       --samples 16 --composite "$mode" -o "$work/validated-$mode.png" --validate -q
   done

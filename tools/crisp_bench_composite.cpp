@@ -446,7 +446,7 @@ struct Bench {
             // idle gaps between frames short.
             const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
                 timer.begin(cb);
-                if (crisp::Status s = compositor.record(cb, renderer.drawn(), renderer.atlas_view(), params); !s) {
+                if (crisp::Status s = compositor.record_reference(cb, renderer.drawn(), renderer.atlas_view(), params); !s) {
                     fail(mode_label(run) + ": " + s.error().message);
                 }
                 timer.end(cb);
@@ -768,6 +768,7 @@ int main(int argc, char** argv) {
             compositor_info.key_format = args.keys;
             compositor_info.gray_layout = gray_layout;
             compositor_info.exact_nodes_per_pixel = result.exact_nodes_per_pixel;
+            compositor_info.reference_modes = true;
             auto compositor = crisp::Compositor::create(compositor_info);
             if (!compositor) fail(compositor.error().message);
             for (const std::string& w : compositor->warnings()) {

@@ -91,12 +91,18 @@ options:
   --color R,G,B[,A]        text colour, sRGB components in [0, 1], straight alpha (default 0,0,0,1)
   --background R,G,B[,A]   background, the same way (default 1,1,1,1); with alpha below 1 the PNG
                            has an alpha channel
-  --composite MODE         how overlapping glyphs are blended: layered (order-independent, the K
-                           nearest per pixel sorted; the default), unsorted (paint order, no OIT),
-                           wboit (weighted blended OIT) or exact (per-pixel sorted lists)
+  --composite MODE         how the glyphs are blended over what is behind them: tiled (screen
+                           tiles in workgroup memory, exact front to back; the default), draw
+                           (sorted quads blended in a render pass), or a reference mode: layered
+                           (the K nearest per pixel in global memory), unsorted (paint order, no
+                           OIT), wboit (weighted blended OIT) or exact (per-pixel sorted lists)
+  --backdrop KIND          tiled and draw: what the text is drawn over, in the canvas image:
+                           flat (the background colour; the default), gradient (a ramp from the
+                           background to its complement with soft stripes) or photo (smooth colour
+                           fields and fine detail, like a photograph)
   --layers K|auto          layered only: layers kept per pixel, 1..8, or auto: as many as the most
                            glyphs one pixel has (measured by a first composite; default auto)
-  --path raster|compute    how layered, wboit and exact run their glyph passes: rasterized quads
+  --path raster|compute    layered, wboit and exact: how their glyph passes run, rasterized quads
                            (default) or compute over 8x8 tiles of each quad; the same image
   --coverage-out OUT.pfm   the text's linear coverage per channel as a PFM image
   --json                   print the report as one JSON object on stdout (compositor notes go
@@ -124,7 +130,8 @@ struct Arguments {
     std::optional<std::array<float, 4>> color;
     std::optional<std::array<float, 4>> background;
     std::string scene;
-    crisp::CompositeMode composite = crisp::CompositeMode::layered;
+    crisp::CompositeMode composite = crisp::CompositeMode::tiled;
+    std::string backdrop = "flat";
     uint32_t layers = crisp::kAutoLayers;
     bool layers_given = false;
     crisp::QuadPath path = crisp::QuadPath::raster;
@@ -235,9 +242,15 @@ Arguments parse_arguments(int argc, char** argv) {
             const std::string_view name = value();
             const std::optional<crisp::CompositeMode> mode = crisp::parse_composite_mode(name);
             if (!mode) {
-                usage_error("--composite takes layered, unsorted, wboit or exact, not '" + std::string(name) + "'");
+                usage_error("--composite takes tiled, draw, layered, unsorted, wboit or exact, not '" +
+                            std::string(name) + "'");
             }
             args.composite = *mode;
+        } else if (arg == "--backdrop") {
+            args.backdrop = value();
+            if (args.backdrop != "flat" && args.backdrop != "gradient" && args.backdrop != "photo") {
+                usage_error("--backdrop takes flat, gradient or photo, not '" + args.backdrop + "'");
+            }
         } else if (arg == "--path") {
             const std::string_view name = value();
             const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(name);
@@ -306,6 +319,11 @@ Arguments parse_arguments(int argc, char** argv) {
     if (args.output.empty()) usage_error("no output given (-o OUT.png)");
     if (args.layers_given && args.composite != crisp::CompositeMode::layered) {
         usage_error("--layers applies to --composite layered only");
+    }
+    if (args.backdrop != "flat" && args.composite != crisp::CompositeMode::tiled &&
+        args.composite != crisp::CompositeMode::draw) {
+        usage_error("--backdrop applies to --composite tiled and draw only (the reference modes draw over a flat "
+                    "background)");
     }
     if (!args.coverage_output.empty() && std::filesystem::path(args.coverage_output).lexically_normal() ==
                                              std::filesystem::path(args.output).lexically_normal()) {
@@ -434,12 +452,150 @@ struct RenderReport {
     CompositeReport composite;
 };
 
+// One composite frame: `record` fills a command buffer, which is submitted and waited for; its wall
+// time goes into out.frame_ms. kExitOk, or the exit code of a failed record or submission (said
+// on stderr).
+int run_composite_frame(crisp::HeadlessContext& context, int frame, CompositeReport& out,
+                        const std::function<crisp::Status(VkCommandBuffer)>& record) {
+    const auto frame_start = std::chrono::steady_clock::now();
+    crisp::Status recorded;
+    const crisp::Status submitted =
+        context.submit_and_wait([&](VkCommandBuffer command_buffer) { recorded = record(command_buffer); });
+    out.frame_ms.push_back(milliseconds_since(frame_start));
+    for (const crisp::Status& status : {std::cref(recorded), std::cref(submitted)}) {
+        if (!status) {
+            std::fprintf(stderr, "crisp-render: composite frame %d: %s\n", frame, status.error().message.c_str());
+            return exit_code_for_vulkan(status.error());
+        }
+    }
+    return kExitOk;
+}
+
+// What the text is drawn over (--backdrop), premultiplied linear RGBA, top row first: the scene's
+// background colour, a ramp from it to its complement with soft diagonal stripes, or smooth colour
+// fields with fine detail, as a photograph has.
+std::vector<float> backdrop_pixels(const std::string& kind, uint32_t width, uint32_t height,
+                                   const float (&background)[4]) {
+    std::array<float, 3> base{};
+    for (size_t c = 0; c < 3; ++c) base[c] = crisp::srgb_to_linear(background[c]);
+    const float alpha = background[3];
+    std::vector<float> pixels(size_t{width} * height * 4);
+    for (uint32_t y = 0; y < height; ++y) {
+        for (uint32_t x = 0; x < width; ++x) {
+            const float u = width > 1 ? static_cast<float>(x) / static_cast<float>(width - 1) : 0.0f;
+            const float v = height > 1 ? static_cast<float>(y) / static_cast<float>(height - 1) : 0.0f;
+            std::array<float, 3> colour = base;
+            if (kind == "gradient") {
+                const float stripe = 0.5f + 0.5f * std::sin(static_cast<float>(x + y) * 0.35f);
+                for (size_t c = 0; c < 3; ++c) {
+                    const float ramp = base[c] + (1.0f - 2.0f * base[c]) * u;
+                    colour[c] = std::clamp(ramp * (0.85f + 0.15f * stripe), 0.0f, 1.0f);
+                }
+            } else if (kind == "photo") {
+                // A sky-to-ground ramp, three soft blobs of colour and a fine texture.
+                const std::array<std::array<float, 5>, 3> blobs = {{{0.25f, 0.3f, 0.9f, 0.5f, 0.2f},
+                                                                   {0.7f, 0.6f, 0.2f, 0.7f, 0.3f},
+                                                                   {0.5f, 0.9f, 0.8f, 0.2f, 0.6f}}};
+                colour = {0.35f + 0.3f * v, 0.5f + 0.1f * v, 0.8f - 0.5f * v};
+                for (const auto& b : blobs) {
+                    const float dx = u - b[0], dy = v - b[1];
+                    const float weight = std::exp(-(dx * dx + dy * dy) * 12.0f);
+                    for (size_t c = 0; c < 3; ++c) colour[c] += weight * (b[c + 2] - colour[c]);
+                }
+                const float grain = 0.04f * std::sin(static_cast<float>(x) * 1.7f) * std::sin(static_cast<float>(y) * 2.3f);
+                for (float& c : colour) c = std::clamp(c + grain, 0.0f, 1.0f);
+            }
+            float* p = &pixels[(size_t{y} * width + x) * 4];
+            for (size_t c = 0; c < 3; ++c) p[c] = colour[c] * alpha;
+            p[3] = alpha;
+        }
+    }
+    return pixels;
+}
+
+// The tile or draw path: the backdrop is uploaded into an R32G32B32A32_SFLOAT canvas image and the
+// glyphs composited into it, twice from the same backdrop (the first frame's tile counts arrive
+// with the second), then read back into report.composite.target.
+int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer& renderer, const Arguments& args,
+                         const Job& job, RenderReport& report) {
+    CompositeReport& out = report.composite;
+    const bool draw = args.composite == crisp::CompositeMode::draw;
+    constexpr VkFormat kFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+    const uint32_t width = job.scene.width, height = job.scene.height;
+    crisp::CompositorCreateInfo info;
+    info.physical_device = context.physical_device();
+    info.device = context.device();
+    info.allocator = context.allocation_callbacks();
+    info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
+    if (draw) info.draw_format = kFormat;
+    crisp::Result<crisp::Compositor> created = crisp::Compositor::create(info);
+    if (!created) {
+        std::fprintf(stderr, "crisp-render: cannot create the compositor: %s\n", created.error().message.c_str());
+        return exit_code_for_vulkan(created.error());
+    }
+    crisp::Compositor& compositor = *created;
+    out.warnings = compositor.warnings();
+    const VkImageUsageFlags usage = (draw ? VkImageUsageFlags{VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT}
+                                          : VkImageUsageFlags{VK_IMAGE_USAGE_STORAGE_BIT}) |
+                                    VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    crisp::Result<crisp::Image> image = context.create_image({kFormat, width, height, usage});
+    if (!image) {
+        std::fprintf(stderr, "crisp-render: cannot make the canvas image: %s\n", image.error().message.c_str());
+        return exit_code_for_vulkan(image.error());
+    }
+    const std::vector<float> backdrop = backdrop_pixels(args.backdrop, width, height, job.scene.background);
+    const std::span<const std::byte> backdrop_bytes = std::as_bytes(std::span(backdrop));
+    const VkRect2D rect{{0, 0}, {width, height}};
+    constexpr int kCompositeFrames = 2;
+    for (int frame = 1; frame <= kCompositeFrames; ++frame) {
+        if (crisp::Status s = context.upload(*image, backdrop_bytes, VK_IMAGE_LAYOUT_GENERAL); !s) {
+            std::fprintf(stderr, "crisp-render: cannot upload the backdrop: %s\n", s.error().message.c_str());
+            return exit_code_for_vulkan(s.error());
+        }
+        const int code = run_composite_frame(context, frame, out, [&](VkCommandBuffer command_buffer) {
+            if (!draw) {
+                const crisp::CompositeTarget target{image->view(), kFormat, VK_FORMAT_UNDEFINED, {width, height}, rect};
+                return compositor.record(command_buffer, renderer.drawn(), renderer.atlas_view(), target);
+            }
+            VkRenderingAttachmentInfo attachment{};
+            attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+            attachment.imageView = image->view();
+            attachment.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+            attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+            attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+            VkRenderingInfo rendering{};
+            rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+            rendering.renderArea = rect;
+            rendering.layerCount = 1;
+            rendering.colorAttachmentCount = 1;
+            rendering.pColorAttachments = &attachment;
+            vkCmdBeginRendering(command_buffer, &rendering);
+            crisp::Status recorded = compositor.record_draw(command_buffer, renderer.drawn(), renderer.atlas_view(), rect);
+            vkCmdEndRendering(command_buffer);
+            return recorded;
+        });
+        if (code != kExitOk) return code;
+    }
+    out.stats = compositor.stats();
+    crisp::Result<std::vector<std::byte>> bytes = context.read_image(*image, VK_IMAGE_LAYOUT_GENERAL);
+    if (!bytes) {
+        std::fprintf(stderr, "crisp-render: cannot read the canvas back: %s\n", bytes.error().message.c_str());
+        return exit_code_for_vulkan(bytes.error());
+    }
+    out.target.resize(size_t{width} * height * 4);
+    std::memcpy(out.target.data(), bytes->data(), out.target.size() * sizeof(float));
+    return kExitOk;
+}
+
 // Composites the renderer's last frame twice, the same glyphs both times: the first frame
 // measures the overlap (what --layers auto sizes K from, and what the report gives; measurements
 // arrive one frame late), the second is the image, read back into report.composite.target.
 int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, const Arguments& args, const Job& job,
               RenderReport& report) {
     CompositeReport& out = report.composite;
+    if (args.composite == crisp::CompositeMode::tiled || args.composite == crisp::CompositeMode::draw) {
+        return composite_into_image(context, renderer, args, job, report);
+    }
     const std::array<crisp::SampleRect, 3>& channels = job.layout.channels;
     out.gray_layout = channels[0] == channels[1] && channels[1] == channels[2];
 
@@ -451,6 +607,7 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
     info.width = job.scene.width;
     info.height = job.scene.height;
     info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
+    info.reference_modes = true;
     info.gray_layout = out.gray_layout;
     info.max_layers = args.layers == crisp::kAutoLayers ? crisp::kMaxCompositeLayers : args.layers;
     if (args.composite != crisp::CompositeMode::exact) info.exact_nodes_per_pixel = 0;  // no node pool
@@ -479,20 +636,13 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
     }
     constexpr int kCompositeFrames = 2;
     for (int frame = 1; frame <= kCompositeFrames; ++frame) {
-        const auto frame_start = std::chrono::steady_clock::now();
-        crisp::Status recorded;
-        const crisp::Status submitted = context.submit_and_wait([&](VkCommandBuffer command_buffer) {
-            recorded = compositor.record(command_buffer, renderer.drawn(), renderer.atlas_view(), params);
-            if (recorded && frame == kCompositeFrames)
-                compositor.record_target_readback(command_buffer, buffer->handle());
+        const int code = run_composite_frame(context, frame, out, [&](VkCommandBuffer command_buffer) {
+            crisp::Status recorded =
+                compositor.record_reference(command_buffer, renderer.drawn(), renderer.atlas_view(), params);
+            if (recorded && frame == kCompositeFrames) compositor.record_target_readback(command_buffer, buffer->handle());
+            return recorded;
         });
-        out.frame_ms.push_back(milliseconds_since(frame_start));
-        for (const crisp::Status& status : {std::cref(recorded), std::cref(submitted)}) {
-            if (!status) {
-                std::fprintf(stderr, "crisp-render: composite frame %d: %s\n", frame, status.error().message.c_str());
-                return exit_code_for_vulkan(status.error());
-            }
-        }
+        if (code != kExitOk) return code;
     }
     out.stats = compositor.stats();
     out.target.resize(pixels * 4);
@@ -722,9 +872,12 @@ bool is_layered(const CompositeReport& c) {
 bool is_exact(const CompositeReport& c) {
     return c.stats.mode == crisp::CompositeMode::exact;
 }
+bool is_tiled(const CompositeReport& c) {
+    return c.stats.mode == crisp::CompositeMode::tiled;
+}
 // The measured max overlap, for the modes that measure it.
 bool has_overlap(const CompositeReport& c) {
-    return c.stats.measured && (is_layered(c) || is_exact(c));
+    return c.stats.measured && (is_layered(c) || is_exact(c) || is_tiled(c));
 }
 
 std::string json_composite(const Arguments& args, const CompositeReport& c) {
@@ -745,7 +898,13 @@ std::string json_composite(const Arguments& args, const CompositeReport& c) {
     out += ", \"buffer_bytes\": " + json_uint(s.buffer_bytes);
     out += ", \"measured\": " + std::string(s.measured ? "true" : "false");
     out += ", \"max_overlap\": " + uint_or_null(has_overlap(c), s.max_overlap);
-    out += ", \"tail_pixels\": " + uint_or_null(s.measured && layered, s.tail_pixels);
+    out += ", \"tail_pixels\": " + uint_or_null(s.measured && (layered || is_tiled(c)), s.tail_pixels);
+    const bool tiles = s.measured && is_tiled(c);
+    out += ", \"tiles\": " + (tiles ? "{\"busy\": " + json_uint(s.busy_tiles) + ", \"exact\": " +
+                                           json_uint(s.exact_tiles) + ", \"layered\": " +
+                                           json_uint(s.layered_tiles) + ", \"pairs\": " + json_uint(s.tile_pairs) + "}"
+                                     : std::string("null"));
+    out += ", \"backdrop\": " + json_string(args.backdrop);
     out += ", \"exact_lost_nodes\": " + uint_or_null(s.measured && exact, s.exact_lost_nodes);
     out += ", \"exact_dropped\": " + uint_or_null(s.measured && exact, s.exact_dropped);
     out += ", \"frame_ms\": [";
@@ -832,6 +991,11 @@ std::string human_composite(const Arguments& args, const CompositeReport& c) {
     if (s.measured && is_exact(c)) {
         out += ", " + std::to_string(s.exact_lost_nodes) + " lost, " + std::to_string(s.exact_dropped) + " dropped";
     }
+    if (s.measured && is_tiled(c)) {
+        out += ", " + std::to_string(s.busy_tiles) + " tiles (" + std::to_string(s.exact_tiles) + " exact, " +
+               std::to_string(s.layered_tiles) + " layered)";
+    }
+    if (args.backdrop != "flat") out += ", over a " + args.backdrop + " backdrop";
     char ms[32];
     std::snprintf(ms, sizeof ms, ", %.1f ms", c.frame_ms.empty() ? 0.0 : c.frame_ms.back());
     return out + ms;

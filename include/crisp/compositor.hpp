@@ -1,18 +1,28 @@
-// crisp: the GPU compositor. It draws the glyphs a Renderer rasterized this frame as quads whose
-// fragments read the atlas accumulators, and blends them over a background into a target image,
-// with order-independent transparency (docs/compositing.md).
+// crisp: the GPU compositor. It composites the glyphs a Renderer rasterized this frame, reading
+// their coverage from the atlas, with order-independent transparency (docs/compositing.md).
 //
 // Per fragment and channel: coverage k = sum / (kCoverageOne * count) from the atlas, opacity
 // o = a * k, transmittance T = 1 - o and premultiplied light L = c * o, with c the glyph's linear
 // colour and a its alpha. Smaller depth is nearer; at equal depth the later paint order is in front.
 //
+// Three ways to put text on screen, per frame:
+//   - record(): the tile path (the default of every tool). Into the caller's storage image, in
+//     compute: quads binned into 16 x 16 screen tiles on the GPU, each tile composited front to
+//     back, exactly, in workgroup memory, per channel over whatever the image holds.
+//   - record_draw(): inside the caller's render pass (dynamic rendering), for targets that cannot
+//     be storage images (an sRGB swapchain image): quads sorted on the CPU, drawn back to front
+//     with dual-source blending per channel.
+//   - record_reference(): the comparison modes (layered OIT in global memory, unsorted, WBOIT and
+//     the exact per-pixel linked lists) into the compositor's own RGBA32F image over a flat
+//     background; made only when CompositorCreateInfo::reference_modes asks for them.
+//
 // A frame, after the renderer's record() in the same command buffer (or a later one):
 //
-//     compositor.record(command_buffer, renderer.drawn(), renderer.atlas_view(), params);
-//     ... the target image (output_image()) is ready for shaders, transfers or presentation ...
+//     compositor.record(command_buffer, renderer.drawn(), renderer.atlas_view(), target);
 //
 // Like the Renderer, the compositor never submits, and the caller must not have more than
-// CompositorCreateInfo::frames_in_flight of its recorded command buffers pending at once.
+// CompositorCreateInfo::frames_in_flight of its recorded command buffers pending at once; each
+// record*() call takes one frame slot.
 #pragma once
 
 #include <crisp/renderer.hpp>
@@ -31,12 +41,14 @@
 namespace crisp {
 
 enum class CompositeMode {
-    layered,   // the K nearest fragments per pixel, sorted by key; the rest estimated (the default)
-    unsorted,  // premultiplied "over" in submission order: what no OIT gives
-    wboit,     // weighted blended OIT (McGuire and Bavoil 2013), equation (10)
-    exact,     // per-pixel linked lists, sorted: the ground truth
+    tiled,     // record(): screen tiles in workgroup memory, into the caller's image
+    draw,      // record_draw(): sorted quads blended inside the caller's render pass
+    layered,   // reference: the K nearest fragments per pixel in global memory; the rest estimated
+    unsorted,  // reference: premultiplied "over" in submission order: what no OIT gives
+    wboit,     // reference: weighted blended OIT (McGuire and Bavoil 2013), equation (10)
+    exact,     // reference: per-pixel linked lists, sorted: the ground truth
 };
-// "layered", "unsorted", "wboit", "exact".
+// "tiled", "draw", "layered", "unsorted", "wboit", "exact".
 const char* composite_mode_name(CompositeMode mode);
 // The mode of that name; nullopt for any other string.
 std::optional<CompositeMode> parse_composite_mode(std::string_view name);
@@ -56,17 +68,52 @@ enum class KeyFormat {
     mono,       // 32-bit keys: 16-bit depth, 8-bit paint order, one 8-bit T for the three channels
 };
 
+// The image formats record() composites into (as storage images). 8-bit ones hold sRGB-encoded
+// colour, which the shader decodes and encodes; float ones hold linear colour. A B8G8R8A8_UNORM
+// image is seen either through a view of its own format (the device needs
+// shaderStorageImageReadWithoutFormat and WriteWithoutFormat: storage_without_format) or through
+// an R8G8B8A8_UNORM view of an image made with VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT (any device
+// that stores R8G8B8A8; CompositeTarget::view_format says so).
+inline constexpr VkFormat kTileTargetFormats[] = {
+    VK_FORMAT_R8G8B8A8_UNORM,
+    VK_FORMAT_B8G8R8A8_UNORM,
+    VK_FORMAT_R16G16B16A16_SFLOAT,
+    VK_FORMAT_R32G32B32A32_SFLOAT,
+};
+// The most quads a screen tile's list holds in workgroup memory (CompositorCreateInfo::tile_capacity).
+inline constexpr uint32_t kMaxTileCapacity = 2048;
+
 struct CompositorCreateInfo {
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkDevice device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
+    uint32_t frames_in_flight = 2;  // 1 to 8
+
+    // ---- The tile path (record()). It needs no device feature beyond the renderer's.
+    // Say whether the device was created with shaderStorageImageReadWithoutFormat and
+    // shaderStorageImageWriteWithoutFormat: B8G8R8A8_UNORM targets need them.
+    bool storage_without_format = false;
+    // Quads a tile's list holds in workgroup memory (4 bytes each): a power of two, 4 to
+    // kMaxTileCapacity. A longer list takes the layered way with K = tile_layers.
+    uint32_t tile_capacity = 1024;
+    uint32_t tile_layers = 8;  // 1..kMaxCompositeLayers
+
+    // ---- The draw path (record_draw()): the colour attachment format of the caller's render
+    // pass; VK_FORMAT_UNDEFINED makes no draw pipeline. The device must have dynamicRendering and
+    // dualSrcBlend enabled, and the format must blend. Blending is linear only where the format
+    // is _SRGB or floating point.
+    VkFormat draw_format = VK_FORMAT_UNDEFINED;
+
+    // ---- The reference modes (record_reference()): off unless asked for, since they hold
+    // per-pixel buffers over the whole target (44 + 8K bytes a pixel, and the exact node pool).
+    bool reference_modes = false;
+    // The reference target's size, each 1..16384 (ignored without reference_modes).
+    uint32_t width = 0;
+    uint32_t height = 0;
     // The device must have been created with fragmentStoresAndAtomics and dualSrcBlend enabled.
     // Say here whether shaderInt64 and shaderBufferInt64Atomics were enabled too: without them
     // layered compositing uses mono keys (and warnings() says so).
     bool int64_atomics = false;
-    uint32_t width = 0;  // the target image, each 1..16384
-    uint32_t height = 0;
-    uint32_t frames_in_flight = 2;  // 1 to 8
     KeyFormat key_format = KeyFormat::automatic;
     bool gray_layout = false;  // the renderer's subpixel layout samples one rect for all channels
     // Layers the layer buffers are sized for: layered frames may use K up to this. 1..8.
@@ -90,8 +137,27 @@ const char* quad_path_name(QuadPath path);
 // The path of that name; nullopt for any other string.
 std::optional<QuadPath> parse_quad_path(std::string_view name);
 
+// The caller's image the tile path composites into.
+struct CompositeTarget {
+    // A 2D view of one mip level and layer, of `format`, of an image made with
+    // VK_IMAGE_USAGE_STORAGE_BIT. When the command buffer reaches crisp's commands the image must
+    // be in VK_IMAGE_LAYOUT_GENERAL with earlier writes made visible to
+    // VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT (VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    // crisp reads and writes it at that stage, leaves it in GENERAL and records no barrier on it:
+    // the caller's next use needs a barrier from COMPUTE_SHADER / SHADER_WRITE.
+    VkImageView view = VK_NULL_HANDLE;
+    VkFormat format = VK_FORMAT_UNDEFINED;  // the image's: one of kTileTargetFormats
+    // The view's format where it differs from the image's (R8G8B8A8_UNORM over B8G8R8A8_UNORM);
+    // VK_FORMAT_UNDEFINED: the same.
+    VkFormat view_format = VK_FORMAT_UNDEFINED;
+    VkExtent2D extent{};                    // the image's size
+    // Where text lands: glyph pixel (0, 0) is rect.offset, and nothing outside the rect is read
+    // or written. An extent of 0 x 0 means the whole image.
+    VkRect2D rect{};
+};
+
 struct CompositeParams {
-    CompositeMode mode = CompositeMode::layered;
+    CompositeMode mode = CompositeMode::layered;  // a reference mode
     QuadPath path = QuadPath::raster;
     uint32_t layers = kAutoLayers;  // layered: 1..max_layers, or kAutoLayers
     // Linear colour and straight alpha of the background behind all glyphs.
@@ -99,15 +165,16 @@ struct CompositeParams {
 };
 
 struct CompositorStats {
-    // This frame (known when record() returns):
-    CompositeMode mode = CompositeMode::layered;
+    // This frame (known when record*() returns):
+    CompositeMode mode = CompositeMode::tiled;
     QuadPath path = QuadPath::raster;  // the path this frame's quad passes took
     uint32_t tiles = 0;                // compute path: 8 x 8 tiles dispatched
     uint32_t layers = 0;           // layered: the K this frame used
     bool mono_keys = false;        // layered: 32-bit keys
     uint32_t quads = 0;            // glyph quads drawn
     uint32_t paint_order_blocks = 0;  // most 256-wide paint-order blocks one depth plane needed
-    uint64_t buffer_bytes = 0;     // per-pixel buffers this mode reads and writes, whole target
+    uint64_t buffer_bytes = 0;     // buffers this frame used: tiled and draw: quads and bins;
+                                   // reference modes: their per-pixel buffers over the whole target
     // From the last frame whose GPU work has completed (frames_in_flight frames ago), if any:
     bool measured = false;
     uint64_t measured_frame = 0;      // which frame (1 = the first record())
@@ -115,6 +182,13 @@ struct CompositorStats {
     uint32_t tail_pixels = 0;         // layered: pixels with fragments past K
     uint64_t exact_lost_nodes = 0;    // exact: fragments the node pool could not hold
     uint64_t exact_dropped = 0;       // exact: fragments past kMaxExactFragmentsPerPixel
+    // tiled: the last completed tiled frame's tiles with quads, how many took the exact way (their
+    // list fit) and the layered way, the (quad, tile) pairs binned; max_overlap and tail_pixels
+    // above count for it too.
+    uint32_t busy_tiles = 0;
+    uint32_t exact_tiles = 0;
+    uint32_t layered_tiles = 0;
+    uint32_t tile_pairs = 0;
 };
 
 // The depth of a world-space label for CompositeParams/TextStyle::depth: the clip-space z / w of
@@ -125,15 +199,18 @@ std::optional<float> depth_from_view_projection(const float view_projection[16],
 
 class Compositor {
 public:
-    // Creates the target image (VK_FORMAT_R32G32B32A32_SFLOAT, premultiplied linear colour, kept in
-    // VK_IMAGE_LAYOUT_GENERAL), the per-pixel buffers and the pipelines. Errors: invalid_argument
-    // for a size outside 1..16384, frames_in_flight outside 1..8, max_layers outside 1..8,
+    // Creates the tile path's pipelines (for each of kTileTargetFormats the device can store to),
+    // the draw path's pipeline when draw_format is set, and the reference modes' target (R32G32B32A32_SFLOAT,
+    // premultiplied linear colour, kept in VK_IMAGE_LAYOUT_GENERAL), per-pixel buffers and
+    // pipelines when reference_modes is set. Errors: invalid_argument for a missing device,
+    // frames_in_flight outside 1..8, tile_capacity not a power of two in 4..kMaxTileCapacity,
+    // tile_layers or max_layers outside 1..8, with reference_modes a size outside 1..16384,
     // exact_nodes_per_pixel above 64, or key_format rgb without int64_atomics; vulkan when the
-    // device lacks fragmentStoresAndAtomics or dualSrcBlend, cannot blend, store to and copy the
-    // target format, one layer of keys or the per-pixel accumulators (44 bytes a pixel) would pass
-    // maxStorageBufferRange (the message names it; layers are split across up to 8 buffers, the
-    // accumulators are not: 128 MiB on lavapipe holds 3 million pixels), or a Vulkan call fails.
-    // A node pool larger than the range is cut to it, with a warning.
+    // device cannot store to any of kTileTargetFormats, draw_format cannot be a blended colour
+    // attachment, the reference modes lack fragmentStoresAndAtomics or dualSrcBlend, one layer of
+    // keys or the per-pixel accumulators (44 bytes a pixel) would pass maxStorageBufferRange (the
+    // message names it), or a Vulkan call fails. A node pool larger than the range is cut to it,
+    // with a warning.
     static Result<Compositor> create(const CompositorCreateInfo& info);
 
     Compositor(Compositor&&) noexcept;
@@ -143,29 +220,57 @@ public:
     // The caller makes sure the GPU is done with the compositor's objects first.
     ~Compositor();
 
-    // Records one frame: `glyphs` (Renderer::drawn(): each instance's rect, colour, depth and paint
-    // order, and where its texels are in the atlas) composited over params.background into the
-    // target. `atlas_view` is Renderer::atlas_view(), in GENERAL layout, written before this by
-    // earlier commands (the renderer's barrier makes it readable). The command buffer must be
-    // recording, outside a render pass. After it the target is readable by fragment and compute
-    // shaders and transfers. Errors: invalid_argument for layers above max_layers, or exact with
-    // no node pool; vulkan for a failed Vulkan call; either leaves no commands recorded.
-    // Non-finite colours or depths are clamped into range, never undefined behaviour; a glyph whose
-    // rect does not lie in the atlas draws nothing where it misses it, and on the compute path a
-    // rect over 65535 texels a side draws nothing (the renderer's are at most a few thousand).
+    // The tile path: records one frame compositing `glyphs` (Renderer::drawn(): each instance's
+    // rect, colour, depth and paint order, and where its texels are in the atlas) into `target`,
+    // per channel: out.rgb = light + T * image.rgb, out.a = 1 - (1 - image.a) * min(T), in linear
+    // colour. Pixels no glyph covers are neither read nor written. `atlas_view` is
+    // Renderer::atlas_view(), written before this by earlier commands (the renderer's barrier
+    // makes it readable). The command buffer must be recording, outside a render pass.
+    // Errors: invalid_argument for a null view, a format this compositor cannot store to (the
+    // message says why), or a rect outside the image or with a side above 16384; vulkan for a
+    // failed allocation; either leaves no commands recorded. Non-finite colours or depths are
+    // clamped into range; a glyph whose rect does not lie in the atlas draws nothing where it
+    // misses it; rects over 65535 texels a side draw nothing.
     Status record(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
-                  const CompositeParams& params);
+                  const CompositeTarget& target);
 
-    // Builds every pipeline the layered mode can use on `path` (K = 1 to max_layers), so that a
-    // frame whose K changes (kAutoLayers follows the overlap) does not compile one mid-frame. Without
-    // it each K's pipelines are built by the first record() that uses them. Errors: vulkan.
+    // The draw path: records draws of `glyphs`, back to front, into the caller's render pass,
+    // which must be active (begun with vkCmdBeginRendering) with one colour attachment of
+    // CompositorCreateInfo::draw_format. `rect` is where text lands, as in CompositeTarget::rect
+    // (the viewport and scissor are set to it); crisp sets the pipeline, descriptor set, push
+    // constants, viewport and scissor. The atlas must already be readable by fragment shaders
+    // (the renderer's record() does that, outside the render pass). Errors: invalid_argument
+    // without a draw pipeline, or for an empty rect or one with a side above 16384; vulkan for a
+    // failed allocation (no commands recorded).
+    Status record_draw(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
+                       const VkRect2D& rect);
+
+    // The reference modes: records one frame composited by params.mode over params.background
+    // into the compositor's own target. Same contract as record() for glyphs and atlas; after
+    // it the target is readable by fragment and compute shaders and transfers. Errors:
+    // invalid_argument without reference_modes, for a mode that is not a reference mode, layers
+    // above max_layers, or exact with no node pool; vulkan for a failed Vulkan call; either
+    // leaves no commands recorded. On the compute path a rect over 65535 texels a side draws
+    // nothing.
+    Status record_reference(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
+                            VkImageView atlas_view, const CompositeParams& params);
+
+    // Builds every pipeline the layered reference mode can use on `path` (K = 1 to max_layers), so
+    // that a frame whose K changes (kAutoLayers follows the overlap) does not compile one
+    // mid-frame. Without it each K's pipelines are built by the first record_reference() that
+    // uses them. Errors: invalid_argument without reference_modes; vulkan.
     Status prepare_layered(QuadPath path);
 
-    // Records a copy of the target into `buffer` (offset 0, width * height * 4 floats, row-major,
-    // premultiplied linear RGBA), with barriers; the buffer is ready for host reads once the
-    // command buffer completes.
+    // True when record() can composite into an image of `format` seen through a view of
+    // `view_format` (VK_FORMAT_UNDEFINED: the same format).
+    bool supports_target_format(VkFormat format, VkFormat view_format = VK_FORMAT_UNDEFINED) const;
+
+    // Records a copy of the reference target into `buffer` (offset 0, width * height * 4 floats,
+    // row-major, premultiplied linear RGBA), with barriers; the buffer is ready for host reads
+    // once the command buffer completes. Does nothing without reference_modes.
     void record_target_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const;
 
+    // The reference target (VK_NULL_HANDLE without reference_modes) and its size.
     VkImage target_image() const;
     VkImageView target_view() const;
     uint32_t width() const;

@@ -72,6 +72,10 @@ struct ImageDesc {
     uint32_t height = 0;
     // Add TRANSFER_DST to upload into it and TRANSFER_SRC to read it back.
     VkImageUsageFlags usage = 0;
+    // The view's format when it differs (R8G8B8A8_UNORM over B8G8R8A8_UNORM, say); the image is
+    // then made with MUTABLE_FORMAT and EXTENDED_USAGE, so `usage` need only suit the view's
+    // format. VK_FORMAT_UNDEFINED: the view has `format`.
+    VkFormat view_format = VK_FORMAT_UNDEFINED;
 };
 
 // A VkImage with its own VkDeviceMemory and a 2D colour view (the view is VK_NULL_HANDLE when

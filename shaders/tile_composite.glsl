@@ -1,0 +1,201 @@
+// The tile pass: one workgroup per non-empty screen tile, one invocation per pixel, compositing
+// the tile's glyph quads into the caller's image (docs/compositing.md). The quads arrive sorted
+// front to back on the CPU, so a quad's index is its key: (depth, paint order, content).
+//
+// - The exact way, when the tile's list fits in workgroup memory (kCapacity quads): the list is
+//   loaded, sorted by index (bitonic), and each pixel walks it front to back, per channel
+//   light += T * L, T *= 1 - o, stopping once T is below kTileOpaque in every channel.
+// - The layered way, when it does not: each pixel keeps its kLayers nearest fragments (the
+//   smallest quad indices) in registers while reading the list unsorted; what falls off the K goes
+//   to a tail of absorbance sums, estimated as docs/oit.md's absorbance_share. Where a pixel has
+//   at most K fragments the result is the exact way's, bit for bit.
+//
+// Then, where the pixel had a fragment: out.rgb = light + T * dst.rgb, and alpha is "over" with each
+// fragment's largest channel opacity, out.a = 1 - (1 - dst.a) * prod(1 - max o), as the draw path's
+// blend does; in linear colour; 8-bit targets are decoded from and encoded to sRGB here.
+// Included by tile_composite_*.comp with CRISP_TARGET_FORMAT set to a GLSL image format qualifier,
+// or undefined for a format-less image (B8G8R8A8, which has no qualifier).
+#include "tile_common.glsl"
+
+layout(local_size_x = kTileInvocations) in;
+
+layout(constant_id = 0) const uint kLayers = 8u;  // the layered way's K, 1..kCompositeMaxLayers
+layout(constant_id = 1) const uint kEncode = kTileEncodeLinear;
+layout(constant_id = 2) const uint kCapacity = kTileDefaultCapacity;  // a power of two
+// 1: the view is R8G8B8A8 over a B8G8R8A8 image (made with MUTABLE_FORMAT): red and blue swap.
+layout(constant_id = 3) const uint kSwapRedBlue = 0u;
+
+layout(set = 0, binding = kTileBindAtlas, rgba16ui) uniform readonly uimage2D atlas;
+#ifdef CRISP_TARGET_FORMAT
+layout(set = 0, binding = kTileBindTarget, CRISP_TARGET_FORMAT) uniform image2D target;
+#else
+layout(set = 0, binding = kTileBindTarget) uniform image2D target;
+#endif
+
+#include "glyph_texel.glsl"
+
+shared uint list[kCapacity];
+shared uint tile_overlap;
+shared uint tile_tail_pixels;
+
+vec3 srgb_to_linear(vec3 c) {
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+vec3 linear_to_srgb(vec3 c) {
+    c = clamp(c, 0.0, 1.0);
+    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
+}
+
+// The list's first `count` entries sorted ascending; entries up to the next power of two are
+// padded with kTileNoQuad, which sorts last.
+void sort_list(uint count) {
+    uint size = 1u;
+    while (size < count) size *= 2u;
+    for (uint i = count + gl_LocalInvocationIndex; i < size; i += kTileInvocations) list[i] = kTileNoQuad;
+    barrier();
+    for (uint k = 2u; k <= size; k *= 2u) {
+        for (uint j = k / 2u; j > 0u; j /= 2u) {
+            for (uint i = gl_LocalInvocationIndex; i < size; i += kTileInvocations) {
+                const uint partner = i ^ j;
+                if (partner > i) {
+                    const uint a = list[i], b = list[partner];
+                    if ((a > b) == ((i & k) == 0u)) {
+                        list[i] = b;
+                        list[partner] = a;
+                    }
+                }
+            }
+            barrier();
+        }
+    }
+}
+
+// Quad `index`'s opacity at the pixel; false where it draws nothing there (outside its rect, no
+// samples, or no opacity in any channel: such a fragment would change nothing).
+bool quad_opacity(uint index, ivec2 pixel, out vec3 opacity, out vec3 colour) {
+    const CompositeQuad q = quads[index];
+    if (pixel.x < q.x || pixel.y < q.y || pixel.x - q.x >= int(q.width) || pixel.y - q.y >= int(q.height)) {
+        return false;
+    }
+    if (!glyph_texel_opacity(q, pixel, opacity)) return false;
+    colour = q.color.rgb;
+    return any(greaterThan(opacity, vec3(0.0)));
+}
+
+struct Blend {
+    vec3 light;
+    vec3 transmittance;
+    float coverage_transmittance;  // alpha: the product of 1 - (the fragment's largest opacity)
+    uint fragments;
+};
+
+void blend_over(inout Blend b, vec3 opacity, vec3 colour) {
+    b.light += b.transmittance * colour * opacity;
+    b.transmittance *= 1.0 - opacity;
+    b.coverage_transmittance *= 1.0 - max(opacity.r, max(opacity.g, opacity.b));
+}
+
+Blend exact_way(uint start, uint count, ivec2 pixel, bool inside) {
+    for (uint i = gl_LocalInvocationIndex; i < count; i += kTileInvocations) list[i] = bins[start + i];
+    sort_list(count);
+    Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
+    if (!inside) return b;
+    for (uint i = 0u; i < count; ++i) {
+        vec3 opacity, colour;
+        if (!quad_opacity(list[i], pixel, opacity, colour)) continue;
+        blend_over(b, opacity, colour);
+        ++b.fragments;
+        if (all(lessThan(b.transmittance, vec3(kTileOpaque)))) break;
+    }
+    return b;
+}
+
+Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, out bool tail) {
+    Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
+    tail = false;
+    if (!inside) return b;
+    uint slots[kCompositeMaxLayers];
+    for (uint s = 0u; s < kLayers; ++s) slots[s] = kTileNoQuad;
+    // The tail, per channel: absorbance sum A, colour weighted by absorbance, and whether some
+    // tail fragment was opaque there.
+    vec3 absorbance = vec3(0.0), weighted = vec3(0.0);
+    bvec3 opaque = bvec3(false);
+    float tail_coverage = 1.0;
+    for (uint i = 0u; i < count; ++i) {
+        uint candidate = bins[start + i];
+        vec3 opacity, colour;
+        if (!quad_opacity(candidate, pixel, opacity, colour)) continue;
+        ++b.fragments;
+        // The compare-and-swap chain keeps the K smallest indices sorted; what is left falls off.
+        for (uint s = 0u; s < kLayers; ++s) {
+            if (candidate < slots[s]) {
+                const uint kept = slots[s];
+                slots[s] = candidate;
+                candidate = kept;
+            }
+        }
+        if (candidate == kTileNoQuad) continue;
+        tail = true;
+        quad_opacity(candidate, pixel, opacity, colour);
+        const vec3 transmittance = 1.0 - opacity;
+        opaque = bvec3(uvec3(opaque) | uvec3(equal(transmittance, vec3(0.0))));
+        const vec3 a = min(-log(max(transmittance, vec3(1e-30))), vec3(kCompositeMaxAbsorbance));
+        absorbance += a;
+        weighted += colour * a;
+        tail_coverage *= 1.0 - max(opacity.r, max(opacity.g, opacity.b));
+    }
+    for (uint s = 0u; s < kLayers; ++s) {
+        vec3 opacity, colour;
+        if (slots[s] != kTileNoQuad && quad_opacity(slots[s], pixel, opacity, colour)) blend_over(b, opacity, colour);
+    }
+    if (tail) {
+        // absorbance_share: the tail absorbs 1 - P of what reaches it, P = exp(-A) (0 where a tail
+        // fragment was opaque), and gives back light in proportion to each fragment's absorbance.
+        const vec3 passed = mix(exp(-absorbance), vec3(0.0), opaque);
+        const vec3 share = mix(vec3(0.0), weighted / max(absorbance, vec3(1e-30)), greaterThan(absorbance, vec3(0.0)));
+        b.light += b.transmittance * (1.0 - passed) * share;
+        b.transmittance *= passed;
+        b.coverage_transmittance *= tail_coverage;
+    }
+    return b;
+}
+
+void main() {
+    const uint busy = gl_WorkGroupID.y * kRasterDispatchWidth + gl_WorkGroupID.x;
+    if (busy >= header[kHeaderBusyTiles]) return;  // uniform over the workgroup
+    const uint tile = header[kTileHeaderWords + busy];
+    const uint tiles = tile_total();
+    const uint count = tile_words[tile];
+    const uint start = tile_words[tiles + tile];
+    const ivec2 pixel = ivec2(uvec2(tile % pc.tiles_x, tile / pc.tiles_x) * kTileSide +
+                              uvec2(gl_LocalInvocationIndex % kTileSide, gl_LocalInvocationIndex / kTileSide));
+    const bool inside = pixel.x < int(pc.width) && pixel.y < int(pc.height);
+    if (gl_LocalInvocationIndex == 0u) {
+        tile_overlap = 0u;
+        tile_tail_pixels = 0u;
+    }
+    // count is uniform, so is the way; the exact way's barriers are reached by every invocation.
+    const bool fits = count <= kCapacity;
+    bool tail = false;
+    const Blend b = fits ? exact_way(start, count, pixel, inside) : layered_way(start, count, pixel, inside, tail);
+
+    barrier();
+    if (b.fragments > 0u) atomicMax(tile_overlap, b.fragments);
+    if (tail) atomicAdd(tile_tail_pixels, 1u);
+    if (b.fragments > 0u) {
+        const ivec2 at = pixel + ivec2(pc.origin_x, pc.origin_y);
+        vec4 destination = imageLoad(target, at);
+        if (kSwapRedBlue != 0u) destination = destination.bgra;
+        if (kEncode == kTileEncodeSrgb) destination.rgb = srgb_to_linear(destination.rgb);
+        vec3 colour = b.light + b.transmittance * destination.rgb;
+        const float alpha = 1.0 - (1.0 - destination.a) * b.coverage_transmittance;
+        if (kEncode == kTileEncodeSrgb) colour = linear_to_srgb(colour);
+        imageStore(target, at, kSwapRedBlue != 0u ? vec4(colour.bgr, alpha) : vec4(colour, alpha));
+    }
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) {
+        atomicAdd(header[fits ? kHeaderExactTiles : kHeaderLayeredTiles], 1u);
+        if (tile_overlap > 0u) atomicMax(header[kHeaderMaxOverlap], tile_overlap);
+        if (tile_tail_pixels > 0u) atomicAdd(header[kHeaderTailPixels], tile_tail_pixels);
+    }
+}

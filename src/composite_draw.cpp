@@ -1,0 +1,116 @@
+// The compositor's draw path: sorted quads blended inside the caller's render pass.
+#include "composite_draw.hpp"
+
+#include "composite_pipeline.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+
+namespace crisp::composite {
+
+namespace {
+
+constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+
+}  // namespace
+
+DrawCompositor::~DrawCompositor() {
+    if (!ref_.device) return;
+    if (pipeline_) vkDestroyPipeline(ref_.device, pipeline_, ref_.allocator);
+    for (VkShaderModule module : {vertex_, fragment_}) {
+        if (module) vkDestroyShaderModule(ref_.device, module, ref_.allocator);
+    }
+    for (Slot& slot : slots_) vk::destroy_buffer(ref_, slot.quads);
+    vk::destroy_descriptor_sets(ref_, descriptors_);
+}
+
+Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice physical_device, VkFormat format,
+                              uint32_t frames_in_flight) {
+    ref_ = device;
+    VkFormatProperties properties{};
+    vkGetPhysicalDeviceFormatProperties(physical_device, format, &properties);
+    if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT) == 0) {
+        return Error{ErrorCode::vulkan, "compositor: draw_format (VkFormat " + std::to_string(format) +
+                                            ") cannot be a blended colour attachment on this device"};
+    }
+    // The bindings composite_fragment.glsl declares for a rasterized quad: the atlas and the quads.
+    const VkDescriptorSetLayoutBinding bindings[] = {
+        {0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kStages, nullptr},
+        {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kStages, nullptr},
+    };
+    if (Status s = vk::create_descriptor_sets(ref_, bindings, kStages, sizeof(gpu::CompositePushConstants),
+                                              frames_in_flight, "compositor draw path", descriptors_);
+        !s) {
+        return s;
+    }
+    slots_.resize(frames_in_flight);
+    for (uint32_t i = 0; i < frames_in_flight; ++i) slots_[i].set = descriptors_.sets[i];
+    Result<VkShaderModule> vertex = vk::create_embedded_shader(ref_, "composite.vert");
+    if (!vertex) return vertex.error();
+    vertex_ = *vertex;
+    Result<VkShaderModule> fragment = vk::create_embedded_shader(ref_, "unsorted.frag");
+    if (!fragment) return fragment.error();
+    fragment_ = *fragment;
+
+    QuadPipeline desc;
+    desc.vertex = vertex_;
+    desc.fragment = fragment_;
+    desc.layout = descriptors_.pipeline_layout;
+    desc.blend_over = true;
+    desc.color_format = format;
+    desc.what = "compositor draw path";
+    Result<VkPipeline> pipeline = create_quad_pipeline(ref_, desc);
+    if (!pipeline) return pipeline.error();
+    pipeline_ = *pipeline;
+    return {};
+}
+
+Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
+                                        VkImageView atlas_view, const VkRect2D& rect) {
+    Slot& slot = slots_[frame_ % slots_.size()];
+    const VkDeviceSize bytes = quads.size_bytes();
+    if (!slot.quads.buffer || slot.quads.size < bytes) {
+        // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
+        vk::destroy_buffer(ref_, slot.quads);
+        if (Status s = vk::create_buffer(ref_, std::max<VkDeviceSize>(256, std::bit_ceil(bytes)),
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, slot.quads);
+            !s) {
+            return s.error();
+        }
+    }
+    if (bytes > 0) std::memcpy(slot.quads.mapped, quads.data(), bytes);
+    const VkDescriptorImageInfo atlas{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
+    const VkDescriptorBufferInfo quad_info{slot.quads.buffer, 0, VK_WHOLE_SIZE};
+    VkWriteDescriptorSet writes[2]{};
+    for (uint32_t i = 0; i < 2; ++i) {
+        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[i].dstSet = slot.set;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+    }
+    writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    writes[0].pImageInfo = &atlas;
+    writes[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[1].pBufferInfo = &quad_info;
+    vkUpdateDescriptorSets(ref_.device, 2, writes, 0, nullptr);
+    ++frame_;
+    if (quads.empty()) return uint64_t{0};
+
+    gpu::CompositePushConstants push{};
+    push.width = rect.extent.width;
+    push.height = rect.extent.height;
+    push.quad_count = static_cast<uint32_t>(quads.size());
+    push.back_to_front = 1;
+    push.origin_x = rect.offset.x;
+    push.origin_y = rect.offset.y;
+    vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
+    vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, descriptors_.pipeline_layout, 0, 1,
+                            &slot.set, 0, nullptr);
+    vkCmdPushConstants(command_buffer, descriptors_.pipeline_layout, kStages, 0, sizeof(push), &push);
+    set_viewport(command_buffer, rect);
+    vkCmdDraw(command_buffer, 4, push.quad_count, 0, 0);
+    return uint64_t{bytes};
+}
+
+}  // namespace crisp::composite

@@ -1,0 +1,41 @@
+// Private: the compositor's glyph quads, built on the CPU from the renderer's drawn glyphs.
+#pragma once
+
+#include "shared.h"
+
+#include <crisp/renderer.hpp>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace crisp::composite {
+
+// Clamps into [0, 1]; NaN becomes 0.
+float clamp01(float value);
+
+// A key's depth bits: floor(clamp01(depth) * 2^bits), saturated below the largest value so that no
+// key equals an empty slot (oit::pack_layer_key).
+uint32_t depth_bits(float depth, int bits);
+
+// One quad per drawn glyph with a non-empty rect, its colour and depth clamped into [0, 1].
+gpu::CompositeQuad make_quad(const DrawnGlyph& glyph);
+
+// The glyphs whose rects reach [0, width) x [0, height), as quads sorted front to back: depth
+// ascending, then paint order descending (later in front), then by content (rect, atlas position,
+// colour), so that the order, and with it a quad's index, depends only on the set of glyphs and
+// never on their submission order. A quad's index in `out` is then its compositing key. Rects
+// wider or taller than 65535 are left out (the renderer's are at most a few thousand).
+void sort_front_to_back(std::span<const DrawnGlyph> glyphs, uint32_t width, uint32_t height,
+                        std::vector<gpu::CompositeQuad>& out);
+
+// How many (quad, tile) pairs the tile compositor's binning makes for `quads` in a rect of
+// width x height pixels: the bins it needs.
+uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height);
+
+// The reference modes' quads, in submission order, with the layered keys' fields: paint orders
+// become dense ranks per depth plane, each further block of 256 one depth step nearer. Returns the
+// most 256-wide blocks one plane needed.
+uint32_t rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::CompositeQuad>& out);
+
+}  // namespace crisp::composite

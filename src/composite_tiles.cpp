@@ -1,0 +1,250 @@
+// The tile compositor: binning on the GPU, then one workgroup per non-empty tile.
+#include "composite_tiles.hpp"
+
+#include "composite_quads.hpp"
+#include "vk_barriers.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <string>
+#include <string_view>
+
+namespace crisp::composite {
+
+namespace {
+
+constexpr VkDeviceSize kWord = 4;
+size_t variant_index(VkFormat format, VkFormat view_format) {
+    const auto found = std::find_if(kTileVariants.begin(), kTileVariants.end(), [&](const TileVariant& v) {
+        return v.image == format && v.view == view_format;
+    });
+    return static_cast<size_t>(found - kTileVariants.begin());
+}
+
+bool is_srgb_encoded(VkFormat format) {
+    return format == VK_FORMAT_R8G8B8A8_UNORM || format == VK_FORMAT_B8G8R8A8_UNORM;
+}
+
+// Workgroups for `count` invocations in groups of `size`, as a 2D grid of rows of
+// kRasterDispatchWidth (the shaders index gl_WorkGroupID.y * gl_NumWorkGroups.x + x).
+VkExtent2D grid(uint32_t count, uint32_t size) {
+    const uint32_t groups = (count + size - 1) / size;
+    const uint32_t width = std::min(groups, gpu::kRasterDispatchWidth);
+    return {width, width == 0 ? 0 : (groups + width - 1) / width};
+}
+
+}  // namespace
+
+TileCompositor::~TileCompositor() {
+    if (!ref_.device) return;
+    for (VkPipeline pipeline : tile_pipelines_) {
+        if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
+    }
+    for (VkPipeline pipeline : {count_, scan_, scatter_}) {
+        if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
+    }
+    for (VkShaderModule module : modules_) vkDestroyShaderModule(ref_.device, module, ref_.allocator);
+    for (Slot& slot : slots_) {
+        for (vk::DeviceBuffer* buffer : {&slot.quads, &slot.tiles, &slot.bins, &slot.header, &slot.readback}) {
+            vk::destroy_buffer(ref_, *buffer);
+        }
+    }
+    vk::destroy_descriptor_sets(ref_, descriptors_);
+}
+
+Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& config) {
+    ref_ = device;
+    config_ = config;
+    constexpr VkShaderStageFlags stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    const VkDescriptorSetLayoutBinding bindings[] = {
+        {gpu::kTileBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stage, nullptr},
+        {gpu::kTileBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
+        {gpu::kTileBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
+        {gpu::kTileBindBins, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
+        {gpu::kTileBindHeader, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
+        {gpu::kTileBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stage, nullptr},
+    };
+    static_assert(std::size(bindings) == gpu::kTileBindingCount);
+    if (Status s = vk::create_descriptor_sets(ref_, bindings, stage, sizeof(gpu::TilePushConstants),
+                                              config.frames_in_flight, "tile compositor", descriptors_);
+        !s) {
+        return s;
+    }
+    slots_.resize(config.frames_in_flight);
+    for (uint32_t i = 0; i < config.frames_in_flight; ++i) slots_[i].set = descriptors_.sets[i];
+
+    auto pipeline = [&](const char* shader, const VkSpecializationInfo* specialization, VkPipeline& out) -> Status {
+        Result<VkShaderModule> module = vk::create_embedded_shader(ref_, shader);
+        if (!module) return module.error();
+        modules_.push_back(*module);
+        Result<VkPipeline> made =
+            vk::create_compute_pipeline(ref_, *module, descriptors_.pipeline_layout, specialization, shader);
+        if (!made) return made.error();
+        out = *made;
+        return {};
+    };
+    const uint32_t scatter = 1;
+    const VkSpecializationMapEntry scatter_entry{0, 0, 4};
+    const VkSpecializationInfo scatter_info{1, &scatter_entry, 4, &scatter};
+    if (Status s = pipeline("tile_bin.comp", nullptr, count_); !s) return s;
+    if (Status s = pipeline("tile_bin.comp", &scatter_info, scatter_); !s) return s;
+    if (Status s = pipeline("tile_scan.comp", nullptr, scan_); !s) return s;
+
+    for (size_t i = 0; i < kTileVariants.size(); ++i) {
+        const TileVariant& variant = kTileVariants[i];
+        VkFormatProperties properties{};
+        vkGetPhysicalDeviceFormatProperties(config.physical_device, variant.view, &properties);
+        if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT) == 0) continue;
+        if (std::string_view(variant.shader) == "tile_composite_any.comp" && !config.storage_without_format) continue;
+        // constant_id 0: K; 1: the target's encoding; 2: the list capacity; 3: red and blue swap.
+        const uint32_t constants[4] = {
+            config.layers, is_srgb_encoded(variant.image) ? gpu::kTileEncodeSrgb : gpu::kTileEncodeLinear,
+            config.capacity, variant.image != variant.view ? 1u : 0u};
+        const VkSpecializationMapEntry entries[4] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}};
+        const VkSpecializationInfo specialization{4, entries, sizeof(constants), constants};
+        if (Status s = pipeline(variant.shader, &specialization, tile_pipelines_[i]); !s) return s;
+    }
+    return {};
+}
+
+bool TileCompositor::supports(VkFormat format, VkFormat view_format) const {
+    const size_t i = variant_index(format, view_format);
+    return i < kTileVariants.size() && tile_pipelines_[i] != VK_NULL_HANDLE;
+}
+
+Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage,
+                            bool host_visible) {
+    if (buffer.buffer && buffer.size >= bytes) return {};
+    // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
+    vk::destroy_buffer(ref_, buffer);
+    return vk::create_buffer(ref_, std::max<VkDeviceSize>(256, std::bit_ceil(bytes)), usage, host_visible, buffer);
+}
+
+Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles,
+                                    uint64_t pairs) {
+    constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    constexpr VkBufferUsageFlags transfer = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    const VkDeviceSize quad_bytes = quads.size_bytes();
+    if (Status s = grow(slot.quads, quad_bytes, storage, true); !s) return s;
+    if (Status s = grow(slot.tiles, VkDeviceSize{tiles} * 3 * kWord, storage | transfer, false); !s) return s;
+    if (Status s = grow(slot.bins, pairs * kWord, storage, false); !s) return s;
+    if (Status s = grow(slot.header, (gpu::kTileHeaderWords + VkDeviceSize{tiles}) * kWord,
+                        storage | transfer | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false);
+        !s) {
+        return s;
+    }
+    if (Status s = grow(slot.readback, sizeof(gpu::TileHeader), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true); !s) return s;
+    if (quad_bytes > 0) std::memcpy(slot.quads.mapped, quads.data(), quad_bytes);
+    return {};
+}
+
+void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view) {
+    const VkDescriptorImageInfo atlas{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
+    const VkDescriptorImageInfo target{VK_NULL_HANDLE, target_view, VK_IMAGE_LAYOUT_GENERAL};
+    const VkDescriptorBufferInfo buffers[] = {
+        {slot.quads.buffer, 0, VK_WHOLE_SIZE},
+        {slot.tiles.buffer, 0, VK_WHOLE_SIZE},
+        {slot.bins.buffer, 0, VK_WHOLE_SIZE},
+        {slot.header.buffer, 0, VK_WHOLE_SIZE},
+    };
+    VkWriteDescriptorSet writes[gpu::kTileBindingCount]{};
+    for (uint32_t i = 0; i < gpu::kTileBindingCount; ++i) {
+        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[i].dstSet = slot.set;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    }
+    writes[gpu::kTileBindAtlas].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    writes[gpu::kTileBindAtlas].pImageInfo = &atlas;
+    writes[gpu::kTileBindTarget].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    writes[gpu::kTileBindTarget].pImageInfo = &target;
+    writes[gpu::kTileBindQuads].pBufferInfo = &buffers[0];
+    writes[gpu::kTileBindTiles].pBufferInfo = &buffers[1];
+    writes[gpu::kTileBindBins].pBufferInfo = &buffers[2];
+    writes[gpu::kTileBindHeader].pBufferInfo = &buffers[3];
+    vkUpdateDescriptorSets(ref_.device, gpu::kTileBindingCount, writes, 0, nullptr);
+}
+
+void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, VkPipeline tile_pipeline,
+                                   const gpu::TilePushConstants& push) {
+    constexpr VkPipelineStageFlags compute = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    constexpr VkPipelineStageFlags transfer = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    constexpr VkAccessFlags shader = vk::kShaderAccess;
+    const uint32_t tiles = push.tiles_x * push.tiles_y;
+    // This slot's buffers were last used by a frame the caller has waited for; the barrier orders
+    // them for the validation layer and for callers who recycle command buffers early.
+    vk::memory_barrier(cb, compute | transfer | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       shader | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT, transfer,
+                       VK_ACCESS_TRANSFER_WRITE_BIT);
+    vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
+    vkCmdFillBuffer(cb, slot.header.buffer, 0, sizeof(gpu::TileHeader), 0);
+    vk::memory_barrier(cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, compute, shader);
+
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set, 0,
+                            nullptr);
+    vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    const VkExtent2D quad_groups = grid(push.quad_count, gpu::kTileBinInvocations);
+    auto bin = [&](VkPipeline pipeline) {
+        if (quad_groups.width == 0) return;
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+        vkCmdDispatch(cb, quad_groups.width, quad_groups.height, 1);
+    };
+    bin(count_);
+    vk::memory_barrier(cb, compute, shader, compute, shader);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, scan_);
+    vkCmdDispatch(cb, 1, 1, 1);
+    vk::memory_barrier(cb, compute, shader, compute, shader);
+    bin(scatter_);
+    vk::memory_barrier(cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_pipeline);
+    vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
+
+    // The frame's counts for the host.
+    vk::memory_barrier(cb, compute, VK_ACCESS_SHADER_WRITE_BIT, transfer, VK_ACCESS_TRANSFER_READ_BIT);
+    const VkBufferCopy copy{0, 0, sizeof(gpu::TileHeader)};
+    vkCmdCopyBuffer(cb, slot.header.buffer, slot.readback.buffer, 1, &copy);
+    vk::memory_barrier(cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                       VK_ACCESS_HOST_READ_BIT);
+}
+
+Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
+                                        VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
+                                        uint64_t& measured_frame) {
+    Slot& slot = slots_[frame_ % slots_.size()];
+    if (slot.pending) {
+        gpu::TileHeader header{};
+        std::memcpy(&header, slot.readback.mapped, sizeof(header));
+        measured = {header.busy_tiles, header.exact_tiles, header.layered_tiles, header.max_overlap,
+                    header.tail_pixels, header.pairs, header.lost_pairs};
+        measured_frame = slot.frame;
+        slot.pending = false;
+    }
+    gpu::TilePushConstants push{};
+    push.origin_x = target.origin.x;
+    push.origin_y = target.origin.y;
+    push.width = target.size.width;
+    push.height = target.size.height;
+    push.tiles_x = (push.width + gpu::kTileSide - 1) / gpu::kTileSide;
+    push.tiles_y = (push.height + gpu::kTileSide - 1) / gpu::kTileSide;
+    push.quad_count = static_cast<uint32_t>(quads.size());
+    const uint64_t pairs = count_tile_pairs(quads, push.width, push.height);
+    if (pairs > 0xFFFFFFFFu / kWord) {
+        return Error{ErrorCode::invalid_argument, "compositor: " + std::to_string(pairs) +
+                                                      " (glyph, tile) pairs in one frame, more than a buffer holds"};
+    }
+    push.bin_capacity = static_cast<uint32_t>(pairs);
+    const uint32_t tiles = push.tiles_x * push.tiles_y;
+    if (Status s = prepare_slot(slot, quads, tiles, pairs); !s) return s.error();
+    write_descriptors(slot, atlas_view, target.view);
+    record_passes(command_buffer, slot, tile_pipelines_[variant_index(target.format, target.view_format)], push);
+    ++frame_;
+    slot.pending = true;
+    slot.frame = frame_;
+    return quads.size_bytes() + VkDeviceSize{tiles} * 3 * kWord + pairs * kWord +
+           (gpu::kTileHeaderWords + VkDeviceSize{tiles}) * kWord;
+}
+
+}  // namespace crisp::composite

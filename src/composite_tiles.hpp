@@ -1,0 +1,113 @@
+// Private: the tile compositor (docs/compositing.md). The frame's quads, sorted front to back on
+// the CPU, are binned into 16 x 16 screen tiles on the GPU (count, prefix sum, scatter), and one
+// workgroup per non-empty tile composites its pixels into the caller's storage image: exactly
+// where the tile's list fits in workgroup memory, with the K nearest layers per pixel where not.
+// Nothing per pixel lives in global memory.
+#pragma once
+
+#include "shared.h"
+#include "vk_resources.hpp"
+
+#include <crisp/result.hpp>
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace crisp::composite {
+
+// The tile pass's pipelines: an image format seen through a view format.
+struct TileVariant {
+    VkFormat image;
+    VkFormat view;
+    const char* shader;
+};
+inline constexpr std::array<TileVariant, 5> kTileVariants = {{
+    {VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM, "tile_composite_rgba8.comp"},
+    {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM, "tile_composite_rgba8.comp"},  // red and blue swap
+    {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_B8G8R8A8_UNORM, "tile_composite_any.comp"},  // storage_without_format
+    {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R16G16B16A16_SFLOAT, "tile_composite_rgba16f.comp"},
+    {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT, "tile_composite_rgba32f.comp"},
+}};
+
+struct TileConfig {
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    uint32_t frames_in_flight = 2;
+    uint32_t layers = gpu::kCompositeMaxLayers;     // K of tiles whose list overflows
+    uint32_t capacity = gpu::kTileDefaultCapacity;  // quads a tile's list holds in workgroup memory
+    bool storage_without_format = false;            // B8G8R8A8 targets allowed
+};
+
+// Where the tile pass draws: glyph pixel (0, 0) is `origin` in the image; `size` pixels from there.
+struct TileTarget {
+    VkImageView view = VK_NULL_HANDLE;
+    VkFormat format = VK_FORMAT_UNDEFINED;       // the image's
+    VkFormat view_format = VK_FORMAT_UNDEFINED;  // the view's
+    VkOffset2D origin{};
+    VkExtent2D size{};
+};
+
+// What the GPU counted in one frame (TileHeader).
+struct TileCounts {
+    uint32_t busy_tiles = 0;
+    uint32_t exact_tiles = 0;
+    uint32_t layered_tiles = 0;
+    uint32_t max_overlap = 0;
+    uint32_t tail_pixels = 0;
+    uint32_t pairs = 0;
+    uint32_t lost_pairs = 0;
+};
+
+class TileCompositor {
+public:
+    TileCompositor() = default;
+    TileCompositor(const TileCompositor&) = delete;
+    TileCompositor& operator=(const TileCompositor&) = delete;
+    ~TileCompositor();
+
+    // Pipelines for every format of kTileFormats the device can store to (B8G8R8A8 only with
+    // storage_without_format), and one descriptor set per frame in flight. Errors: vulkan.
+    Status create(const vk::DeviceRef& device, const TileConfig& config);
+
+    // True when an image of `format` seen through a view of `view_format` can be a target.
+    bool supports(VkFormat format, VkFormat view_format) const;
+
+    // Records the frame: `quads` sorted front to back (sort_front_to_back for target.size).
+    // Returns the buffer bytes the frame used; `measured` gets the counts of the frame that last
+    // used this frame slot, if it has not been read yet (`measured_frame` says which).
+    Result<uint64_t> record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
+                            VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
+                            uint64_t& measured_frame);
+
+private:
+    struct Slot {
+        vk::DeviceBuffer quads;     // host-visible CompositeQuad[]
+        vk::DeviceBuffer tiles;     // three planes of tile words
+        vk::DeviceBuffer bins;      // quad indices
+        vk::DeviceBuffer header;    // TileHeader, then the busy tiles' indices
+        vk::DeviceBuffer readback;  // host-visible copy of TileHeader
+        VkDescriptorSet set = VK_NULL_HANDLE;
+        bool pending = false;
+        uint64_t frame = 0;
+    };
+
+    Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible);
+    Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
+    void write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view);
+    void record_passes(VkCommandBuffer command_buffer, const Slot& slot, VkPipeline tile_pipeline,
+                       const gpu::TilePushConstants& push);
+
+    vk::DeviceRef ref_;
+    TileConfig config_;
+    vk::DescriptorSets descriptors_;
+    std::vector<VkShaderModule> modules_;
+    VkPipeline count_ = VK_NULL_HANDLE, scan_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
+    std::array<VkPipeline, kTileVariants.size()> tile_pipelines_{};
+    std::vector<Slot> slots_;
+    uint64_t frame_ = 0;
+};
+
+}  // namespace crisp::composite

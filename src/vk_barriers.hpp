@@ -1,0 +1,23 @@
+// Private: the pipeline barriers crisp's passes record, in one place.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+namespace crisp::vk {
+
+inline constexpr VkPipelineStageFlags kShaderStages =
+    VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+inline constexpr VkAccessFlags kShaderAccess = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+
+// A global memory barrier: `source_access` at `source` stages made visible to
+// `destination_access` at `destination` stages.
+inline void memory_barrier(VkCommandBuffer command_buffer, VkPipelineStageFlags source, VkAccessFlags source_access,
+                           VkPipelineStageFlags destination, VkAccessFlags destination_access) {
+    VkMemoryBarrier barrier{};
+    barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    barrier.srcAccessMask = source_access;
+    barrier.dstAccessMask = destination_access;
+    vkCmdPipelineBarrier(command_buffer, source, destination, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+}
+
+}  // namespace crisp::vk

@@ -1,0 +1,520 @@
+// The tile path (Compositor::record) and the draw path (Compositor::record_draw) on lavapipe with
+// validation and synchronization validation on: every target format against a CPU computation
+// over a non-uniform background, per channel; bit-identical images for shuffled submission;
+// coplanar ties by paint order; overflowing tiles taking the layered way; the caller's rect.
+#include "composite_fixture.hpp"
+
+#include <crisp/compositor.hpp>
+#include <crisp/vulkan_context.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace crisp {
+namespace {
+
+using namespace compositing_test;
+using Rgba = std::array<float, 4>;
+
+// ---- Texel encodings of the target formats -----------------------------------------------------
+
+float srgb_to_linear(float c) {
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+float linear_to_srgb(float c) {
+    c = std::clamp(c, 0.0f, 1.0f);
+    return c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+uint16_t float_to_half(float value) {
+    // Round to nearest even through the float's bits; the test values are finite and in [0, 1].
+    const uint32_t bits = std::bit_cast<uint32_t>(value);
+    const uint32_t sign = (bits >> 16) & 0x8000u;
+    const int exponent = static_cast<int>((bits >> 23) & 0xFF) - 127 + 15;
+    uint32_t mantissa = bits & 0x7FFFFFu;
+    if (exponent <= 0) {
+        if (exponent < -10) return static_cast<uint16_t>(sign);
+        mantissa |= 0x800000u;
+        const int shift = 14 - exponent;
+        uint32_t half = mantissa >> shift;
+        const uint32_t rest = mantissa & ((1u << shift) - 1), mid = 1u << (shift - 1);
+        if (rest > mid || (rest == mid && (half & 1u))) ++half;
+        return static_cast<uint16_t>(sign | half);
+    }
+    uint32_t half = (static_cast<uint32_t>(exponent) << 10) | (mantissa >> 13);
+    const uint32_t rest = mantissa & 0x1FFFu;
+    if (rest > 0x1000u || (rest == 0x1000u && (half & 1u))) ++half;
+    return static_cast<uint16_t>(sign | half);
+}
+
+float half_to_float(uint16_t half) {
+    const uint32_t sign = (half & 0x8000u) << 16;
+    const uint32_t exponent = (half >> 10) & 0x1Fu, mantissa = half & 0x3FFu;
+    if (exponent == 0) return std::ldexp(static_cast<float>(mantissa), -24) * (sign ? -1.0f : 1.0f);
+    return std::bit_cast<float>(sign | ((exponent - 15 + 127) << 23) | (mantissa << 13));
+}
+
+bool is_8bit(VkFormat format) {
+    return format == VK_FORMAT_R8G8B8A8_UNORM || format == VK_FORMAT_B8G8R8A8_UNORM ||
+           format == VK_FORMAT_R8G8B8A8_SRGB || format == VK_FORMAT_B8G8R8A8_SRGB;
+}
+bool is_bgra(VkFormat format) {
+    return format == VK_FORMAT_B8G8R8A8_UNORM || format == VK_FORMAT_B8G8R8A8_SRGB;
+}
+
+// Linear RGBA (alpha as is) to the bytes of one texel; 8-bit formats hold sRGB colour.
+void encode(VkFormat format, const Rgba& linear, std::byte* out) {
+    if (is_8bit(format)) {
+        uint8_t texel[4];
+        for (size_t c = 0; c < 4; ++c) {
+            const float v = c < 3 ? linear_to_srgb(linear[c]) : std::clamp(linear[c], 0.0f, 1.0f);
+            texel[c] = static_cast<uint8_t>(std::lround(v * 255.0f));
+        }
+        if (is_bgra(format)) std::swap(texel[0], texel[2]);
+        std::memcpy(out, texel, 4);
+    } else if (format == VK_FORMAT_R16G16B16A16_SFLOAT) {
+        uint16_t texel[4];
+        for (size_t c = 0; c < 4; ++c) texel[c] = float_to_half(linear[c]);
+        std::memcpy(out, texel, 8);
+    } else {
+        std::memcpy(out, linear.data(), 16);
+    }
+}
+
+Rgba decode(VkFormat format, const std::byte* in) {
+    Rgba linear{};
+    if (is_8bit(format)) {
+        uint8_t texel[4];
+        std::memcpy(texel, in, 4);
+        if (is_bgra(format)) std::swap(texel[0], texel[2]);
+        for (int c = 0; c < 4; ++c) {
+            const float v = static_cast<float>(texel[c]) / 255.0f;
+            linear[static_cast<size_t>(c)] = c < 3 ? srgb_to_linear(v) : v;
+        }
+    } else if (format == VK_FORMAT_R16G16B16A16_SFLOAT) {
+        uint16_t texel[4];
+        std::memcpy(texel, in, 8);
+        for (int c = 0; c < 4; ++c) linear[static_cast<size_t>(c)] = half_to_float(texel[c]);
+    } else {
+        std::memcpy(linear.data(), in, 16);
+    }
+    return linear;
+}
+
+// ---- Targets -----------------------------------------------------------------------------------
+
+// A non-uniform scene behind the text: a colour ramp across, another down, diagonal stripes in
+// blue and a checkered alpha.
+Rgba backdrop(uint32_t x, uint32_t y, uint32_t width, uint32_t height) {
+    const float u = static_cast<float>(x) / static_cast<float>(width - 1);
+    const float v = static_cast<float>(y) / static_cast<float>(height - 1);
+    const float stripe = ((x + 2 * y) / 5) % 2 == 0 ? 0.85f : 0.15f;
+    return {0.1f + 0.8f * u, 0.9f - 0.7f * v, stripe, (x + y) % 2 == 0 ? 1.0f : 0.6f};
+}
+
+struct Target {
+    Image image;
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    VkFormat view_format = VK_FORMAT_UNDEFINED;  // the view's, where it differs
+    uint32_t width = 0, height = 0;
+    std::vector<std::byte> initial;  // the backdrop as uploaded
+};
+
+Target make_target(VkFormat format, uint32_t width, uint32_t height, VkImageUsageFlags usage,
+                   VkFormat view_format = VK_FORMAT_UNDEFINED) {
+    HeadlessContext& context = *fixture().context;
+    Target t;
+    t.format = format;
+    t.view_format = view_format;
+    t.width = width;
+    t.height = height;
+    auto image = context.create_image(
+        {format, width, height, usage | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, view_format});
+    EXPECT_TRUE(image) << (image ? "" : image.error().message);
+    if (!image) return t;
+    t.image = std::move(*image);
+    const uint32_t texel = format_texel_size(format);
+    t.initial.resize(size_t{width} * height * texel);
+    for (uint32_t y = 0; y < height; ++y) {
+        for (uint32_t x = 0; x < width; ++x) {
+            encode(format, backdrop(x, y, width, height), &t.initial[(size_t{y} * width + x) * texel]);
+        }
+    }
+    EXPECT_TRUE(context.upload(t.image, t.initial, VK_IMAGE_LAYOUT_GENERAL));
+    return t;
+}
+
+std::vector<std::byte> read_target(const Target& t) {
+    auto bytes = fixture().context->read_image(t.image, VK_IMAGE_LAYOUT_GENERAL);
+    EXPECT_TRUE(bytes);
+    return bytes ? *bytes : std::vector<std::byte>{};
+}
+
+CompositorCreateInfo tile_info(uint32_t frames_in_flight = 2) {
+    Fixture& f = fixture();
+    CompositorCreateInfo info;
+    info.physical_device = f.context->physical_device();
+    info.device = f.context->device();
+    info.frames_in_flight = frames_in_flight;
+    return info;
+}
+
+// Composites `glyphs` into the target with the tile path, rect at `origin` with the scene's size.
+void composite_tiles(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs, Target& t,
+                     VkOffset2D origin = {0, 0}) {
+    CompositeTarget target;
+    target.view = t.image.view();
+    target.format = t.format;
+    target.view_format = t.view_format;
+    target.extent = {t.width, t.height};
+    target.rect = {origin, {kWidth, kHeight}};
+    EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
+        const Status s = compositor.record(cb, glyphs, scene.renderer->atlas_view(), target);
+        EXPECT_TRUE(s) << (s ? "" : s.error().message);
+    }));
+}
+
+// Draws `glyphs` into the target inside a dynamic-rendering pass that loads what it holds.
+void composite_draw(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs, Target& t) {
+    EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
+        VkRenderingAttachmentInfo attachment{};
+        attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+        attachment.imageView = t.image.view();
+        attachment.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+        attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+        attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        VkRenderingInfo rendering{};
+        rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+        rendering.renderArea = {{0, 0}, {t.width, t.height}};
+        rendering.layerCount = 1;
+        rendering.colorAttachmentCount = 1;
+        rendering.pColorAttachments = &attachment;
+        vkCmdBeginRendering(cb, &rendering);
+        const Status s = compositor.record_draw(cb, glyphs, scene.renderer->atlas_view(), {{0, 0}, {kWidth, kHeight}});
+        EXPECT_TRUE(s) << (s ? "" : s.error().message);
+        vkCmdEndRendering(cb);
+    }));
+}
+
+// The CPU computation: each pixel's fragments front to back (depth ascending, later paint order
+// in front) in double precision over the backdrop as stored, per channel; alpha is "over" with
+// each fragment's largest opacity: 1 - (1 - a) * prod(1 - max o).
+// Also returns how many fragments each pixel had.
+std::vector<Rgba> expected_image(const Scene& scene, const Target& t, VkOffset2D origin, std::vector<size_t>* counts) {
+    const uint32_t texel = format_texel_size(t.format);
+    std::vector<Rgba> out(size_t{t.width} * t.height);
+    if (counts) counts->assign(out.size(), 0);
+    for (uint32_t y = 0; y < t.height; ++y) {
+        for (uint32_t x = 0; x < t.width; ++x) {
+            const size_t at = size_t{y} * t.width + x;
+            const Rgba back = decode(t.format, &t.initial[at * texel]);
+            out[at] = back;
+            const int64_t sx = int64_t{x} - origin.x, sy = int64_t{y} - origin.y;
+            if (sx < 0 || sy < 0 || sx >= kWidth || sy >= kHeight) continue;
+            std::vector<oit::Fragment> list = scene.pixels[static_cast<size_t>(sy) * kWidth + static_cast<size_t>(sx)];
+            std::stable_sort(list.begin(), list.end(), [](const oit::Fragment& a, const oit::Fragment& b) {
+                return a.depth != b.depth ? a.depth < b.depth : a.paint_order > b.paint_order;
+            });
+            if (counts) (*counts)[at] = list.size();
+            if (list.empty()) continue;
+            double light[3] = {}, transmittance[3] = {1, 1, 1}, coverage_transmittance = 1.0;
+            for (const oit::Fragment& f : list) {
+                for (int c = 0; c < 3; ++c) {
+                    light[c] += transmittance[c] * double{f.light[c]};
+                    transmittance[c] *= double{f.transmittance[c]};
+                }
+                coverage_transmittance *= double{std::min({f.transmittance[0], f.transmittance[1], f.transmittance[2]})};
+            }
+            for (size_t c = 0; c < 3; ++c) out[at][c] = static_cast<float>(light[c] + transmittance[c] * double{back[c]});
+            out[at][3] = static_cast<float>(1.0 - (1.0 - double{back[3]}) * coverage_transmittance);
+        }
+    }
+    return out;
+}
+
+// The largest difference between the image and the expectation: in 8-bit codes of the stored
+// encoding for 8-bit formats, in linear units otherwise.
+double worst_difference(const Target& t, const std::vector<std::byte>& bytes, const std::vector<Rgba>& expected) {
+    const uint32_t texel = format_texel_size(t.format);
+    double worst = 0.0;
+    for (size_t i = 0; i < expected.size(); ++i) {
+        const Rgba got = decode(t.format, &bytes[i * texel]);
+        for (size_t c = 0; c < 4; ++c) {
+            double d = std::abs(double{got[c]} - double{expected[i][c]});
+            if (is_8bit(t.format)) {
+                const auto code = [&](float v) { return double{c < 3 ? linear_to_srgb(v) : std::clamp(v, 0.0f, 1.0f)} * 255.0; };
+                d = std::abs(code(got[c]) - code(expected[i][c]));
+            }
+            worst = std::max(worst, d);
+        }
+    }
+    return worst;
+}
+
+// The tolerance of a format: one code of 8 bits; half a unit in the last place of a half near 1
+// plus the walk's early exit; float: the early exit (T below 2^-16 stops it).
+double tolerance(VkFormat format) {
+    if (is_8bit(format)) return 1.0;
+    if (format == VK_FORMAT_R16G16B16A16_SFLOAT) return 1.0 / 1024.0;
+    return 4e-5;
+}
+
+std::vector<TextRun> dense_runs(float alpha) {
+    std::vector<TextRun> runs = overlapping_runs(alpha);
+    const std::vector<TextRun> more = {
+        {"fonts@&", 0.3f, 17.6f, {0.8f, 0.7f, 0.1f, alpha}, 0.5f},
+        {"Hamburgefo", -2.1f, 27.9f, {0.5f, 0.1f, 0.6f, alpha}, 0.1f},
+        {"stivHam", 5.2f, 31.3f, {0.1f, 0.5f, 0.5f, alpha}, 0.7f},
+    };
+    runs.insert(runs.end(), more.begin(), more.end());
+    return runs;
+}
+
+// Image and view formats: B8G8R8A8 through an R8G8B8A8 view of a MUTABLE_FORMAT image (lavapipe has
+// no shaderStorageImageReadWithoutFormat for a B8G8R8A8 view).
+struct TileFormat {
+    VkFormat image, view;
+};
+constexpr TileFormat kTileFormats[] = {
+    {VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_UNDEFINED},
+    {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM},
+    {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_UNDEFINED},
+    {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_UNDEFINED},
+};
+constexpr VkFormat kDrawFormats[] = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB,
+                                     VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT};
+
+// ---- Tests -------------------------------------------------------------------------------------
+
+TEST(TileCompositor, EveryFormatMatchesTheCpuComputationPerChannel) {
+    const Scene scene = render_scene(overlapping_runs(0.7f));
+    auto compositor = Compositor::create(tile_info());
+    ASSERT_TRUE(compositor) << compositor.error().message;
+    for (const TileFormat& tile_format : kTileFormats) {
+        const VkFormat format = tile_format.image;
+        SCOPED_TRACE("VkFormat " + std::to_string(format) + " view " + std::to_string(tile_format.view));
+        ASSERT_TRUE(compositor->supports_target_format(format, tile_format.view));
+        Target t = make_target(format, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT, tile_format.view);
+        composite_tiles(*compositor, scene, scene.drawn, t);
+        const std::vector<std::byte> bytes = read_target(t);
+        EXPECT_LE(worst_difference(t, bytes, expected_image(scene, t, {0, 0}, nullptr)), tolerance(format));
+        // Pixels without glyphs are never written: the backdrop's bytes stay.
+        const uint32_t texel = format_texel_size(format);
+        size_t untouched = 0, differing_channels = 0;
+        for (size_t p = 0; p < scene.pixels.size(); ++p) {
+            if (!scene.pixels[p].empty()) {
+                const oit::Fragment& f = scene.pixels[p][0];
+                if (f.transmittance[0] != f.transmittance[1] || f.transmittance[1] != f.transmittance[2]) {
+                    ++differing_channels;
+                }
+                continue;
+            }
+            EXPECT_EQ(std::memcmp(&bytes[p * texel], &t.initial[p * texel], texel), 0) << "pixel " << p;
+            ++untouched;
+        }
+        EXPECT_GT(untouched, 0u);
+        EXPECT_GT(differing_channels, 0u);  // subpixel coverage: the channels do differ
+    }
+    const CompositorStats& stats = compositor->stats();
+    EXPECT_EQ(stats.mode, CompositeMode::tiled);
+    EXPECT_GT(stats.quads, 0u);  // the glyphs that reach the rect
+    EXPECT_LE(stats.quads, scene.drawn.size());
+    EXPECT_TRUE(stats.measured);
+    EXPECT_GT(stats.busy_tiles, 0u);
+    EXPECT_EQ(stats.exact_tiles, stats.busy_tiles);  // every list fits in workgroup memory
+    EXPECT_EQ(stats.layered_tiles, 0u);
+    EXPECT_EQ(stats.max_overlap, max_overlap(scene));
+    expect_no_validation_messages();
+}
+
+TEST(TileCompositor, DrawPathMatchesTheCpuComputationPerChannel) {
+    const Scene scene = render_scene(overlapping_runs(0.7f));
+    for (VkFormat format : kDrawFormats) {
+        SCOPED_TRACE("VkFormat " + std::to_string(format));
+        CompositorCreateInfo info = tile_info();
+        info.draw_format = format;
+        auto compositor = Compositor::create(info);
+        ASSERT_TRUE(compositor) << compositor.error().message;
+        Target t = make_target(format, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
+        composite_draw(*compositor, scene, scene.drawn, t);
+        // Each blend rounds to the attachment: a code per overlapping layer on 8-bit targets.
+        const double allowed = is_8bit(format) ? static_cast<double>(max_overlap(scene)) : tolerance(format);
+        EXPECT_LE(worst_difference(t, read_target(t), expected_image(scene, t, {0, 0}, nullptr)), allowed);
+    }
+    expect_no_validation_messages();
+}
+
+TEST(TileCompositor, ShuffledSubmissionGivesBitIdenticalImages) {
+    const Scene scene = render_scene(overlapping_runs(0.6f));
+    CompositorCreateInfo info = tile_info();
+    info.draw_format = VK_FORMAT_R8G8B8A8_SRGB;
+    auto compositor = Compositor::create(info);
+    ASSERT_TRUE(compositor);
+    std::vector<DrawnGlyph> shuffled = scene.drawn;
+    std::mt19937 random(7);
+    Target a = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+    composite_tiles(*compositor, scene, scene.drawn, a);
+    Target c = make_target(VK_FORMAT_R8G8B8A8_SRGB, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
+    composite_draw(*compositor, scene, scene.drawn, c);
+    const std::vector<std::byte> tiles = read_target(a), drawn = read_target(c);
+    for (int round = 0; round < 3; ++round) {
+        std::shuffle(shuffled.begin(), shuffled.end(), random);
+        Target b = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+        composite_tiles(*compositor, scene, shuffled, b);
+        EXPECT_EQ(read_target(b), tiles) << "tile path, shuffle " << round;
+        Target d = make_target(VK_FORMAT_R8G8B8A8_SRGB, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
+        composite_draw(*compositor, scene, shuffled, d);
+        EXPECT_EQ(read_target(d), drawn) << "draw path, shuffle " << round;
+    }
+    expect_no_validation_messages();
+}
+
+TEST(TileCompositor, CoplanarGlyphsResolveByPaintOrder) {
+    // Two opaque-ish runs on one plane over each other: the later paint order is in front.
+    const std::vector<TextRun> runs = {
+        {"Hamburg", 1.0f, 24.0f, {0.9f, 0.1f, 0.1f, 0.9f}, 0.5f},
+        {"Hamburg", 2.5f, 25.5f, {0.1f, 0.1f, 0.9f, 0.9f}, 0.5f},
+    };
+    const Scene scene = render_scene(runs);
+    auto compositor = Compositor::create(tile_info());
+    ASSERT_TRUE(compositor);
+    Target t = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+    composite_tiles(*compositor, scene, scene.drawn, t);
+    const std::vector<std::byte> bytes = read_target(t);
+    EXPECT_LE(worst_difference(t, bytes, expected_image(scene, t, {0, 0}, nullptr)), tolerance(t.format));
+    // The same glyphs with the paint orders of the two runs swapped put red in front instead.
+    std::vector<DrawnGlyph> swapped = scene.drawn;
+    const uint32_t first_blue = static_cast<uint32_t>(scene.drawn.size() / 2);
+    for (DrawnGlyph& g : swapped) {
+        g.instance.paint_order = g.instance.paint_order >= first_blue ? g.instance.paint_order - first_blue
+                                                                      : g.instance.paint_order + first_blue;
+    }
+    Target s = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+    composite_tiles(*compositor, scene, swapped, s);
+    const std::vector<std::byte> other = read_target(s);
+    double most_red_gain = 0.0;
+    for (size_t p = 0; p < scene.pixels.size(); ++p) {
+        const Rgba before = decode(t.format, &bytes[p * 16]), after = decode(t.format, &other[p * 16]);
+        most_red_gain = std::max(most_red_gain, static_cast<double>(after[0] - before[0]));
+    }
+    EXPECT_GT(most_red_gain, 0.3);
+    expect_no_validation_messages();
+}
+
+TEST(TileCompositor, OverflowingTilesTakeTheLayeredWayWithinOneCodeOfExact) {
+    const Scene scene = render_scene(dense_runs(0.5f));
+    CompositorCreateInfo info = tile_info(1);  // stats of a frame come back at the next record()
+    info.tile_capacity = 4;
+    auto exact = Compositor::create(tile_info(1));
+    ASSERT_TRUE(exact);
+    for (uint32_t layers : {8u, 2u}) {
+        SCOPED_TRACE("K = " + std::to_string(layers));
+        info.tile_layers = layers;
+        auto compositor = Compositor::create(info);
+        ASSERT_TRUE(compositor);
+        Target t = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+        composite_tiles(*compositor, scene, scene.drawn, t);
+        Target again = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+        composite_tiles(*compositor, scene, scene.drawn, again);
+        const CompositorStats& stats = compositor->stats();
+        ASSERT_TRUE(stats.measured);
+        EXPECT_GT(stats.layered_tiles, 0u);
+        EXPECT_EQ(stats.exact_tiles + stats.layered_tiles, stats.busy_tiles);
+        const bool tail = max_overlap(scene) > layers;
+        EXPECT_EQ(stats.tail_pixels > 0, tail);
+
+        Target e = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+        composite_tiles(*exact, scene, scene.drawn, e);
+        std::vector<size_t> counts;
+        const std::vector<Rgba> expected = expected_image(scene, t, {0, 0}, &counts);
+        const std::vector<std::byte> got = read_target(t), exact_bytes = read_target(e);
+        double within = 0.0, past = 0.0;
+        size_t identical = 0, fitting = 0;
+        for (size_t p = 0; p < expected.size(); ++p) {
+            const Rgba g = decode(t.format, &got[p * 16]);
+            double d = 0.0;
+            for (size_t c = 0; c < 4; ++c) d = std::max(d, std::abs(double{g[c]} - double{expected[p][c]}));
+            if (counts[p] <= layers) {
+                within = std::max(within, d);
+                ++fitting;
+                identical += std::memcmp(&got[p * 16], &exact_bytes[p * 16], 16) == 0;
+            } else {
+                past = std::max(past, d);
+            }
+        }
+        // Where the overlap fits K the layered way is the exact way, bit for bit.
+        EXPECT_LE(within, 1.0 / 255.0);
+        EXPECT_EQ(identical, fitting);
+        if (tail) {
+            EXPECT_GT(past, 0.0);  // past K the tail is an estimate
+            EXPECT_LT(past, 0.25);
+        }
+    }
+    expect_no_validation_messages();
+}
+
+TEST(TileCompositor, DrawsOnlyInsideTheCallersRect) {
+    const Scene scene = render_scene(overlapping_runs(0.8f));
+    auto compositor = Compositor::create(tile_info());
+    ASSERT_TRUE(compositor);
+    const uint32_t width = kWidth + 21, height = kHeight + 13;
+    const VkOffset2D origin{9, 5};
+    Target t = make_target(VK_FORMAT_R8G8B8A8_UNORM, width, height, VK_IMAGE_USAGE_STORAGE_BIT);
+    composite_tiles(*compositor, scene, scene.drawn, t, origin);
+    const std::vector<std::byte> bytes = read_target(t);
+    EXPECT_LE(worst_difference(t, bytes, expected_image(scene, t, origin, nullptr)), 1.0);
+    for (uint32_t y = 0; y < height; ++y) {
+        for (uint32_t x = 0; x < width; ++x) {
+            const bool inside = x >= 9 && y >= 5 && x < 9 + kWidth && y < 5 + kHeight;
+            if (inside) continue;
+            const size_t at = (size_t{y} * width + x) * 4;
+            EXPECT_EQ(std::memcmp(&bytes[at], &t.initial[at], 4), 0) << x << ", " << y;
+        }
+    }
+    expect_no_validation_messages();
+}
+
+TEST(TileCompositor, RefusesWhatItCannotDraw) {
+    const Scene scene = render_scene({{"Ham", 2.0f, 20.0f, {0.1f, 0.1f, 0.1f, 1.0f}, 0.5f}});
+    CompositorCreateInfo info = tile_info();
+    info.tile_capacity = 100;  // not a power of two
+    EXPECT_EQ(Compositor::create(info).error().code, ErrorCode::invalid_argument);
+    info = tile_info();
+    info.tile_layers = 0;
+    EXPECT_EQ(Compositor::create(info).error().code, ErrorCode::invalid_argument);
+    info = tile_info();
+    auto compositor = Compositor::create(info);
+    ASSERT_TRUE(compositor);
+    EXPECT_FALSE(compositor->supports_target_format(VK_FORMAT_B8G8R8A8_UNORM));
+    EXPECT_FALSE(compositor->supports_target_format(VK_FORMAT_R8G8B8A8_SRGB));
+    Target t = make_target(VK_FORMAT_R8G8B8A8_UNORM, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+    CompositeTarget target{t.image.view(), VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_UNDEFINED, {kWidth, kHeight}, {}};
+    EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
+        const Status wrong_format = compositor->record(cb, scene.drawn, scene.renderer->atlas_view(), target);
+        ASSERT_FALSE(wrong_format);
+        EXPECT_NE(wrong_format.error().message.find("storage_without_format"), std::string::npos);
+        target.format = VK_FORMAT_R8G8B8A8_UNORM;
+        target.rect = {{10, 0}, {kWidth, kHeight}};  // past the right edge
+        EXPECT_EQ(compositor->record(cb, scene.drawn, scene.renderer->atlas_view(), target).error().code,
+                  ErrorCode::invalid_argument);
+        EXPECT_EQ(compositor->record_draw(cb, scene.drawn, scene.renderer->atlas_view(), {{0, 0}, {8, 8}}).error().code,
+                  ErrorCode::invalid_argument);  // no draw_format
+        CompositeParams params;
+        EXPECT_EQ(compositor->record_reference(cb, scene.drawn, scene.renderer->atlas_view(), params).error().code,
+                  ErrorCode::invalid_argument);  // no reference_modes
+    }));
+    // Untouched: every refusal recorded nothing.
+    EXPECT_EQ(read_target(t), t.initial);
+    expect_no_validation_messages();
+}
+
+}  // namespace
+}  // namespace crisp
