@@ -184,7 +184,7 @@ CRISP_CONSTANT(uint, kTileBinInvocations, 64u);
 // Quad indices a tile's list holds in workgroup memory by default; a longer list takes the
 // layered way (the K nearest per pixel, the rest estimated).
 CRISP_CONSTANT(uint, kTileDefaultCapacity, 1024u);
-CRISP_CONSTANT(uint, kTileMaxCapacity, 2048u);  // 8 KiB of the 16 KiB every device offers
+CRISP_CONSTANT(uint, kTileMaxCapacity, 1024u);  // 15 KiB of workgroup memory in all, of the 16 KiB every device offers
 CRISP_CONSTANT(uint, kTileNoQuad, 0xFFFFFFFFu);
 // Below this in every channel the transmittance left hides whatever lies behind (less than a
 // 16-bit code): a pixel's walk stops there.

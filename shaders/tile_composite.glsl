@@ -34,9 +34,16 @@ layout(set = 0, binding = kTileBindTarget) uniform image2D target;
 
 #include "glyph_texel.glsl"
 
-shared uint list[kCapacity];
+shared uint unsorted[kCapacity];  // the tile's list as the scatter left it
+shared uint list[kCapacity];      // ... sorted
+// A chunk of the sorted list, staged for the walk: per quad its rect in tile pixels (x0, y0, x1, y1
+// in bytes, clamped to the tile), its atlas texel minus its position, and its colour.
+shared uint chunk_rect[kTileInvocations];
+shared ivec2 chunk_texel[kTileInvocations];
+shared vec4 chunk_colour[kTileInvocations];
 shared uint tile_overlap;
 shared uint tile_tail_pixels;
+shared uint tile_busy_pixels;  // pixels of the tile still walking
 
 vec3 srgb_to_linear(vec3 c) {
     return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
@@ -46,28 +53,19 @@ vec3 linear_to_srgb(vec3 c) {
     return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
 }
 
-// The list's first `count` entries sorted ascending; entries up to the next power of two are
-// padded with kTileNoQuad, which sorts last.
-void sort_list(uint count) {
-    uint size = 1u;
-    while (size < count) size *= 2u;
-    for (uint i = count + gl_LocalInvocationIndex; i < size; i += kTileInvocations) list[i] = kTileNoQuad;
+// The tile's list from the bins into `list`, sorted ascending: each entry's place is the number
+// of entries smaller than it (a quad is in a tile's list once, so entries are distinct). One
+// barrier; count^2 / kTileInvocations reads of workgroup memory per invocation.
+void sort_list(uint start, uint count) {
+    for (uint i = gl_LocalInvocationIndex; i < count; i += kTileInvocations) unsorted[i] = bins[start + i];
     barrier();
-    for (uint k = 2u; k <= size; k *= 2u) {
-        for (uint j = k / 2u; j > 0u; j /= 2u) {
-            for (uint i = gl_LocalInvocationIndex; i < size; i += kTileInvocations) {
-                const uint partner = i ^ j;
-                if (partner > i) {
-                    const uint a = list[i], b = list[partner];
-                    if ((a > b) == ((i & k) == 0u)) {
-                        list[i] = b;
-                        list[partner] = a;
-                    }
-                }
-            }
-            barrier();
-        }
+    for (uint i = gl_LocalInvocationIndex; i < count; i += kTileInvocations) {
+        const uint key = unsorted[i];
+        uint place = 0u;
+        for (uint j = 0u; j < count; ++j) place += unsorted[j] < key ? 1u : 0u;
+        list[place] = key;
     }
+    barrier();
 }
 
 // Quad `index`'s opacity at the pixel; false where it draws nothing there (outside its rect, no
@@ -95,17 +93,55 @@ void blend_over(inout Blend b, vec3 opacity, vec3 colour) {
     b.coverage_transmittance *= 1.0 - max(opacity.r, max(opacity.g, opacity.b));
 }
 
-Blend exact_way(uint start, uint count, ivec2 pixel, bool inside) {
-    for (uint i = gl_LocalInvocationIndex; i < count; i += kTileInvocations) list[i] = bins[start + i];
-    sort_list(count);
+// Stages quads list[base ..] (up to kTileInvocations) for the walk, relative to the tile's corner.
+void stage_chunk(uint base, uint count, ivec2 corner) {
+    const uint i = base + gl_LocalInvocationIndex;
+    if (i >= count) return;
+    const CompositeQuad q = quads[list[i]];
+    const ivec2 low = clamp(ivec2(q.x, q.y) - corner, ivec2(0), ivec2(kTileSide));
+    const ivec2 high = clamp(ivec2(q.x, q.y) + ivec2(q.width, q.height) - corner, ivec2(0), ivec2(kTileSide));
+    chunk_rect[gl_LocalInvocationIndex] = uint(low.x) | (uint(low.y) << 8) | (uint(high.x) << 16) | (uint(high.y) << 24);
+    chunk_texel[gl_LocalInvocationIndex] = ivec2(q.atlas_x, q.atlas_y) - ivec2(q.x, q.y);
+    chunk_colour[gl_LocalInvocationIndex] = q.color;
+}
+
+// The exact way: the sorted list, staged a chunk at a time into workgroup memory, walked front to
+// back by every pixel; the workgroup stops once every pixel's transmittance is spent.
+Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) {
+    if (gl_LocalInvocationIndex == 0u) tile_busy_pixels = 0u;
+    sort_list(start, count);
     Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
-    if (!inside) return b;
-    for (uint i = 0u; i < count; ++i) {
-        vec3 opacity, colour;
-        if (!quad_opacity(list[i], pixel, opacity, colour)) continue;
-        blend_over(b, opacity, colour);
-        ++b.fragments;
-        if (all(lessThan(b.transmittance, vec3(kTileOpaque)))) break;
+    bool walking = inside;
+    if (walking) atomicAdd(tile_busy_pixels, 1u);
+    const ivec2 local = pixel - corner;
+    const ivec2 atlas_size = imageSize(atlas);
+    for (uint base = 0u; base < count; base += kTileInvocations) {
+        stage_chunk(base, count, corner);
+        barrier();
+        const uint staged = min(kTileInvocations, count - base);
+        for (uint j = 0u; walking && j < staged; ++j) {
+            const uint rect = chunk_rect[j];
+            if (local.x < int(rect & 255u) || local.y < int((rect >> 8) & 255u) || local.x >= int((rect >> 16) & 255u) ||
+                local.y >= int(rect >> 24)) {
+                continue;
+            }
+            const ivec2 texel = pixel + chunk_texel[j];
+            if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, atlas_size))) continue;
+            const uvec4 sums = imageLoad(atlas, texel);
+            if (sums.a == 0u) continue;
+            const vec4 colour = chunk_colour[j];
+            const vec3 opacity =
+                colour.a * min(vec3(sums.rgb) / (float(kRasterCoverageOne) * float(sums.a)), vec3(1.0));
+            if (!any(greaterThan(opacity, vec3(0.0)))) continue;
+            blend_over(b, opacity, colour.rgb);
+            ++b.fragments;
+            if (all(lessThan(b.transmittance, vec3(kTileOpaque)))) {
+                walking = false;
+                atomicAdd(tile_busy_pixels, 0xFFFFFFFFu);  // minus one
+            }
+        }
+        barrier();
+        if (tile_busy_pixels == 0u) break;  // read between two barriers: uniform
     }
     return b;
 }
@@ -177,7 +213,8 @@ void main() {
     // count is uniform, so is the way; the exact way's barriers are reached by every invocation.
     const bool fits = count <= kCapacity;
     bool tail = false;
-    const Blend b = fits ? exact_way(start, count, pixel, inside) : layered_way(start, count, pixel, inside, tail);
+    const ivec2 corner = pixel - ivec2(gl_LocalInvocationIndex % kTileSide, gl_LocalInvocationIndex / kTileSide);
+    const Blend b = fits ? exact_way(start, count, corner, pixel, inside) : layered_way(start, count, pixel, inside, tail);
 
     barrier();
     if (b.fragments > 0u) atomicMax(tile_overlap, b.fragments);

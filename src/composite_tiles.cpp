@@ -46,7 +46,7 @@ TileCompositor::~TileCompositor() {
     }
     for (VkShaderModule module : modules_) vkDestroyShaderModule(ref_.device, module, ref_.allocator);
     for (Slot& slot : slots_) {
-        for (vk::DeviceBuffer* buffer : {&slot.quads, &slot.tiles, &slot.bins, &slot.header, &slot.readback}) {
+        for (vk::DeviceBuffer* buffer : {&slot.quads, &slot.tiles, &slot.bins, &slot.header}) {
             vk::destroy_buffer(ref_, *buffer);
         }
     }
@@ -129,12 +129,12 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
     if (Status s = grow(slot.quads, quad_bytes, storage, true); !s) return s;
     if (Status s = grow(slot.tiles, VkDeviceSize{tiles} * 3 * kWord, storage | transfer, false); !s) return s;
     if (Status s = grow(slot.bins, pairs * kWord, storage, false); !s) return s;
+    // Host-visible, so that the host reads the frame's counts straight from it once the frame is done.
     if (Status s = grow(slot.header, (gpu::kTileHeaderWords + VkDeviceSize{tiles}) * kWord,
-                        storage | transfer | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false);
+                        storage | transfer | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true);
         !s) {
         return s;
     }
-    if (Status s = grow(slot.readback, sizeof(gpu::TileHeader), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true); !s) return s;
     if (quad_bytes > 0) std::memcpy(slot.quads.mapped, quads.data(), quad_bytes);
     return {};
 }
@@ -201,13 +201,8 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, VkPipel
                        shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_pipeline);
     vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
-
     // The frame's counts for the host.
-    vk::memory_barrier(cb, compute, VK_ACCESS_SHADER_WRITE_BIT, transfer, VK_ACCESS_TRANSFER_READ_BIT);
-    const VkBufferCopy copy{0, 0, sizeof(gpu::TileHeader)};
-    vkCmdCopyBuffer(cb, slot.header.buffer, slot.readback.buffer, 1, &copy);
-    vk::memory_barrier(cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-                       VK_ACCESS_HOST_READ_BIT);
+    vk::memory_barrier(cb, compute, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
 Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
@@ -216,7 +211,7 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     Slot& slot = slots_[frame_ % slots_.size()];
     if (slot.pending) {
         gpu::TileHeader header{};
-        std::memcpy(&header, slot.readback.mapped, sizeof(header));
+        std::memcpy(&header, slot.header.mapped, sizeof(header));
         measured = {header.busy_tiles, header.exact_tiles, header.layered_tiles, header.max_overlap,
                     header.tail_pixels, header.pairs, header.lost_pairs};
         measured_frame = slot.frame;

@@ -87,8 +87,7 @@ private:
         vk::DeviceBuffer quads;     // host-visible CompositeQuad[]
         vk::DeviceBuffer tiles;     // three planes of tile words
         vk::DeviceBuffer bins;      // quad indices
-        vk::DeviceBuffer header;    // TileHeader, then the busy tiles' indices
-        vk::DeviceBuffer readback;  // host-visible copy of TileHeader
+        vk::DeviceBuffer header;    // host-visible: TileHeader, then the busy tiles' indices
         VkDescriptorSet set = VK_NULL_HANDLE;
         bool pending = false;
         uint64_t frame = 0;

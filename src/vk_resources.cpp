@@ -55,7 +55,10 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
     const VkMemoryPropertyFlags required =
         host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
                      : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-    const auto type = find_memory_type(device.memory_properties, requirements.memoryTypeBits, required, 0);
+    // Host-visible buffers carry per-frame uploads the GPU reads: device-local memory the host can
+    // map (resizable BAR) saves the GPU reading them across the bus, where there is such memory.
+    const VkMemoryPropertyFlags preferred = host_visible ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : 0;
+    const auto type = find_memory_type(device.memory_properties, requirements.memoryTypeBits, required, preferred);
     if (!type) {
         destroy_buffer(device, out);
         return Error{ErrorCode::vulkan, "no memory type for a buffer of " + std::to_string(size) + " bytes"};

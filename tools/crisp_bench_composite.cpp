@@ -1,9 +1,10 @@
 // crisp-bench-composite: what each compositing mode costs and how far it is from exact, for scenes
-// of N overlapping layers of text at high and low alpha. Per mode (layered with K = 1, 2, 4, 8 and
-// auto, unsorted, wboit, exact): the GPU time of Compositor::record() on converged static text
-// (Vulkan timestamp queries), the error of its image against the exact mode's in 8-bit sRGB codes,
-// and its bytes per pixel. The exact mode is itself checked against the CPU reference
-// (src/oit_reference). Prints Markdown (or JSON with --json); docs/benchmarks-compositing.md.
+// of N overlapping layers of text at high and low alpha. Per mode (the tile path into RGBA32F and
+// RGBA8 images, the whole frame of converged text with it, the draw path, and the reference modes:
+// exact, unsorted, wboit, layered with K = 1, 2, 4, 8 and auto): the GPU time of its record call on
+// converged static text (Vulkan timestamp queries), the error of its image against the exact CPU
+// reference (src/oit_reference) in 8-bit sRGB codes, and its bytes per pixel. Prints Markdown (or
+// JSON with --json); docs/benchmarks-compositing.md.
 #include "cli.hpp"
 #include "gpu_tools.hpp"
 #include "vk_resources.hpp"
@@ -69,8 +70,11 @@ struct Args {
     uint32_t subpixel_steps = 4;
     crisp::KeyFormat keys = crisp::KeyFormat::automatic;
     crisp::QuadPath path = crisp::QuadPath::raster;
+    std::vector<std::string> modes = {"tiled", "tiled-rgba8", "frame", "draw", "exact", "unsorted", "wboit",
+                                      "layered-1", "layered-2", "layered-4", "layered-8", "layered-auto"};
     bool cpu_check = true;
     bool json = false;
+    std::string json_out;
     bool validate = false;
     bool validate_sync = false;
 };
@@ -79,8 +83,14 @@ struct Args {
     std::fprintf(code ? stderr : stdout,
                  "usage: crisp-bench-composite [options]\n"
                  "For scenes of N overlapping layers of text, measures each compositing mode's GPU time\n"
-                 "(timestamp queries around Compositor::record), its error against the exact mode in 8-bit\n"
-                 "sRGB codes, and its bytes per pixel. Progress goes to stderr.\n\n"
+                 "(timestamp queries around its record call), its error against the exact CPU reference (or,\n"
+                 "with --no-cpu-check, the exact mode) in 8-bit sRGB codes, and its bytes per pixel.\n"
+                 "Progress goes to stderr.\n\n"
+                 "  --modes LIST       modes, comma-separated, from tiled (the tile path into RGBA32F),\n"
+                 "                     tiled-rgba8 (into R8G8B8A8_UNORM), frame (the renderer's converged\n"
+                 "                     frame and the tile path together), draw (the draw path, RGBA32F),\n"
+                 "                     exact, unsorted, wboit, layered-K (K = 1..8) and layered-auto\n"
+                 "                     (default: all of them, layered with K = 1, 2, 4, 8 and auto)\n"
                  "  --layers LIST      layer counts, comma-separated (default 1,2,4,8,16,32)\n"
                  "  --alphas LIST      text alphas, comma-separated, in (0, 1] (default 0.9,0.3)\n"
                  "  --canvas W,H       target size, also WxH (default 512,256)\n"
@@ -100,6 +110,7 @@ struct Args {
                  "  --validate         turn the validation layer on\n"
                  "  --validate-sync    the validation layer with synchronization validation\n"
                  "  --json             print JSON instead of Markdown\n"
+                 "  --json-out FILE    also write the JSON to FILE\n"
                  "  -h, --help         this text\n",
                  kFramesInFlight, kDefaultWarmupFrames, kDefaultWarmupMs);
     std::exit(code);
@@ -195,6 +206,15 @@ Args parse(int argc, char** argv) {
             const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(value());
             if (!path) fail("--path: raster or compute");
             args.path = *path;
+        } else if (arg == "--modes") {
+            args.modes.clear();
+            const std::string list = value();
+            size_t begin = 0;
+            while (begin <= list.size()) {
+                const size_t end = std::min(list.find(',', begin), list.size());
+                args.modes.push_back(list.substr(begin, end - begin));
+                begin = end + 1;
+            }
         } else if (arg == "--no-cpu-check") {
             args.cpu_check = false;
         } else if (arg == "--device") {
@@ -205,6 +225,8 @@ Args parse(int argc, char** argv) {
             args.validate = args.validate_sync = true;
         } else if (arg == "--json") {
             args.json = true;
+        } else if (arg == "--json-out") {
+            args.json_out = value();
         } else {
             std::fprintf(stderr, "crisp-bench-composite: unknown argument %s\n", arg.c_str());
             usage(2);
@@ -377,8 +399,29 @@ CpuExact cpu_exact(std::span<const crisp::DrawnGlyph> drawn, std::span<const uin
 
 struct ModeRun {
     crisp::CompositeMode mode;
-    uint32_t layers;  // layered: K, or kAutoLayers
+    uint32_t layers = 0;                                 // layered: K, or kAutoLayers
+    VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;     // tiled and draw: the target image's
+    bool with_renderer = false;                          // tiled: the renderer's frame timed too
 };
+
+// The run a --modes name stands for; nullopt for an unknown name.
+std::optional<ModeRun> parse_mode_run(const std::string& name) {
+    if (name == "tiled-rgba8") return ModeRun{crisp::CompositeMode::tiled, 0, VK_FORMAT_R8G8B8A8_UNORM, false};
+    if (name == "frame") return ModeRun{crisp::CompositeMode::tiled, 0, VK_FORMAT_R32G32B32A32_SFLOAT, true};
+    if (name == "layered-auto") return ModeRun{crisp::CompositeMode::layered, crisp::kAutoLayers};
+    if (name.rfind("layered-", 0) == 0) {
+        const std::optional<uint32_t> k = crisp::cli::parse_number<uint32_t>(name.substr(8));
+        if (!k || *k < 1 || *k > crisp::kMaxCompositeLayers) return std::nullopt;
+        return ModeRun{crisp::CompositeMode::layered, *k};
+    }
+    const std::optional<crisp::CompositeMode> mode = crisp::parse_composite_mode(name);
+    if (!mode || *mode == crisp::CompositeMode::layered) return std::nullopt;
+    return ModeRun{*mode};
+}
+
+bool is_reference(const ModeRun& run) {
+    return run.mode != crisp::CompositeMode::tiled && run.mode != crisp::CompositeMode::draw;
+}
 
 struct Measurement {
     ModeRun run;
@@ -403,10 +446,12 @@ struct SceneResult {
 };
 
 std::string mode_label(const ModeRun& run) {
+    if (run.with_renderer) return "frame: renderer + tiled";
     std::string label = crisp::composite_mode_name(run.mode);
     if (run.mode == crisp::CompositeMode::layered) {
         label += run.layers == crisp::kAutoLayers ? " auto" : " K=" + std::to_string(run.layers);
     }
+    if (run.format == VK_FORMAT_R8G8B8A8_UNORM) label += " rgba8";
     return label;
 }
 
@@ -416,12 +461,36 @@ double median(std::vector<double> values) {
     return n == 0 ? 0.0 : n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
+// The tile and draw paths' target images: cleared to the background before each frame, read back
+// after the last.
+struct Targets {
+    crisp::Image rgba32f;  // storage, colour attachment
+    crisp::Image rgba8;    // storage
+    const crisp::Image& of(VkFormat format) const { return format == VK_FORMAT_R8G8B8A8_UNORM ? rgba8 : rgba32f; }
+};
+
+// Every use of a target image before, then `destination` after, from `old_layout` to `layout`.
+void image_barrier(VkCommandBuffer cb, VkImage image, VkPipelineStageFlags destination, VkAccessFlags access,
+                   VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL, VkImageLayout old_layout = VK_IMAGE_LAYOUT_GENERAL) {
+    VkImageMemoryBarrier barrier{};
+    barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    barrier.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT | VK_ACCESS_MEMORY_READ_BIT;
+    barrier.dstAccessMask = access;
+    barrier.oldLayout = old_layout;
+    barrier.newLayout = layout;
+    barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.image = image;
+    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, destination, 0, 0, nullptr, 0, nullptr, 1, &barrier);
+}
+
 struct Bench {
     const Args& args;
     crisp::HeadlessContext& context;
     crisp::Renderer& renderer;
     const crisp::tools::GpuTimer& timer;
     crisp::Buffer& target_readback;
+    Targets& targets;
     std::vector<std::string>& warnings;
 
     void warn(const std::string& text) {
@@ -429,7 +498,104 @@ struct Bench {
         warnings.push_back(text);
     }
 
-    Measurement measure(crisp::Compositor& compositor, const std::string& scene_name, const ModeRun& run) {
+    // The run's commands: the tile path, the draw path in a dynamic-rendering pass, or a reference mode.
+    void record(VkCommandBuffer cb, crisp::Compositor& compositor, const ModeRun& run,
+                const crisp::CompositeParams& params) {
+        const VkRect2D rect{{0, 0}, {args.width, args.height}};
+        const crisp::Image& image = targets.of(run.format);
+        crisp::Status s;
+        if (run.mode == crisp::CompositeMode::tiled) {
+            if (run.with_renderer) s = renderer.record(cb);
+            if (s) {
+                const crisp::CompositeTarget target{image.view(), run.format, VK_FORMAT_UNDEFINED, rect.extent, rect};
+                s = compositor.record(cb, renderer.drawn(), renderer.atlas_view(), target);
+            }
+        } else if (run.mode == crisp::CompositeMode::draw) {
+            VkRenderingAttachmentInfo attachment{};
+            attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+            attachment.imageView = image.view();
+            attachment.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+            attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+            attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+            VkRenderingInfo rendering{};
+            rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+            rendering.renderArea = rect;
+            rendering.layerCount = 1;
+            rendering.colorAttachmentCount = 1;
+            rendering.pColorAttachments = &attachment;
+            vkCmdBeginRendering(cb, &rendering);
+            s = compositor.record_draw(cb, renderer.drawn(), renderer.atlas_view(), rect);
+            vkCmdEndRendering(cb);
+        } else {
+            s = compositor.record_reference(cb, renderer.drawn(), renderer.atlas_view(), params);
+        }
+        if (!s) fail(mode_label(run) + ": " + s.error().message);
+    }
+
+    // Clears the tile or draw path's image to the background before the timed commands.
+    void clear_target(VkCommandBuffer cb, const ModeRun& run, const crisp::CompositeParams& params) {
+        const VkImage image = targets.of(run.format).handle();
+        image_barrier(cb, image, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+        VkClearColorValue colour{};
+        for (int c = 0; c < 4; ++c) colour.float32[c] = params.background[c];
+        if (run.format == VK_FORMAT_R8G8B8A8_UNORM) {
+            for (int c = 0; c < 3; ++c) colour.float32[c] = kBackgroundSrgb;  // the image holds sRGB codes
+        }
+        const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        vkCmdClearColorImage(cb, image, VK_IMAGE_LAYOUT_GENERAL, &colour, 1, &range);
+        image_barrier(cb, image,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
+                          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+    }
+
+    void read_back(VkCommandBuffer cb, crisp::Compositor& compositor, const ModeRun& run) {
+        if (is_reference(run)) {
+            compositor.record_target_readback(cb, target_readback.handle());
+            return;
+        }
+        const VkImage image = targets.of(run.format).handle();
+        image_barrier(cb, image, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+                      VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {args.width, args.height, 1};
+        vkCmdCopyImageToBuffer(cb, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target_readback.handle(), 1, &region);
+        image_barrier(cb, image, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_IMAGE_LAYOUT_GENERAL,
+                      VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+        VkMemoryBarrier barrier{};
+        barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+        barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr,
+                             0, nullptr);
+    }
+
+    // 8-bit sRGB codes of the image read back (RGBA32F premultiplied over an opaque background, or
+    // R8G8B8A8 holding the codes).
+    std::vector<uint8_t> codes_read_back(const ModeRun& run, const std::string& scene_name) {
+        const size_t pixels = size_t{args.width} * args.height;
+        if (!is_reference(run) && run.format == VK_FORMAT_R8G8B8A8_UNORM) {
+            std::vector<uint8_t> codes(pixels * 3);
+            const std::byte* bytes = target_readback.mapped().data();
+            for (size_t p = 0; p < pixels; ++p) {
+                for (size_t c = 0; c < 3; ++c) codes[3 * p + c] = static_cast<uint8_t>(bytes[4 * p + c]);
+            }
+            return codes;
+        }
+        std::vector<float> rgba(pixels * 4);
+        std::memcpy(rgba.data(), target_readback.mapped().data(), rgba.size() * sizeof(float));
+        float alpha_error = 0.0f;
+        std::vector<uint8_t> codes = srgb_codes(rgba, alpha_error);
+        if (alpha_error > 1e-3f) {
+            warn(scene_name + ", " + mode_label(run) + ": target alpha off 1 by up to " + std::to_string(alpha_error) +
+                 " over an opaque background");
+        }
+        return codes;
+    }
+
+    Measurement measure(crisp::Compositor& compositor, const Scene& scene, const std::string& scene_name,
+                        const ModeRun& run) {
         Measurement m;
         m.run = run;
         crisp::CompositeParams params;
@@ -443,14 +609,17 @@ struct Bench {
         auto frame = [&](bool last) {
             // The text has converged: the renderer would record nothing but a barrier, and its
             // drawn() list stays valid until its next begin_frame(). Leaving it out keeps the GPU's
-            // idle gaps between frames short.
+            // idle gaps between frames short; the frame run puts it in, with its CPU side.
+            if (run.with_renderer) {
+                renderer.begin_frame();
+                renderer.draw(scene.glyphs);
+            }
             const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
+                if (!is_reference(run)) clear_target(cb, run, params);
                 timer.begin(cb);
-                if (crisp::Status s = compositor.record_reference(cb, renderer.drawn(), renderer.atlas_view(), params); !s) {
-                    fail(mode_label(run) + ": " + s.error().message);
-                }
+                record(cb, compositor, run, params);
                 timer.end(cb);
-                if (last) compositor.record_target_readback(cb, target_readback.handle());
+                if (last) read_back(cb, compositor, run);
             });
             if (!status) fail(status.error().message);
             const crisp::Result<double> ms = timer.milliseconds();
@@ -468,15 +637,7 @@ struct Bench {
         for (uint32_t f = 0; f < args.frames; ++f) m.gpu_ms.push_back(frame(f + 1 == args.frames));
         m.stats = compositor.stats();
         m.median_ms = median(m.gpu_ms);
-        const size_t floats = size_t{args.width} * args.height * 4;
-        std::vector<float> rgba(floats);
-        std::memcpy(rgba.data(), target_readback.mapped().data(), floats * sizeof(float));
-        float alpha_error = 0.0f;
-        m.codes = srgb_codes(rgba, alpha_error);
-        if (alpha_error > 1e-3f) {
-            warn(scene_name + ", " + mode_label(run) + ": target alpha off 1 by up to " + std::to_string(alpha_error) +
-                 " over an opaque background");
-        }
+        m.codes = codes_read_back(run, scene_name);
         return m;
     }
 };
@@ -513,58 +674,61 @@ double buffer_bytes_per_pixel(const Measurement& m, const Args& args) {
     return static_cast<double>(m.stats.buffer_bytes) / (static_cast<double>(args.width) * args.height);
 }
 
-void print_json(const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
+void print_json(std::FILE* out, const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
                 const std::vector<std::string>& warnings) {
-    std::printf("{\n  \"device\": %s,\n  \"driver_name\": %s,\n  \"driver_info\": %s,\n  \"driver_version\": %u,\n",
+    std::fprintf(out, "{\n  \"device\": %s,\n  \"driver_name\": %s,\n  \"driver_info\": %s,\n  \"driver_version\": %u,\n",
                 json_string(header.device).c_str(), json_string(header.driver_name).c_str(),
                 json_string(header.driver_info).c_str(), header.driver_version);
-    std::printf("  \"api_version\": %s,\n  \"int64_atomics\": %s,\n  \"layout\": %s,\n  \"layered_keys\": %s,\n",
+    std::fprintf(out, "  \"api_version\": %s,\n  \"int64_atomics\": %s,\n  \"layout\": %s,\n  \"layered_keys\": %s,\n",
                 json_string(header.api).c_str(), header.int64_atomics ? "true" : "false",
                 json_string(header.layout).c_str(), json_string(header.keys).c_str());
-    std::printf("  \"quad_path\": %s,\n", json_string(crisp::quad_path_name(args.path)).c_str());
-    std::printf("  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
+    std::fprintf(out, "  \"quad_path\": %s,\n", json_string(crisp::quad_path_name(args.path)).c_str());
+    std::fprintf(out, "  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
                 args.height, json_string(args.font).c_str(), static_cast<double>(args.size), args.samples);
-    std::printf("  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"timed_frames\": %u,\n",
+    std::fprintf(out, "  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"timed_frames\": %u,\n",
                 args.subpixel_steps, args.warmup, args.warmup_ms, args.frames);
-    std::printf("  \"background_srgb\": %g,\n  \"target_bytes_per_pixel\": %u,\n  \"scenes\": [\n",
+    std::fprintf(out, "  \"background_srgb\": %g,\n  \"target_bytes_per_pixel\": %u,\n  \"scenes\": [\n",
                 static_cast<double>(kBackgroundSrgb), kTargetBytesPerPixel);
     for (size_t s = 0; s < scenes.size(); ++s) {
         const SceneResult& r = scenes[s];
-        std::printf(
+        std::fprintf(out, 
             "    {\"layers\": %u, \"alpha\": %g, \"glyphs\": %zu, \"drawn_glyphs\": %zu, "
             "\"converge_frames\": %u, \"exact_nodes_per_pixel\": %u,\n",
             r.layers, static_cast<double>(r.alpha), r.glyphs, r.drawn, r.converge_frames, r.exact_nodes_per_pixel);
         if (r.cpu) {
-            std::printf(
+            std::fprintf(out, 
                 "     \"cpu_fragments\": %llu, \"cpu_max_overlap\": %u, "
                 "\"exact_vs_cpu\": {\"rmse\": %.6g, \"max\": %d},\n",
                 static_cast<unsigned long long>(r.cpu->fragments), r.cpu->max_overlap, r.exact_vs_cpu.rmse,
                 r.exact_vs_cpu.max);
         }
-        std::printf("     \"modes\": [\n");
+        std::fprintf(out, "     \"modes\": [\n");
         for (size_t i = 0; i < r.modes.size(); ++i) {
             const Measurement& m = r.modes[i];
-            std::printf(
+            std::fprintf(out, 
                 "       {\"mode\": %s, \"layers_requested\": %u, \"layers\": %u, \"mono_keys\": %s, "
                 "\"warmup_frames\": %u, \"gpu_ms_median\": %.6g, \"gpu_ms\": [",
                 json_string(crisp::composite_mode_name(m.run.mode)).c_str(), m.run.layers, m.stats.layers,
                 m.stats.mono_keys ? "true" : "false", m.warmup_frames, m.median_ms);
-            for (size_t f = 0; f < m.gpu_ms.size(); ++f) std::printf("%s%.6g", f ? ", " : "", m.gpu_ms[f]);
-            std::printf(
+            for (size_t f = 0; f < m.gpu_ms.size(); ++f) std::fprintf(out, "%s%.6g", f ? ", " : "", m.gpu_ms[f]);
+            std::fprintf(out, 
                 "], \"rmse\": %.6g, \"max\": %d, \"buffer_bytes\": %llu, \"buffer_bytes_per_pixel\": %.6g, "
                 "\"quads\": %u, \"paint_order_blocks\": %u, \"measured\": %s, \"max_overlap\": %u, "
-                "\"tail_pixels\": %u, \"exact_lost_nodes\": %llu, \"exact_dropped\": %llu}%s\n",
+                "\"tail_pixels\": %u, \"exact_lost_nodes\": %llu, \"exact_dropped\": %llu, \"label\": %s, "
+                "\"busy_tiles\": %u, \"exact_tiles\": %u, \"layered_tiles\": %u, \"tile_pairs\": %u}%s\n",
                 m.error.rmse, m.error.max, static_cast<unsigned long long>(m.stats.buffer_bytes),
                 buffer_bytes_per_pixel(m, args), m.stats.quads, m.stats.paint_order_blocks,
                 m.stats.measured ? "true" : "false", m.stats.max_overlap, m.stats.tail_pixels,
                 static_cast<unsigned long long>(m.stats.exact_lost_nodes),
-                static_cast<unsigned long long>(m.stats.exact_dropped), i + 1 < r.modes.size() ? "," : "");
+                static_cast<unsigned long long>(m.stats.exact_dropped), json_string(mode_label(m.run)).c_str(),
+                m.stats.busy_tiles, m.stats.exact_tiles, m.stats.layered_tiles, m.stats.tile_pairs,
+                i + 1 < r.modes.size() ? "," : "");
         }
-        std::printf("     ]}%s\n", s + 1 < scenes.size() ? "," : "");
+        std::fprintf(out, "     ]}%s\n", s + 1 < scenes.size() ? "," : "");
     }
-    std::printf("  ],\n  \"warnings\": [");
-    for (size_t i = 0; i < warnings.size(); ++i) std::printf("%s%s", i ? ", " : "", json_string(warnings[i]).c_str());
-    std::printf("]\n}\n");
+    std::fprintf(out, "  ],\n  \"warnings\": [");
+    for (size_t i = 0; i < warnings.size(); ++i) std::fprintf(out, "%s%s", i ? ", " : "", json_string(warnings[i]).c_str());
+    std::fprintf(out, "]\n}\n");
 }
 
 void print_markdown(const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
@@ -580,36 +744,43 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
         args.subpixel_steps, args.samples, static_cast<double>(kBackgroundSrgb));
     for (const std::string& w : header.compositor_warnings) std::printf("Compositor: %s.\n", w.c_str());
     std::printf(
-        "GPU ms: median of %u frames after at least %u warm-up frames and %g ms, timestamps around "
-        "Compositor::record() alone. "
-        "RMSE and max: 8-bit sRGB codes against the exact mode, over all pixels and channels. B/px: the "
-        "mode's per-pixel buffers (CompositorStats::buffer_bytes / pixels); the RGBA32F target adds %u B/px "
-        "to every mode.\n",
-        args.frames, args.warmup, args.warmup_ms, kTargetBytesPerPixel);
+        "GPU ms: median of %u frames after at least %u warm-up frames and %g ms, timestamps around the "
+        "mode's record call alone (frame: the renderer's record() of the converged text too). "
+        "RMSE and max: 8-bit sRGB codes against %s, over all pixels and channels. B/px: the buffers the "
+        "mode uses (CompositorStats::buffer_bytes / pixels: the tile and draw paths' quads and bins, the "
+        "reference modes' per-pixel buffers); the target image adds %u B/px (RGBA32F) or 4 (rgba8).\n",
+        args.frames, args.warmup, args.warmup_ms,
+        args.cpu_check ? "the exact CPU reference (double precision, every fragment)" : "the exact mode",
+        kTargetBytesPerPixel);
     for (const float alpha : args.alphas) {
         std::printf("\n### alpha %g\n\n", static_cast<double>(alpha));
         std::printf(
-            "| layers | mode | K | GPU ms | RMSE | max | B/px | max overlap | tail pixels |\n"
-            "|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+            "| layers | mode | K | GPU ms | RMSE | max | B/px | max overlap | tail pixels | tiles: exact / layered |\n"
+            "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
         for (const SceneResult& r : scenes) {
             if (r.alpha != alpha) continue;
             for (const Measurement& m : r.modes) {
                 const bool layered = m.run.mode == crisp::CompositeMode::layered;
                 const bool exact = m.run.mode == crisp::CompositeMode::exact;
+                const bool tiled = m.run.mode == crisp::CompositeMode::tiled;
                 char k[32] = "";
                 if (layered) {
                     std::snprintf(k, sizeof k, m.run.layers == crisp::kAutoLayers ? "auto: %u" : "%u", m.stats.layers);
                 }
                 char error[64] = "reference";
-                if (!exact) std::snprintf(error, sizeof error, "%.3f | %d", m.error.rmse, m.error.max);
+                if (!exact || args.cpu_check) std::snprintf(error, sizeof error, "%.3f | %d", m.error.rmse, m.error.max);
                 char overlap[32] = "";
-                if ((layered || exact) && m.stats.measured)
+                if ((layered || exact || tiled) && m.stats.measured)
                     std::snprintf(overlap, sizeof overlap, "%u", m.stats.max_overlap);
                 char tail[32] = "";
-                if (layered && m.stats.measured) std::snprintf(tail, sizeof tail, "%u", m.stats.tail_pixels);
-                std::printf("| %u | %s | %s | %.4g | %s%s | %.1f | %s | %s |\n", r.layers,
-                            crisp::composite_mode_name(m.run.mode), k, m.median_ms, error, exact ? " | " : "",
-                            buffer_bytes_per_pixel(m, args), overlap, tail);
+                if ((layered || tiled) && m.stats.measured) std::snprintf(tail, sizeof tail, "%u", m.stats.tail_pixels);
+                char tiles[48] = "";
+                if (tiled && m.stats.measured) {
+                    std::snprintf(tiles, sizeof tiles, "%u / %u", m.stats.exact_tiles, m.stats.layered_tiles);
+                }
+                std::printf("| %u | %s | %s | %.4g | %s%s | %.2f | %s | %s | %s |\n", r.layers, mode_label(m.run).c_str(),
+                            k, m.median_ms, error, exact && !args.cpu_check ? " | " : "",
+                            buffer_bytes_per_pixel(m, args), overlap, tail, tiles);
             }
         }
     }
@@ -701,13 +872,44 @@ int main(int argc, char** argv) {
         atlas_readback = std::move(*buffer);
     }
 
+    std::vector<ModeRun> runs;
+    for (const std::string& name : args.modes) {
+        const std::optional<ModeRun> run = parse_mode_run(name);
+        if (!run) fail("--modes: unknown mode '" + name + "'");
+        runs.push_back(*run);
+    }
+    const bool reference_modes = std::any_of(runs.begin(), runs.end(), is_reference);
+    const auto exact_run = std::find_if(runs.begin(), runs.end(),
+                                        [](const ModeRun& r) { return r.mode == crisp::CompositeMode::exact; });
+    if (!args.cpu_check && exact_run == runs.end()) fail("--no-cpu-check needs the exact mode as the reference");
+
+    Targets targets;
+    struct TargetDesc {
+        crisp::Image* image;
+        VkFormat format;
+        VkImageUsageFlags usage;
+    };
+    const TargetDesc target_descs[] = {
+        {&targets.rgba32f, VK_FORMAT_R32G32B32A32_SFLOAT,
+         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT},
+        {&targets.rgba8, VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_STORAGE_BIT},
+    };
+    for (const TargetDesc& d : target_descs) {
+        crisp::ImageDesc desc;
+        desc.format = d.format;
+        desc.width = args.width;
+        desc.height = args.height;
+        desc.usage = d.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+        auto made = context->create_image(desc);
+        if (!made) fail(made.error().message);
+        *d.image = std::move(*made);
+        // To GENERAL, where the frames keep it.
+        const std::vector<std::byte> zeros(size_t{args.width} * args.height * crisp::format_texel_size(d.format));
+        if (crisp::Status st = context->upload(*d.image, zeros, VK_IMAGE_LAYOUT_GENERAL); !st) fail(st.error().message);
+    }
+
     std::vector<std::string> warnings;
-    Bench bench{args,
-                *context,
-                *renderer,
-                *timer,
-                *target_readback,
-                warnings};
+    Bench bench{args, *context, *renderer, *timer, *target_readback, targets, warnings};
 
     Header header;
     header.device = context->device_name();
@@ -724,12 +926,6 @@ int main(int argc, char** argv) {
     const crisp::oit::LinearRgb background = {crisp::srgb_to_linear(kBackgroundSrgb),
                                               crisp::srgb_to_linear(kBackgroundSrgb),
                                               crisp::srgb_to_linear(kBackgroundSrgb)};
-
-    std::vector<ModeRun> runs = {
-        {crisp::CompositeMode::exact, 0},   {crisp::CompositeMode::unsorted, 0},
-        {crisp::CompositeMode::wboit, 0},   {crisp::CompositeMode::layered, 1},
-        {crisp::CompositeMode::layered, 2}, {crisp::CompositeMode::layered, 4},
-        {crisp::CompositeMode::layered, 8}, {crisp::CompositeMode::layered, crisp::kAutoLayers}};
 
     std::vector<SceneResult> results;
     for (const uint32_t layers : args.layers) {
@@ -768,7 +964,8 @@ int main(int argc, char** argv) {
             compositor_info.key_format = args.keys;
             compositor_info.gray_layout = gray_layout;
             compositor_info.exact_nodes_per_pixel = result.exact_nodes_per_pixel;
-            compositor_info.reference_modes = true;
+            compositor_info.reference_modes = reference_modes;
+            compositor_info.draw_format = VK_FORMAT_R32G32B32A32_SFLOAT;
             auto compositor = crisp::Compositor::create(compositor_info);
             if (!compositor) fail(compositor.error().message);
             for (const std::string& w : compositor->warnings()) {
@@ -780,16 +977,21 @@ int main(int argc, char** argv) {
 
             for (const ModeRun& run : runs) {
                 std::fprintf(stderr, "%s: %s\n", name.c_str(), mode_label(run).c_str());
-                result.modes.push_back(bench.measure(*compositor, name, run));
+                result.modes.push_back(bench.measure(*compositor, scene, name, run));
             }
-            const Measurement& exact = result.modes.front();
-            if (exact.stats.exact_lost_nodes > 0 || exact.stats.exact_dropped > 0) {
-                bench.warn(name + ": the exact mode lost " + std::to_string(exact.stats.exact_lost_nodes) +
-                           " fragments (node pool) and dropped " + std::to_string(exact.stats.exact_dropped) +
+            const Measurement* exact = nullptr;
+            for (const Measurement& m : result.modes) {
+                if (m.run.mode == crisp::CompositeMode::exact) exact = &m;
+            }
+            if (exact && (exact->stats.exact_lost_nodes > 0 || exact->stats.exact_dropped > 0)) {
+                bench.warn(name + ": the exact mode lost " + std::to_string(exact->stats.exact_lost_nodes) +
+                           " fragments (node pool) and dropped " + std::to_string(exact->stats.exact_dropped) +
                            " (past 64 per pixel): it is not exact here");
             }
-            if (!exact.stats.measured) bench.warn(name + ": the exact mode's stats were not measured");
-            for (Measurement& m : result.modes) m.error = compare(m.codes, exact.codes);
+            if (exact && !exact->stats.measured) bench.warn(name + ": the exact mode's stats were not measured");
+            if (!args.cpu_check) {
+                for (Measurement& m : result.modes) m.error = compare(m.codes, exact->codes);
+            }
 
             if (args.cpu_check) {
                 std::fprintf(stderr, "%s: CPU reference\n", name.c_str());
@@ -800,7 +1002,8 @@ int main(int argc, char** argv) {
                 std::memcpy(atlas.data(), atlas_readback->mapped().data(), atlas.size() * sizeof(uint16_t));
                 result.cpu =
                     cpu_exact(renderer->drawn(), atlas, atlas_config.width, args.width, args.height, background);
-                result.exact_vs_cpu = compare(exact.codes, result.cpu->codes);
+                if (exact) result.exact_vs_cpu = compare(exact->codes, result.cpu->codes);
+                for (Measurement& m : result.modes) m.error = compare(m.codes, result.cpu->codes);
                 result.cpu->codes = {};
             }
             for (Measurement& m : result.modes) {
@@ -811,10 +1014,17 @@ int main(int argc, char** argv) {
         }
     }
 
-    if (args.json)
-        print_json(args, header, results, warnings);
-    else
+    if (args.json) {
+        print_json(stdout, args, header, results, warnings);
+    } else {
         print_markdown(args, header, results, warnings);
+    }
+    if (!args.json_out.empty()) {
+        std::FILE* file = std::fopen(args.json_out.c_str(), "w");
+        if (!file) fail("cannot write " + args.json_out);
+        print_json(file, args, header, results, warnings);
+        if (std::fclose(file) != 0) fail("cannot write " + args.json_out);
+    }
     const auto messages = context->validation_messages();
     if (messages.errors + messages.warnings > 0) {
         std::fprintf(stderr, "validation: %u errors, %u warnings\n", messages.errors, messages.warnings);

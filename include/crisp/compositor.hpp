@@ -81,7 +81,7 @@ inline constexpr VkFormat kTileTargetFormats[] = {
     VK_FORMAT_R32G32B32A32_SFLOAT,
 };
 // The most quads a screen tile's list holds in workgroup memory (CompositorCreateInfo::tile_capacity).
-inline constexpr uint32_t kMaxTileCapacity = 2048;
+inline constexpr uint32_t kMaxTileCapacity = 1024;
 
 struct CompositorCreateInfo {
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
@@ -93,7 +93,7 @@ struct CompositorCreateInfo {
     // Say whether the device was created with shaderStorageImageReadWithoutFormat and
     // shaderStorageImageWriteWithoutFormat: B8G8R8A8_UNORM targets need them.
     bool storage_without_format = false;
-    // Quads a tile's list holds in workgroup memory (4 bytes each): a power of two, 4 to
+    // Quads a tile's list holds in workgroup memory (8 bytes each): a power of two, 4 to
     // kMaxTileCapacity. A longer list takes the layered way with K = tile_layers.
     uint32_t tile_capacity = 1024;
     uint32_t tile_layers = 8;  // 1..kMaxCompositeLayers
