@@ -177,8 +177,13 @@ struct CompositePushConstants {
 // composites one tile, an invocation per pixel.
 CRISP_CONSTANT(uint, kTileSide, 16u);
 CRISP_CONSTANT(uint, kTileInvocations, 256u);
-// Invocations of the one workgroup that scans the tile counts.
-CRISP_CONSTANT(uint, kTileScanInvocations, 1024u);
+// The scan of the tile counts: workgroups of kTileScanInvocations, each invocation taking
+// kTileScanPerInvocation consecutive tiles, so a block of kTileScanBlock tiles per workgroup; the
+// block sums are scanned by one workgroup, so at most kTileScanBlock blocks: 2^20 tiles, a
+// 16384 x 16384 target.
+CRISP_CONSTANT(uint, kTileScanInvocations, 256u);
+CRISP_CONSTANT(uint, kTileScanPerInvocation, 4u);
+CRISP_CONSTANT(uint, kTileScanBlock, 1024u);
 // Invocations per workgroup of the binning passes (one quad each).
 CRISP_CONSTANT(uint, kTileBinInvocations, 64u);
 // Quad indices a tile's list holds in workgroup memory by default; a longer list takes the
@@ -193,7 +198,7 @@ CRISP_CONSTANT(float, kTileOpaque, 1.0f / 65536.0f);
 // Bindings of the tile compositor's descriptor set (tile_common.glsl declares the same).
 CRISP_CONSTANT(uint, kTileBindAtlas, 0u);    // the atlas, storage image
 CRISP_CONSTANT(uint, kTileBindQuads, 1u);    // CompositeQuad[], front to back
-CRISP_CONSTANT(uint, kTileBindTiles, 2u);    // per tile: count, start, cursor (plane-major)
+CRISP_CONSTANT(uint, kTileBindTiles, 2u);    // per tile: count, start, cursor (plane-major); block sums
 CRISP_CONSTANT(uint, kTileBindBins, 3u);     // quad indices, each tile's at its start
 CRISP_CONSTANT(uint, kTileBindHeader, 4u);   // TileHeader, then the non-empty tiles' indices
 CRISP_CONSTANT(uint, kTileBindTarget, 5u);   // the caller's image, storage image
@@ -211,7 +216,7 @@ struct TileHeader {
     uint busy_tiles;    // tiles with at least one quad
     uint pairs;         // (quad, tile) pairs binned
     uint lost_pairs;    // pairs past the bins' capacity (never, when the CPU sized them)
-    uint exact_tiles;   // tiles composited exactly (their list fit in workgroup memory)
+    uint padding2;      // (the exact tiles are busy_tiles - layered_tiles)
     uint layered_tiles; // tiles that took the layered way
     uint max_overlap;   // most fragments one pixel had
     uint tail_pixels;   // layered tiles: pixels with fragments past K
@@ -234,6 +239,8 @@ struct TilePushConstants {
 #ifdef __cplusplus
 static_assert(sizeof(RasterItem) == 72);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
+static_assert(kTileScanBlock == kTileScanInvocations * kTileScanPerInvocation);
+static_assert(kTileScanBlock * kTileScanBlock * kTileSide * kTileSide >= 16384u * 16384u);
 static_assert(sizeof(TilePushConstants) == 32);
 static_assert(sizeof(CompositeQuad) == 64);
 static_assert(offsetof(CompositeQuad, color) == 48);

@@ -29,7 +29,6 @@ const uint kHeaderDispatchZ = 2u;
 const uint kHeaderBusyTiles = 3u;
 const uint kHeaderPairs = 4u;
 const uint kHeaderLostPairs = 5u;
-const uint kHeaderExactTiles = 6u;
 const uint kHeaderLayeredTiles = 7u;
 const uint kHeaderMaxOverlap = 8u;
 const uint kHeaderTailPixels = 9u;

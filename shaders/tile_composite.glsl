@@ -15,6 +15,9 @@
 // blend does; in linear colour; 8-bit targets are decoded from and encoded to sRGB here.
 // Included by tile_composite_*.comp with CRISP_TARGET_FORMAT set to a GLSL image format qualifier,
 // or undefined for a format-less image (B8G8R8A8, which has no qualifier).
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
 #include "tile_common.glsl"
 
 layout(local_size_x = kTileInvocations) in;
@@ -108,11 +111,11 @@ void stage_chunk(uint base, uint count, ivec2 corner) {
 // The exact way: the sorted list, staged a chunk at a time into workgroup memory, walked front to
 // back by every pixel; the workgroup stops once every pixel's transmittance is spent.
 Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) {
-    if (gl_LocalInvocationIndex == 0u) tile_busy_pixels = 0u;
-    sort_list(start, count);
+    sort_list(start, count);  // its barriers also order tile_busy_pixels' reset before the adds
     Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
     bool walking = inside;
-    if (walking) atomicAdd(tile_busy_pixels, 1u);
+    const uint walkers = subgroupAdd(walking ? 1u : 0u);
+    if (subgroupElect() && walkers > 0u) atomicAdd(tile_busy_pixels, walkers);
     const ivec2 local = pixel - corner;
     const ivec2 atlas_size = imageSize(atlas);
     for (uint base = 0u; base < count; base += kTileInvocations) {
@@ -209,6 +212,7 @@ void main() {
     if (gl_LocalInvocationIndex == 0u) {
         tile_overlap = 0u;
         tile_tail_pixels = 0u;
+        tile_busy_pixels = 0u;
     }
     // count is uniform, so is the way; the exact way's barriers are reached by every invocation.
     const bool fits = count <= kCapacity;
@@ -216,9 +220,14 @@ void main() {
     const ivec2 corner = pixel - ivec2(gl_LocalInvocationIndex % kTileSide, gl_LocalInvocationIndex / kTileSide);
     const Blend b = fits ? exact_way(start, count, corner, pixel, inside) : layered_way(start, count, pixel, inside, tail);
 
-    barrier();
-    if (b.fragments > 0u) atomicMax(tile_overlap, b.fragments);
-    if (tail) atomicAdd(tile_tail_pixels, 1u);
+    // The tile's statistics: one workgroup-memory atomic per subgroup, then few global ones: the
+    // layered tiles are rare, and the overlap only where it passes the largest seen so far.
+    const uint most = subgroupMax(b.fragments);
+    const uint tails = subgroupAdd(tail ? 1u : 0u);
+    if (subgroupElect()) {
+        if (most > 0u) atomicMax(tile_overlap, most);
+        if (tails > 0u) atomicAdd(tile_tail_pixels, tails);
+    }
     if (b.fragments > 0u) {
         const ivec2 at = pixel + ivec2(pc.origin_x, pc.origin_y);
         vec4 destination = imageLoad(target, at);
@@ -231,8 +240,8 @@ void main() {
     }
     barrier();
     if (gl_LocalInvocationIndex == 0u) {
-        atomicAdd(header[fits ? kHeaderExactTiles : kHeaderLayeredTiles], 1u);
-        if (tile_overlap > 0u) atomicMax(header[kHeaderMaxOverlap], tile_overlap);
+        if (!fits) atomicAdd(header[kHeaderLayeredTiles], 1u);
+        if (tile_overlap > header[kHeaderMaxOverlap]) atomicMax(header[kHeaderMaxOverlap], tile_overlap);
         if (tile_tail_pixels > 0u) atomicAdd(header[kHeaderTailPixels], tile_tail_pixels);
     }
 }

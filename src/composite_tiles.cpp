@@ -26,6 +26,11 @@ bool is_srgb_encoded(VkFormat format) {
     return format == VK_FORMAT_R8G8B8A8_UNORM || format == VK_FORMAT_B8G8R8A8_UNORM;
 }
 
+// Words of the tiles buffer: count, start and cursor per tile, and two words per scan block.
+VkDeviceSize tile_words(uint32_t tiles) {
+    return VkDeviceSize{tiles} * 3 + 2 * VkDeviceSize{(tiles + gpu::kTileScanBlock - 1) / gpu::kTileScanBlock};
+}
+
 // Workgroups for `count` invocations in groups of `size`, as a 2D grid of rows of
 // kRasterDispatchWidth (the shaders index gl_WorkGroupID.y * gl_NumWorkGroups.x + x).
 VkExtent2D grid(uint32_t count, uint32_t size) {
@@ -41,7 +46,7 @@ TileCompositor::~TileCompositor() {
     for (VkPipeline pipeline : tile_pipelines_) {
         if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
     }
-    for (VkPipeline pipeline : {count_, scan_, scatter_}) {
+    for (VkPipeline pipeline : {count_, scan_[0], scan_[1], scan_[2], scatter_}) {
         if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
     }
     for (VkShaderModule module : modules_) vkDestroyShaderModule(ref_.device, module, ref_.allocator);
@@ -56,6 +61,18 @@ TileCompositor::~TileCompositor() {
 Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& config) {
     ref_ = device;
     config_ = config;
+    // The tile pass reduces its statistics per subgroup.
+    VkPhysicalDeviceSubgroupProperties subgroup{};
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    VkPhysicalDeviceProperties2 device_properties{};
+    device_properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    device_properties.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(config.physical_device, &device_properties);
+    if ((subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) == 0 ||
+        (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) == 0) {
+        return Error{ErrorCode::vulkan, std::string("compositor: ") + device_properties.properties.deviceName +
+                                            " has no subgroup arithmetic in compute shaders"};
+    }
     constexpr VkShaderStageFlags stage = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorSetLayoutBinding bindings[] = {
         {gpu::kTileBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stage, nullptr},
@@ -89,7 +106,11 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     const VkSpecializationInfo scatter_info{1, &scatter_entry, 4, &scatter};
     if (Status s = pipeline("tile_bin.comp", nullptr, count_); !s) return s;
     if (Status s = pipeline("tile_bin.comp", &scatter_info, scatter_); !s) return s;
-    if (Status s = pipeline("tile_scan.comp", nullptr, scan_); !s) return s;
+    for (uint32_t phase = 0; phase < scan_.size(); ++phase) {
+        const VkSpecializationMapEntry phase_entry{0, 0, 4};
+        const VkSpecializationInfo phase_info{1, &phase_entry, 4, &phase};
+        if (Status s = pipeline("tile_scan.comp", &phase_info, scan_[phase]); !s) return s;
+    }
 
     for (size_t i = 0; i < kTileVariants.size(); ++i) {
         const TileVariant& variant = kTileVariants[i];
@@ -127,7 +148,7 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
     constexpr VkBufferUsageFlags transfer = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     const VkDeviceSize quad_bytes = quads.size_bytes();
     if (Status s = grow(slot.quads, quad_bytes, storage, true); !s) return s;
-    if (Status s = grow(slot.tiles, VkDeviceSize{tiles} * 3 * kWord, storage | transfer, false); !s) return s;
+    if (Status s = grow(slot.tiles, tile_words(tiles) * kWord, storage | transfer, false); !s) return s;
     if (Status s = grow(slot.bins, pairs * kWord, storage, false); !s) return s;
     // Host-visible, so that the host reads the frame's counts straight from it once the frame is done.
     if (Status s = grow(slot.header, (gpu::kTileHeaderWords + VkDeviceSize{tiles}) * kWord,
@@ -192,9 +213,17 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, VkPipel
         vkCmdDispatch(cb, quad_groups.width, quad_groups.height, 1);
     };
     bin(count_);
-    vk::memory_barrier(cb, compute, shader, compute, shader);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, scan_);
-    vkCmdDispatch(cb, 1, 1, 1);
+    // The prefix sum: block sums, their scan in one workgroup, the blocks' own scans.
+    const VkExtent2D blocks = grid(tiles, gpu::kTileScanBlock);
+    for (uint32_t phase = 0; phase < scan_.size(); ++phase) {
+        vk::memory_barrier(cb, compute, shader, compute, shader);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, scan_[phase]);
+        if (phase == 1) {
+            vkCmdDispatch(cb, 1, 1, 1);
+        } else {
+            vkCmdDispatch(cb, blocks.width, blocks.height, 1);
+        }
+    }
     vk::memory_barrier(cb, compute, shader, compute, shader);
     bin(scatter_);
     vk::memory_barrier(cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
@@ -212,8 +241,8 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     if (slot.pending) {
         gpu::TileHeader header{};
         std::memcpy(&header, slot.header.mapped, sizeof(header));
-        measured = {header.busy_tiles, header.exact_tiles, header.layered_tiles, header.max_overlap,
-                    header.tail_pixels, header.pairs, header.lost_pairs};
+        measured = {header.busy_tiles, header.busy_tiles - header.layered_tiles, header.layered_tiles,
+                    header.max_overlap, header.tail_pixels, header.pairs, header.lost_pairs};
         measured_frame = slot.frame;
         slot.pending = false;
     }
@@ -238,7 +267,7 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     ++frame_;
     slot.pending = true;
     slot.frame = frame_;
-    return quads.size_bytes() + VkDeviceSize{tiles} * 3 * kWord + pairs * kWord +
+    return quads.size_bytes() + tile_words(tiles) * kWord + pairs * kWord +
            (gpu::kTileHeaderWords + VkDeviceSize{tiles}) * kWord;
 }
 

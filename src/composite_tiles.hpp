@@ -103,7 +103,8 @@ private:
     TileConfig config_;
     vk::DescriptorSets descriptors_;
     std::vector<VkShaderModule> modules_;
-    VkPipeline count_ = VK_NULL_HANDLE, scan_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
+    VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
+    std::array<VkPipeline, 3> scan_{};  // reduce, blocks, down
     std::array<VkPipeline, kTileVariants.size()> tile_pipelines_{};
     std::vector<Slot> slots_;
     uint64_t frame_ = 0;

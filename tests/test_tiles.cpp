@@ -482,6 +482,64 @@ TEST(TileCompositor, DrawsOnlyInsideTheCallersRect) {
     expect_no_validation_messages();
 }
 
+// A target of several thousand tiles: the prefix sum runs over several blocks, and copies of the
+// scene in the first, middle and last of them land where they should.
+TEST(TileCompositor, ScansTileCountsAcrossBlocks) {
+    const Scene scene = render_scene(overlapping_runs(0.7f));
+    auto compositor = Compositor::create(tile_info());
+    ASSERT_TRUE(compositor);
+    const uint32_t width = 1200, height = 700;  // 75 x 44 tiles: 4 blocks of 1024
+    const VkOffset2D offsets[] = {{0, 0}, {610, 330}, {width - kWidth, height - kHeight}};
+    std::vector<DrawnGlyph> copies;
+    uint32_t paint_base = 0;
+    for (const VkOffset2D& o : offsets) {
+        for (DrawnGlyph g : scene.drawn) {
+            g.instance.x += o.x;
+            g.instance.y += o.y;
+            g.instance.paint_order += paint_base;
+            copies.push_back(g);
+        }
+        paint_base += 1000;
+    }
+    Target t = make_target(VK_FORMAT_R16G16B16A16_SFLOAT, width, height, VK_IMAGE_USAGE_STORAGE_BIT);
+    CompositeTarget target{t.image.view(), t.format, VK_FORMAT_UNDEFINED, {width, height}, {}};
+    EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
+        EXPECT_TRUE(compositor->record(cb, copies, scene.renderer->atlas_view(), target));
+    }));
+    const std::vector<std::byte> bytes = read_target(t);
+    // Each copy's kWidth x kHeight region is what scene.pixels describes (glyph rects reach a
+    // little past it); far from every copy nothing is written.
+    const uint32_t texel = format_texel_size(t.format);
+    for (const VkOffset2D& o : offsets) {
+        const std::vector<Rgba> part = expected_image(scene, t, o, nullptr);
+        double worst = 0.0;
+        for (uint32_t y = 0; y < kHeight; ++y) {
+            for (uint32_t x = 0; x < kWidth; ++x) {
+                const size_t at = (size_t{y} + static_cast<size_t>(o.y)) * width + x + static_cast<size_t>(o.x);
+                const Rgba got = decode(t.format, &bytes[at * texel]);
+                for (size_t c = 0; c < 4; ++c) worst = std::max(worst, std::abs(double{got[c]} - double{part[at][c]}));
+            }
+        }
+        EXPECT_LE(worst, tolerance(t.format)) << "copy at " << o.x << ", " << o.y;
+    }
+    size_t far_pixels = 0;
+    for (uint32_t y = 0; y < height; ++y) {
+        for (uint32_t x = 0; x < width; ++x) {
+            bool far = true;
+            for (const VkOffset2D& o : offsets) {
+                far = far && (int64_t{x} + 32 < o.x || int64_t{x} > o.x + int64_t{kWidth} + 32 ||
+                              int64_t{y} + 32 < o.y || int64_t{y} > o.y + int64_t{kHeight} + 32);
+            }
+            if (!far) continue;
+            ++far_pixels;
+            const size_t at = (size_t{y} * width + x) * texel;
+            ASSERT_EQ(std::memcmp(&bytes[at], &t.initial[at], texel), 0) << x << ", " << y;
+        }
+    }
+    EXPECT_GT(far_pixels, size_t{width} * height / 2);
+    expect_no_validation_messages();
+}
+
 TEST(TileCompositor, RefusesWhatItCannotDraw) {
     const Scene scene = render_scene({{"Ham", 2.0f, 20.0f, {0.1f, 0.1f, 0.1f, 1.0f}, 0.5f}});
     CompositorCreateInfo info = tile_info();
