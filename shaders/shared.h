@@ -186,9 +186,12 @@ CRISP_CONSTANT(uint, kTileScanPerInvocation, 4u);
 CRISP_CONSTANT(uint, kTileScanBlock, 1024u);
 // Invocations per workgroup of the binning passes (one quad each).
 CRISP_CONSTANT(uint, kTileBinInvocations, 64u);
-// Quad indices a tile's list holds in workgroup memory by default; a longer list takes the
-// layered way (the K nearest per pixel, the rest estimated).
-CRISP_CONSTANT(uint, kTileDefaultCapacity, 1024u);
+// Quad indices a tile's list holds in workgroup memory by default (8 bytes each: the list as
+// scattered and sorted); a longer list takes the layered way (the K nearest per pixel, the rest
+// estimated). Workgroup memory is kept small: it bounds how many tiles an SM composites at once.
+CRISP_CONSTANT(uint, kTileDefaultCapacity, 256u);
+// Quads staged in workgroup memory at a time for the exact way's walk (28 bytes each).
+CRISP_CONSTANT(uint, kTileChunk, 64u);
 CRISP_CONSTANT(uint, kTileMaxCapacity, 1024u);  // 15 KiB of workgroup memory in all, of the 16 KiB every device offers
 CRISP_CONSTANT(uint, kTileNoQuad, 0xFFFFFFFFu);
 // Below this in every channel the transmittance left hides whatever lies behind (less than a
@@ -209,21 +212,28 @@ CRISP_CONSTANT(uint, kTileEncodeLinear, 0u);  // float formats: the image holds 
 CRISP_CONSTANT(uint, kTileEncodeSrgb, 1u);    // 8-bit UNORM formats: sRGB-encoded in the shader
 
 // The start of the header buffer; the list of non-empty tiles follows it.
+// The start of the header buffer; the list of busy tiles follows it, then the list of the tiles
+// handed to the layered pass (tiles_x * tiles_y words each).
 struct TileHeader {
-    uint dispatch_x;  // VkDispatchIndirectCommand of the tile pass
+    uint dispatch_x;  // VkDispatchIndirectCommand of the exact pass
     uint dispatch_y;
     uint dispatch_z;
-    uint busy_tiles;    // tiles with at least one quad
-    uint pairs;         // (quad, tile) pairs binned
-    uint lost_pairs;    // pairs past the bins' capacity (never, when the CPU sized them)
-    uint padding2;      // (the exact tiles are busy_tiles - layered_tiles)
-    uint layered_tiles; // tiles that took the layered way
-    uint max_overlap;   // most fragments one pixel had
-    uint tail_pixels;   // layered tiles: pixels with fragments past K
+    uint busy_tiles;     // tiles with at least one quad
+    uint pairs;          // (quad, tile) pairs binned
+    uint lost_pairs;     // pairs past the bins' capacity (never, when the CPU sized them)
+    uint layered_tiles;  // tiles that took the layered way (the exact ones: busy - layered)
+    uint max_overlap;    // most fragments one pixel had
+    uint tail_pixels;    // layered tiles: pixels with fragments past K
     uint padding0;
+    uint layered_dispatch_x;  // VkDispatchIndirectCommand of the layered pass (at byte 40)
+    uint layered_dispatch_y;
+    uint layered_dispatch_z;
     uint padding1;
+    uint padding2;
+    uint padding3;
 };
-CRISP_CONSTANT(uint, kTileHeaderWords, 12u);
+CRISP_CONSTANT(uint, kTileHeaderWords, 16u);
+CRISP_CONSTANT(uint, kTileLayeredDispatchOffset, 40u);  // bytes
 
 struct TilePushConstants {
     int origin_x;  // the caller's rect: its top-left pixel in the image, and its size
@@ -239,6 +249,7 @@ struct TilePushConstants {
 #ifdef __cplusplus
 static_assert(sizeof(RasterItem) == 72);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
+static_assert(offsetof(TileHeader, layered_dispatch_x) == kTileLayeredDispatchOffset);
 static_assert(kTileScanBlock == kTileScanInvocations * kTileScanPerInvocation);
 static_assert(kTileScanBlock * kTileScanBlock * kTileSide * kTileSide >= 16384u * 16384u);
 static_assert(sizeof(TilePushConstants) == 32);

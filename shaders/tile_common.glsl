@@ -17,7 +17,8 @@ layout(std430, set = 0, binding = kTileBindTiles) buffer Tiles {
 layout(std430, set = 0, binding = kTileBindBins) buffer Bins {
     uint bins[];
 };
-// TileHeader's words, then the indices of the non-empty tiles.
+// TileHeader's words, then the indices of the non-empty tiles, then of the tiles the exact pass
+// hands to the layered pass.
 layout(std430, set = 0, binding = kTileBindHeader) buffer Header {
     uint header[];
 };
@@ -29,9 +30,12 @@ const uint kHeaderDispatchZ = 2u;
 const uint kHeaderBusyTiles = 3u;
 const uint kHeaderPairs = 4u;
 const uint kHeaderLostPairs = 5u;
-const uint kHeaderLayeredTiles = 7u;
-const uint kHeaderMaxOverlap = 8u;
-const uint kHeaderTailPixels = 9u;
+const uint kHeaderLayeredTiles = 6u;
+const uint kHeaderMaxOverlap = 7u;
+const uint kHeaderTailPixels = 8u;
+const uint kHeaderLayeredDispatchX = 10u;
+const uint kHeaderLayeredDispatchY = 11u;
+const uint kHeaderLayeredDispatchZ = 12u;
 
 uint tile_total() {
     return pc.tiles_x * pc.tiles_y;

@@ -5,10 +5,11 @@
 // - The exact way, when the tile's list fits in workgroup memory (kCapacity quads): the list is
 //   loaded, sorted by index (bitonic), and each pixel walks it front to back, per channel
 //   light += T * L, T *= 1 - o, stopping once T is below kTileOpaque in every channel.
-// - The layered way, when it does not: each pixel keeps its kLayers nearest fragments (the
-//   smallest quad indices) in registers while reading the list unsorted; what falls off the K goes
-//   to a tail of absorbance sums, estimated as docs/oit.md's absorbance_share. Where a pixel has
-//   at most K fragments the result is the exact way's, bit for bit.
+// - The layered way, when it does not (a second, indirect dispatch over the tiles the first handed
+//   on): each pixel keeps its kLayers nearest fragments (the smallest quad indices) in registers
+//   while reading the list unsorted; what falls off the K goes to a tail of absorbance sums,
+//   estimated as docs/oit.md's absorbance_share. Where a pixel has at most K fragments the result
+//   is the exact way's, bit for bit.
 //
 // Then, where the pixel had a fragment: out.rgb = light + T * dst.rgb, and alpha is "over" with each
 // fragment's largest channel opacity, out.a = 1 - (1 - dst.a) * prod(1 - max o), as the draw path's
@@ -27,6 +28,9 @@ layout(constant_id = 1) const uint kEncode = kTileEncodeLinear;
 layout(constant_id = 2) const uint kCapacity = kTileDefaultCapacity;  // a power of two
 // 1: the view is R8G8B8A8 over a B8G8R8A8 image (made with MUTABLE_FORMAT): red and blue swap.
 layout(constant_id = 3) const uint kSwapRedBlue = 0u;
+// 0: the exact pass over the busy tiles; 1: the layered pass over the tiles it could not take.
+// Separate pipelines, so that each is compiled with only its own registers.
+layout(constant_id = 4) const uint kLayeredPass = 0u;
 
 layout(set = 0, binding = kTileBindAtlas, rgba16ui) uniform readonly uimage2D atlas;
 #ifdef CRISP_TARGET_FORMAT
@@ -41,9 +45,9 @@ shared uint unsorted[kCapacity];  // the tile's list as the scatter left it
 shared uint list[kCapacity];      // ... sorted
 // A chunk of the sorted list, staged for the walk: per quad its rect in tile pixels (x0, y0, x1, y1
 // in bytes, clamped to the tile), its atlas texel minus its position, and its colour.
-shared uint chunk_rect[kTileInvocations];
-shared ivec2 chunk_texel[kTileInvocations];
-shared vec4 chunk_colour[kTileInvocations];
+shared uint chunk_rect[kTileChunk];
+shared ivec2 chunk_texel[kTileChunk];
+shared vec4 chunk_colour[kTileChunk];
 shared uint tile_overlap;
 shared uint tile_tail_pixels;
 shared uint tile_busy_pixels;  // pixels of the tile still walking
@@ -96,10 +100,10 @@ void blend_over(inout Blend b, vec3 opacity, vec3 colour) {
     b.coverage_transmittance *= 1.0 - max(opacity.r, max(opacity.g, opacity.b));
 }
 
-// Stages quads list[base ..] (up to kTileInvocations) for the walk, relative to the tile's corner.
+// Stages quads list[base ..] (up to kTileChunk) for the walk, relative to the tile's corner.
 void stage_chunk(uint base, uint count, ivec2 corner) {
     const uint i = base + gl_LocalInvocationIndex;
-    if (i >= count) return;
+    if (gl_LocalInvocationIndex >= kTileChunk || i >= count) return;
     const CompositeQuad q = quads[list[i]];
     const ivec2 low = clamp(ivec2(q.x, q.y) - corner, ivec2(0), ivec2(kTileSide));
     const ivec2 high = clamp(ivec2(q.x, q.y) + ivec2(q.width, q.height) - corner, ivec2(0), ivec2(kTileSide));
@@ -111,6 +115,7 @@ void stage_chunk(uint base, uint count, ivec2 corner) {
 // The exact way: the sorted list, staged a chunk at a time into workgroup memory, walked front to
 // back by every pixel; the workgroup stops once every pixel's transmittance is spent.
 Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) {
+    if (gl_LocalInvocationIndex == 0u) tile_busy_pixels = 0u;
     sort_list(start, count);  // its barriers also order tile_busy_pixels' reset before the adds
     Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
     bool walking = inside;
@@ -118,10 +123,10 @@ Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) 
     if (subgroupElect() && walkers > 0u) atomicAdd(tile_busy_pixels, walkers);
     const ivec2 local = pixel - corner;
     const ivec2 atlas_size = imageSize(atlas);
-    for (uint base = 0u; base < count; base += kTileInvocations) {
+    for (uint base = 0u; base < count; base += kTileChunk) {
         stage_chunk(base, count, corner);
         barrier();
-        const uint staged = min(kTileInvocations, count - base);
+        const uint staged = min(kTileChunk, count - base);
         for (uint j = 0u; walking && j < staged; ++j) {
             const uint rect = chunk_rect[j];
             if (local.x < int(rect & 255u) || local.y < int((rect >> 8) & 255u) || local.x >= int((rect >> 16) & 255u) ||
@@ -199,29 +204,15 @@ Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, out bool tai
     return b;
 }
 
-void main() {
-    const uint busy = gl_WorkGroupID.y * kRasterDispatchWidth + gl_WorkGroupID.x;
-    if (busy >= header[kHeaderBusyTiles]) return;  // uniform over the workgroup
-    const uint tile = header[kTileHeaderWords + busy];
-    const uint tiles = tile_total();
-    const uint count = tile_words[tile];
-    const uint start = tile_words[tiles + tile];
-    const ivec2 pixel = ivec2(uvec2(tile % pc.tiles_x, tile / pc.tiles_x) * kTileSide +
-                              uvec2(gl_LocalInvocationIndex % kTileSide, gl_LocalInvocationIndex / kTileSide));
-    const bool inside = pixel.x < int(pc.width) && pixel.y < int(pc.height);
+// The pixel's result into the caller's image, and the tile's statistics: one workgroup-memory
+// atomic per subgroup, then few global ones (the overlap only where it passes the largest seen so
+// far). Reached by every invocation of the workgroup.
+void finish_tile(ivec2 pixel, Blend b, bool tail) {
     if (gl_LocalInvocationIndex == 0u) {
         tile_overlap = 0u;
         tile_tail_pixels = 0u;
-        tile_busy_pixels = 0u;
     }
-    // count is uniform, so is the way; the exact way's barriers are reached by every invocation.
-    const bool fits = count <= kCapacity;
-    bool tail = false;
-    const ivec2 corner = pixel - ivec2(gl_LocalInvocationIndex % kTileSide, gl_LocalInvocationIndex / kTileSide);
-    const Blend b = fits ? exact_way(start, count, corner, pixel, inside) : layered_way(start, count, pixel, inside, tail);
-
-    // The tile's statistics: one workgroup-memory atomic per subgroup, then few global ones: the
-    // layered tiles are rare, and the overlap only where it passes the largest seen so far.
+    barrier();
     const uint most = subgroupMax(b.fragments);
     const uint tails = subgroupAdd(tail ? 1u : 0u);
     if (subgroupElect()) {
@@ -240,8 +231,55 @@ void main() {
     }
     barrier();
     if (gl_LocalInvocationIndex == 0u) {
-        if (!fits) atomicAdd(header[kHeaderLayeredTiles], 1u);
         if (tile_overlap > header[kHeaderMaxOverlap]) atomicMax(header[kHeaderMaxOverlap], tile_overlap);
         if (tile_tail_pixels > 0u) atomicAdd(header[kHeaderTailPixels], tile_tail_pixels);
+    }
+}
+
+// This invocation's pixel of `tile`, in the caller's rect; false past its right or bottom edge.
+bool tile_pixel(uint tile, out ivec2 corner, out ivec2 pixel) {
+    corner = ivec2(uvec2(tile % pc.tiles_x, tile / pc.tiles_x) * kTileSide);
+    pixel = corner + ivec2(gl_LocalInvocationIndex % kTileSide, gl_LocalInvocationIndex / kTileSide);
+    return pixel.x < int(pc.width) && pixel.y < int(pc.height);
+}
+
+// The exact pass: one workgroup per busy tile. A tile whose list does not fit is handed to the
+// layered pass: its index goes onto the overflow list, and the layered dispatch grows.
+void exact_pass() {
+    const uint busy = gl_WorkGroupID.y * kRasterDispatchWidth + gl_WorkGroupID.x;
+    if (busy >= header[kHeaderBusyTiles]) return;  // uniform over the workgroup
+    const uint tile = header[kTileHeaderWords + busy];
+    const uint count = tile_words[tile];
+    if (count > kCapacity) {
+        if (gl_LocalInvocationIndex == 0u) {
+            const uint slot = atomicAdd(header[kHeaderLayeredTiles], 1u);
+            header[kTileHeaderWords + tile_total() + slot] = tile;
+            if (slot < kRasterDispatchWidth) atomicAdd(header[kHeaderLayeredDispatchX], 1u);
+        }
+        return;
+    }
+    ivec2 corner, pixel;
+    const bool inside = tile_pixel(tile, corner, pixel);
+    finish_tile(pixel, exact_way(tile_words[tile_total() + tile], count, corner, pixel, inside), false);
+}
+
+// The layered pass: the overflow list's tiles, workgroup i taking i, i + kRasterDispatchWidth, ...
+void layered_pass() {
+    const uint overflowing = header[kHeaderLayeredTiles];
+    for (uint i = gl_WorkGroupID.x; i < overflowing; i += kRasterDispatchWidth) {
+        const uint tile = header[kTileHeaderWords + tile_total() + i];
+        ivec2 corner, pixel;
+        const bool inside = tile_pixel(tile, corner, pixel);
+        bool tail = false;
+        const Blend b = layered_way(tile_words[tile_total() + tile], tile_words[tile], pixel, inside, tail);
+        finish_tile(pixel, b, tail);
+    }
+}
+
+void main() {
+    if (kLayeredPass == 0u) {
+        exact_pass();
+    } else {
+        layered_pass();
     }
 }

@@ -81,6 +81,8 @@ void main() {
             header[kHeaderDispatchZ] = 1u;
             header[kHeaderBusyTiles] = busy;
             header[kHeaderPairs] = inclusive.x;
+            header[kHeaderLayeredDispatchY] = 1u;  // x: the exact pass counts the tiles it hands on
+            header[kHeaderLayeredDispatchZ] = 1u;
         }
         return;
     }

@@ -26,6 +26,11 @@ bool is_srgb_encoded(VkFormat format) {
     return format == VK_FORMAT_R8G8B8A8_UNORM || format == VK_FORMAT_B8G8R8A8_UNORM;
 }
 
+// Words of the header buffer: TileHeader, the busy tiles, the tiles handed to the layered pass.
+VkDeviceSize header_words(uint32_t tiles) {
+    return gpu::kTileHeaderWords + 2 * VkDeviceSize{tiles};
+}
+
 // Words of the tiles buffer: count, start and cursor per tile, and two words per scan block.
 VkDeviceSize tile_words(uint32_t tiles) {
     return VkDeviceSize{tiles} * 3 + 2 * VkDeviceSize{(tiles + gpu::kTileScanBlock - 1) / gpu::kTileScanBlock};
@@ -43,8 +48,10 @@ VkExtent2D grid(uint32_t count, uint32_t size) {
 
 TileCompositor::~TileCompositor() {
     if (!ref_.device) return;
-    for (VkPipeline pipeline : tile_pipelines_) {
-        if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
+    for (const auto& passes : tile_pipelines_) {
+        for (VkPipeline pipeline : passes) {
+            if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
+        }
     }
     for (VkPipeline pipeline : {count_, scan_[0], scan_[1], scan_[2], scatter_}) {
         if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
@@ -118,20 +125,23 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
         vkGetPhysicalDeviceFormatProperties(config.physical_device, variant.view, &properties);
         if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT) == 0) continue;
         if (std::string_view(variant.shader) == "tile_composite_any.comp" && !config.storage_without_format) continue;
-        // constant_id 0: K; 1: the target's encoding; 2: the list capacity; 3: red and blue swap.
-        const uint32_t constants[4] = {
-            config.layers, is_srgb_encoded(variant.image) ? gpu::kTileEncodeSrgb : gpu::kTileEncodeLinear,
-            config.capacity, variant.image != variant.view ? 1u : 0u};
-        const VkSpecializationMapEntry entries[4] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}};
-        const VkSpecializationInfo specialization{4, entries, sizeof(constants), constants};
-        if (Status s = pipeline(variant.shader, &specialization, tile_pipelines_[i]); !s) return s;
+        // constant_id 0: K; 1: the target's encoding; 2: the list capacity; 3: red and blue swap;
+        // 4: the pass (exact, layered).
+        for (uint32_t pass = 0; pass < 2; ++pass) {
+            const uint32_t constants[5] = {
+                config.layers, is_srgb_encoded(variant.image) ? gpu::kTileEncodeSrgb : gpu::kTileEncodeLinear,
+                config.capacity, variant.image != variant.view ? 1u : 0u, pass};
+            const VkSpecializationMapEntry entries[5] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {4, 16, 4}};
+            const VkSpecializationInfo specialization{5, entries, sizeof(constants), constants};
+            if (Status s = pipeline(variant.shader, &specialization, tile_pipelines_[i][pass]); !s) return s;
+        }
     }
     return {};
 }
 
 bool TileCompositor::supports(VkFormat format, VkFormat view_format) const {
     const size_t i = variant_index(format, view_format);
-    return i < kTileVariants.size() && tile_pipelines_[i] != VK_NULL_HANDLE;
+    return i < kTileVariants.size() && tile_pipelines_[i][0] != VK_NULL_HANDLE;
 }
 
 Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage,
@@ -151,7 +161,7 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
     if (Status s = grow(slot.tiles, tile_words(tiles) * kWord, storage | transfer, false); !s) return s;
     if (Status s = grow(slot.bins, pairs * kWord, storage, false); !s) return s;
     // Host-visible, so that the host reads the frame's counts straight from it once the frame is done.
-    if (Status s = grow(slot.header, (gpu::kTileHeaderWords + VkDeviceSize{tiles}) * kWord,
+    if (Status s = grow(slot.header, header_words(tiles) * kWord,
                         storage | transfer | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true);
         !s) {
         return s;
@@ -188,7 +198,7 @@ void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view,
     vkUpdateDescriptorSets(ref_.device, gpu::kTileBindingCount, writes, 0, nullptr);
 }
 
-void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, VkPipeline tile_pipeline,
+void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
                                    const gpu::TilePushConstants& push) {
     constexpr VkPipelineStageFlags compute = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
     constexpr VkPipelineStageFlags transfer = VK_PIPELINE_STAGE_TRANSFER_BIT;
@@ -228,8 +238,13 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, VkPipel
     bin(scatter_);
     vk::memory_barrier(cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
                        shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_pipeline);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[0]);
     vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
+    // The tiles the exact pass handed on; usually none, and then an empty dispatch.
+    vk::memory_barrier(cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[1]);
+    vkCmdDispatchIndirect(cb, slot.header.buffer, gpu::kTileLayeredDispatchOffset);
     // The frame's counts for the host.
     vk::memory_barrier(cb, compute, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
@@ -268,7 +283,7 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     slot.pending = true;
     slot.frame = frame_;
     return quads.size_bytes() + tile_words(tiles) * kWord + pairs * kWord +
-           (gpu::kTileHeaderWords + VkDeviceSize{tiles}) * kWord;
+           header_words(tiles) * kWord;
 }
 
 }  // namespace crisp::composite

@@ -96,7 +96,7 @@ private:
     Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible);
     Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
     void write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view);
-    void record_passes(VkCommandBuffer command_buffer, const Slot& slot, VkPipeline tile_pipeline,
+    void record_passes(VkCommandBuffer command_buffer, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
                        const gpu::TilePushConstants& push);
 
     vk::DeviceRef ref_;
@@ -105,7 +105,7 @@ private:
     std::vector<VkShaderModule> modules_;
     VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
     std::array<VkPipeline, 3> scan_{};  // reduce, blocks, down
-    std::array<VkPipeline, kTileVariants.size()> tile_pipelines_{};
+    std::array<std::array<VkPipeline, 2>, kTileVariants.size()> tile_pipelines_{};  // exact, layered pass
     std::vector<Slot> slots_;
     uint64_t frame_ = 0;
 };

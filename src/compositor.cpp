@@ -23,6 +23,7 @@ namespace {
 constexpr uint32_t kMaxTargetSide = 16384;
 constexpr uint32_t kMaxNodesPerPixel = 64;
 static_assert(kMaxTileCapacity == gpu::kTileMaxCapacity);
+static_assert(CompositorCreateInfo{}.tile_capacity == gpu::kTileDefaultCapacity);
 
 std::string rect_string(const VkRect2D& rect) {
     return std::to_string(rect.extent.width) + "x" + std::to_string(rect.extent.height) + " at (" +

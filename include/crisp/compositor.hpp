@@ -95,7 +95,7 @@ struct CompositorCreateInfo {
     bool storage_without_format = false;
     // Quads a tile's list holds in workgroup memory (8 bytes each): a power of two, 4 to
     // kMaxTileCapacity. A longer list takes the layered way with K = tile_layers.
-    uint32_t tile_capacity = 1024;
+    uint32_t tile_capacity = 256;
     uint32_t tile_layers = 8;  // 1..kMaxCompositeLayers
 
     // ---- The draw path (record_draw()): the colour attachment format of the caller's render
