@@ -60,10 +60,21 @@ vec3 linear_to_srgb(vec3 c) {
     return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
 }
 
+// Stages quad `index` at `slot` of the chunk for the walk: its rect relative to the tile's corner
+// (clamped to the tile, a byte per edge), its atlas texel minus its position, and its colour.
+void stage_quad(uint slot, uint index, ivec2 corner) {
+    const CompositeQuad q = quads[index];
+    const ivec2 low = clamp(ivec2(q.x, q.y) - corner, ivec2(0), ivec2(kTileSide));
+    const ivec2 high = clamp(ivec2(q.x, q.y) + ivec2(q.width, q.height) - corner, ivec2(0), ivec2(kTileSide));
+    chunk_rect[slot] = uint(low.x) | (uint(low.y) << 8) | (uint(high.x) << 16) | (uint(high.y) << 24);
+    chunk_texel[slot] = ivec2(q.atlas_x, q.atlas_y) - ivec2(q.x, q.y);
+    chunk_colour[slot] = q.color;
+}
+
 // The tile's list from the bins into `list`, sorted ascending: each entry's place is the number
 // of entries smaller than it (a quad is in a tile's list once, so entries are distinct). One
 // barrier; count^2 / kTileInvocations reads of workgroup memory per invocation.
-void sort_list(uint start, uint count) {
+void sort_list(uint start, uint count, ivec2 corner) {
     for (uint i = gl_LocalInvocationIndex; i < count; i += kTileInvocations) unsorted[i] = bins[start + i];
     barrier();
     for (uint i = gl_LocalInvocationIndex; i < count; i += kTileInvocations) {
@@ -71,6 +82,7 @@ void sort_list(uint start, uint count) {
         uint place = 0u;
         for (uint j = 0u; j < count; ++j) place += unsorted[j] < key ? 1u : 0u;
         list[place] = key;
+        if (place < kTileChunk) stage_quad(place, key, corner);  // the first chunk, staged at once
     }
     barrier();
 }
@@ -100,23 +112,13 @@ void blend_over(inout Blend b, vec3 opacity, vec3 colour) {
     b.coverage_transmittance *= 1.0 - max(opacity.r, max(opacity.g, opacity.b));
 }
 
-// Stages quads list[base ..] (up to kTileChunk) for the walk, relative to the tile's corner.
-void stage_chunk(uint base, uint count, ivec2 corner) {
-    const uint i = base + gl_LocalInvocationIndex;
-    if (gl_LocalInvocationIndex >= kTileChunk || i >= count) return;
-    const CompositeQuad q = quads[list[i]];
-    const ivec2 low = clamp(ivec2(q.x, q.y) - corner, ivec2(0), ivec2(kTileSide));
-    const ivec2 high = clamp(ivec2(q.x, q.y) + ivec2(q.width, q.height) - corner, ivec2(0), ivec2(kTileSide));
-    chunk_rect[gl_LocalInvocationIndex] = uint(low.x) | (uint(low.y) << 8) | (uint(high.x) << 16) | (uint(high.y) << 24);
-    chunk_texel[gl_LocalInvocationIndex] = ivec2(q.atlas_x, q.atlas_y) - ivec2(q.x, q.y);
-    chunk_colour[gl_LocalInvocationIndex] = q.color;
-}
-
-// The exact way: the sorted list, staged a chunk at a time into workgroup memory, walked front to
-// back by every pixel; the workgroup stops once every pixel's transmittance is spent.
+// The exact way: the sorted list, staged a chunk at a time into workgroup memory (the first
+// chunk by the sort itself), walked front to back by every pixel; the workgroup stops after a
+// chunk once every pixel's transmittance is spent. Inside a chunk the walk carries no early exit,
+// so that the texel loads of successive quads do not wait on each other.
 Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) {
     if (gl_LocalInvocationIndex == 0u) tile_busy_pixels = 0u;
-    sort_list(start, count);  // its barriers also order tile_busy_pixels' reset before the adds
+    sort_list(start, count, corner);  // its barriers also order tile_busy_pixels' reset before the adds
     Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
     bool walking = inside;
     const uint walkers = subgroupAdd(walking ? 1u : 0u);
@@ -124,32 +126,40 @@ Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) 
     const ivec2 local = pixel - corner;
     const ivec2 atlas_size = imageSize(atlas);
     for (uint base = 0u; base < count; base += kTileChunk) {
-        stage_chunk(base, count, corner);
-        barrier();
+        if (base > 0u) {
+            // The barrier that ended the last chunk's walk lets its staged quads be replaced.
+            const uint i = base + gl_LocalInvocationIndex;
+            if (gl_LocalInvocationIndex < kTileChunk && i < count) stage_quad(gl_LocalInvocationIndex, list[i], corner);
+            barrier();
+        }
         const uint staged = min(kTileChunk, count - base);
-        for (uint j = 0u; walking && j < staged; ++j) {
-            const uint rect = chunk_rect[j];
-            if (local.x < int(rect & 255u) || local.y < int((rect >> 8) & 255u) || local.x >= int((rect >> 16) & 255u) ||
-                local.y >= int(rect >> 24)) {
-                continue;
+        if (walking) {
+            for (uint j = 0u; j < staged; ++j) {
+                const uint rect = chunk_rect[j];
+                if (local.x < int(rect & 255u) || local.y < int((rect >> 8) & 255u) ||
+                    local.x >= int((rect >> 16) & 255u) || local.y >= int(rect >> 24)) {
+                    continue;
+                }
+                const ivec2 texel = pixel + chunk_texel[j];
+                if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, atlas_size))) continue;
+                const uvec4 sums = imageLoad(atlas, texel);
+                if (sums.a == 0u) continue;
+                const vec4 colour = chunk_colour[j];
+                const vec3 opacity =
+                    colour.a * min(vec3(sums.rgb) / (float(kRasterCoverageOne) * float(sums.a)), vec3(1.0));
+                if (!any(greaterThan(opacity, vec3(0.0)))) continue;
+                blend_over(b, opacity, colour.rgb);
+                ++b.fragments;
             }
-            const ivec2 texel = pixel + chunk_texel[j];
-            if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, atlas_size))) continue;
-            const uvec4 sums = imageLoad(atlas, texel);
-            if (sums.a == 0u) continue;
-            const vec4 colour = chunk_colour[j];
-            const vec3 opacity =
-                colour.a * min(vec3(sums.rgb) / (float(kRasterCoverageOne) * float(sums.a)), vec3(1.0));
-            if (!any(greaterThan(opacity, vec3(0.0)))) continue;
-            blend_over(b, opacity, colour.rgb);
-            ++b.fragments;
             if (all(lessThan(b.transmittance, vec3(kTileOpaque)))) {
                 walking = false;
                 atomicAdd(tile_busy_pixels, 0xFFFFFFFFu);  // minus one
             }
         }
-        barrier();
-        if (tile_busy_pixels == 0u) break;  // read between two barriers: uniform
+        if (base + kTileChunk < count) {
+            barrier();
+            if (tile_busy_pixels == 0u) break;  // read between two barriers: uniform
+        }
     }
     return b;
 }

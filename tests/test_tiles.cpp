@@ -461,6 +461,43 @@ TEST(TileCompositor, OverflowingTilesTakeTheLayeredWayWithinOneCodeOfExact) {
     expect_no_validation_messages();
 }
 
+// Tiles whose lists pass the 64 quads staged at a time: the walk goes on chunk after chunk.
+TEST(TileCompositor, LongListsAreWalkedChunkAfterChunk) {
+    std::vector<TextRun> runs;
+    for (int i = 0; i < 72; ++i) {  // whole-pixel offsets: the same atlas entries serve every run
+        const float f = static_cast<float>(i);
+        runs.push_back({"Hamburg", 0.5f + static_cast<float>(i % 6), 22.0f + static_cast<float>(i / 6),
+                        {0.2f + 0.01f * f, 0.5f, 0.9f - 0.01f * f, 0.08f}, 0.013f * f});
+    }
+    const Scene scene = render_scene(runs);
+    auto compositor = Compositor::create(tile_info(1));
+    ASSERT_TRUE(compositor);
+    Target t = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+    composite_tiles(*compositor, scene, scene.drawn, t);
+    Target again = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+    composite_tiles(*compositor, scene, scene.drawn, again);
+    EXPECT_LE(worst_difference(t, read_target(t), expected_image(scene, t, {0, 0}, nullptr)), tolerance(t.format));
+    const CompositorStats& stats = compositor->stats();
+    ASSERT_TRUE(stats.measured);
+    EXPECT_EQ(stats.exact_tiles, stats.busy_tiles);
+    EXPECT_EQ(stats.max_overlap, max_overlap(scene));
+    // Some 16 x 16 tile's list holds more than one 64-quad chunk.
+    size_t longest = 0;
+    for (uint32_t ty = 0; ty * 16 < kHeight; ++ty) {
+        for (uint32_t tx = 0; tx * 16 < kWidth; ++tx) {
+            size_t quads = 0;
+            for (const DrawnGlyph& g : scene.drawn) {
+                const GlyphInstance& i = g.instance;
+                quads += i.x < int32_t(tx * 16 + 16) && i.y < int32_t(ty * 16 + 16) &&
+                         i.x + int32_t(i.width) > int32_t(tx * 16) && i.y + int32_t(i.height) > int32_t(ty * 16);
+            }
+            longest = std::max(longest, quads);
+        }
+    }
+    EXPECT_GT(longest, 64u);
+    expect_no_validation_messages();
+}
+
 TEST(TileCompositor, DrawsOnlyInsideTheCallersRect) {
     const Scene scene = render_scene(overlapping_runs(0.8f));
     auto compositor = Compositor::create(tile_info());

@@ -103,9 +103,13 @@ public:
     }
 
     // Around the work to time, in one command buffer.
-    void begin(VkCommandBuffer command_buffer) const {
+    // `after_earlier_work`: the start is stamped once the commands before it have completed (they
+    // are not counted), rather than when the GPU reaches this point (they may still be running).
+    void begin(VkCommandBuffer command_buffer, bool after_earlier_work = false) const {
         vkCmdResetQueryPool(command_buffer, pool_, 0, 2);
-        vkCmdWriteTimestamp(command_buffer, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, pool_, 0);
+        vkCmdWriteTimestamp(command_buffer,
+                            after_earlier_work ? VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                            pool_, 0);
     }
     void end(VkCommandBuffer command_buffer) const {
         vkCmdWriteTimestamp(command_buffer, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, 1);
