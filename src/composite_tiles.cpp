@@ -198,24 +198,12 @@ void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view,
     vkUpdateDescriptorSets(ref_.device, gpu::kTileBindingCount, writes, 0, nullptr);
 }
 
-void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
-                                   const gpu::TilePushConstants& push) {
+// Count, prefix sum, scatter: the frame's quads into the slot's bins. The descriptor set and push
+// constants are bound.
+void TileCompositor::record_binning(VkCommandBuffer cb, const gpu::TilePushConstants& push) {
     constexpr VkPipelineStageFlags compute = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
-    constexpr VkPipelineStageFlags transfer = VK_PIPELINE_STAGE_TRANSFER_BIT;
     constexpr VkAccessFlags shader = vk::kShaderAccess;
     const uint32_t tiles = push.tiles_x * push.tiles_y;
-    // This slot's buffers were last used by a frame the caller has waited for; the barrier orders
-    // them for the validation layer and for callers who recycle command buffers early.
-    vk::memory_barrier(cb, compute | transfer | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
-                       shader | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT, transfer,
-                       VK_ACCESS_TRANSFER_WRITE_BIT);
-    vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
-    vkCmdFillBuffer(cb, slot.header.buffer, 0, sizeof(gpu::TileHeader), 0);
-    vk::memory_barrier(cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, compute, shader);
-
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set, 0,
-                            nullptr);
-    vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
     const VkExtent2D quad_groups = grid(push.quad_count, gpu::kTileBinInvocations);
     auto bin = [&](VkPipeline pipeline) {
         if (quad_groups.width == 0) return;
@@ -238,6 +226,37 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const s
     bin(scatter_);
     vk::memory_barrier(cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
                        shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+}
+
+void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
+                                   const gpu::TilePushConstants& push, bool reuse_bins) {
+    constexpr VkPipelineStageFlags compute = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    constexpr VkPipelineStageFlags transfer = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    constexpr VkAccessFlags shader = vk::kShaderAccess;
+    const uint32_t tiles = push.tiles_x * push.tiles_y;
+    // This slot's buffers were last used by a frame the caller has waited for; the barrier orders
+    // them for the validation layer and for callers who recycle command buffers early.
+    vk::memory_barrier(cb, compute | transfer | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       shader | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT, transfer,
+                       VK_ACCESS_TRANSFER_WRITE_BIT);
+    if (reuse_bins) {
+        // The bins, the busy list and the exact pass's dispatch stand; the tile passes' counts
+        // and the layered dispatch start again.
+        constexpr uint32_t reset[] = {0, 0, 0, 0, 0, 1, 1};  // layered tiles .. layered dispatch z
+        static_assert(offsetof(gpu::TileHeader, layered_dispatch_z) - offsetof(gpu::TileHeader, layered_tiles) ==
+                      sizeof(reset) - kWord);
+        vkCmdUpdateBuffer(cb, slot.header.buffer, offsetof(gpu::TileHeader, layered_tiles), sizeof(reset), reset);
+    } else {
+        vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
+        vkCmdFillBuffer(cb, slot.header.buffer, 0, sizeof(gpu::TileHeader), 0);
+    }
+    vk::memory_barrier(cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set, 0,
+                            nullptr);
+    vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    if (!reuse_bins) record_binning(cb, push);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[0]);
     vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
     // The tiles the exact pass handed on; usually none, and then an empty dispatch.
@@ -251,7 +270,7 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const s
 
 Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
                                         VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
-                                        uint64_t& measured_frame) {
+                                        uint64_t& measured_frame, bool& reused) {
     Slot& slot = slots_[frame_ % slots_.size()];
     if (slot.pending) {
         gpu::TileHeader header{};
@@ -276,9 +295,21 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     }
     push.bin_capacity = static_cast<uint32_t>(pairs);
     const uint32_t tiles = push.tiles_x * push.tiles_y;
-    if (Status s = prepare_slot(slot, quads, tiles, pairs); !s) return s.error();
+    // Static text: the slot's bins already hold these very quads for a rect of this size.
+    reused = config_.reuse_static_bins && slot.bins_valid && slot.binned_width == push.width &&
+             slot.binned_height == push.height && slot.binned.size() == quads.size() &&
+             (quads.empty() || std::memcmp(slot.binned.data(), quads.data(), quads.size_bytes()) == 0);
+    if (!reused) {
+        slot.bins_valid = false;
+        if (Status s = prepare_slot(slot, quads, tiles, pairs); !s) return s.error();
+        slot.binned.assign(quads.begin(), quads.end());
+        slot.binned_width = push.width;
+        slot.binned_height = push.height;
+        slot.bins_valid = true;
+    }
     write_descriptors(slot, atlas_view, target.view);
-    record_passes(command_buffer, slot, tile_pipelines_[variant_index(target.format, target.view_format)], push);
+    record_passes(command_buffer, slot, tile_pipelines_[variant_index(target.format, target.view_format)], push,
+                  reused);
     ++frame_;
     slot.pending = true;
     slot.frame = frame_;

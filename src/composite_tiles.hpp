@@ -39,6 +39,7 @@ struct TileConfig {
     uint32_t layers = gpu::kCompositeMaxLayers;     // K of tiles whose list overflows
     uint32_t capacity = gpu::kTileDefaultCapacity;  // quads a tile's list holds in workgroup memory
     bool storage_without_format = false;            // B8G8R8A8 targets allowed
+    bool reuse_static_bins = true;                  // skip binning when the quads did not change
 };
 
 // Where the tile pass draws: glyph pixel (0, 0) is `origin` in the image; `size` pixels from there.
@@ -77,10 +78,12 @@ public:
 
     // Records the frame: `quads` sorted front to back (sort_front_to_back for target.size).
     // Returns the buffer bytes the frame used; `measured` gets the counts of the frame that last
-    // used this frame slot, if it has not been read yet (`measured_frame` says which).
+    // used this frame slot, if it has not been read yet (`measured_frame` says which). `reused`
+    // says whether the slot's bins already held these quads (static text), so that the frame
+    // skipped the upload and the binning passes.
     Result<uint64_t> record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
                             VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
-                            uint64_t& measured_frame);
+                            uint64_t& measured_frame, bool& reused);
 
 private:
     struct Slot {
@@ -91,13 +94,18 @@ private:
         VkDescriptorSet set = VK_NULL_HANDLE;
         bool pending = false;
         uint64_t frame = 0;
+        // What the bins hold: the quads and the rect size they were binned for.
+        std::vector<gpu::CompositeQuad> binned;
+        uint32_t binned_width = 0, binned_height = 0;
+        bool bins_valid = false;
     };
 
     Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible);
     Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
     void write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view);
+    void record_binning(VkCommandBuffer command_buffer, const gpu::TilePushConstants& push);
     void record_passes(VkCommandBuffer command_buffer, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
-                       const gpu::TilePushConstants& push);
+                       const gpu::TilePushConstants& push, bool reuse_bins);
 
     vk::DeviceRef ref_;
     TileConfig config_;

@@ -172,6 +172,7 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     tiles.layers = info.tile_layers;
     tiles.capacity = info.tile_capacity;
     tiles.storage_without_format = info.storage_without_format;
+    tiles.reuse_static_bins = info.reuse_static_bins;
     if (Status s = state->tiles.create(state->ref, tiles); !s) return s.error();
     if (!std::any_of(std::begin(kTileTargetFormats), std::end(kTileTargetFormats),
                      [&](VkFormat format) { return state->tiles.supports(format, format); })) {
@@ -214,8 +215,10 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     composite::sort_front_to_back(glyphs, rect->extent.width, rect->extent.height, s.quads);
     composite::TileCounts counts;
     uint64_t measured_frame = 0;
+    bool reused = false;
     const composite::TileTarget tile_target{target.view, target.format, view_format, rect->offset, rect->extent};
-    Result<uint64_t> bytes = s.tiles.record(command_buffer, s.quads, atlas_view, tile_target, counts, measured_frame);
+    Result<uint64_t> bytes =
+        s.tiles.record(command_buffer, s.quads, atlas_view, tile_target, counts, measured_frame, reused);
     if (!bytes) return bytes.error();
     if (measured_frame != 0) s.take(counts, measured_frame);
     s.stats.mode = CompositeMode::tiled;
@@ -224,6 +227,7 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     s.stats.layers = 0;
     s.stats.tiles = 0;
     s.stats.buffer_bytes = *bytes;
+    s.stats.bins_reused = reused;
     return {};
 }
 

@@ -498,6 +498,46 @@ TEST(TileCompositor, LongListsAreWalkedChunkAfterChunk) {
     expect_no_validation_messages();
 }
 
+// Static text: a frame slot that binned these very glyphs skips the binning, with the same image;
+// any change bins again.
+TEST(TileCompositor, StaticTextReusesItsBins) {
+    const Scene scene = render_scene(overlapping_runs(0.7f));
+    auto compositor = Compositor::create(tile_info(2));
+    ASSERT_TRUE(compositor);
+    std::vector<std::vector<std::byte>> images;
+    std::vector<bool> reused;
+    std::vector<DrawnGlyph> glyphs = scene.drawn;
+    for (int frame = 0; frame < 5; ++frame) {
+        if (frame == 3) glyphs[0].instance.color[0] = 0.5f;  // a hover colour: the quads change
+        Target t = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+        composite_tiles(*compositor, scene, glyphs, t);
+        images.push_back(read_target(t));
+        reused.push_back(compositor->stats().bins_reused);
+        if (frame == 2) {
+            EXPECT_TRUE(compositor->stats().measured);
+            EXPECT_EQ(compositor->stats().max_overlap, max_overlap(scene));  // frame 0's, binned
+        }
+    }
+    // Two slots: frames 0 and 1 bin, one slot each; frame 2 finds slot 0 holding its glyphs; frame 3
+    // changed a colour; frame 4 finds slot 0 holding the old glyphs: both bin.
+    EXPECT_EQ(reused, (std::vector<bool>{false, false, true, false, false}));
+    EXPECT_EQ(images[2], images[0]);
+    EXPECT_NE(images[3], images[0]);
+    EXPECT_EQ(images[4], images[3]);
+    EXPECT_EQ(compositor->stats().max_overlap, max_overlap(scene));  // frame 2's: reused bins count right
+    CompositorCreateInfo info = tile_info(2);
+    info.reuse_static_bins = false;
+    auto always = Compositor::create(info);
+    ASSERT_TRUE(always);
+    for (int frame = 0; frame < 3; ++frame) {
+        Target t = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+        composite_tiles(*always, scene, scene.drawn, t);
+        EXPECT_FALSE(always->stats().bins_reused);
+        EXPECT_EQ(read_target(t), images[0]);
+    }
+    expect_no_validation_messages();
+}
+
 TEST(TileCompositor, DrawsOnlyInsideTheCallersRect) {
     const Scene scene = render_scene(overlapping_runs(0.8f));
     auto compositor = Compositor::create(tile_info());

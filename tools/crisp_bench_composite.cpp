@@ -70,7 +70,7 @@ struct Args {
     uint32_t subpixel_steps = 4;
     crisp::KeyFormat keys = crisp::KeyFormat::automatic;
     crisp::QuadPath path = crisp::QuadPath::raster;
-    std::vector<std::string> modes = {"tiled", "tiled-rgba8", "frame", "draw", "exact", "unsorted", "wboit",
+    std::vector<std::string> modes = {"tiled", "tiled-rebin", "tiled-rgba8", "frame", "draw", "exact", "unsorted", "wboit",
                                       "layered-1", "layered-2", "layered-4", "layered-8", "layered-auto"};
     bool cpu_check = true;
     bool json = false;
@@ -86,7 +86,8 @@ struct Args {
                  "(timestamp queries around its record call), its error against the exact CPU reference (or,\n"
                  "with --no-cpu-check, the exact mode) in 8-bit sRGB codes, and its bytes per pixel.\n"
                  "Progress goes to stderr.\n\n"
-                 "  --modes LIST       modes, comma-separated, from tiled (the tile path into RGBA32F),\n"
+                 "  --modes LIST       modes, comma-separated, from tiled (the tile path into RGBA32F; static\n"
+                 "                     text: the bins are reused), tiled-rebin (binned every frame),\n"
                  "                     tiled-rgba8 (into R8G8B8A8_UNORM), frame (the renderer's converged\n"
                  "                     frame and the tile path together), draw (the draw path, RGBA32F),\n"
                  "                     exact, unsorted, wboit, layered-K (K = 1..8) and layered-auto\n"
@@ -402,12 +403,14 @@ struct ModeRun {
     uint32_t layers = 0;                                 // layered: K, or kAutoLayers
     VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;     // tiled and draw: the target image's
     bool with_renderer = false;                          // tiled: the renderer's frame timed too
+    bool rebin = false;  // tiled: bin every frame (reuse_static_bins off), as for text that changes
 };
 
 // The run a --modes name stands for; nullopt for an unknown name.
 std::optional<ModeRun> parse_mode_run(const std::string& name) {
     if (name == "tiled-rgba8") return ModeRun{crisp::CompositeMode::tiled, 0, VK_FORMAT_R8G8B8A8_UNORM, false};
     if (name == "frame") return ModeRun{crisp::CompositeMode::tiled, 0, VK_FORMAT_R32G32B32A32_SFLOAT, true};
+    if (name == "tiled-rebin") return ModeRun{crisp::CompositeMode::tiled, 0, VK_FORMAT_R32G32B32A32_SFLOAT, false, true};
     if (name == "layered-auto") return ModeRun{crisp::CompositeMode::layered, crisp::kAutoLayers};
     if (name.rfind("layered-", 0) == 0) {
         const std::optional<uint32_t> k = crisp::cli::parse_number<uint32_t>(name.substr(8));
@@ -452,6 +455,7 @@ std::string mode_label(const ModeRun& run) {
         label += run.layers == crisp::kAutoLayers ? " auto" : " K=" + std::to_string(run.layers);
     }
     if (run.format == VK_FORMAT_R8G8B8A8_UNORM) label += " rgba8";
+    if (run.rebin) label += ", binned every frame";
     return label;
 }
 
@@ -968,6 +972,10 @@ int main(int argc, char** argv) {
             compositor_info.draw_format = VK_FORMAT_R32G32B32A32_SFLOAT;
             auto compositor = crisp::Compositor::create(compositor_info);
             if (!compositor) fail(compositor.error().message);
+            compositor_info.reuse_static_bins = false;
+            compositor_info.reference_modes = false;
+            auto rebinning = crisp::Compositor::create(compositor_info);
+            if (!rebinning) fail(rebinning.error().message);
             for (const std::string& w : compositor->warnings()) {
                 if (std::find(header.compositor_warnings.begin(), header.compositor_warnings.end(), w) ==
                     header.compositor_warnings.end()) {
@@ -977,7 +985,7 @@ int main(int argc, char** argv) {
 
             for (const ModeRun& run : runs) {
                 std::fprintf(stderr, "%s: %s\n", name.c_str(), mode_label(run).c_str());
-                result.modes.push_back(bench.measure(*compositor, scene, name, run));
+                result.modes.push_back(bench.measure(run.rebin ? *rebinning : *compositor, scene, name, run));
             }
             const Measurement* exact = nullptr;
             for (const Measurement& m : result.modes) {

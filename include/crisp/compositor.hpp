@@ -97,6 +97,11 @@ struct CompositorCreateInfo {
     // kMaxTileCapacity. A longer list takes the layered way with K = tile_layers.
     uint32_t tile_capacity = 256;
     uint32_t tile_layers = 8;  // 1..kMaxCompositeLayers
+    // Static text: where a frame's glyphs are those the same frame slot binned frames_in_flight
+    // frames ago (same rects, atlas positions, colours, depths and order, same rect size), skip
+    // the upload and the binning passes and composite from the bins it has. Off only to measure
+    // what binning costs.
+    bool reuse_static_bins = true;
 
     // ---- The draw path (record_draw()): the colour attachment format of the caller's render
     // pass; VK_FORMAT_UNDEFINED makes no draw pipeline. The device must have dynamicRendering and
@@ -169,6 +174,7 @@ struct CompositorStats {
     CompositeMode mode = CompositeMode::tiled;
     QuadPath path = QuadPath::raster;  // the path this frame's quad passes took
     uint32_t tiles = 0;                // compute path: 8 x 8 tiles dispatched
+    bool bins_reused = false;          // tiled: the glyphs were unchanged, binning was skipped
     uint32_t layers = 0;           // layered: the K this frame used
     bool mono_keys = false;        // layered: 32-bit keys
     uint32_t quads = 0;            // glyph quads drawn
