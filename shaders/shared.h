@@ -90,8 +90,7 @@ struct RasterPushConstants {
 
 // ---- The compositor (composite.vert and the *.frag / *_resolve.comp of each mode).
 
-// Layer buffers a layered pipeline binds: a layer never straddles two, so K <= 8 needs at most 8.
-CRISP_CONSTANT(uint, kCompositeMaxLayerBuffers, 8u);
+// The tile path's layered way keeps at most this many layers per pixel.
 CRISP_CONSTANT(uint, kCompositeMaxLayers, 8u);
 // Threads per workgroup of the per-pixel resolve passes, and of the compute quad passes (one
 // 8 x 8 tile of a quad each): 8 x 8 pixels.
@@ -99,27 +98,18 @@ CRISP_CONSTANT(uint, kCompositeTile, 8u);
 // Light sums are u8.24 fixed point: integer addition is associative, so the sum of a pixel's
 // fragments is bit-identical whatever order they arrive in.
 CRISP_CONSTANT(float, kCompositeLightScale, 16777216.0f);
-// Absorbance (-ln T) sums are u16.16 fixed point; one fragment adds at most kCompositeMaxAbsorbance.
+// Absorbance (-ln T) sums (wboit) are u16.16 fixed point; one fragment adds at most
+// kCompositeMaxAbsorbance (so does one in the tile path's layered tail, in float).
 CRISP_CONSTANT(float, kCompositeAbsorbanceScale, 65536.0f);
 CRISP_CONSTANT(float, kCompositeMaxAbsorbance, 24.0f);
-// The layered tail's count word: the count in the low 29 bits, "a tail key had T code 0" for red,
-// green and blue in bits 29, 30 and 31.
-CRISP_CONSTANT(uint, kCompositeTailCountMask, 0x1FFFFFFFu);
-CRISP_CONSTANT(uint, kCompositeTailZeroShift, 29u);
 // The exact mode sorts at most this many fragments per pixel; the rest are counted and dropped.
 CRISP_CONSTANT(uint, kCompositeExactMaxPerPixel, 64u);
 // uint words per exact-mode list node: next, key depth, rank, T rgb, L rgb (floats as bits).
 CRISP_CONSTANT(uint, kCompositeNodeWords, 9u);
 CRISP_CONSTANT(uint, kCompositeNoNode, 0xFFFFFFFFu);
 
-// Per-pixel words of each mode in the accumulator buffer (sized for the largest, kLayeredWords), plane-major (word w of pixel p at
-// w * pixels + p).
-CRISP_CONSTANT(uint, kLayeredTailCount, 0u);     // count | zero flags
-CRISP_CONSTANT(uint, kLayeredTailAbsorbance, 1u);  // 3 words: red, green, blue
-CRISP_CONSTANT(uint, kLayeredLight, 4u);           // 3 words
-CRISP_CONSTANT(uint, kLayeredGroupLight, 7u);      // 3 words: light of the last slot key's copies
-CRISP_CONSTANT(uint, kLayeredGroupCount, 10u);     // how many copies (kept and in the tail)
-CRISP_CONSTANT(uint, kLayeredWords, 11u);
+// Per-pixel words of each reference mode in the accumulator buffer (sized for the larger,
+// kWboitWords), plane-major (word w of pixel p at w * pixels + p).
 CRISP_CONSTANT(uint, kWboitLight, 0u);       // 3 words: sum w * L
 CRISP_CONSTANT(uint, kWboitOpacity, 3u);     // 3 words: sum w * o
 CRISP_CONSTANT(uint, kWboitAbsorbance, 6u);  // 3 words: sum -ln T
@@ -130,9 +120,8 @@ CRISP_CONSTANT(uint, kExactWords, 1u);
 // The stats buffer, uint words, cleared every frame and copied back for the host.
 CRISP_CONSTANT(uint, kStatNodesUsed, 0u);      // exact: nodes asked for (past capacity: lost)
 CRISP_CONSTANT(uint, kStatListOverflow, 1u);   // exact: fragments past kCompositeExactMaxPerPixel
-CRISP_CONSTANT(uint, kStatMaxOverlap, 2u);     // layered and exact: most fragments in one pixel
-CRISP_CONSTANT(uint, kStatTailPixels, 3u);     // layered: pixels with a tail
-CRISP_CONSTANT(uint, kStatWords, 4u);
+CRISP_CONSTANT(uint, kStatMaxOverlap, 2u);     // exact: most fragments in one pixel
+CRISP_CONSTANT(uint, kStatWords, 3u);
 
 // One glyph quad, in a std430 storage buffer: its rect on the target and in the atlas, and what
 // the compositor derived from its depth and paint order.
@@ -143,12 +132,12 @@ struct CompositeQuad {
     uint height;
     uint atlas_x;  // the rect's top-left texel in the atlas
     uint atlas_y;
-    uint key_depth;    // 64-bit keys: depth fixed point (bits 63..32), nearer per paint-order block
-    uint key_depth16;  // 32-bit keys: the same in 16 bits (bits 31..16)
-    uint key_order;    // 255 - (rank & 255): the key's paint-order byte
-    uint rank;         // dense rank of the paint order among the quads of its depth plane
-    float depth;       // [0, 1], for the WBOIT weight
-    uint padding;
+    uint key_depth;  // exact mode: depth fixed point, one step nearer per 256 paint-order ranks
+    uint rank;       // exact mode: dense rank of the paint order among the quads of its depth plane
+    float depth;     // [0, 1], for the WBOIT weight
+    uint padding0;
+    uint padding1;
+    uint padding2;
     vec4 color;  // linear, straight alpha
 };
 
@@ -157,7 +146,7 @@ struct CompositePushConstants {
     uint width;       // the target
     uint height;
     uint pixels;            // width * height
-    uint layers_per_buffer; // layered: whole layers per layer buffer
+    uint padding3;
     uint node_capacity;     // exact: nodes in the pool
     uint tile_count;        // compute quad passes: tiles in the frame's tile list
     uint quad_count;        // quads in the quad buffer

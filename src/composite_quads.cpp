@@ -93,7 +93,7 @@ uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t wi
     return pairs;
 }
 
-uint32_t rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::CompositeQuad>& out) {
+void rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::CompositeQuad>& out) {
     out.clear();
     struct Order {
         uint32_t depth;
@@ -108,13 +108,12 @@ uint32_t rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::Composi
         orders.push_back({depth_bits(instance.depth, 32), instance.paint_order, static_cast<uint32_t>(out.size())});
         out.push_back(make_quad(glyph));
     }
-    // Paint orders become dense ranks within each depth plane, so that the key's 8 bits of paint
-    // order hold 256 distinct ones per plane; each further block of 256 is one depth step nearer.
+    // Paint orders become dense ranks within each depth plane; each block of 256 ranks is also one
+    // depth step nearer, as the first compositor's 8-bit paint-order keys needed.
     std::sort(orders.begin(), orders.end(), [](const Order& a, const Order& b) {
         return std::tie(a.depth, a.paint_order) < std::tie(b.depth, b.paint_order);
     });
     uint32_t rank = 0;
-    uint32_t blocks = 0;
     for (size_t i = 0; i < orders.size(); ++i) {
         const Order& o = orders[i];
         if (i == 0 || o.depth != orders[i - 1].depth) {
@@ -124,14 +123,9 @@ uint32_t rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::Composi
         }
         gpu::CompositeQuad& q = out[o.quad];
         const uint32_t block = rank >> 8;
-        blocks = std::max(blocks, block + 1);
         q.rank = rank;
-        q.key_order = 255u - (rank & 255u);
         q.key_depth = o.depth - std::min(o.depth, block);
-        const uint32_t depth16 = depth_bits(q.depth, 16);
-        q.key_depth16 = depth16 - std::min(depth16, block);
     }
-    return blocks;
 }
 
 }  // namespace crisp::composite

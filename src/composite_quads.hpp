@@ -33,9 +33,8 @@ void sort_front_to_back(std::span<const DrawnGlyph> glyphs, uint32_t width, uint
 // width x height pixels: the bins it needs.
 uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height);
 
-// The reference modes' quads, in submission order, with the layered keys' fields: paint orders
-// become dense ranks per depth plane, each further block of 256 one depth step nearer. Returns the
-// most 256-wide blocks one plane needed.
-uint32_t rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::CompositeQuad>& out);
+// The reference modes' quads, in submission order, with the exact mode's key: paint orders become
+// dense ranks per depth plane.
+void rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::CompositeQuad>& out);
 
 }  // namespace crisp::composite

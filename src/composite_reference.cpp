@@ -1,4 +1,4 @@
-// The compositor's reference modes (docs/compositing.md): layered OIT in global memory, unsorted,
+// The compositor's reference modes (docs/compositing.md): unsorted,
 // weighted blended OIT and the exact per-pixel linked lists, into the compositor's own RGBA32F
 // target over a flat background. Every pass but unsorted reads or writes per-pixel storage
 // buffers; unsorted blends into the target as a colour attachment.
@@ -33,14 +33,15 @@ static_assert(kMaxExactFragmentsPerPixel == gpu::kCompositeExactMaxPerPixel);
 enum Binding : uint32_t {
     kBindAtlas = 0,
     kBindQuads = 1,
-    kBindLayers = 2,  // kCompositeMaxLayerBuffers descriptors
     kBindAccumulators = 3,
     kBindNodes = 4,
     kBindStats = 5,
     kBindTarget = 6,
     kBindTiles = 7,
 };
-constexpr uint32_t kBindingCount = 8;
+constexpr uint32_t kBindings[] = {kBindAtlas, kBindQuads, kBindAccumulators, kBindNodes,
+                                  kBindStats, kBindTarget, kBindTiles};
+constexpr uint32_t kBindingCount = std::size(kBindings);
 constexpr VkShaderStageFlags kPushStages =
     VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT | VK_SHADER_STAGE_COMPUTE_BIT;
 
@@ -51,11 +52,6 @@ ReferenceCompositor::~ReferenceCompositor() {
     if (!ref.device) return;
     VkDevice device = ref.device;
     const VkAllocationCallbacks* allocator = ref.allocator;
-    for (LayeredPipelines& p : layered) {
-        for (VkPipeline pipeline : {p.build, p.composite, p.resolve, p.build_compute, p.composite_compute}) {
-            if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
-        }
-    }
     for (VkPipeline pipeline : {unsorted, wboit, exact, wboit_resolve, exact_resolve, wboit_compute, exact_compute}) {
         if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
     }
@@ -70,7 +66,6 @@ ReferenceCompositor::~ReferenceCompositor() {
         vk::destroy_buffer(ref, slot.tiles);
         vk::destroy_buffer(ref, slot.stats);
     }
-    for (vk::DeviceBuffer& buffer : layer_buffers) vk::destroy_buffer(ref, buffer);
     vk::destroy_buffer(ref, accumulators);
     vk::destroy_buffer(ref, nodes);
     vk::destroy_buffer(ref, stats_words);
@@ -107,67 +102,14 @@ Result<VkPipeline> ReferenceCompositor::compute_pipeline(const char* shader, con
     return vk::create_compute_pipeline(ref, *compute_module, descriptors.pipeline_layout, specialization, shader);
 }
 
-Result<ReferenceCompositor::LayeredPipelines*> ReferenceCompositor::layered_pipelines(uint32_t layers, bool compute) {
-    LayeredPipelines& p = layered[layers];
-    // constant_id 0: K; 1: the pass (build, composite); 2: 64-bit keys (resolve).
-    struct Constants {
-        uint32_t layers, pass, key64;
-    };
-    const VkSpecializationMapEntry entries[3] = {
-        {0, offsetof(Constants, layers), 4}, {1, offsetof(Constants, pass), 4}, {2, offsetof(Constants, key64), 4}};
-    auto make = [&](VkPipeline& pipeline, uint32_t pass, const char* shader, bool graphics) -> Status {
-        if (pipeline) return {};
-        const Constants constants{layers, pass, mono ? 0u : 1u};
-        VkSpecializationInfo specialization{};
-        specialization.mapEntryCount = 3;
-        specialization.pMapEntries = entries;
-        specialization.dataSize = sizeof(constants);
-        specialization.pData = &constants;
-        Result<VkPipeline> made =
-            graphics ? graphics_pipeline(shader, &specialization, false) : compute_pipeline(shader, &specialization);
-        if (!made) return made.error();
-        pipeline = *made;
-        return {};
-    };
-    if (Status s = make(p.resolve, 2, "layered_resolve.comp", false); !s) return s.error();
-    if (compute) {
-        const char* shader = mono ? "layered32_quads.comp" : "layered64_quads.comp";
-        if (Status s = make(p.build_compute, 0, shader, false); !s) return s.error();
-        if (Status s = make(p.composite_compute, 1, shader, false); !s) return s.error();
-    } else {
-        const char* shader = mono ? "layered32.frag" : "layered64.frag";
-        if (Status s = make(p.build, 0, shader, true); !s) return s.error();
-        if (Status s = make(p.composite, 1, shader, true); !s) return s.error();
-    }
-    return &p;
-}
-
-// Per-pixel buffers. A layer lies whole in one buffer, layer-major (layer i of pixel p at
-// i * pixels + p), and layers are split across buffers where one would pass the range.
+// Per-pixel buffers: the accumulators (plane-major), the exact mode's node pool and the stats.
 Status ReferenceCompositor::create_buffers(const CompositorCreateInfo& info, std::vector<std::string>& warnings) {
     VkPhysicalDeviceProperties properties{};
     vkGetPhysicalDeviceProperties(info.physical_device, &properties);
     const VkDeviceSize range = properties.limits.maxStorageBufferRange;
-    const VkDeviceSize layer_range =
-        info.max_layer_buffer_bytes != 0 ? std::min<VkDeviceSize>(range, info.max_layer_buffer_bytes) : range;
     const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    const VkDeviceSize key_bytes = mono ? 4 : 8;
-    const VkDeviceSize layer_bytes = VkDeviceSize{pixels} * key_bytes;
-    if (layer_bytes > layer_range) {
-        return Error{ErrorCode::vulkan, "compositor: one layer of " + std::to_string(width) + "x" +
-                                            std::to_string(height) + " keys is " + std::to_string(layer_bytes) +
-                                            " bytes, above maxStorageBufferRange (" + std::to_string(layer_range) +
-                                            ")"};
-    }
-    layers_per_buffer = static_cast<uint32_t>(std::min<VkDeviceSize>(max_layers, layer_range / layer_bytes));
-    for (uint32_t first = 0; first < max_layers; first += layers_per_buffer) {
-        const uint32_t count = std::min(layers_per_buffer, max_layers - first);
-        vk::DeviceBuffer buffer;
-        if (Status s = vk::create_buffer(ref, layer_bytes * count, storage, false, buffer); !s) return s;
-        layer_buffers.push_back(buffer);
-    }
-    static_assert(gpu::kLayeredWords >= gpu::kWboitWords && gpu::kLayeredWords >= gpu::kExactWords);
-    const VkDeviceSize accumulator_bytes = VkDeviceSize{pixels} * gpu::kLayeredWords * kWord;
+    static_assert(gpu::kWboitWords >= gpu::kExactWords);
+    const VkDeviceSize accumulator_bytes = VkDeviceSize{pixels} * gpu::kWboitWords * kWord;
     if (accumulator_bytes > range) {
         return Error{ErrorCode::vulkan, "compositor: the per-pixel accumulators of a " + std::to_string(width) + "x" +
                                             std::to_string(height) + " target need " +
@@ -255,23 +197,6 @@ Status ReferenceCompositor::create(const vk::DeviceRef& device, const Compositor
     height = info.height;
     pixels = info.width * info.height;
     frames_in_flight = info.frames_in_flight;
-    max_layers = info.max_layers;
-    switch (info.key_format) {
-        case KeyFormat::rgb:
-            mono = false;
-            break;
-        case KeyFormat::mono:
-            mono = true;
-            break;
-        case KeyFormat::automatic:
-            mono = info.gray_layout || !info.int64_atomics;
-            if (!info.gray_layout && !info.int64_atomics) {
-                warnings.push_back(
-                    "no 64-bit buffer atomics (shaderInt64, shaderBufferInt64Atomics): layered compositing uses mono "
-                    "keys, one transmittance for the three subpixel channels");
-            }
-            break;
-    }
     VkPhysicalDeviceProperties properties{};
     vkGetPhysicalDeviceProperties(info.physical_device, &properties);
     VkPhysicalDeviceFeatures features{};
@@ -308,7 +233,6 @@ Status ReferenceCompositor::create(const vk::DeviceRef& device, const Compositor
     const VkDescriptorSetLayoutBinding bindings[] = {
         {kBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stages, nullptr},
         {kBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
-        {kBindLayers, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, gpu::kCompositeMaxLayerBuffers, stages, nullptr},
         {kBindAccumulators, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
         {kBindNodes, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
         {kBindStats, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
@@ -334,7 +258,7 @@ Status ReferenceCompositor::create(const vk::DeviceRef& device, const Compositor
 
     if (Status s = create_passes(); !s) return s;
 
-    // The fixed pipelines; layered ones are made per K on first use.
+    // The fixed pipelines; the compute quad passes are made on first use.
     struct Made {
         VkPipeline* pipeline;
         Result<VkPipeline> result;
@@ -363,15 +287,10 @@ void ReferenceCompositor::read_back_stats(FrameSlot& slot, CompositorStats& stat
     stats.measured = true;
     stats.measured_frame = slot.frame;
     stats.max_overlap = words[gpu::kStatMaxOverlap];
-    stats.tail_pixels = words[gpu::kStatTailPixels];
     stats.exact_lost_nodes = slot.mode == CompositeMode::exact && words[gpu::kStatNodesUsed] > node_capacity
                                  ? words[gpu::kStatNodesUsed] - node_capacity
                                  : 0;
     stats.exact_dropped = words[gpu::kStatListOverflow];
-    if (slot.mode == CompositeMode::layered || slot.mode == CompositeMode::exact) {
-        have_overlap = true;
-        last_overlap = stats.max_overlap;
-    }
 }
 
 void ReferenceCompositor::build_tiles() {
@@ -417,11 +336,6 @@ void ReferenceCompositor::write_descriptors(const FrameSlot& slot, VkImageView a
     const VkDescriptorImageInfo atlas_info{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
     const VkDescriptorImageInfo target_info{VK_NULL_HANDLE, target_.view, VK_IMAGE_LAYOUT_GENERAL};
     const VkDescriptorBufferInfo quads_info{slot.quads.buffer, 0, VK_WHOLE_SIZE};
-    std::array<VkDescriptorBufferInfo, gpu::kCompositeMaxLayerBuffers> layer_infos{};
-    for (uint32_t i = 0; i < layer_infos.size(); ++i) {
-        // Unused entries repeat the first buffer; the shaders never index them.
-        layer_infos[i] = {layer_buffers[i < layer_buffers.size() ? i : 0].buffer, 0, VK_WHOLE_SIZE};
-    }
     const VkDescriptorBufferInfo accumulator_info{accumulators.buffer, 0, VK_WHOLE_SIZE};
     const VkDescriptorBufferInfo node_info{nodes.buffer, 0, VK_WHOLE_SIZE};
     const VkDescriptorBufferInfo stats_info{stats_words.buffer, 0, VK_WHOLE_SIZE};
@@ -430,32 +344,42 @@ void ReferenceCompositor::write_descriptors(const FrameSlot& slot, VkImageView a
     for (uint32_t i = 0; i < kBindingCount; ++i) {
         writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
         writes[i].dstSet = slot.set;
-        writes[i].dstBinding = i;
+        writes[i].dstBinding = kBindings[i];
         writes[i].descriptorCount = 1;
         writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        switch (kBindings[i]) {
+            case kBindAtlas:
+                writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+                writes[i].pImageInfo = &atlas_info;
+                break;
+            case kBindTarget:
+                writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+                writes[i].pImageInfo = &target_info;
+                break;
+            case kBindQuads:
+                writes[i].pBufferInfo = &quads_info;
+                break;
+            case kBindAccumulators:
+                writes[i].pBufferInfo = &accumulator_info;
+                break;
+            case kBindNodes:
+                writes[i].pBufferInfo = &node_info;
+                break;
+            case kBindStats:
+                writes[i].pBufferInfo = &stats_info;
+                break;
+            default:
+                writes[i].pBufferInfo = &tiles_info;
+                break;
+        }
     }
-    writes[kBindAtlas].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    writes[kBindAtlas].pImageInfo = &atlas_info;
-    writes[kBindQuads].pBufferInfo = &quads_info;
-    writes[kBindLayers].descriptorCount = gpu::kCompositeMaxLayerBuffers;
-    writes[kBindLayers].pBufferInfo = layer_infos.data();
-    writes[kBindAccumulators].pBufferInfo = &accumulator_info;
-    writes[kBindNodes].pBufferInfo = &node_info;
-    writes[kBindStats].pBufferInfo = &stats_info;
-    writes[kBindTarget].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    writes[kBindTarget].pImageInfo = &target_info;
-    writes[kBindTiles].pBufferInfo = &tiles_info;
     vkUpdateDescriptorSets(ref.device, kBindingCount, writes, 0, nullptr);
 }
+
 Status ReferenceCompositor::check(const CompositeParams& params) const {
     if (params.mode == CompositeMode::tiled || params.mode == CompositeMode::draw) {
         return Error{ErrorCode::invalid_argument, std::string("compositor: ") + composite_mode_name(params.mode) +
                                                       " is not a reference mode (record() and record_draw() take it)"};
-    }
-    if (params.layers > max_layers) {
-        return Error{ErrorCode::invalid_argument, "compositor: " + std::to_string(params.layers) +
-                                                      " layers asked for, the buffers hold " +
-                                                      std::to_string(max_layers)};
     }
     if (params.mode == CompositeMode::exact && node_capacity == 0) {
         return Error{ErrorCode::invalid_argument,
@@ -464,17 +388,9 @@ Status ReferenceCompositor::check(const CompositeParams& params) const {
     return {};
 }
 
-Result<ReferenceCompositor::Passes> ReferenceCompositor::passes_for(const CompositeParams& params) {
-    Passes passes;
-    passes.compute = params.path == QuadPath::compute && params.mode != CompositeMode::unsorted;
-    if (params.mode == CompositeMode::layered) {
-        passes.layers = params.layers != kAutoLayers
-                            ? params.layers
-                            : (have_overlap ? std::clamp(last_overlap, 1u, max_layers) : max_layers);
-        Result<LayeredPipelines*> made = layered_pipelines(passes.layers, passes.compute);
-        if (!made) return made.error();
-        passes.layered = *made;
-    } else if (passes.compute) {
+Result<bool> ReferenceCompositor::compute_pass_for(const CompositeParams& params) {
+    const bool compute = params.path == QuadPath::compute && params.mode != CompositeMode::unsorted;
+    if (compute) {
         const bool is_wboit = params.mode == CompositeMode::wboit;
         VkPipeline& pipeline = is_wboit ? wboit_compute : exact_compute;
         if (!pipeline) {
@@ -483,7 +399,7 @@ Result<ReferenceCompositor::Passes> ReferenceCompositor::passes_for(const Compos
             pipeline = *made;
         }
     }
-    return passes;
+    return compute;
 }
 
 gpu::CompositePushConstants ReferenceCompositor::push_constants(const CompositeParams& params) const {
@@ -494,7 +410,6 @@ gpu::CompositePushConstants ReferenceCompositor::push_constants(const CompositeP
     push.width = width;
     push.height = height;
     push.pixels = pixels;
-    push.layers_per_buffer = layers_per_buffer;
     push.node_capacity = node_capacity;
     push.tile_count = static_cast<uint32_t>(tile_data.size() / 2);
     push.quad_count = static_cast<uint32_t>(quad_data.size());
@@ -524,7 +439,7 @@ void ReferenceCompositor::record_target_init(VkCommandBuffer command_buffer) {
 // Every earlier use of the buffers and the target (this compositor's last frames, the caller's
 // reads of the target) before this frame's clears; then the mode's clears. Returns the bytes of
 // per-pixel buffers the mode uses.
-uint64_t ReferenceCompositor::record_clears(VkCommandBuffer command_buffer, CompositeMode mode, uint32_t layers) {
+uint64_t ReferenceCompositor::record_clears(VkCommandBuffer command_buffer, CompositeMode mode) {
     constexpr VkPipelineStageFlags stages =
         kShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
     memory_barrier(command_buffer, stages,
@@ -537,17 +452,6 @@ uint64_t ReferenceCompositor::record_clears(VkCommandBuffer command_buffer, Comp
     vkCmdFillBuffer(command_buffer, stats_words.buffer, 0, VK_WHOLE_SIZE, 0);
     uint64_t buffer_bytes = 0;
     switch (mode) {
-        case CompositeMode::layered: {
-            const VkDeviceSize layer_bytes = pixel_words * (mono ? 1 : 2);
-            for (uint32_t first = 0; first < layers; first += layers_per_buffer) {
-                const uint32_t count = std::min(layers_per_buffer, layers - first);
-                vkCmdFillBuffer(command_buffer, layer_buffers[first / layers_per_buffer].buffer, 0,
-                                layer_bytes * count, 0xFFFFFFFFu);
-            }
-            vkCmdFillBuffer(command_buffer, accumulators.buffer, 0, pixel_words * gpu::kLayeredWords, 0);
-            buffer_bytes = layer_bytes * layers + pixel_words * gpu::kLayeredWords;
-            break;
-        }
         case CompositeMode::wboit:
             vkCmdFillBuffer(command_buffer, accumulators.buffer, 0, pixel_words * gpu::kWboitWords, 0);
             buffer_bytes = pixel_words * gpu::kWboitWords;
@@ -605,10 +509,10 @@ void ReferenceCompositor::record_dispatch(VkCommandBuffer command_buffer, const 
 // The mode's quad passes (rasterized, or compute over the frame's 8 x 8 tiles, one workgroup
 // each in rows of kRasterDispatchWidth) and its per-pixel resolve; then the stats for the host.
 void ReferenceCompositor::record_passes(VkCommandBuffer command_buffer, const FrameSlot& slot, CompositeMode mode,
-                                        const Passes& passes, const gpu::CompositePushConstants& push) {
+                                        bool compute, const gpu::CompositePushConstants& push) {
     const uint32_t rows = std::min(push.tile_count, gpu::kRasterDispatchWidth);
     auto quads = [&](VkPipeline raster, VkPipeline computed) {
-        if (passes.compute) {
+        if (compute) {
             record_dispatch(command_buffer, slot, computed, rows, rows == 0 ? 0 : (push.tile_count + rows - 1) / rows,
                             push);
         } else {
@@ -616,7 +520,7 @@ void ReferenceCompositor::record_passes(VkCommandBuffer command_buffer, const Fr
         }
     };
     const VkPipelineStageFlags quad_stage =
-        passes.compute ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
+        compute ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
     auto quads_to = [&](VkPipelineStageFlags stage) {
         memory_barrier(command_buffer, quad_stage, VK_ACCESS_SHADER_WRITE_BIT, stage, kShaderAccess);
     };
@@ -628,12 +532,6 @@ void ReferenceCompositor::record_passes(VkCommandBuffer command_buffer, const Fr
     VkPipelineStageFlags last_stage = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
     VkAccessFlags last_access = VK_ACCESS_SHADER_WRITE_BIT;
     switch (mode) {
-        case CompositeMode::layered:
-            quads(passes.layered->build, passes.layered->build_compute);
-            quads_to(quad_stage);
-            quads(passes.layered->composite, passes.layered->composite_compute);
-            resolve(passes.layered->resolve);
-            break;
         case CompositeMode::wboit:
             quads(wboit, wboit_compute);
             resolve(wboit_resolve);
@@ -665,11 +563,11 @@ Status ReferenceCompositor::record(VkCommandBuffer command_buffer, std::span<con
     if (Status s = check(params); !s) return s;
     FrameSlot& slot = slots[frame % frames_in_flight];
     read_back_stats(slot, stats);
-    Result<Passes> passes = passes_for(params);
-    if (!passes) return passes.error();
+    Result<bool> compute = compute_pass_for(params);
+    if (!compute) return compute.error();
 
-    stats.paint_order_blocks = rank_quads(glyphs, quad_data);
-    if (passes->compute) {
+    rank_quads(glyphs, quad_data);
+    if (*compute) {
         build_tiles();
     } else {
         tile_data.clear();
@@ -687,28 +585,18 @@ Status ReferenceCompositor::record(VkCommandBuffer command_buffer, std::span<con
 
     const gpu::CompositePushConstants push = push_constants(params);
     record_target_init(command_buffer);
-    const uint64_t buffer_bytes = record_clears(command_buffer, params.mode, passes->layers);
-    record_passes(command_buffer, slot, params.mode, *passes, push);
+    const uint64_t buffer_bytes = record_clears(command_buffer, params.mode);
+    record_passes(command_buffer, slot, params.mode, *compute, push);
 
     ++frame;
     slot.pending = true;
     slot.frame = frame;
     slot.mode = params.mode;
     stats.mode = params.mode;
-    stats.path = passes->compute ? QuadPath::compute : QuadPath::raster;
+    stats.path = *compute ? QuadPath::compute : QuadPath::raster;
     stats.tiles = tile_count;
-    stats.layers = passes->layers;
-    stats.mono_keys = params.mode == CompositeMode::layered && mono;
     stats.quads = push.quad_count;
     stats.buffer_bytes = buffer_bytes;
-    return {};
-}
-
-Status ReferenceCompositor::prepare_layered(QuadPath path) {
-    for (uint32_t layers = 1; layers <= max_layers; ++layers) {
-        Result<LayeredPipelines*> made = layered_pipelines(layers, path == QuadPath::compute);
-        if (!made) return made.error();
-    }
     return {};
 }
 

@@ -1,4 +1,4 @@
-// Private: the compositor's reference modes (layered in global memory, unsorted, wboit, exact),
+// Private: the compositor's reference modes (unsorted, wboit, exact),
 // into the compositor's own RGBA32F target over a flat background (docs/compositing.md).
 #pragma once
 
@@ -27,7 +27,6 @@ public:
     Status create(const vk::DeviceRef& device, const CompositorCreateInfo& info, std::vector<std::string>& warnings);
     Status record(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
                   const CompositeParams& params, CompositorStats& stats);
-    Status prepare_layered(QuadPath path);
     void record_target_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const;
     const vk::DeviceImage& target() const { return target_; }
 
@@ -41,20 +40,7 @@ private:
         VkDescriptorSet set = VK_NULL_HANDLE;
         bool pending = false;  // recorded, its stats not read yet
         uint64_t frame = 0;
-        CompositeMode mode = CompositeMode::layered;
-    };
-    struct LayeredPipelines {
-        VkPipeline build = VK_NULL_HANDLE;
-        VkPipeline composite = VK_NULL_HANDLE;
-        VkPipeline resolve = VK_NULL_HANDLE;
-        VkPipeline build_compute = VK_NULL_HANDLE;  // the quad passes as compute dispatches
-        VkPipeline composite_compute = VK_NULL_HANDLE;
-    };
-    // What a frame's passes run.
-    struct Passes {
-        bool compute = false;
-        uint32_t layers = 0;                   // layered: K
-        LayeredPipelines* layered = nullptr;  // layered
+        CompositeMode mode = CompositeMode::exact;
     };
 
     Status create_buffers(const CompositorCreateInfo& info, std::vector<std::string>& warnings);
@@ -62,17 +48,17 @@ private:
     Result<VkShaderModule> module(const char* name);
     Result<VkPipeline> graphics_pipeline(const char* fragment, const VkSpecializationInfo* specialization, bool blend);
     Result<VkPipeline> compute_pipeline(const char* shader, const VkSpecializationInfo* specialization);
-    Result<LayeredPipelines*> layered_pipelines(uint32_t layers, bool compute);
     Status check(const CompositeParams& params) const;
-    Result<Passes> passes_for(const CompositeParams& params);
+    // Whether the frame's quad passes run as compute (making their pipeline on first use).
+    Result<bool> compute_pass_for(const CompositeParams& params);
     void read_back_stats(FrameSlot& slot, CompositorStats& stats);
     void build_tiles();
     Status upload(vk::DeviceBuffer& buffer, uint32_t& capacity, const void* data, uint32_t count, size_t size);
     void write_descriptors(const FrameSlot& slot, VkImageView atlas_view);
     gpu::CompositePushConstants push_constants(const CompositeParams& params) const;
     void record_target_init(VkCommandBuffer command_buffer);
-    uint64_t record_clears(VkCommandBuffer command_buffer, CompositeMode mode, uint32_t layers);
-    void record_passes(VkCommandBuffer command_buffer, const FrameSlot& slot, CompositeMode mode, const Passes& passes,
+    uint64_t record_clears(VkCommandBuffer command_buffer, CompositeMode mode);
+    void record_passes(VkCommandBuffer command_buffer, const FrameSlot& slot, CompositeMode mode, bool compute,
                        const gpu::CompositePushConstants& push);
     void record_draw(VkCommandBuffer command_buffer, const FrameSlot& slot, VkPipeline pipeline, bool color,
                      const gpu::CompositePushConstants& push);
@@ -82,16 +68,12 @@ private:
     vk::DeviceRef ref;
     uint32_t width = 0, height = 0, pixels = 0;
     uint32_t frames_in_flight = 2;
-    uint32_t max_layers = kMaxCompositeLayers;
-    bool mono = false;
-    uint32_t layers_per_buffer = 1;
     uint32_t node_capacity = 0;
 
     vk::DeviceImage target_;
     bool target_initialized = false;
 
-    std::vector<vk::DeviceBuffer> layer_buffers;
-    vk::DeviceBuffer accumulators;  // kLayeredWords (the most any mode uses) words per pixel
+    vk::DeviceBuffer accumulators;  // kWboitWords (the most either mode uses) words per pixel
     vk::DeviceBuffer nodes;         // exact mode's pool; a stand-in of 16 bytes when there is none
     vk::DeviceBuffer stats_words;   // device-local kStatWords
 
@@ -104,12 +86,9 @@ private:
     VkPipeline unsorted = VK_NULL_HANDLE, wboit = VK_NULL_HANDLE, exact = VK_NULL_HANDLE;
     VkPipeline wboit_resolve = VK_NULL_HANDLE, exact_resolve = VK_NULL_HANDLE;
     VkPipeline wboit_compute = VK_NULL_HANDLE, exact_compute = VK_NULL_HANDLE;  // made on first use
-    std::array<LayeredPipelines, kMaxCompositeLayers + 1> layered{};            // by K, made on first use
 
     std::vector<FrameSlot> slots;
     uint64_t frame = 0;
-    bool have_overlap = false;
-    uint32_t last_overlap = 0;
     std::vector<gpu::CompositeQuad> quad_data;
     std::vector<uint32_t> tile_data;  // pairs: quad index, tile origin in its rect (x | y << 16)
 };

@@ -61,11 +61,7 @@ Status check_create_info(const CompositorCreateInfo& info) {
         return invalid("the target size " + std::to_string(info.width) + "x" + std::to_string(info.height) +
                        " is outside 1..16384 per side");
     }
-    if (info.max_layers < 1 || info.max_layers > kMaxCompositeLayers) return invalid("max_layers must be 1 to 8");
     if (info.exact_nodes_per_pixel > kMaxNodesPerPixel) return invalid("exact_nodes_per_pixel must be at most 64");
-    if (info.key_format == KeyFormat::rgb && !info.int64_atomics) {
-        return invalid("rgb keys need shaderInt64 and shaderBufferInt64Atomics (int64_atomics)");
-    }
     return {};
 }
 
@@ -82,8 +78,6 @@ const char* composite_mode_name(CompositeMode mode) {
             return "tiled";
         case CompositeMode::draw:
             return "draw";
-        case CompositeMode::layered:
-            return "layered";
         case CompositeMode::unsorted:
             return "unsorted";
         case CompositeMode::wboit:
@@ -105,8 +99,8 @@ std::optional<QuadPath> parse_quad_path(std::string_view name) {
 }
 
 std::optional<CompositeMode> parse_composite_mode(std::string_view name) {
-    for (CompositeMode mode : {CompositeMode::tiled, CompositeMode::draw, CompositeMode::layered,
-                               CompositeMode::unsorted, CompositeMode::wboit, CompositeMode::exact}) {
+    for (CompositeMode mode :
+         {CompositeMode::tiled, CompositeMode::draw, CompositeMode::unsorted, CompositeMode::wboit, CompositeMode::exact}) {
         if (name == composite_mode_name(mode)) return mode;
     }
     return std::nullopt;
@@ -224,7 +218,6 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     s.stats.mode = CompositeMode::tiled;
     s.stats.path = QuadPath::compute;
     s.stats.quads = static_cast<uint32_t>(s.quads.size());
-    s.stats.layers = 0;
     s.stats.tiles = 0;
     s.stats.buffer_bytes = *bytes;
     s.stats.bins_reused = reused;
@@ -256,11 +249,6 @@ Status Compositor::record_reference(VkCommandBuffer command_buffer, std::span<co
                                     VkImageView atlas_view, const CompositeParams& params) {
     if (!state_->reference) return no_reference_modes();
     return state_->reference->record(command_buffer, glyphs, atlas_view, params, state_->stats);
-}
-
-Status Compositor::prepare_layered(QuadPath path) {
-    if (!state_->reference) return no_reference_modes();
-    return state_->reference->prepare_layered(path);
 }
 
 bool Compositor::supports_target_format(VkFormat format, VkFormat view_format) const {

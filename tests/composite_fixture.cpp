@@ -24,13 +24,11 @@ Fixture& fixture() {
         VkPhysicalDeviceVulkan12Features vulkan12{};
         vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
         vulkan12.pNext = &vulkan13;
-        vulkan12.shaderBufferInt64Atomics = VK_TRUE;
         VkPhysicalDeviceFeatures2 features{};
         features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
         features.pNext = &vulkan12;
         features.features.fragmentStoresAndAtomics = VK_TRUE;
         features.features.dualSrcBlend = VK_TRUE;
-        features.features.shaderInt64 = VK_TRUE;
         HeadlessContextOptions options;
         options.api_version = VK_API_VERSION_1_3;
         options.validation = true;
@@ -41,7 +39,6 @@ Fixture& fixture() {
         auto context = HeadlessContext::create(options);
         EXPECT_TRUE(context) << (context ? "" : context.error().message);
         if (context) made.context = std::make_unique<HeadlessContext>(std::move(*context));
-        made.int64 = true;
         made.font = test::bake_test_font("Hamburgefonstiv@&1");
         return made;
     }();
@@ -125,16 +122,13 @@ Scene render_scene(const std::vector<TextRun>& runs, const char* layout_name, fl
     return scene;
 }
 
-CompositorCreateInfo compositor_info(KeyFormat keys, bool gray) {
+CompositorCreateInfo compositor_info() {
     Fixture& f = fixture();
     CompositorCreateInfo info;
     info.physical_device = f.context->physical_device();
     info.device = f.context->device();
-    info.int64_atomics = f.int64;
     info.width = kWidth;
     info.height = kHeight;
-    info.key_format = keys;
-    info.gray_layout = gray;
     info.reference_modes = true;
     return info;
 }
@@ -142,14 +136,13 @@ CompositorCreateInfo compositor_info(KeyFormat keys, bool gray) {
 
 // Composites the scene's glyphs (in the given order) and returns linear premultiplied RGBA.
 std::vector<float> composite(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs,
-                             CompositeMode mode, uint32_t layers, QuadPath path) {
+                             CompositeMode mode, QuadPath path) {
     HeadlessContext& context = *fixture().context;
     const VkDeviceSize bytes = VkDeviceSize{kWidth} * kHeight * 4 * sizeof(float);
     auto readback = context.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
     EXPECT_TRUE(readback);
     CompositeParams params;
     params.mode = mode;
-    params.layers = layers;
     params.path = path;
     std::copy(kBackground, kBackground + 4, params.background);
     EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) {
@@ -161,8 +154,8 @@ std::vector<float> composite(Compositor& compositor, const Scene& scene, std::sp
     return image;
 }
 
-std::vector<float> composite(Compositor& compositor, const Scene& scene, CompositeMode mode, uint32_t layers) {
-    return composite(compositor, scene, scene.drawn, mode, layers, QuadPath::raster);
+std::vector<float> composite(Compositor& compositor, const Scene& scene, CompositeMode mode) {
+    return composite(compositor, scene, scene.drawn, mode, QuadPath::raster);
 }
 
 oit::LinearRgb background_rgb() {

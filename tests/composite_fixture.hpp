@@ -26,7 +26,6 @@ constexpr float kBackground[4] = {0.9f, 0.85f, 0.7f, 1.0f};  // linear
 struct Fixture {
     std::unique_ptr<HeadlessContext> context;
     std::unique_ptr<Font> font;
-    bool int64 = false;
 };
 
 // The shared context (created once) and font.
@@ -54,14 +53,13 @@ struct Scene {
 Scene render_scene(const std::vector<TextRun>& runs, const char* layout_name = "rgb", float size = 20.0f);
 
 // The reference modes at kWidth x kHeight, for the fixture's device.
-CompositorCreateInfo compositor_info(KeyFormat keys = KeyFormat::automatic, bool gray = false);
+CompositorCreateInfo compositor_info();
 
 // Composites the scene's glyphs (in the given order) with a reference mode and returns linear
 // premultiplied RGBA.
 std::vector<float> composite(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs,
-                             CompositeMode mode, uint32_t layers = kAutoLayers, QuadPath path = QuadPath::raster);
-std::vector<float> composite(Compositor& compositor, const Scene& scene, CompositeMode mode,
-                             uint32_t layers = kAutoLayers);
+                             CompositeMode mode, QuadPath path = QuadPath::raster);
+std::vector<float> composite(Compositor& compositor, const Scene& scene, CompositeMode mode);
 
 oit::LinearRgb background_rgb();
 void expect_no_validation_messages();

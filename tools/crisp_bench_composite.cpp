@@ -1,7 +1,7 @@
 // crisp-bench-composite: what each compositing mode costs and how far it is from exact, for scenes
 // of N overlapping layers of text at high and low alpha. Per mode (the tile path into RGBA32F and
 // RGBA8 images, the whole frame of converged text with it, the draw path, and the reference modes:
-// exact, unsorted, wboit, layered with K = 1, 2, 4, 8 and auto): the GPU time of its record call on
+// exact, unsorted, wboit): the GPU time of its record call on
 // converged static text (Vulkan timestamp queries), the error of its image against the exact CPU
 // reference (src/oit_reference) in 8-bit sRGB codes, and its bytes per pixel. Prints Markdown (or
 // JSON with --json); docs/benchmarks-compositing.md.
@@ -68,10 +68,9 @@ struct Args {
     double warmup_ms = kDefaultWarmupMs;
     uint32_t samples = 512;
     uint32_t subpixel_steps = 4;
-    crisp::KeyFormat keys = crisp::KeyFormat::automatic;
     crisp::QuadPath path = crisp::QuadPath::raster;
-    std::vector<std::string> modes = {"tiled", "tiled-rebin", "tiled-rgba8", "frame", "draw", "exact", "unsorted", "wboit",
-                                      "layered-1", "layered-2", "layered-4", "layered-8", "layered-auto"};
+    std::vector<std::string> modes = {"tiled", "tiled-rebin", "tiled-rgba8", "frame",
+                                      "draw",  "exact",       "unsorted",    "wboit"};
     bool cpu_check = true;
     bool json = false;
     std::string json_out;
@@ -90,8 +89,7 @@ struct Args {
                  "                     text: the bins are reused), tiled-rebin (binned every frame),\n"
                  "                     tiled-rgba8 (into R8G8B8A8_UNORM), frame (the renderer's converged\n"
                  "                     frame and the tile path together), draw (the draw path, RGBA32F),\n"
-                 "                     exact, unsorted, wboit, layered-K (K = 1..8) and layered-auto\n"
-                 "                     (default: all of them, layered with K = 1, 2, 4, 8 and auto)\n"
+                 "                     exact, unsorted and wboit (default: all of them)\n"
                  "  --layers LIST      layer counts, comma-separated (default 1,2,4,8,16,32)\n"
                  "  --alphas LIST      text alphas, comma-separated, in (0, 1] (default 0.9,0.3)\n"
                  "  --canvas W,H       target size, also WxH (default 512,256)\n"
@@ -103,8 +101,7 @@ struct Args {
                  "  --samples N        samples per glyph the text converges to (default 512)\n"
                  "  --subpixel-steps N subpixel positions per pixel in glyph keys (default 4)\n"
                  "  --layout NAME      subpixel layout preset or file (default rgb)\n"
-                 "  --keys NAME        layered keys: auto, rgb or mono (default auto)\n"
-                 "  --path NAME        quad passes of layered, wboit and exact: raster or compute\n"
+                 "  --path NAME        quad passes of wboit and exact: raster or compute\n"
                  "                     (default raster; unsorted is always rasterized)\n"
                  "  --no-cpu-check     skip checking the exact mode against the CPU reference\n"
                  "  --device TEXT      pick a device whose name contains TEXT\n"
@@ -193,16 +190,6 @@ Args parse(int argc, char** argv) {
             args.subpixel_steps = number<uint32_t>(value());
         } else if (arg == "--layout") {
             args.layout = value();
-        } else if (arg == "--keys") {
-            const std::string v = value();
-            if (v == "auto")
-                args.keys = crisp::KeyFormat::automatic;
-            else if (v == "rgb")
-                args.keys = crisp::KeyFormat::rgb;
-            else if (v == "mono")
-                args.keys = crisp::KeyFormat::mono;
-            else
-                fail("--keys: auto, rgb or mono");
         } else if (arg == "--path") {
             const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(value());
             if (!path) fail("--path: raster or compute");
@@ -400,7 +387,6 @@ CpuExact cpu_exact(std::span<const crisp::DrawnGlyph> drawn, std::span<const uin
 
 struct ModeRun {
     crisp::CompositeMode mode;
-    uint32_t layers = 0;                                 // layered: K, or kAutoLayers
     VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;     // tiled and draw: the target image's
     bool with_renderer = false;                          // tiled: the renderer's frame timed too
     bool rebin = false;  // tiled: bin every frame (reuse_static_bins off), as for text that changes
@@ -408,17 +394,11 @@ struct ModeRun {
 
 // The run a --modes name stands for; nullopt for an unknown name.
 std::optional<ModeRun> parse_mode_run(const std::string& name) {
-    if (name == "tiled-rgba8") return ModeRun{crisp::CompositeMode::tiled, 0, VK_FORMAT_R8G8B8A8_UNORM, false};
-    if (name == "frame") return ModeRun{crisp::CompositeMode::tiled, 0, VK_FORMAT_R32G32B32A32_SFLOAT, true};
-    if (name == "tiled-rebin") return ModeRun{crisp::CompositeMode::tiled, 0, VK_FORMAT_R32G32B32A32_SFLOAT, false, true};
-    if (name == "layered-auto") return ModeRun{crisp::CompositeMode::layered, crisp::kAutoLayers};
-    if (name.rfind("layered-", 0) == 0) {
-        const std::optional<uint32_t> k = crisp::cli::parse_number<uint32_t>(name.substr(8));
-        if (!k || *k < 1 || *k > crisp::kMaxCompositeLayers) return std::nullopt;
-        return ModeRun{crisp::CompositeMode::layered, *k};
-    }
+    if (name == "tiled-rgba8") return ModeRun{crisp::CompositeMode::tiled, VK_FORMAT_R8G8B8A8_UNORM, false};
+    if (name == "frame") return ModeRun{crisp::CompositeMode::tiled, VK_FORMAT_R32G32B32A32_SFLOAT, true};
+    if (name == "tiled-rebin") return ModeRun{crisp::CompositeMode::tiled, VK_FORMAT_R32G32B32A32_SFLOAT, false, true};
     const std::optional<crisp::CompositeMode> mode = crisp::parse_composite_mode(name);
-    if (!mode || *mode == crisp::CompositeMode::layered) return std::nullopt;
+    if (!mode) return std::nullopt;
     return ModeRun{*mode};
 }
 
@@ -451,9 +431,6 @@ struct SceneResult {
 std::string mode_label(const ModeRun& run) {
     if (run.with_renderer) return "frame: renderer + tiled";
     std::string label = crisp::composite_mode_name(run.mode);
-    if (run.mode == crisp::CompositeMode::layered) {
-        label += run.layers == crisp::kAutoLayers ? " auto" : " K=" + std::to_string(run.layers);
-    }
     if (run.format == VK_FORMAT_R8G8B8A8_UNORM) label += " rgba8";
     if (run.rebin) label += ", binned every frame";
     return label;
@@ -604,7 +581,6 @@ struct Bench {
         m.run = run;
         crisp::CompositeParams params;
         params.mode = run.mode;
-        params.layers = run.layers;
         params.path = args.path;
         const float grey = crisp::srgb_to_linear(kBackgroundSrgb);
         params.background[0] = params.background[1] = params.background[2] = grey;
@@ -668,9 +644,8 @@ std::string json_string(const std::string& text) {
 struct Header {
     std::string device, driver_name, driver_info, api;
     uint32_t driver_version = 0;
-    bool int64_atomics = false;
+    bool storage_without_format = false;
     std::string layout;
-    std::string keys;  // what the layered frames used
     std::vector<std::string> compositor_warnings;
 };
 
@@ -683,9 +658,9 @@ void print_json(std::FILE* out, const Args& args, const Header& header, const st
     std::fprintf(out, "{\n  \"device\": %s,\n  \"driver_name\": %s,\n  \"driver_info\": %s,\n  \"driver_version\": %u,\n",
                 json_string(header.device).c_str(), json_string(header.driver_name).c_str(),
                 json_string(header.driver_info).c_str(), header.driver_version);
-    std::fprintf(out, "  \"api_version\": %s,\n  \"int64_atomics\": %s,\n  \"layout\": %s,\n  \"layered_keys\": %s,\n",
-                json_string(header.api).c_str(), header.int64_atomics ? "true" : "false",
-                json_string(header.layout).c_str(), json_string(header.keys).c_str());
+    std::fprintf(out, "  \"api_version\": %s,\n  \"storage_without_format\": %s,\n  \"layout\": %s,\n",
+                 json_string(header.api).c_str(), header.storage_without_format ? "true" : "false",
+                 json_string(header.layout).c_str());
     std::fprintf(out, "  \"quad_path\": %s,\n", json_string(crisp::quad_path_name(args.path)).c_str());
     std::fprintf(out, "  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
                 args.height, json_string(args.font).c_str(), static_cast<double>(args.size), args.samples);
@@ -710,18 +685,17 @@ void print_json(std::FILE* out, const Args& args, const Header& header, const st
         for (size_t i = 0; i < r.modes.size(); ++i) {
             const Measurement& m = r.modes[i];
             std::fprintf(out, 
-                "       {\"mode\": %s, \"layers_requested\": %u, \"layers\": %u, \"mono_keys\": %s, "
+                "       {\"mode\": %s, "
                 "\"warmup_frames\": %u, \"gpu_ms_median\": %.6g, \"gpu_ms\": [",
-                json_string(crisp::composite_mode_name(m.run.mode)).c_str(), m.run.layers, m.stats.layers,
-                m.stats.mono_keys ? "true" : "false", m.warmup_frames, m.median_ms);
+                json_string(crisp::composite_mode_name(m.run.mode)).c_str(), m.warmup_frames, m.median_ms);
             for (size_t f = 0; f < m.gpu_ms.size(); ++f) std::fprintf(out, "%s%.6g", f ? ", " : "", m.gpu_ms[f]);
             std::fprintf(out, 
                 "], \"rmse\": %.6g, \"max\": %d, \"buffer_bytes\": %llu, \"buffer_bytes_per_pixel\": %.6g, "
-                "\"quads\": %u, \"paint_order_blocks\": %u, \"measured\": %s, \"max_overlap\": %u, "
+                "\"quads\": %u, \"bins_reused\": %s, \"measured\": %s, \"max_overlap\": %u, "
                 "\"tail_pixels\": %u, \"exact_lost_nodes\": %llu, \"exact_dropped\": %llu, \"label\": %s, "
                 "\"busy_tiles\": %u, \"exact_tiles\": %u, \"layered_tiles\": %u, \"tile_pairs\": %u}%s\n",
                 m.error.rmse, m.error.max, static_cast<unsigned long long>(m.stats.buffer_bytes),
-                buffer_bytes_per_pixel(m, args), m.stats.quads, m.stats.paint_order_blocks,
+                buffer_bytes_per_pixel(m, args), m.stats.quads, m.stats.bins_reused ? "true" : "false",
                 m.stats.measured ? "true" : "false", m.stats.max_overlap, m.stats.tail_pixels,
                 static_cast<unsigned long long>(m.stats.exact_lost_nodes),
                 static_cast<unsigned long long>(m.stats.exact_dropped), json_string(mode_label(m.run)).c_str(),
@@ -740,9 +714,8 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
     std::printf("Device: %s, driver %s (%s); Vulkan %s in use.\n", header.device.c_str(), header.driver_name.c_str(),
                 header.driver_info.c_str(), header.api.c_str());
     std::printf(
-        "64-bit buffer atomics: %s; layered keys: %s; quad passes: %s. Canvas %ux%u; %s at %g px, layout %s, %u "
+        "Reference quad passes: %s. Canvas %ux%u; %s at %g px, layout %s, %u "
         "subpixel steps, %u samples per glyph; background sRGB %g grey.\n",
-        header.int64_atomics ? "enabled" : "not available", header.keys == "mono" ? "mono (32-bit)" : "rgb (64-bit)",
         crisp::quad_path_name(args.path),
         args.width, args.height, args.font.c_str(), static_cast<double>(args.size), header.layout.c_str(),
         args.subpixel_steps, args.samples, static_cast<double>(kBackgroundSrgb));
@@ -759,31 +732,26 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
     for (const float alpha : args.alphas) {
         std::printf("\n### alpha %g\n\n", static_cast<double>(alpha));
         std::printf(
-            "| layers | mode | K | GPU ms | RMSE | max | B/px | max overlap | tail pixels | tiles: exact / layered |\n"
-            "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+            "| layers | mode | GPU ms | RMSE | max | B/px | max overlap | tail pixels | tiles: exact / layered |\n"
+            "|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
         for (const SceneResult& r : scenes) {
             if (r.alpha != alpha) continue;
             for (const Measurement& m : r.modes) {
-                const bool layered = m.run.mode == crisp::CompositeMode::layered;
                 const bool exact = m.run.mode == crisp::CompositeMode::exact;
                 const bool tiled = m.run.mode == crisp::CompositeMode::tiled;
-                char k[32] = "";
-                if (layered) {
-                    std::snprintf(k, sizeof k, m.run.layers == crisp::kAutoLayers ? "auto: %u" : "%u", m.stats.layers);
-                }
                 char error[64] = "reference";
                 if (!exact || args.cpu_check) std::snprintf(error, sizeof error, "%.3f | %d", m.error.rmse, m.error.max);
                 char overlap[32] = "";
-                if ((layered || exact || tiled) && m.stats.measured)
+                if ((exact || tiled) && m.stats.measured)
                     std::snprintf(overlap, sizeof overlap, "%u", m.stats.max_overlap);
                 char tail[32] = "";
-                if ((layered || tiled) && m.stats.measured) std::snprintf(tail, sizeof tail, "%u", m.stats.tail_pixels);
+                if (tiled && m.stats.measured) std::snprintf(tail, sizeof tail, "%u", m.stats.tail_pixels);
                 char tiles[48] = "";
                 if (tiled && m.stats.measured) {
                     std::snprintf(tiles, sizeof tiles, "%u / %u", m.stats.exact_tiles, m.stats.layered_tiles);
                 }
-                std::printf("| %u | %s | %s | %.4g | %s%s | %.2f | %s | %s | %s |\n", r.layers, mode_label(m.run).c_str(),
-                            k, m.median_ms, error, exact && !args.cpu_check ? " | " : "",
+                std::printf("| %u | %s | %.4g | %s%s | %.2f | %s | %s | %s |\n", r.layers, mode_label(m.run).c_str(),
+                            m.median_ms, error, exact && !args.cpu_check ? " | " : "",
                             buffer_bytes_per_pixel(m, args), overlap, tail, tiles);
             }
         }
@@ -827,12 +795,9 @@ int main(int argc, char** argv) {
     options.validation = args.validate;
     options.synchronization_validation = args.validate_sync;
     options.device_name_contains = args.device;
-    bool int64_atomics = false;
-    auto context = crisp::tools::create_context(options, int64_atomics);
+    bool storage_without_format = false;
+    auto context = crisp::tools::create_context(options, storage_without_format);
     if (!context) fail(context.error().message);
-    if (!int64_atomics) {
-        std::fprintf(stderr, "no device with shaderInt64 and shaderBufferInt64Atomics: layered keys are mono\n");
-    }
 
     auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});
     if (!baked) fail(baked.error().message);
@@ -840,7 +805,6 @@ int main(int argc, char** argv) {
     if (!font) fail(font.error().message);
     auto layout = crisp::resolve_subpixel_layout(args.layout);
     if (!layout) fail(layout.error().message);
-    const bool gray_layout = layout->channels[0] == layout->channels[1] && layout->channels[1] == layout->channels[2];
 
     crisp::RendererCreateInfo info = crisp::renderer_create_info(*context);
     info.frames_in_flight = kFramesInFlight;
@@ -921,7 +885,7 @@ int main(int argc, char** argv) {
     header.driver_info = context->driver_info();
     header.driver_version = context->driver_version();
     header.api = crisp::vk::version_string(context->api_version());
-    header.int64_atomics = int64_atomics;
+    header.storage_without_format = storage_without_format;
     header.layout = layout->name;
 
     const uint64_t range = context->properties().limits.maxStorageBufferRange;
@@ -961,12 +925,9 @@ int main(int argc, char** argv) {
             crisp::CompositorCreateInfo compositor_info;
             compositor_info.physical_device = context->physical_device();
             compositor_info.device = context->device();
-            compositor_info.int64_atomics = int64_atomics;
             compositor_info.width = args.width;
             compositor_info.height = args.height;
             compositor_info.frames_in_flight = kFramesInFlight;
-            compositor_info.key_format = args.keys;
-            compositor_info.gray_layout = gray_layout;
             compositor_info.exact_nodes_per_pixel = result.exact_nodes_per_pixel;
             compositor_info.reference_modes = reference_modes;
             compositor_info.draw_format = VK_FORMAT_R32G32B32A32_SFLOAT;
@@ -1016,7 +977,6 @@ int main(int argc, char** argv) {
             }
             for (Measurement& m : result.modes) {
                 m.codes = {};
-                if (m.run.mode == crisp::CompositeMode::layered) header.keys = m.stats.mono_keys ? "mono" : "rgb";
             }
             results.push_back(std::move(result));
         }

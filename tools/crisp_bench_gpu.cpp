@@ -116,8 +116,8 @@ int main(int argc, char** argv) {
     crisp::HeadlessContextOptions options;
     options.validation = args.validate;
     options.device_name_contains = args.device;
-    bool int64_atomics = false;  // the rasterizer does not use them
-    auto context = crisp::tools::create_context(options, int64_atomics);
+    bool storage_without_format = false;  // the rasterizer does not use it
+    auto context = crisp::tools::create_context(options, storage_without_format);
     if (!context) fail(context.error().message);
 
     auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});

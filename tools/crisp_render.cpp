@@ -93,16 +93,14 @@ options:
                            has an alpha channel
   --composite MODE         how the glyphs are blended over what is behind them: tiled (screen
                            tiles in workgroup memory, exact front to back; the default), draw
-                           (sorted quads blended in a render pass), or a reference mode: layered
-                           (the K nearest per pixel in global memory), unsorted (paint order, no
-                           OIT), wboit (weighted blended OIT) or exact (per-pixel sorted lists)
+                           (sorted quads blended in a render pass), or a reference mode: unsorted
+                           (paint order, no OIT), wboit (weighted blended OIT) or exact
+                           (per-pixel sorted lists)
   --backdrop KIND          tiled and draw: what the text is drawn over, in the canvas image:
                            flat (the background colour; the default), gradient (a ramp from the
                            background to its complement with soft stripes) or photo (smooth colour
                            fields and fine detail, like a photograph)
-  --layers K|auto          layered only: layers kept per pixel, 1..8, or auto: as many as the most
-                           glyphs one pixel has (measured by a first composite; default auto)
-  --path raster|compute    layered, wboit and exact: how their glyph passes run, rasterized quads
+  --path raster|compute    wboit and exact: how their glyph passes run, rasterized quads
                            (default) or compute over 8x8 tiles of each quad; the same image
   --coverage-out OUT.pfm   the text's linear coverage per channel as a PFM image
   --json                   print the report as one JSON object on stdout (compositor notes go
@@ -132,8 +130,6 @@ struct Arguments {
     std::string scene;
     crisp::CompositeMode composite = crisp::CompositeMode::tiled;
     std::string backdrop = "flat";
-    uint32_t layers = crisp::kAutoLayers;
-    bool layers_given = false;
     crisp::QuadPath path = crisp::QuadPath::raster;
     std::string output;
     std::string coverage_output;
@@ -242,7 +238,7 @@ Arguments parse_arguments(int argc, char** argv) {
             const std::string_view name = value();
             const std::optional<crisp::CompositeMode> mode = crisp::parse_composite_mode(name);
             if (!mode) {
-                usage_error("--composite takes tiled, draw, layered, unsorted, wboit or exact, not '" +
+                usage_error("--composite takes tiled, draw, unsorted, wboit or exact, not '" +
                             std::string(name) + "'");
             }
             args.composite = *mode;
@@ -256,19 +252,6 @@ Arguments parse_arguments(int argc, char** argv) {
             const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(name);
             if (!path) usage_error("--path takes raster or compute, not '" + std::string(name) + "'");
             args.path = *path;
-        } else if (arg == "--layers") {
-            const std::string_view text = value();
-            args.layers_given = true;
-            if (text == "auto") {
-                args.layers = crisp::kAutoLayers;
-            } else {
-                const std::optional<uint32_t> layers = crisp::cli::parse_number<uint32_t>(text);
-                if (!layers || *layers < 1 || *layers > crisp::kMaxCompositeLayers) {
-                    usage_error("--layers takes 1.." + std::to_string(crisp::kMaxCompositeLayers) + " or auto, not '" +
-                                std::string(text) + "'");
-                }
-                args.layers = *layers;
-            }
         } else if (arg == "-o" || arg == "--output") {
             args.output = value();
         } else if (arg == "--coverage-out") {
@@ -317,9 +300,6 @@ Arguments parse_arguments(int argc, char** argv) {
         if (!args.canvas) usage_error("no --canvas given");
     }
     if (args.output.empty()) usage_error("no output given (-o OUT.png)");
-    if (args.layers_given && args.composite != crisp::CompositeMode::layered) {
-        usage_error("--layers applies to --composite layered only");
-    }
     if (args.backdrop != "flat" && args.composite != crisp::CompositeMode::tiled &&
         args.composite != crisp::CompositeMode::draw) {
         usage_error("--backdrop applies to --composite tiled and draw only (the reference modes draw over a flat "
@@ -426,8 +406,7 @@ struct Job {
 struct CompositeReport {
     crisp::CompositorStats stats;  // the image's frame; its measurements are the first frame's
     std::vector<std::string> warnings;
-    bool int64_atomics = false;
-    bool gray_layout = false;
+    bool storage_without_format = false;  // the device's, as the context enabled it
     std::vector<double> frame_ms;  // CPU wall time of each composite frame: record, submit and wait
     std::vector<float> target;     // premultiplied linear RGBA, top row first
 };
@@ -527,6 +506,7 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
     info.device = context.device();
     info.allocator = context.allocation_callbacks();
     info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
+    info.storage_without_format = out.storage_without_format;
     if (draw) info.draw_format = kFormat;
     crisp::Result<crisp::Compositor> created = crisp::Compositor::create(info);
     if (!created) {
@@ -588,28 +568,22 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
 }
 
 // Composites the renderer's last frame twice, the same glyphs both times: the first frame
-// measures the overlap (what --layers auto sizes K from, and what the report gives; measurements
-// arrive one frame late), the second is the image, read back into report.composite.target.
+// measures the overlap (what the report gives; measurements arrive one frame later), the second
+// is the image, read back into report.composite.target.
 int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, const Arguments& args, const Job& job,
               RenderReport& report) {
     CompositeReport& out = report.composite;
     if (args.composite == crisp::CompositeMode::tiled || args.composite == crisp::CompositeMode::draw) {
         return composite_into_image(context, renderer, args, job, report);
     }
-    const std::array<crisp::SampleRect, 3>& channels = job.layout.channels;
-    out.gray_layout = channels[0] == channels[1] && channels[1] == channels[2];
-
     crisp::CompositorCreateInfo info;
     info.physical_device = context.physical_device();
     info.device = context.device();
     info.allocator = context.allocation_callbacks();
-    info.int64_atomics = out.int64_atomics;
     info.width = job.scene.width;
     info.height = job.scene.height;
     info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
     info.reference_modes = true;
-    info.gray_layout = out.gray_layout;
-    info.max_layers = args.layers == crisp::kAutoLayers ? crisp::kMaxCompositeLayers : args.layers;
     if (args.composite != crisp::CompositeMode::exact) info.exact_nodes_per_pixel = 0;  // no node pool
     crisp::Result<crisp::Compositor> created = crisp::Compositor::create(info);
     if (!created) {
@@ -621,7 +595,6 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
 
     crisp::CompositeParams params;
     params.mode = args.composite;
-    params.layers = args.layers;
     params.path = args.path;
     for (size_t c = 0; c < 3; ++c) params.background[c] = crisp::srgb_to_linear(job.scene.background[c]);
     params.background[3] = job.scene.background[3];
@@ -866,9 +839,6 @@ struct Summary {
     crisp::ValidationMessages validation;
 };
 
-bool is_layered(const CompositeReport& c) {
-    return c.stats.mode == crisp::CompositeMode::layered;
-}
 bool is_exact(const CompositeReport& c) {
     return c.stats.mode == crisp::CompositeMode::exact;
 }
@@ -877,28 +847,22 @@ bool is_tiled(const CompositeReport& c) {
 }
 // The measured max overlap, for the modes that measure it.
 bool has_overlap(const CompositeReport& c) {
-    return c.stats.measured && (is_layered(c) || is_exact(c) || is_tiled(c));
+    return c.stats.measured && (is_exact(c) || is_tiled(c));
 }
 
 std::string json_composite(const Arguments& args, const CompositeReport& c) {
     const crisp::CompositorStats& s = c.stats;
-    const bool layered = is_layered(c), exact = is_exact(c);
+    const bool exact = is_exact(c);
     auto uint_or_null = [](bool present, uint64_t v) { return present ? json_uint(v) : std::string("null"); };
     std::string out = "{\"mode\": " + json_string(crisp::composite_mode_name(s.mode));
-    out += ", \"layers_requested\": " + (!layered                            ? std::string("null")
-                                         : args.layers == crisp::kAutoLayers ? json_string("auto")
-                                                                             : json_uint(args.layers));
     out += ", \"path\": " + json_string(crisp::quad_path_name(s.path));
-    out += ", \"layers\": " + uint_or_null(layered, s.layers);
-    out += ", \"mono_keys\": " + (layered ? std::string(s.mono_keys ? "true" : "false") : std::string("null"));
-    out += ", \"int64_atomics\": " + std::string(c.int64_atomics ? "true" : "false");
-    out += ", \"gray_layout\": " + std::string(c.gray_layout ? "true" : "false");
+    out += ", \"storage_without_format\": " + std::string(c.storage_without_format ? "true" : "false");
     out += ", \"quads\": " + json_uint(s.quads);
-    out += ", \"paint_order_blocks\": " + json_uint(s.paint_order_blocks);
+    out += ", \"bins_reused\": " + std::string(s.bins_reused ? "true" : "false");
     out += ", \"buffer_bytes\": " + json_uint(s.buffer_bytes);
     out += ", \"measured\": " + std::string(s.measured ? "true" : "false");
     out += ", \"max_overlap\": " + uint_or_null(has_overlap(c), s.max_overlap);
-    out += ", \"tail_pixels\": " + uint_or_null(s.measured && (layered || is_tiled(c)), s.tail_pixels);
+    out += ", \"tail_pixels\": " + uint_or_null(s.measured && is_tiled(c), s.tail_pixels);
     const bool tiles = s.measured && is_tiled(c);
     out += ", \"tiles\": " + (tiles ? "{\"busy\": " + json_uint(s.busy_tiles) + ", \"exact\": " +
                                            json_uint(s.exact_tiles) + ", \"layered\": " +
@@ -977,17 +941,12 @@ void print_json(const Summary& s) {
     std::fputs(out.c_str(), stdout);
 }
 
-// "layered, K 3 (auto), rgb keys, max overlap 3, 0 tail pixels, 1.2 ms"
+// "tiled, compute path, max overlap 3, 30 tiles (30 exact, 0 layered), 1.2 ms"
 std::string human_composite(const Arguments& args, const CompositeReport& c) {
     const crisp::CompositorStats& s = c.stats;
     std::string out = crisp::composite_mode_name(s.mode);
-    if (is_layered(c)) {
-        out += ", K " + std::to_string(s.layers) + (args.layers == crisp::kAutoLayers ? " (auto)" : "") +
-               (s.mono_keys ? ", mono keys" : ", rgb keys");
-    }
     if (s.path == crisp::QuadPath::compute) out += ", compute path";
     if (has_overlap(c)) out += ", max overlap " + std::to_string(s.max_overlap);
-    if (s.measured && is_layered(c)) out += ", " + std::to_string(s.tail_pixels) + " tail pixels";
     if (s.measured && is_exact(c)) {
         out += ", " + std::to_string(s.exact_lost_nodes) + " lost, " + std::to_string(s.exact_dropped) + " dropped";
     }
@@ -1121,7 +1080,7 @@ int run(const Arguments& args) {
     options.validation = args.validate;
     options.device_name_contains = args.device;
     crisp::Result<crisp::HeadlessContext> context =
-        crisp::tools::create_context(options, report.composite.int64_atomics);
+        crisp::tools::create_context(options, report.composite.storage_without_format);
     if (!context) fail(exit_code_for_vulkan(context.error()), "Vulkan: " + context.error().message);
 
     if (const int code = render(*context, args, job, report); code != kExitOk) return code;

@@ -16,28 +16,21 @@
 namespace crisp::tools {
 
 // A context from `options` (validation, device name) plus the features crisp's renderer and
-// compositor need, with the optional ones where a device offers them: shaderInt64 and
-// shaderBufferInt64Atomics (the layered reference mode's 64-bit keys; `int64_atomics` says whether
-// they are on), and shaderStorageImageReadWithoutFormat and WriteWithoutFormat (B8G8R8A8 tile
-// targets; `storage_without_format`). Tries the richest set first. When no attempt finds a
-// device, the error is the last attempt's (it names what else is missing), prefixed by the first's.
-inline Result<HeadlessContext> create_context(HeadlessContextOptions options, bool& int64_atomics,
-                                              bool& storage_without_format) {
-    auto attempt = [&](bool int64, bool without_format) {
+// compositor need (docs/vulkan.md), with shaderStorageImageReadWithoutFormat and WriteWithoutFormat
+// (B8G8R8A8 tile targets) where a device offers them: `storage_without_format` says whether they
+// are on. When neither attempt finds a device, the error is the second's (it names what else is
+// missing), prefixed by the first's.
+inline Result<HeadlessContext> create_context(HeadlessContextOptions options, bool& storage_without_format) {
+    auto attempt = [&](bool without_format) {
         VkPhysicalDeviceVulkan13Features vulkan13{};
         vulkan13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
         vulkan13.dynamicRendering = VK_TRUE;  // the compositor's draw path
-        VkPhysicalDeviceVulkan12Features vulkan12{};
-        vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
-        vulkan12.pNext = &vulkan13;
-        vulkan12.shaderBufferInt64Atomics = int64 ? VK_TRUE : VK_FALSE;
         VkPhysicalDeviceFeatures2 features{};
         features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-        features.pNext = &vulkan12;
+        features.pNext = &vulkan13;
         features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;  // the renderer
         features.features.fragmentStoresAndAtomics = VK_TRUE;                // the reference modes
         features.features.dualSrcBlend = VK_TRUE;                             // unsorted, the draw path
-        features.features.shaderInt64 = int64 ? VK_TRUE : VK_FALSE;
         features.features.shaderStorageImageReadWithoutFormat = without_format ? VK_TRUE : VK_FALSE;
         features.features.shaderStorageImageWriteWithoutFormat = without_format ? VK_TRUE : VK_FALSE;
         HeadlessContextOptions with = options;
@@ -46,22 +39,14 @@ inline Result<HeadlessContext> create_context(HeadlessContextOptions options, bo
         with.required_compute_subgroup_operations = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
         return HeadlessContext::create(with);
     };
-    std::string first;
-    Result<HeadlessContext> context = Error{ErrorCode::vulkan, "no attempt made"};
-    for (const auto& [int64, without_format] : {std::pair{true, true}, {true, false}, {false, true}, {false, false}}) {
-        int64_atomics = int64;
-        storage_without_format = without_format;
-        context = attempt(int64, without_format);
-        if (context) return context;
-        if (first.empty()) first = context.error().message;
-    }
-    return Error{context.error().code, first + "; with neither 64-bit atomics nor format-less storage images: " +
-                                           context.error().message};
-}
-
-inline Result<HeadlessContext> create_context(HeadlessContextOptions options, bool& int64_atomics) {
-    bool storage_without_format = false;
-    return create_context(std::move(options), int64_atomics, storage_without_format);
+    storage_without_format = true;
+    Result<HeadlessContext> context = attempt(true);
+    if (context) return context;
+    const std::string first = context.error().message;
+    storage_without_format = false;
+    context = attempt(false);
+    if (context) return context;
+    return Error{context.error().code, first + "; without format-less storage images: " + context.error().message};
 }
 
 // The GPU time between two points of a command buffer, from a pool of two timestamp queries.

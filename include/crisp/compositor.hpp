@@ -12,9 +12,9 @@
 //   - record_draw(): inside the caller's render pass (dynamic rendering), for targets that cannot
 //     be storage images (an sRGB swapchain image): quads sorted on the CPU, drawn back to front
 //     with dual-source blending per channel.
-//   - record_reference(): the comparison modes (layered OIT in global memory, unsorted, WBOIT and
-//     the exact per-pixel linked lists) into the compositor's own RGBA32F image over a flat
-//     background; made only when CompositorCreateInfo::reference_modes asks for them.
+//   - record_reference(): the comparison modes (unsorted, WBOIT and the exact per-pixel linked
+//     lists) into the compositor's own RGBA32F image over a flat background; made only when
+//     CompositorCreateInfo::reference_modes asks for them.
 //
 // A frame, after the renderer's record() in the same command buffer (or a later one):
 //
@@ -43,30 +43,19 @@ namespace crisp {
 enum class CompositeMode {
     tiled,     // record(): screen tiles in workgroup memory, into the caller's image
     draw,      // record_draw(): sorted quads blended inside the caller's render pass
-    layered,   // reference: the K nearest fragments per pixel in global memory; the rest estimated
     unsorted,  // reference: premultiplied "over" in submission order: what no OIT gives
     wboit,     // reference: weighted blended OIT (McGuire and Bavoil 2013), equation (10)
     exact,     // reference: per-pixel linked lists, sorted: the ground truth
 };
-// "tiled", "draw", "layered", "unsorted", "wboit", "exact".
+// "tiled", "draw", "unsorted", "wboit", "exact".
 const char* composite_mode_name(CompositeMode mode);
 // The mode of that name; nullopt for any other string.
 std::optional<CompositeMode> parse_composite_mode(std::string_view name);
 
-// The most layers a layered pipeline keeps per pixel.
+// The most layers the tile path's layered way keeps per pixel (CompositorCreateInfo::tile_layers).
 inline constexpr uint32_t kMaxCompositeLayers = 8;
-// CompositeParams::layers: size K from the largest per-pixel overlap the compositor measured in
-// its last completed frame (at most kMaxCompositeLayers; kMaxCompositeLayers until it has one).
-inline constexpr uint32_t kAutoLayers = 0;
 // The most fragments the exact mode sorts per pixel; more are dropped and counted.
 inline constexpr uint32_t kMaxExactFragmentsPerPixel = 64;
-
-// How the layered keys are built.
-enum class KeyFormat {
-    automatic,  // mono for a gray subpixel layout, rgb where the device allows it, else mono
-    rgb,        // 64-bit keys: 32-bit depth, 8-bit paint order, 8-bit T per channel
-    mono,       // 32-bit keys: 16-bit depth, 8-bit paint order, one 8-bit T for the three channels
-};
 
 // The image formats record() composites into (as storage images). 8-bit ones hold sRGB-encoded
 // colour, which the shader decodes and encodes; float ones hold linear colour. A B8G8R8A8_UNORM
@@ -116,22 +105,12 @@ struct CompositorCreateInfo {
     uint32_t width = 0;
     uint32_t height = 0;
     // The device must have been created with fragmentStoresAndAtomics and dualSrcBlend enabled.
-    // Say here whether shaderInt64 and shaderBufferInt64Atomics were enabled too: without them
-    // layered compositing uses mono keys (and warnings() says so).
-    bool int64_atomics = false;
-    KeyFormat key_format = KeyFormat::automatic;
-    bool gray_layout = false;  // the renderer's subpixel layout samples one rect for all channels
-    // Layers the layer buffers are sized for: layered frames may use K up to this. 1..8.
-    uint32_t max_layers = kMaxCompositeLayers;
     // The exact mode's node pool, in nodes per target pixel on average (each node 36 bytes);
     // 0 makes no pool and the exact mode unavailable. At most 64.
     uint32_t exact_nodes_per_pixel = 16;
-    // Caps the size of one layer buffer below the device's maxStorageBufferRange (0: no cap), so
-    // that tests can make the layer buffers split on a small target.
-    uint64_t max_layer_buffer_bytes = 0;
 };
 
-// How the quad passes of the layered, wboit and exact modes run (unsorted is always rasterized:
+// How the quad passes of the wboit and exact reference modes run (unsorted is always rasterized:
 // it needs the blend unit's submission order).
 enum class QuadPath {
     raster,   // quads drawn, one fragment per pixel, early fragment tests (the seed's way)
@@ -162,9 +141,8 @@ struct CompositeTarget {
 };
 
 struct CompositeParams {
-    CompositeMode mode = CompositeMode::layered;  // a reference mode
+    CompositeMode mode = CompositeMode::exact;  // a reference mode
     QuadPath path = QuadPath::raster;
-    uint32_t layers = kAutoLayers;  // layered: 1..max_layers, or kAutoLayers
     // Linear colour and straight alpha of the background behind all glyphs.
     float background[4] = {1.0f, 1.0f, 1.0f, 1.0f};
 };
@@ -175,17 +153,14 @@ struct CompositorStats {
     QuadPath path = QuadPath::raster;  // the path this frame's quad passes took
     uint32_t tiles = 0;                // compute path: 8 x 8 tiles dispatched
     bool bins_reused = false;          // tiled: the glyphs were unchanged, binning was skipped
-    uint32_t layers = 0;           // layered: the K this frame used
-    bool mono_keys = false;        // layered: 32-bit keys
     uint32_t quads = 0;            // glyph quads drawn
-    uint32_t paint_order_blocks = 0;  // most 256-wide paint-order blocks one depth plane needed
     uint64_t buffer_bytes = 0;     // buffers this frame used: tiled and draw: quads and bins;
                                    // reference modes: their per-pixel buffers over the whole target
     // From the last frame whose GPU work has completed (frames_in_flight frames ago), if any:
     bool measured = false;
     uint64_t measured_frame = 0;      // which frame (1 = the first record())
-    uint32_t max_overlap = 0;         // layered and exact: most fragments one pixel had
-    uint32_t tail_pixels = 0;         // layered: pixels with fragments past K
+    uint32_t max_overlap = 0;         // tiled and exact: most fragments one pixel had
+    uint32_t tail_pixels = 0;         // tiled: pixels with fragments past K (the layered way)
     uint64_t exact_lost_nodes = 0;    // exact: fragments the node pool could not hold
     uint64_t exact_dropped = 0;       // exact: fragments past kMaxExactFragmentsPerPixel
     // tiled: the last completed tiled frame's tiles with quads, how many took the exact way (their
@@ -210,11 +185,11 @@ public:
     // premultiplied linear colour, kept in VK_IMAGE_LAYOUT_GENERAL), per-pixel buffers and
     // pipelines when reference_modes is set. Errors: invalid_argument for a missing device,
     // frames_in_flight outside 1..8, tile_capacity not a power of two in 4..kMaxTileCapacity,
-    // tile_layers or max_layers outside 1..8, with reference_modes a size outside 1..16384,
-    // exact_nodes_per_pixel above 64, or key_format rgb without int64_atomics; vulkan when the
+    // tile_layers outside 1..8, with reference_modes a size outside 1..16384 or
+    // exact_nodes_per_pixel above 64; vulkan when the
     // device cannot store to any of kTileTargetFormats, draw_format cannot be a blended colour
-    // attachment, the reference modes lack fragmentStoresAndAtomics or dualSrcBlend, one layer of
-    // keys or the per-pixel accumulators (44 bytes a pixel) would pass maxStorageBufferRange (the
+    // attachment, the reference modes lack fragmentStoresAndAtomics or dualSrcBlend, their per-pixel
+    // accumulators (36 bytes a pixel) would pass maxStorageBufferRange (the
     // message names it), or a Vulkan call fails. A node pool larger than the range is cut to it,
     // with a warning.
     static Result<Compositor> create(const CompositorCreateInfo& info);
@@ -254,18 +229,12 @@ public:
     // The reference modes: records one frame composited by params.mode over params.background
     // into the compositor's own target. Same contract as record() for glyphs and atlas; after
     // it the target is readable by fragment and compute shaders and transfers. Errors:
-    // invalid_argument without reference_modes, for a mode that is not a reference mode, layers
-    // above max_layers, or exact with no node pool; vulkan for a failed Vulkan call; either
+    // invalid_argument without reference_modes, for a mode that is not a reference mode, or exact
+    // with no node pool; vulkan for a failed Vulkan call; either
     // leaves no commands recorded. On the compute path a rect over 65535 texels a side draws
     // nothing.
     Status record_reference(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
                             VkImageView atlas_view, const CompositeParams& params);
-
-    // Builds every pipeline the layered reference mode can use on `path` (K = 1 to max_layers), so
-    // that a frame whose K changes (kAutoLayers follows the overlap) does not compile one
-    // mid-frame. Without it each K's pipelines are built by the first record_reference() that
-    // uses them. Errors: invalid_argument without reference_modes; vulkan.
-    Status prepare_layered(QuadPath path);
 
     // True when record() can composite into an image of `format` seen through a view of
     // `view_format` (VK_FORMAT_UNDEFINED: the same format).
@@ -282,8 +251,8 @@ public:
     uint32_t width() const;
     uint32_t height() const;
     const CompositorStats& stats() const;
-    // What the compositor chose that the caller may want to know ("no 64-bit buffer atomics:
-    // layered keys are mono").
+    // What the compositor chose that the caller may want to know ("exact mode:
+    // maxStorageBufferRange holds N of the M list nodes asked for").
     const std::vector<std::string>& warnings() const;
 
 private:
