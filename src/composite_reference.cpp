@@ -227,7 +227,13 @@ Status ReferenceCompositor::create(const vk::DeviceRef& device, const Compositor
     }
 
     if (Status s = create_buffers(info, warnings); !s) return s;
-    // Descriptors and the pipeline layout.
+    if (Status s = create_descriptors(); !s) return s;
+    if (Status s = create_passes(); !s) return s;
+    return create_pipelines();
+}
+
+// The descriptor set layout every pipeline shares, one set and one stats read-back per frame slot.
+Status ReferenceCompositor::create_descriptors() {
     const VkShaderStageFlags stages =
         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT | VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorSetLayoutBinding bindings[] = {
@@ -255,10 +261,11 @@ Status ReferenceCompositor::create(const vk::DeviceRef& device, const Compositor
             return s;
         }
     }
+    return {};
+}
 
-    if (Status s = create_passes(); !s) return s;
-
-    // The fixed pipelines; the compute quad passes are made on first use.
+// The fixed pipelines; the compute quad passes are made on first use.
+Status ReferenceCompositor::create_pipelines() {
     struct Made {
         VkPipeline* pipeline;
         Result<VkPipeline> result;

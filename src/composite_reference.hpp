@@ -44,7 +44,9 @@ private:
     };
 
     Status create_buffers(const CompositorCreateInfo& info, std::vector<std::string>& warnings);
+    Status create_descriptors();
     Status create_passes();
+    Status create_pipelines();
     Result<VkShaderModule> module(const char* name);
     Result<VkPipeline> graphics_pipeline(const char* fragment, const VkSpecializationInfo* specialization, bool blend);
     Result<VkPipeline> compute_pipeline(const char* shader, const VkSpecializationInfo* specialization);
