@@ -352,60 +352,86 @@ TEST(TileCompositor, DrawPathMatchesTheCpuComputationPerChannel) {
     expect_no_validation_messages();
 }
 
+// Every target format of both paths: the image does not depend on the submission order.
 TEST(TileCompositor, ShuffledSubmissionGivesBitIdenticalImages) {
     const Scene scene = render_scene(overlapping_runs(0.6f));
-    CompositorCreateInfo info = tile_info();
-    info.draw_format = VK_FORMAT_R8G8B8A8_SRGB;
-    auto compositor = Compositor::create(info);
-    ASSERT_TRUE(compositor);
-    std::vector<DrawnGlyph> shuffled = scene.drawn;
     std::mt19937 random(7);
-    Target a = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
-    composite_tiles(*compositor, scene, scene.drawn, a);
-    Target c = make_target(VK_FORMAT_R8G8B8A8_SRGB, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
-    composite_draw(*compositor, scene, scene.drawn, c);
-    const std::vector<std::byte> tiles = read_target(a), drawn = read_target(c);
-    for (int round = 0; round < 3; ++round) {
-        std::shuffle(shuffled.begin(), shuffled.end(), random);
-        Target b = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
-        composite_tiles(*compositor, scene, shuffled, b);
-        EXPECT_EQ(read_target(b), tiles) << "tile path, shuffle " << round;
-        Target d = make_target(VK_FORMAT_R8G8B8A8_SRGB, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
-        composite_draw(*compositor, scene, shuffled, d);
-        EXPECT_EQ(read_target(d), drawn) << "draw path, shuffle " << round;
+    std::vector<std::vector<DrawnGlyph>> orders(3, scene.drawn);
+    for (std::vector<DrawnGlyph>& order : orders) std::shuffle(order.begin(), order.end(), random);
+    auto tiles = Compositor::create(tile_info());
+    ASSERT_TRUE(tiles);
+    for (const TileFormat& format : kTileFormats) {
+        auto image = [&](std::span<const DrawnGlyph> glyphs) {
+            Target t = make_target(format.image, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT, format.view);
+            composite_tiles(*tiles, scene, glyphs, t);
+            return read_target(t);
+        };
+        const std::vector<std::byte> first = image(scene.drawn);
+        for (const std::vector<DrawnGlyph>& order : orders) {
+            EXPECT_EQ(image(order), first) << "tile path, VkFormat " << format.image;
+        }
+    }
+    for (VkFormat format : kDrawFormats) {
+        CompositorCreateInfo info = tile_info();
+        info.draw_format = format;
+        auto draw = Compositor::create(info);
+        ASSERT_TRUE(draw);
+        auto image = [&](std::span<const DrawnGlyph> glyphs) {
+            Target t = make_target(format, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
+            composite_draw(*draw, scene, glyphs, t);
+            return read_target(t);
+        };
+        const std::vector<std::byte> first = image(scene.drawn);
+        for (const std::vector<DrawnGlyph>& order : orders) {
+            EXPECT_EQ(image(order), first) << "draw path, VkFormat " << format;
+        }
     }
     expect_no_validation_messages();
 }
 
+// Two runs on one plane over each other, both paths: the later paint order is in front, and
+// swapping the runs' paint orders swaps which shows.
 TEST(TileCompositor, CoplanarGlyphsResolveByPaintOrder) {
-    // Two opaque-ish runs on one plane over each other: the later paint order is in front.
     const std::vector<TextRun> runs = {
         {"Hamburg", 1.0f, 24.0f, {0.9f, 0.1f, 0.1f, 0.9f}, 0.5f},
         {"Hamburg", 2.5f, 25.5f, {0.1f, 0.1f, 0.9f, 0.9f}, 0.5f},
     };
     const Scene scene = render_scene(runs);
-    auto compositor = Compositor::create(tile_info());
-    ASSERT_TRUE(compositor);
-    Target t = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
-    composite_tiles(*compositor, scene, scene.drawn, t);
-    const std::vector<std::byte> bytes = read_target(t);
-    EXPECT_LE(worst_difference(t, bytes, expected_image(scene, t, {0, 0}, nullptr)), tolerance(t.format));
-    // The same glyphs with the paint orders of the two runs swapped put red in front instead.
     std::vector<DrawnGlyph> swapped = scene.drawn;
     const uint32_t first_blue = static_cast<uint32_t>(scene.drawn.size() / 2);
     for (DrawnGlyph& g : swapped) {
         g.instance.paint_order = g.instance.paint_order >= first_blue ? g.instance.paint_order - first_blue
                                                                       : g.instance.paint_order + first_blue;
     }
-    Target s = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
-    composite_tiles(*compositor, scene, swapped, s);
-    const std::vector<std::byte> other = read_target(s);
-    double most_red_gain = 0.0;
-    for (size_t p = 0; p < scene.pixels.size(); ++p) {
-        const Rgba before = decode(t.format, &bytes[p * 16]), after = decode(t.format, &other[p * 16]);
-        most_red_gain = std::max(most_red_gain, static_cast<double>(after[0] - before[0]));
+    constexpr VkFormat kFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+    CompositorCreateInfo info = tile_info();
+    info.draw_format = kFormat;
+    auto compositor = Compositor::create(info);
+    ASSERT_TRUE(compositor);
+    for (bool draw : {false, true}) {
+        SCOPED_TRACE(draw ? "draw path" : "tile path");
+        auto image = [&](std::span<const DrawnGlyph> glyphs, Target& t) {
+            t = make_target(kFormat, kWidth, kHeight,
+                            draw ? VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT : VK_IMAGE_USAGE_STORAGE_BIT);
+            if (draw) {
+                composite_draw(*compositor, scene, glyphs, t);
+            } else {
+                composite_tiles(*compositor, scene, glyphs, t);
+            }
+            return read_target(t);
+        };
+        Target t, s;
+        const std::vector<std::byte> bytes = image(scene.drawn, t);
+        EXPECT_LE(worst_difference(t, bytes, expected_image(scene, t, {0, 0}, nullptr)), tolerance(kFormat));
+        // The same glyphs with the paint orders of the two runs swapped put red in front instead.
+        const std::vector<std::byte> other = image(swapped, s);
+        double most_red_gain = 0.0;
+        for (size_t p = 0; p < scene.pixels.size(); ++p) {
+            const Rgba before = decode(kFormat, &bytes[p * 16]), after = decode(kFormat, &other[p * 16]);
+            most_red_gain = std::max(most_red_gain, static_cast<double>(after[0] - before[0]));
+        }
+        EXPECT_GT(most_red_gain, 0.3);
     }
-    EXPECT_GT(most_red_gain, 0.3);
     expect_no_validation_messages();
 }
 
