@@ -181,7 +181,7 @@ CRISP_CONSTANT(uint, kTileBinInvocations, 64u);
 CRISP_CONSTANT(uint, kTileDefaultCapacity, 256u);
 // Quads staged in workgroup memory at a time for the exact way's walk (28 bytes each).
 CRISP_CONSTANT(uint, kTileChunk, 64u);
-CRISP_CONSTANT(uint, kTileMaxCapacity, 1024u);  // 15 KiB of workgroup memory in all, of the 16 KiB every device offers
+CRISP_CONSTANT(uint, kTileMaxCapacity, 1024u);  // about 10 KiB of workgroup memory in all, of the 16 KiB every device offers
 CRISP_CONSTANT(uint, kTileNoQuad, 0xFFFFFFFFu);
 // Below this in every channel the transmittance left hides whatever lies behind (less than a
 // 16-bit code): a pixel's walk stops there.

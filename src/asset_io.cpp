@@ -6,6 +6,7 @@
 // what the in-memory FontAsset cannot express (section sizes, counts, reserved fields); every rule
 // about the decoded values lives in validate_asset, which the baker also runs before it writes.
 #include "file_io.hpp"
+#include "limits.hpp"
 
 #include <crisp/asset.hpp>
 
@@ -701,7 +702,7 @@ Status save_asset_file(const FontAsset& asset, const std::filesystem::path& path
 }
 
 Result<FontAsset> load_asset_file(const std::filesystem::path& path) {
-    Result<std::vector<std::byte>> bytes = read_file(path);
+    Result<std::vector<std::byte>> bytes = read_file(path, limits::kAssetFileBytes);
     if (!bytes) return bytes.error();
     return load_asset(*bytes);
 }

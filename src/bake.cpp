@@ -1,5 +1,6 @@
 #include "bands.hpp"
 #include "file_io.hpp"
+#include "limits.hpp"
 #include "outline.hpp"
 
 #include <crisp/bake.hpp>
@@ -217,6 +218,41 @@ GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em,
 
 }  // namespace
 
+namespace {
+
+bool starts_with(std::span<const std::byte> bytes, std::string_view prefix) {
+    if (bytes.size() < prefix.size()) return false;
+    for (size_t i = 0; i < prefix.size(); ++i) {
+        if (bytes[i] != static_cast<std::byte>(prefix[i])) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+Status check_font_container(std::span<const std::byte> font_bytes) {
+    // FreeType opens these, but HarfBuzz (shaping, from the asset's font bytes) does not, and the
+    // asset must hold bytes it can shape: refused up front, saying what to do instead.
+    if (starts_with(font_bytes, "wOFF")) {
+        return Error{ErrorCode::font_unsupported,
+                     "a WOFF font: crisp bakes TrueType and OpenType; decompress it first (fontTools: "
+                     "python3 -c \"from fontTools.ttLib import TTFont; f = TTFont('in.woff'); f.flavor = None; "
+                     "f.save('out.otf')\")"};
+    }
+    if (starts_with(font_bytes, "wOF2")) {
+        return Error{ErrorCode::font_unsupported,
+                     "a WOFF2 font: crisp bakes TrueType and OpenType; decompress it first (woff2_decompress from "
+                     "the woff2 package, or fontTools with brotli)"};
+    }
+    if ((font_bytes.size() >= 2 && font_bytes[0] == std::byte{0x80} && font_bytes[1] == std::byte{0x01}) ||
+        starts_with(font_bytes, "%!PS-AdobeFont") || starts_with(font_bytes, "%!FontType1")) {
+        return Error{ErrorCode::font_unsupported,
+                     "a PostScript Type 1 font: crisp bakes TrueType and OpenType; convert it to OpenType CFF first "
+                     "(FontForge, for one)"};
+    }
+    return {};
+}
+
 Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options) {
     const auto started = std::chrono::steady_clock::now();
     if (!(options.tolerance_em > 0.0f && options.tolerance_em <= 0.1f)) {
@@ -228,6 +264,7 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     if (font_bytes.size() > 0x7FFFFFFF) {
         return Error{ErrorCode::font_unreadable, "the font is larger than 2 GiB"};
     }
+    if (Status supported = check_font_container(font_bytes); !supported) return supported.error();
 
     FT_Library raw_library = nullptr;
     if (const FT_Error error = FT_Init_FreeType(&raw_library); error != 0) {
@@ -351,7 +388,7 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
 }
 
 Result<BakeResult> bake_font_file(const std::filesystem::path& path, const BakeOptions& options) {
-    Result<std::vector<std::byte>> bytes = read_file(path);
+    Result<std::vector<std::byte>> bytes = read_file(path, limits::kFontFileBytes);
     if (!bytes) return bytes.error();
     return bake_font(*bytes, options);
 }

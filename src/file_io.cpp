@@ -61,10 +61,35 @@ Status write_all(int fd, std::span<const std::byte> bytes) {
 
 }  // namespace
 
-Status write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes) {
-    std::filesystem::path file_name = path.filename();
+Status check_output_path(const std::filesystem::path& path, std::span<const std::filesystem::path> inputs) {
+    const std::filesystem::path file_name = path.filename();
     if (file_name.empty() || file_name == "." || file_name == "..")
         return Error{ErrorCode::io, "cannot write " + path.string() + ": not a file name"};
+    std::error_code error;
+    const std::filesystem::file_status status = std::filesystem::status(path, error);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+        return Error{ErrorCode::io, "refusing to write " + path.string() +
+                                        ": it exists and is not a regular file (a device, directory, FIFO or socket), "
+                                        "which writing would replace"};
+    }
+    std::filesystem::path directory = path.parent_path();
+    if (directory.empty()) directory = ".";
+    if (!std::filesystem::is_directory(directory, error)) {
+        const int reason = std::filesystem::exists(directory, error) ? ENOTDIR : ENOENT;
+        return Error{ErrorCode::io,
+                     "cannot write " + path.string() + ": " + directory.string() + ": " + errno_text(reason)};
+    }
+    for (const std::filesystem::path& input : inputs) {
+        if (std::filesystem::exists(status) && std::filesystem::equivalent(path, input, error)) {
+            return Error{ErrorCode::io, "refusing to write " + path.string() + ": it is the input " + input.string()};
+        }
+    }
+    return {};
+}
+
+Status write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes) {
+    if (Status checked = check_output_path(path); !checked) return checked;
+    std::filesystem::path file_name = path.filename();
     std::filesystem::path directory = path.parent_path();
     if (directory.empty()) directory = ".";
 
@@ -117,7 +142,7 @@ Status write_file_atomically(const std::filesystem::path& path, std::span<const 
     return {};
 }
 
-Result<std::vector<std::byte>> read_file(const std::filesystem::path& path) {
+Result<std::vector<std::byte>> read_file(const std::filesystem::path& path, uint64_t max_bytes) {
     int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return io_error("cannot read", path, errno);
 
@@ -132,12 +157,32 @@ Result<std::vector<std::byte>> read_file(const std::filesystem::path& path) {
         ::close(fd);
         return io_error("cannot read", path, EISDIR);
     }
-    // One byte more than the size fstat gives, so a regular file is read in one call and its end
-    // is seen without growing; files fstat cannot size (pipes, /proc) grow as they are read.
-    bytes.resize(S_ISREG(info.st_mode) && info.st_size > 0 ? static_cast<size_t>(info.st_size) + 1 : 65536);
+    if (!S_ISREG(info.st_mode)) {
+        ::close(fd);
+        return Error{ErrorCode::io, "cannot read " + path.string() +
+                                        ": not a regular file (a device, FIFO or socket has no size to check, and may "
+                                        "never end)"};
+    }
+    auto too_large = [&] {
+        return Error{ErrorCode::io, "cannot read " + path.string() + ": larger than the " + std::to_string(max_bytes) +
+                                        " bytes allowed for this kind of input (docs/limits.md)"};
+    };
+    if (static_cast<uint64_t>(info.st_size) > max_bytes) {
+        ::close(fd);
+        return too_large();
+    }
+    // One byte more than the size fstat gives, so the file is read in one call and its end is seen
+    // without growing; a file that grows while it is read grows the buffer up to the limit.
+    bytes.resize(static_cast<size_t>(info.st_size) + 1);
     size_t used = 0;
     for (;;) {
-        if (used == bytes.size()) bytes.resize(bytes.size() * 2);
+        if (used == bytes.size()) {
+            if (used > max_bytes) {
+                ::close(fd);
+                return too_large();
+            }
+            bytes.resize(static_cast<size_t>(std::min<uint64_t>(uint64_t{bytes.size()} * 2, max_bytes + 1)));
+        }
         ssize_t got = ::read(fd, bytes.data() + used, std::min<size_t>(bytes.size() - used, size_t{1} << 30));
         if (got == 0) break;
         if (got < 0) {

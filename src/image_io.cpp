@@ -1,6 +1,7 @@
 #include "image_io.hpp"
 
 #include "file_io.hpp"
+#include "limits.hpp"
 
 #include <crisp/asset.hpp>
 
@@ -256,7 +257,7 @@ Result<PfmImage> parse_pfm(std::span<const std::byte> bytes) {
 }
 
 Result<PfmImage> read_pfm(const std::filesystem::path& path) {
-    Result<std::vector<std::byte>> bytes = read_file(path);
+    Result<std::vector<std::byte>> bytes = read_file(path, limits::kImageFileBytes);
     if (!bytes) return bytes.error();
     Result<PfmImage> image = parse_pfm(*bytes);
     if (!image) return Error{image.error().code, path.string() + ": " + image.error().message};

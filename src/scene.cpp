@@ -1,6 +1,7 @@
 #include "scene.hpp"
 
 #include "file_io.hpp"
+#include "limits.hpp"
 #include "json.hpp"
 
 #include <crisp/renderer.hpp>
@@ -202,7 +203,7 @@ Result<Scene> parse_scene(std::string_view json) {
 }
 
 Result<Scene> load_scene_file(const std::filesystem::path& path) {
-    auto bytes = read_file(path);
+    auto bytes = read_file(path, limits::kSceneFileBytes);
     if (!bytes) return bytes.error();
     const std::string_view text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
     auto scene = parse_scene(text);

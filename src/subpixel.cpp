@@ -1,4 +1,5 @@
 #include "file_io.hpp"
+#include "limits.hpp"
 #include "json.hpp"
 
 #include <crisp/asset.hpp>
@@ -119,7 +120,7 @@ Result<SubpixelLayout> parse_subpixel_layout(std::string_view text) {
 }
 
 Result<SubpixelLayout> load_subpixel_layout_file(const std::filesystem::path& path) {
-    auto bytes = read_file(path);
+    auto bytes = read_file(path, limits::kLayoutFileBytes);
     if (!bytes) return bytes.error();
     const std::string_view text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
     auto layout = parse_subpixel_layout(text);

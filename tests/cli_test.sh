@@ -78,6 +78,61 @@ expect_exit 0 "variable" -- "$bake" "$source/fonts/Inter-roman.var.ttf" --var wg
 python3 -c "import json,sys; r=json.load(open(sys.argv[1])); assert any(a['tag']=='wght' and a['value']==800 for a in r['axes']), r" "$work/out" ||
   fail "--var did not reach the asset"
 
+# Bounded inputs and safe outputs (docs/limits.md): a device is not read, nothing but a regular
+# file is replaced, the input is never the output, and containers crisp cannot shape say so.
+expect_exit 3 "/dev/zero as the font" -- timeout 20 "$bake" /dev/zero -o "$work/zero.crisp"
+grep -q "not a regular file" "$work/err" || fail "/dev/zero: $(cat "$work/err")"
+mkfifo "$work/fifo.crisp"
+expect_exit 4 "a FIFO as the output" -- timeout 20 "$bake" "$font" --text a -o "$work/fifo.crisp"
+[ -p "$work/fifo.crisp" ] || fail "the FIFO was replaced"
+cp "$font" "$work/input.ttf"
+expect_exit 4 "the input as the output" -- "$bake" "$work/input.ttf" --text a -o "$work/input.ttf"
+cmp -s "$font" "$work/input.ttf" || fail "the input was overwritten"
+grep -q "input" "$work/err" || fail "the refusal does not say why: $(cat "$work/err")"
+printf 'wOF2\0\1\0\0xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx' > "$work/font.woff2"
+expect_exit 3 "WOFF2" -- "$bake" "$work/font.woff2" -o "$work/woff2.crisp"
+grep -q "decompress" "$work/err" || fail "WOFF2: no advice: $(cat "$work/err")"
+expect_exit 2 "a tolerance below float range" -- "$bake" "$font" --tolerance 1e-46
+grep -q "out of range" "$work/err" || fail "1e-46: $(cat "$work/err")"
+# A family name with terminal escapes (a crafted asset could retitle the terminal) is printed escaped.
+/usr/bin/python3 - "$font" "$work/evil.ttf" <<'PY' || fail "could not make the escape font"  # Debian's python3 has fontTools
+import sys
+from fontTools.ttLib import TTFont
+font = TTFont(sys.argv[1])
+for record in font["name"].names:
+    if record.nameID in (1, 16):
+        record.string = "Evil\x1b]0;pwned\x07Sans"
+font.save(sys.argv[2])
+PY
+expect_exit 0 "escape font" -- "$bake" "$work/evil.ttf" --text a -o "$work/evil.crisp" -q
+# The baker already turns the control characters into '?'; an asset written by other means may keep
+# them: put them back and fix the checksum (CRC-32C of all but bytes 24..27, docs/asset-format.md).
+/usr/bin/python3 - "$work/evil.crisp" <<'PY' || fail "could not craft the escape asset"
+import struct, sys
+path = sys.argv[1]
+data = bytearray(open(path, "rb").read())
+at = data.find(b"Evil?]0;pwned?Sans")
+assert at > 0
+data[at + 4] = 0x1B
+data[at + 13] = 0x07
+table = []
+for n in range(256):
+    c = n
+    for _ in range(8):
+        c = (c >> 1) ^ 0x82F63B78 if c & 1 else c >> 1
+    table.append(c)
+crc = 0xFFFFFFFF
+for byte in bytes(data[:24]) + bytes(data[28:]):
+    crc = table[(crc ^ byte) & 0xFF] ^ (crc >> 8)
+struct.pack_into("<I", data, 24, crc ^ 0xFFFFFFFF)
+open(path, "wb").write(data)
+PY
+expect_exit 0 "check escape asset" -- "$bake" --check "$work/evil.crisp"
+if grep -q $'\x1b' "$work/out" || grep -q $'\x07' "$work/out"; then
+  fail "--check printed a raw control character"
+fi
+grep -q 'Evil\\x1b' "$work/out" || fail "--check does not show the escaped name: $(cat -v "$work/out")"
+
 if [ "$failures" -ne 0 ]; then
   echo "$failures CLI checks failed" >&2
   exit 1

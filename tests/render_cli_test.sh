@@ -36,6 +36,17 @@ expect_exit 2 "no size" -- "$render" --font "$font" --text Hi --origin 0,20 --ca
 expect_exit 2 "no origin" -- "$render" --font "$font" --text Hi --size 20 --canvas 48,32 -o x.png
 expect_exit 2 "no canvas" -- "$render" --font "$font" --text Hi --size 20 --origin 0,20 -o x.png
 expect_exit 2 "no output" -- "$render" "${base[@]}"
+expect_exit 2 "--size below the float range" -- "$render" "${base[@]}" --size 1e-46 -o x.png
+expect_stderr "out of range" "--size 1e-46"
+# Bounded inputs and safe outputs (docs/limits.md), before any GPU work.
+expect_exit 3 "/dev/zero as the font" -- timeout 20 "$render" "${base[@]/$font//dev/zero}" -o "$work/zero.png"
+expect_stderr "not a regular file" "/dev/zero as the font"
+mkfifo "$work/out.fifo"
+expect_exit 4 "a FIFO as the output" -- timeout 20 "$render" "${base[@]}" -o "$work/out.fifo"
+[ -p "$work/out.fifo" ] || fail "the FIFO was replaced"
+cp "$font" "$work/font-copy.crisp"
+expect_exit 4 "the font as the output" -- "$render" "${base[@]/$font/$work/font-copy.crisp}" -o "$work/font-copy.crisp"
+cmp -s "$font" "$work/font-copy.crisp" || fail "the input asset was overwritten"
 for size in 0 -3 4096.5 1e9 abc nan inf ""; do
   expect_exit 2 "--size '$size'" -- "$render" "${base[@]}" --size "$size" -o x.png
 done
@@ -58,6 +69,8 @@ expect_exit 2 "17 fonts" -- "$render" "${seventeen[@]}" --text Hi --size 20 --or
 expect_exit 2 "one file for both outputs" -- "$render" "${base[@]}" -o same.out --coverage-out ./same.out
 expect_exit 2 "--path bogus" -- "$render" "${base[@]}" --path bogus -o x.png
 expect_stderr "bogus" "--path bogus"
+expect_exit 2 "--path with the tile path" -- "$render" "${base[@]}" --path compute -o x.png
+expect_stderr "--path applies" "--path with the tile path"
 expect_exit 2 "--composite bogus" -- "$render" "${base[@]}" --composite bogus -o x.png
 expect_stderr "bogus" "--composite bogus"
 # The first compositor's layered mode and its --layers are gone: the tile path replaced them.

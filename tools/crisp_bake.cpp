@@ -1,5 +1,6 @@
 // crisp-bake: turns a font into a .crisp asset, or checks an asset.
 #include "cli.hpp"
+#include "file_io.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>
@@ -11,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -71,8 +74,9 @@ struct Arguments {
 
 template <class T>
 T parse_number(std::string_view option, std::string_view text) {
-    const std::optional<T> value = crisp::cli::parse_number<T>(text);
-    if (!value) usage_error(std::string(option) + ": '" + std::string(text) + "' is not a valid number");
+    std::string why;
+    const std::optional<T> value = crisp::cli::parse_number<T>(text, &why);
+    if (!value) usage_error(std::string(option) + ": '" + std::string(text) + "' " + why);
     return *value;
 }
 
@@ -257,7 +261,8 @@ int run_check(const Arguments& args) {
             json_number(info.max_deviation_em).c_str());
     } else if (!args.quiet) {
         std::printf("%s: valid crisp asset (version %u)\n", args.check.c_str(), crisp::kAssetVersion);
-        std::printf("  font        %s %s, face %u, %u units per em%s\n", info.family.c_str(), info.style.c_str(),
+        std::printf("  font        %s %s, face %u, %u units per em%s\n", crisp::cli::printable(info.family).c_str(),
+                    crisp::cli::printable(info.style).c_str(),
                     info.face_index, info.units_per_em, (info.flags & crisp::kFontCubic) ? ", cubic outlines" : "");
         if (!info.axes.empty()) std::printf("  axes        %s\n", axes_text(info).c_str());
         std::printf("  metrics     ascender %d, descender %d, line gap %d\n", info.ascender, info.descender,
@@ -313,7 +318,8 @@ void print_report(const Arguments& args, const crisp::FontInfo& info, const cris
     }
     if (args.quiet) return;
     std::printf("%s -> %s\n", args.font.c_str(), args.output.c_str());
-    std::printf("  font          %s %s, face %u, %u units per em\n", info.family.c_str(), info.style.c_str(),
+    std::printf("  font          %s %s, face %u, %u units per em\n", crisp::cli::printable(info.family).c_str(),
+                crisp::cli::printable(info.style).c_str(),
                 info.face_index, info.units_per_em);
     if (!info.axes.empty()) std::printf("  axes          %s\n", axes_text(info).c_str());
     std::printf("  glyphs        %u in the face, %u baked (%u empty), %u failed\n", r.glyph_count, r.baked_glyphs,
@@ -366,6 +372,12 @@ int main(int argc, char** argv) {
     if (!args.check.empty()) return run_check(args);
 
     if (!args.quiet && isatty(STDERR_FILENO)) args.bake.progress = draw_progress;
+    // Before any work: an output that cannot or must not be written (a device, a directory, the input).
+    const std::filesystem::path input(args.font);
+    if (const crisp::Status checked = crisp::check_output_path(args.output, std::span(&input, 1)); !checked) {
+        std::fprintf(stderr, "crisp-bake: %s\n", checked.error().message.c_str());
+        return kExitOutput;
+    }
 
     auto baked = crisp::bake_font_file(args.font, args.bake);
     if (!baked) {

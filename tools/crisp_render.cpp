@@ -2,6 +2,7 @@
 // GPU with crisp::Compositor into a PNG and, on request, reads the atlas back for a PFM of the
 // text's coverage. The text comes from the command line or from a scene file.
 #include "cli.hpp"
+#include "file_io.hpp"
 #include "gpu_tools.hpp"
 #include "image_io.hpp"
 #include "json.hpp"
@@ -131,6 +132,7 @@ struct Arguments {
     crisp::CompositeMode composite = crisp::CompositeMode::tiled;
     std::string backdrop = "flat";
     crisp::QuadPath path = crisp::QuadPath::raster;
+    bool path_given = false;
     std::string output;
     std::string coverage_output;
     bool json = false;
@@ -155,8 +157,9 @@ struct Arguments {
 
 template <class T>
 T parse_number(std::string_view option, std::string_view text) {
-    const std::optional<T> value = crisp::cli::parse_number<T>(text);
-    if (!value) usage_error(std::string(option) + ": '" + std::string(text) + "' is not a finite number");
+    std::string why;
+    const std::optional<T> value = crisp::cli::parse_number<T>(text, &why);
+    if (!value) usage_error(std::string(option) + ": '" + std::string(text) + "' " + why);
     return *value;
 }
 
@@ -252,6 +255,7 @@ Arguments parse_arguments(int argc, char** argv) {
             const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(name);
             if (!path) usage_error("--path takes raster or compute, not '" + std::string(name) + "'");
             args.path = *path;
+            args.path_given = true;
         } else if (arg == "-o" || arg == "--output") {
             args.output = value();
         } else if (arg == "--coverage-out") {
@@ -300,6 +304,11 @@ Arguments parse_arguments(int argc, char** argv) {
         if (!args.canvas) usage_error("no --canvas given");
     }
     if (args.output.empty()) usage_error("no output given (-o OUT.png)");
+    if (args.path_given && args.composite != crisp::CompositeMode::wboit &&
+        args.composite != crisp::CompositeMode::exact) {
+        usage_error("--path applies to --composite wboit and exact only (tiled always computes; draw and unsorted "
+                    "are always rasterized)");
+    }
     if (args.backdrop != "flat" && args.composite != crisp::CompositeMode::tiled &&
         args.composite != crisp::CompositeMode::draw) {
         usage_error("--backdrop applies to --composite tiled and draw only (the reference modes draw over a flat "
@@ -312,16 +321,15 @@ Arguments parse_arguments(int argc, char** argv) {
     return args;
 }
 
-// Refuses an output whose directory does not exist, or that is a directory, before any rendering.
-void check_output_path(const std::string& path) {
-    const std::filesystem::path file(path);
-    std::filesystem::path directory = file.parent_path();
-    if (directory.empty()) directory = ".";
-    std::error_code error;
-    if (!std::filesystem::is_directory(directory, error)) {
-        fail(kExitOutput, "cannot write " + path + ": " + directory.string() + " is not a directory");
+// Refuses, before any rendering, an output that cannot be written (its directory missing), must not
+// be replaced (a device node, directory, FIFO), or is one of the inputs.
+void check_output_path(const std::string& path, const Arguments& args) {
+    std::vector<std::filesystem::path> inputs(args.fonts.begin(), args.fonts.end());
+    if (!args.scene.empty()) inputs.emplace_back(args.scene);
+    if (args.layout) inputs.emplace_back(*args.layout);
+    if (const crisp::Status checked = crisp::check_output_path(path, inputs); !checked) {
+        fail(kExitOutput, checked.error().message);
     }
-    if (std::filesystem::is_directory(file, error)) fail(kExitOutput, "cannot write " + path + ": it is a directory");
 }
 
 // ---- JSON, by hand
@@ -971,7 +979,8 @@ void print_human(const Summary& s) {
     if (!args.scene.empty()) std::printf("  scene    %s, %zu runs\n", args.scene.c_str(), job.scene.runs.size());
     std::printf("  device   %s (%s, %s)\n", s.context->device_name().c_str(), s.context->driver_name().c_str(),
                 s.context->driver_info().c_str());
-    std::printf("  layout   %s, %u samples per texel and channel\n", job.layout.name.c_str(), args.samples);
+    std::printf("  layout   %s, %u samples per texel and channel\n", crisp::cli::printable(job.layout.name).c_str(),
+                args.samples);
     std::printf("  glyphs   %u drawn, %zu laid out (%u outside the canvas), %u missing, %u failed\n",
                 r.last_frame.drawn_glyphs, job.laid_out, s.culled_glyphs, job.missing, r.last_frame.failed_glyphs);
     std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)\n", static_cast<unsigned long long>(r.frames),
@@ -1045,8 +1054,8 @@ void lay_out(const Arguments& args, Job& job) {
 
 int run(const Arguments& args) {
     const auto start = std::chrono::steady_clock::now();
-    check_output_path(args.output);
-    if (!args.coverage_output.empty()) check_output_path(args.coverage_output);
+    check_output_path(args.output, args);
+    if (!args.coverage_output.empty()) check_output_path(args.coverage_output, args);
 
     Job job;
     if (args.scene.empty()) {

@@ -87,14 +87,21 @@ struct BakeResult {
 };
 
 // Bakes a font held in memory. Errors: ErrorCode::font_unreadable (FreeType cannot open the
-// bytes, or face_index is past the collection), font_unsupported (no scalable outlines, a
-// variation on a face without axes or an unknown axis tag), invalid_argument (a tolerance outside
+// bytes, or face_index is past the collection), font_unsupported (a WOFF, WOFF2 or Type 1 font, as
+// check_font_container says; no scalable outlines; a variation on a face without axes or an
+// unknown axis tag), invalid_argument (a tolerance outside
 // (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be converted and
 // allow_failed is false; the report inside the message names them). Hostile font bytes never
 // crash the baker.
 Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options);
 
-// Reads the file, then bake_font. An unreadable file returns ErrorCode::io.
+// font_unsupported, with what to do instead, for the font containers crisp does not bake though
+// FreeType could open them: WOFF, WOFF2 (decompress them first) and PostScript Type 1 (PFA, PFB:
+// convert them to OpenType CFF); success for anything else (TrueType, OpenType, collections).
+Status check_font_container(std::span<const std::byte> font_bytes);
+
+// Reads the file, then bake_font. An unreadable file returns ErrorCode::io: a file that is not a
+// regular file, or larger than 256 MiB (docs/limits.md), is refused before it is read.
 Result<BakeResult> bake_font_file(const std::filesystem::path& path, const BakeOptions& options);
 
 // Parses "wght=700" into a Variation; returns invalid_argument naming the fault otherwise.

@@ -99,7 +99,7 @@ struct CompositorCreateInfo {
     VkFormat draw_format = VK_FORMAT_UNDEFINED;
 
     // ---- The reference modes (record_reference()): off unless asked for, since they hold
-    // per-pixel buffers over the whole target (44 + 8K bytes a pixel, and the exact node pool).
+    // per-pixel buffers over the whole target (36 bytes a pixel, and the exact node pool).
     bool reference_modes = false;
     // The reference target's size, each 1..16384 (ignored without reference_modes).
     uint32_t width = 0;

@@ -1,0 +1,113 @@
+// Bounded inputs and safe outputs (docs/limits.md): reads only of regular files within a limit,
+// writes that refuse to replace what is not a regular file or is an input, and font containers
+// the baker refuses up front with what to do instead.
+#include "file_io.hpp"
+#include "limits.hpp"
+#include "test_support.hpp"
+
+#include <crisp/asset.hpp>
+#include <crisp/bake.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <sys/stat.h>
+
+namespace crisp {
+namespace {
+
+namespace fs = std::filesystem;
+using test::TemporaryDirectory;
+
+std::vector<std::byte> bytes_of(std::string_view text) {
+    std::vector<std::byte> out(text.size());
+    for (size_t i = 0; i < text.size(); ++i) out[i] = static_cast<std::byte>(text[i]);
+    return out;
+}
+
+TEST(Limits, ReadsOnlyRegularFiles) {
+    TemporaryDirectory directory;
+    ASSERT_FALSE(directory.path().empty());
+    const fs::path fifo = directory.path() / "fifo";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    // A FIFO with no writer would block a reader forever: it is refused before it is opened for
+    // reading... and /dev/zero, which never ends, before a byte is read.
+    for (const fs::path& path : {fs::path("/dev/zero"), directory.path()}) {
+        auto read = read_file(path, limits::kFontFileBytes);
+        ASSERT_FALSE(read) << path;
+        EXPECT_EQ(read.error().code, ErrorCode::io);
+    }
+    EXPECT_NE(read_file("/dev/zero", limits::kFontFileBytes).error().message.find("not a regular file"),
+              std::string::npos);
+    auto asset = load_asset_file("/dev/zero");
+    ASSERT_FALSE(asset);
+    EXPECT_NE(asset.error().message.find("not a regular file"), std::string::npos);
+}
+
+TEST(Limits, ReadsNoMoreThanTheLimit) {
+    TemporaryDirectory directory;
+    const fs::path file = directory.path() / "big.bin";
+    ASSERT_TRUE(write_file_atomically(file, std::vector<std::byte>(2048, std::byte{7})));
+    auto refused = read_file(file, 2047);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("2047 bytes allowed"), std::string::npos);
+    auto read = read_file(file, 2048);
+    ASSERT_TRUE(read);
+    EXPECT_EQ(read->size(), 2048u);
+}
+
+TEST(Limits, WritesNeverReplaceWhatIsNotARegularFile) {
+    TemporaryDirectory directory;
+    const fs::path fifo = directory.path() / "fifo";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const fs::path folder = directory.path() / "folder";
+    fs::create_directory(folder);
+    for (const fs::path& target : {fifo, folder}) {
+        const Status written = write_file_atomically(target, bytes_of("x"));
+        ASSERT_FALSE(written) << target;
+        EXPECT_NE(written.error().message.find("not a regular file"), std::string::npos);
+    }
+    EXPECT_TRUE(fs::is_fifo(fifo));
+    EXPECT_TRUE(fs::is_directory(folder));
+    EXPECT_EQ(directory.entries(), (std::vector<std::string>{"fifo", "folder"}));  // no temporary left
+    // The same checks, before any work: and the input itself, under any of its names.
+    const fs::path input = directory.path() / "font.ttf";
+    ASSERT_TRUE(write_file_atomically(input, bytes_of("font")));
+    const fs::path link = directory.path() / "link.ttf";
+    fs::create_symlink(input, link);
+    const fs::path inputs[] = {input};
+    EXPECT_FALSE(check_output_path(input, inputs));
+    EXPECT_FALSE(check_output_path(link, inputs));
+    EXPECT_FALSE(check_output_path(directory.path() / "missing" / "out.crisp", inputs));
+    EXPECT_FALSE(check_output_path(fifo, inputs));
+    EXPECT_TRUE(check_output_path(directory.path() / "out.crisp", inputs));
+    EXPECT_TRUE(check_output_path("/dev/null").error().message.find("not a regular file") != std::string::npos);
+}
+
+TEST(Limits, FontContainersThatCannotBeShapedAreRefusedUpFront) {
+    const std::pair<const char*, const char*> cases[] = {
+        {"wOFF\x00\x01\x00\x00", "decompress"},
+        {"wOF2\x00\x01\x00\x00", "woff2_decompress"},
+        {"\x80\x01\x10\x00\x00\x00%!PS-AdobeFont-1.0", "Type 1"},
+        {"%!PS-AdobeFont-1.0: Test 001", "Type 1"},
+        {"%!FontType1-1.0: Test", "Type 1"},
+    };
+    for (const auto& [magic, advice] : cases) {
+        std::vector<std::byte> bytes = bytes_of(std::string_view(magic, std::string_view(magic).size() +
+                                                                             (magic[0] == 'w' ? 4 : 0)));
+        bytes.resize(bytes.size() + 64);
+        auto baked = bake_font(bytes, BakeOptions{});
+        ASSERT_FALSE(baked) << magic;
+        EXPECT_EQ(baked.error().code, ErrorCode::font_unsupported) << magic;
+        EXPECT_NE(baked.error().message.find(advice), std::string::npos) << baked.error().message;
+    }
+    // A real TrueType font passes the check.
+    EXPECT_TRUE(check_font_container(test::read_file(test::kDejaVuSans)));
+}
+
+}  // namespace
+}  // namespace crisp
