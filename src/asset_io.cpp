@@ -9,6 +9,7 @@
 #include "limits.hpp"
 
 #include <crisp/asset.hpp>
+#include <crisp/bake.hpp>
 
 #include <hb.h>
 
@@ -76,6 +77,8 @@ constexpr uint64_t kMaxAxes = 64;
 constexpr uint64_t kMaxNameBytes = 1024;
 constexpr float kMaxCoordinateEm = 64.0f;
 constexpr uint32_t kMaxBandsPerGlyph = 256;
+// kMaxCurvesPerGlyph curves and a pad between each two of its contours.
+constexpr uint32_t kMaxCurveSlotsPerGlyph = 2 * kMaxCurvesPerGlyph;
 constexpr size_t kMinFontBytes = 12;  // an sfnt header
 constexpr uint32_t kKnownFontFlags = kFontCubic | kFontVariable;
 constexpr uint32_t kKnownGlyphFlags = kGlyphBaked | kGlyphFailed;
@@ -295,6 +298,9 @@ Status check_glyph(const FontAsset& asset, size_t index) {
 
     if ((glyph.flags & kGlyphBaked) == 0)
         return invalid("asset: glyph {}: {} curves but the glyph is not baked", index, glyph.curve_count);
+    if (glyph.curve_count > kMaxCurveSlotsPerGlyph)
+        return invalid("asset: glyph {}: {} curve slots, at most {} (docs/limits.md)", index, glyph.curve_count,
+                       kMaxCurveSlotsPerGlyph);
     if (glyph.bbox_min_x > glyph.bbox_max_x || glyph.bbox_min_y > glyph.bbox_max_y)
         return invalid("asset: glyph {}: bbox [{}, {}] x [{}, {}] is inverted", index, glyph.bbox_min_x,
                        glyph.bbox_max_x, glyph.bbox_min_y, glyph.bbox_max_y);

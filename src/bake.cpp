@@ -258,8 +258,9 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     if (!(options.tolerance_em > 0.0f && options.tolerance_em <= 0.1f)) {
         return Error{ErrorCode::invalid_argument, "tolerance must be in (0, 0.1] em"};
     }
-    if (options.max_curves_per_glyph == 0) {
-        return Error{ErrorCode::invalid_argument, "the curve limit per glyph must be at least 1"};
+    if (options.max_curves_per_glyph == 0 || options.max_curves_per_glyph > kMaxCurvesPerGlyph) {
+        return Error{ErrorCode::invalid_argument,
+                     "the curve limit per glyph must be 1 to " + std::to_string(kMaxCurvesPerGlyph)};
     }
     if (font_bytes.size() > 0x7FFFFFFF) {
         return Error{ErrorCode::font_unreadable, "the font is larger than 2 GiB"};

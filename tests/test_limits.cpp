@@ -109,5 +109,33 @@ TEST(Limits, FontContainersThatCannotBeShapedAreRefusedUpFront) {
     EXPECT_TRUE(check_font_container(test::read_file(test::kDejaVuSans)));
 }
 
+// Curves per glyph are bounded in the baker and the loader alike: a glyph's cost in every sample
+// grows with them.
+TEST(Limits, CurvesPerGlyphAreBoundedInTheBakerAndTheLoader) {
+    BakeOptions options;
+    EXPECT_EQ(options.max_curves_per_glyph, kMaxCurvesPerGlyph);
+    options.max_curves_per_glyph = kMaxCurvesPerGlyph + 1;
+    const std::vector<std::byte> font = test::read_file(test::kDejaVuSans);
+    auto refused = bake_font(font, options);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::invalid_argument);
+
+    options = BakeOptions{};
+    options.all_glyphs = false;
+    options.codepoints = {'a'};
+    auto baked = bake_font(font, options);
+    ASSERT_TRUE(baked) << baked.error().message;
+    FontAsset asset = baked->asset;
+    ASSERT_TRUE(validate_asset(asset));
+    for (GlyphRecord& glyph : asset.glyphs) {
+        if (glyph.curve_count == 0) continue;
+        glyph.curve_count = 2 * kMaxCurvesPerGlyph + 1;
+        break;
+    }
+    const Status invalid = validate_asset(asset);
+    ASSERT_FALSE(invalid);
+    EXPECT_NE(invalid.error().message.find("curve slots, at most"), std::string::npos) << invalid.error().message;
+}
+
 }  // namespace
 }  // namespace crisp

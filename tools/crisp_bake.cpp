@@ -46,7 +46,7 @@ options:
   --codepoints RANGES      the same for code points: U+0020-007E,0x4E00-0x4E10,65
   --tolerance EM           largest cubic-to-quadratic deviation in em (default 1/4096)
   --split-y-extrema        split curves at their y-extrema (measured not to pay; see docs)
-  --max-curves N           a glyph with more than N curves fails (default 65535)
+  --max-curves N           a glyph with more than N curves fails, 1..4096 (default 4096)
   --allow-failed           bake failed glyphs as empty glyphs instead of giving up
   --json                   print the report as JSON on stdout
   -q, --quiet              no progress bar and no report (errors still go to stderr)
@@ -120,7 +120,9 @@ Arguments parse_arguments(int argc, char** argv) {
             args.bake.split_y_extrema = true;
         } else if (arg == "--max-curves") {
             args.bake.max_curves_per_glyph = parse_number<uint32_t>(arg, value());
-            if (args.bake.max_curves_per_glyph == 0) usage_error("--max-curves must be at least 1");
+            if (args.bake.max_curves_per_glyph == 0 || args.bake.max_curves_per_glyph > crisp::kMaxCurvesPerGlyph) {
+                usage_error("--max-curves must be 1 to " + std::to_string(crisp::kMaxCurvesPerGlyph));
+            }
         } else if (arg == "--allow-failed") {
             args.bake.allow_failed = true;
         } else if (arg == "--json") {

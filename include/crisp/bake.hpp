@@ -26,6 +26,10 @@ inline constexpr float kDefaultToleranceEm = 1.0f / 4096.0f;
 // Bands are added until the fullest band holds at most this many curves, or until kMaxBands.
 inline constexpr uint32_t kTargetCurvesPerBand = 8;
 inline constexpr uint32_t kMaxBands = 32;
+// The most curves one glyph may have, in the baker and (with the pads between its contours, twice
+// as many curve slots) in the loader: the most complex glyphs of common fonts have about 550 (a CJK
+// face's), and a glyph's cost in every sample grows with its curves (docs/limits.md).
+inline constexpr uint32_t kMaxCurvesPerGlyph = 4096;
 // Each band reaches this fraction of its height past both of its edges, so a curve whose y-extent
 // ends exactly on an edge (or within float rounding of it) is listed in both bands.
 inline constexpr float kBandOverlap = 1.0f / 256.0f;
@@ -44,7 +48,8 @@ struct BakeOptions {
     bool all_glyphs = true;                    // false: bake only `codepoints` (and their closure)
     float tolerance_em = kDefaultToleranceEm;  // largest cubic-to-quadratic deviation, in (0, 0.1]
     bool split_y_extrema = false;              // split quadratics at y-extrema (docs/cubic-lowering.md)
-    uint32_t max_curves_per_glyph = 65535;     // a glyph with more curves fails
+    // A glyph with more curves fails; at most kMaxCurvesPerGlyph.
+    uint32_t max_curves_per_glyph = kMaxCurvesPerGlyph;
     bool allow_failed = false;                 // keep going past failed glyphs, baking them empty
     // Called now and then with (glyphs done, glyphs to do); may be empty.
     std::function<void(uint32_t, uint32_t)> progress;
