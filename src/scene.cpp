@@ -193,6 +193,10 @@ Result<Scene> parse_scene(std::string_view json) {
     if (runs->type != Type::array) {
         return fault("runs", "expected an array of run objects, got " + std::string(runs->type_name()));
     }
+    if (runs->array.size() > kMaxSceneRuns) {
+        return fault("runs", "at most " + std::to_string(kMaxSceneRuns) + " runs (docs/limits.md), got " +
+                                 std::to_string(runs->array.size()));
+    }
     scene.runs.resize(runs->array.size());
     for (size_t i = 0; i < runs->array.size(); ++i) {
         if (auto error = read_run(runs->array[i], element("runs", i), scene.fonts.size(), scene.runs[i])) {

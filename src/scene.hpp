@@ -22,6 +22,8 @@ namespace crisp {
 inline constexpr uint32_t kMaxSceneFonts = 8;        // the renderer's kMaxRendererFonts
 inline constexpr uint32_t kMaxSceneCanvas = 16384;   // crisp-render's --canvas limit, per side
 inline constexpr float kMaxSceneTextSize = 4096.0f;  // pixels per em, crisp-render's --size limit
+// Runs one scene may hold (docs/limits.md): a screen of UI text is hundreds.
+inline constexpr uint32_t kMaxSceneRuns = 65536;
 
 struct SceneRun {
     uint32_t font = 0;                          // index into Scene::fonts

@@ -47,6 +47,14 @@ expect_exit 4 "a FIFO as the output" -- timeout 20 "$render" "${base[@]}" -o "$w
 cp "$font" "$work/font-copy.crisp"
 expect_exit 4 "the font as the output" -- "$render" "${base[@]/$font/$work/font-copy.crisp}" -o "$work/font-copy.crisp"
 cmp -s "$font" "$work/font-copy.crisp" || fail "the input asset was overwritten"
+# More glyphs than one render lays out (4 Mi): refused, exit 7, naming the limit.
+python3 - "$work/many.json" <<'PY'
+import json, sys
+runs = [{"text": "H" * 900000, "size": 8, "origin": [0, 8]} for _ in range(5)]
+json.dump({"fonts": ["dejavu.crisp"], "canvas": [32, 32], "runs": runs}, open(sys.argv[1], "w"))
+PY
+expect_exit 7 "a scene of 4.5 million glyphs" -- timeout 120 "$render" --scene "$work/many.json" -o "$work/many.png"
+expect_stderr "glyphs, crisp-render's limit" "a scene of 4.5 million glyphs"
 for size in 0 -3 4096.5 1e9 abc nan inf ""; do
   expect_exit 2 "--size '$size'" -- "$render" "${base[@]}" --size "$size" -o x.png
 done

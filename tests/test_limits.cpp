@@ -3,10 +3,12 @@
 // the baker refuses up front with what to do instead.
 #include "file_io.hpp"
 #include "limits.hpp"
+#include "scene.hpp"
 #include "test_support.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>
+#include <crisp/layout.hpp>
 
 #include <gtest/gtest.h>
 
@@ -135,6 +137,27 @@ TEST(Limits, CurvesPerGlyphAreBoundedInTheBakerAndTheLoader) {
     const Status invalid = validate_asset(asset);
     ASSERT_FALSE(invalid);
     EXPECT_NE(invalid.error().message.find("curve slots, at most"), std::string::npos) << invalid.error().message;
+}
+
+// Runs per scene and bytes of text per layout are bounded, each refusal naming its limit.
+TEST(Limits, ScenesAndTextAreBounded) {
+    std::string json = R"({"fonts": ["a.crisp"], "canvas": [8, 8], "runs": [)";
+    for (uint32_t i = 0; i <= kMaxSceneRuns; ++i) {
+        json += i ? "," : "";
+        json += R"({"text": "a", "size": 8, "origin": [0, 8]})";
+    }
+    json += "]}";
+    auto scene = parse_scene(json);
+    ASSERT_FALSE(scene);
+    EXPECT_NE(scene.error().message.find("at most 65536 runs"), std::string::npos) << scene.error().message;
+
+    auto font = test::bake_test_font("a");
+    ASSERT_TRUE(font);
+    const Font* fonts[] = {font.get()};
+    const std::string text(kMaxTextBytes + 1, 'a');
+    auto laid = layout_text(fonts, text, TextStyle{}, LayoutOptions{});
+    ASSERT_FALSE(laid);
+    EXPECT_EQ(laid.error().code, ErrorCode::invalid_argument);
 }
 
 }  // namespace

@@ -55,6 +55,9 @@ enum ExitCode : int {
 };
 
 constexpr uint32_t kDefaultSamples = 512;
+// Glyphs one render lays out, all runs together: a 3840x2160 screen of 12 px text is 80,000, and 32
+// layers of 18 px text over it about a million; the atlas and the GPU buffers stay far below a GiB.
+constexpr size_t kMaxGlyphs = size_t{4} << 20;
 constexpr uint32_t kMaxCanvas = 16384;
 // The default schedule reaches kMaxRendererSamples in about 1030 frames; far more means the
 // renderer stopped making progress.
@@ -1043,6 +1046,11 @@ void lay_out(const Arguments& args, Job& job) {
         }
         paint_order = text.next_paint_order;
         job.laid_out += text.glyphs.size();
+        if (job.laid_out > kMaxGlyphs) {
+            fail(args.scene.empty() ? kExitUsage : kExitScene,
+                 (args.scene.empty() ? std::string("the text") : args.scene) + " lays out more than " +
+                     std::to_string(kMaxGlyphs) + " glyphs, crisp-render's limit (docs/limits.md)");
+        }
         job.missing += text.missing_glyphs;
         job.blank += text.blank_glyphs;
         job.out_of_range += text.out_of_range_glyphs;

@@ -38,8 +38,10 @@ inline constexpr float kMaxTextSize = 4096.0f;
 // Glyphs whose pen lands farther than this from the canvas origin (in pixels, either axis) are
 // not emitted (TextLayout::out_of_range_glyphs counts them), so every emitted rect fits int32.
 inline constexpr double kMaxCoordinate = 1 << 30;
-// Longest text accepted, in bytes (FriBidi and HarfBuzz index text with int).
-inline constexpr size_t kMaxTextBytes = 0x7FFFFFFF;
+// Longest text accepted, in bytes: 16 MiB, a few long books, whose glyph instances, itemization and
+// shaping buffers stay within a few GiB (docs/limits.md). (FriBidi and HarfBuzz index text with
+// int; this is far below.)
+inline constexpr size_t kMaxTextBytes = size_t{16} << 20;
 
 enum class Align : uint8_t {
     left,
