@@ -159,7 +159,7 @@ void reset(TextLayout& out, uint32_t first_paint_order) {
     out.glyphs.clear();
     out.lines.clear();
     out.x = out.y = out.width = out.height = out.line_height = 0.0f;
-    out.shaped_glyphs = out.missing_glyphs = out.blank_glyphs = out.out_of_range_glyphs = 0;
+    out.shaped_glyphs = out.missing_glyphs = out.blank_glyphs = out.out_of_range_glyphs = out.mark_splits = 0;
     out.next_paint_order = first_paint_order;
 }
 
@@ -181,6 +181,7 @@ struct Layouter::State {
     double tab_width = 0.0;             // pixels; 0: tabs are spaces
     hb_language_t language = nullptr;
     bool failed = false;                // HarfBuzz ran out of memory
+    uint32_t mark_splits = 0;           // clusters cut after kMaxMarksPerCluster attached characters
 
     // Whole text.
     std::vector<uint32_t> codepoints;
@@ -249,7 +250,9 @@ bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t e
     const double scale_x = per_unit * size_x, scale_y = per_unit * size_y;
     const bool snap = options->snap_to_pixels;
     auto pixels = [snap](double value) { return static_cast<float>(snap ? std::round(value) : value); };
-    shaped.reserve(shaped.size() + count);
+    // Grown geometrically: reserving exactly size + count here reallocated on every run (quadratic
+    // in a paragraph of many runs).
+    if (shaped.capacity() < shaped.size() + count) shaped.reserve(std::max(shaped.size() + count, 2 * shaped.capacity()));
     for (unsigned k = 0; k < count; ++k) {
         // HarfBuzz returns right-to-left runs in visual order; keep everything logical.
         const unsigned i = rtl ? count - 1 - k : k;
@@ -288,9 +291,22 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     runs.clear();
     shaped.clear();
     uint32_t run_begin = p0;
+    // Combining marks (and joiners, selectors) attached to one base: HarfBuzz reorders a cluster's
+    // marks in time quadratic in their number, so past kMaxMarksPerCluster a new run starts.
+    uint32_t attached = (flags[p0] & kCharAttached) != 0 ? 1 : 0;
     for (uint32_t i = p0 + 1; i <= p1; ++i) {
-        if (i < p1 && levels[i] == levels[i - 1] && scripts[i] == scripts[i - 1] && font_of[i] == font_of[i - 1])
+        bool split = false;
+        if (i < p1) {
+            attached = (flags[i] & kCharAttached) != 0 ? attached + 1 : 0;
+            split = attached > kMaxMarksPerCluster;
+        }
+        if (i < p1 && !split && levels[i] == levels[i - 1] && scripts[i] == scripts[i - 1] &&
+            font_of[i] == font_of[i - 1])
             continue;
+        if (split) {
+            ++mark_splits;
+            attached = 1;  // the mark at i starts the next run
+        }
         Run run;
         run.begin = run_begin;
         run.end = i;
@@ -543,6 +559,7 @@ void Layouter::State::finish(const TextStyle& style, TextLayout& out) {
 
     out.glyphs.reserve(placed.size());
     out.shaped_glyphs = static_cast<uint32_t>(std::min<size_t>(placed.size(), UINT32_MAX));
+    out.mark_splits = mark_splits;
     size_t p = 0;
     for (size_t i = 0; i < lines.size(); ++i) {
         TextLine& record = out.lines[i];
@@ -606,6 +623,7 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
     for (const Font* font : fonts) font_views.push_back({font->asset().glyphs.data(), font->asset().glyphs.size(), font->id()});
     options = &layout_options;
     failed = false;
+    mark_splits = 0;
     size_x = static_cast<double>(std::lround(static_cast<double>(style.size) * kSizeOne)) / kSizeOne;
     const float size_y_asked = style.size_y == 0.0f ? style.size : style.size_y;
     size_y = static_cast<double>(std::lround(static_cast<double>(size_y_asked) * kSizeOne)) / kSizeOne;

@@ -42,6 +42,12 @@ inline constexpr double kMaxCoordinate = 1 << 30;
 // shaping buffers stay within a few GiB (docs/limits.md). (FriBidi and HarfBuzz index text with
 // int; this is far below.)
 inline constexpr size_t kMaxTextBytes = size_t{16} << 20;
+// Combining marks (joiners and variation selectors count too) shaped with one base character:
+// past this many a new shaping run starts, and the further marks are drawn after the base rather
+// than attached to it (TextLayout::mark_splits counts the cuts). HarfBuzz reorders a cluster's
+// marks in time quadratic in their number: 'a' and 100,000 marks took 21 s. Real text stacks a
+// handful (Vietnamese, Tibetan, Indic up to about 10); "Zalgo" text dozens.
+inline constexpr uint32_t kMaxMarksPerCluster = 64;
 
 enum class Align : uint8_t {
     left,
@@ -130,6 +136,7 @@ struct TextLayout {
     uint32_t missing_glyphs = 0;   // .notdef glyphs (characters no font has); they are emitted
     uint32_t blank_glyphs = 0;     // glyphs without an outline (dropped unless keep_blank_glyphs)
     uint32_t out_of_range_glyphs = 0;  // not emitted: pen beyond kMaxCoordinate
+    uint32_t mark_splits = 0;      // clusters cut after kMaxMarksPerCluster combining marks
     uint32_t next_paint_order = 0; // first_paint_order + glyphs.size()
 };
 
