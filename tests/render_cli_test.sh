@@ -47,6 +47,12 @@ expect_exit 4 "a FIFO as the output" -- timeout 20 "$render" "${base[@]}" -o "$w
 cp "$font" "$work/font-copy.crisp"
 expect_exit 4 "the font as the output" -- "$render" "${base[@]/$font/$work/font-copy.crisp}" -o "$work/font-copy.crisp"
 cmp -s "$font" "$work/font-copy.crisp" || fail "the input asset was overwritten"
+# Every output is checked before any work, and written together: a --coverage-out that cannot be
+# written leaves an existing PNG as it was.
+printf 'existing' > "$work/kept.png"
+expect_exit 4 "an unwritable --coverage-out" -- "$render" "${base[@]}" -o "$work/kept.png" \
+  --coverage-out "$work/no/such/dir/c.pfm"
+[ "$(cat "$work/kept.png")" = existing ] || fail "the PNG was replaced though --coverage-out failed"
 # More glyphs than one render lays out (4 Mi): refused, exit 7, naming the limit.
 python3 - "$work/many.json" <<'PY'
 import json, sys

@@ -186,5 +186,34 @@ TEST(Limits, LongClustersOfMarksAreShapedInRunsOfBoundedLength) {
     EXPECT_EQ(few->mark_splits, 0u);
 }
 
+// A run's outputs are put in place together: when one cannot be written, none is replaced, and no
+// temporary is left; temporaries a killed writer left behind go at the next write.
+TEST(Limits, OutputsAreReplacedTogetherOrNotAtAll) {
+    TemporaryDirectory directory;
+    const fs::path png = directory.path() / "out.png";
+    const fs::path pfm = directory.path() / "out.pfm";
+    ASSERT_TRUE(write_file_atomically(png, bytes_of("old png")));
+    const std::vector<std::byte> new_png = bytes_of("new png"), new_pfm = bytes_of("new pfm");
+    const OutputFile refused[] = {{png, new_png}, {directory.path() / "missing" / "out.pfm", new_pfm}};
+    EXPECT_FALSE(write_files_atomically(refused));
+    EXPECT_EQ(test::read_file(png.string()), bytes_of("old png"));
+    EXPECT_EQ(directory.entries(), std::vector<std::string>{"out.png"});
+    const OutputFile both[] = {{png, new_png}, {pfm, new_pfm}};
+    ASSERT_TRUE(write_files_atomically(both));
+    EXPECT_EQ(test::read_file(png.string()), new_png);
+    EXPECT_EQ(test::read_file(pfm.string()), new_pfm);
+
+    // A temporary of png's pattern, two minutes old (a writer killed mid-write), and a fresh one
+    // (maybe another writer's): the next write of png removes the first only.
+    const fs::path stale = directory.path() / ".out.png.tmp-ABCDEF";
+    const fs::path fresh = directory.path() / ".out.png.tmp-GHIJKL";
+    ASSERT_TRUE(write_file_atomically(stale, bytes_of("x")));
+    ASSERT_TRUE(write_file_atomically(fresh, bytes_of("x")));
+    fs::last_write_time(stale, fs::file_time_type::clock::now() - std::chrono::minutes(2));
+    ASSERT_TRUE(write_file_atomically(png, new_png));
+    EXPECT_FALSE(fs::exists(stale));
+    EXPECT_TRUE(fs::exists(fresh));
+}
+
 }  // namespace
 }  // namespace crisp

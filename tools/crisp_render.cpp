@@ -1107,21 +1107,25 @@ int run(const Arguments& args) {
 
     const uint32_t width = job.scene.width, height = job.scene.height;
     const auto write_start = std::chrono::steady_clock::now();
-    {
-        const bool opaque = job.scene.background[3] >= 1.0f;
-        const std::vector<float> pixels = png_pixels(report.composite.target, opaque);
-        report.composite.target = {};
-        if (crisp::Status status = crisp::write_png_srgb8(args.output, width, height, opaque ? 3 : 4, pixels);
-            !status) {
-            fail(status.error().code == crisp::ErrorCode::io ? kExitOutput : kExitInternal, status.error().message);
-        }
-    }
+    // Both outputs are encoded, then put in place together: a failure replaces neither. Errors
+    // return (the context is destroyed on the way out), never exit with live Vulkan objects.
+    auto write_failed = [](const crisp::Error& error) {
+        std::fprintf(stderr, "crisp-render: %s\n", error.message.c_str());
+        return error.code == crisp::ErrorCode::io ? kExitOutput : kExitInternal;
+    };
+    const bool opaque = job.scene.background[3] >= 1.0f;
+    crisp::Result<std::vector<std::byte>> png =
+        crisp::encode_png_srgb8(width, height, opaque ? 3 : 4, png_pixels(report.composite.target, opaque));
+    report.composite.target = {};
+    if (!png) return write_failed(png.error());
+    std::vector<crisp::OutputFile> outputs = {{args.output, *png}};
+    crisp::Result<std::vector<std::byte>> pfm = std::vector<std::byte>{};
     if (!args.coverage_output.empty()) {
-        const std::vector<float> coverage = coverage_image(width, height, report);
-        if (crisp::Status status = crisp::write_pfm(args.coverage_output, width, height, coverage); !status) {
-            fail(status.error().code == crisp::ErrorCode::io ? kExitOutput : kExitInternal, status.error().message);
-        }
+        pfm = crisp::encode_pfm(width, height, coverage_image(width, height, report));
+        if (!pfm) return write_failed(pfm.error());
+        outputs.push_back({args.coverage_output, *pfm});
     }
+    if (crisp::Status status = crisp::write_files_atomically(outputs); !status) return write_failed(status.error());
     summary.write_ms = milliseconds_since(write_start);
     summary.total_ms = milliseconds_since(start);
 
