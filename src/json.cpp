@@ -411,6 +411,12 @@ void append_string(std::string& out, std::string_view text) {
     out += '"';
 }
 
+std::string quote(std::string_view text) {
+    std::string out;
+    append_string(out, text);
+    return out;
+}
+
 void append_number(std::string& out, double value) {
     char buffer[32];
     const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);

@@ -47,6 +47,8 @@ Result<Value> parse(std::string_view text);
 
 // Appends `text` as a JSON string literal, quoted and escaped; ill-formed UTF-8 becomes U+FFFD.
 void append_string(std::string& out, std::string_view text);
+// `text` as a JSON string literal (append_string to an empty string).
+std::string quote(std::string_view text);
 
 // Appends a number in the shortest form that reads back to the same double.
 void append_number(std::string& out, double value);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "oit_reference.hpp"
+#include "test_support.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/font.hpp>
@@ -38,9 +39,7 @@ struct TextRun {
     float depth;
 };
 
-struct Texel {
-    uint16_t r, g, b, count;
-};
+using test::Texel;
 
 // A scene rendered to convergence: its glyphs, the atlas texels, and the fragments of every pixel
 // (in draw order) as the compositor's shaders compute them.

@@ -50,9 +50,7 @@ struct Accuracy {
     bool in_range = true;  // every coverage finite and within [0, 1]
 };
 
-struct Texel {
-    uint16_t r, g, b, count;
-};
+using test::Texel;
 
 // Renders the glyph instances with `samples` samples per glyph and measures the error.
 Accuracy render_and_measure(const Font& font, std::span<const GlyphInstance> glyphs, const SubpixelLayout& layout,

@@ -35,9 +35,7 @@ Fixture& fixture() {
     return f;
 }
 
-struct Texel {
-    uint16_t r, g, b, count;
-};
+using test::Texel;
 
 // Renders `text` until it converges and returns the atlas texels.
 std::vector<Texel> render(Renderer& renderer, const TextLayout& layout, uint32_t& frames) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,12 @@
 #include <vector>
 
 namespace crisp::test {
+
+// One texel of the atlas as Renderer::record_atlas_readback() copies it: the red, green and blue
+// hits in kCoverageOne units, then the sample count.
+struct Texel {
+    uint16_t r, g, b, count;
+};
 
 inline std::string source_path(const std::string& relative) {
     return std::string(CRISP_SOURCE_DIR) + "/" + relative;

@@ -1,6 +1,7 @@
 // crisp-bake: turns a font into a .crisp asset, or checks an asset.
 #include "cli.hpp"
 #include "file_io.hpp"
+#include "json.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>
@@ -154,21 +155,7 @@ Arguments parse_arguments(int argc, char** argv) {
 }
 
 std::string json_string(std::string_view s) {
-    std::string out = "\"";
-    for (const char c : s) {
-        const auto u = static_cast<unsigned char>(c);
-        if (c == '"' || c == '\\') {
-            out += '\\';
-            out += c;
-        } else if (u < 0x20) {
-            char buffer[8];
-            std::snprintf(buffer, sizeof buffer, "\\u%04x", u);
-            out += buffer;
-        } else {
-            out += c;
-        }
-    }
-    return out + "\"";
+    return crisp::json::quote(s);
 }
 
 std::string json_number(double v) {

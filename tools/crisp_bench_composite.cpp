@@ -9,6 +9,7 @@
 #include "gpu_tools.hpp"
 #include "vk_resources.hpp"
 #include "image_io.hpp"
+#include "json.hpp"
 #include "oit_reference.hpp"
 
 #include <crisp/bake.hpp>
@@ -625,20 +626,7 @@ struct Bench {
 // ---- Output
 
 std::string json_string(const std::string& text) {
-    std::string out = "\"";
-    for (const char ch : text) {
-        if (ch == '"' || ch == '\\') {
-            out += '\\';
-            out += ch;
-        } else if (static_cast<unsigned char>(ch) < 0x20) {
-            char escaped[8];
-            std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(ch));
-            out += escaped;
-        } else {
-            out += ch;
-        }
-    }
-    return out + "\"";
+    return crisp::json::quote(text);
 }
 
 struct Header {

@@ -338,9 +338,7 @@ void check_output_path(const std::string& path, const Arguments& args) {
 // ---- JSON, by hand
 
 std::string json_string(std::string_view s) {
-    std::string out;
-    crisp::json::append_string(out, s);
-    return out;
+    return crisp::json::quote(s);
 }
 
 std::string json_number(double v) {
