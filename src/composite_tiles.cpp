@@ -69,16 +69,8 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     ref_ = device;
     config_ = config;
     // The tile pass reduces its statistics per subgroup.
-    VkPhysicalDeviceSubgroupProperties subgroup{};
-    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
-    VkPhysicalDeviceProperties2 device_properties{};
-    device_properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-    device_properties.pNext = &subgroup;
-    vkGetPhysicalDeviceProperties2(config.physical_device, &device_properties);
-    if ((subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) == 0 ||
-        (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) == 0) {
-        return Error{ErrorCode::vulkan, std::string("compositor: ") + device_properties.properties.deviceName +
-                                            " has no subgroup arithmetic in compute shaders"};
+    if (!vk::has_compute_subgroup_arithmetic(config.physical_device)) {
+        return Error{ErrorCode::vulkan, "compositor: the device has no subgroup arithmetic in compute shaders"};
     }
     constexpr VkShaderStageFlags stage = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorSetLayoutBinding bindings[] = {

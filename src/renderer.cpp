@@ -223,14 +223,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     if (!features.shaderStorageBufferArrayDynamicIndexing) {
         return Error{ErrorCode::vulkan, "renderer: the device lacks shaderStorageBufferArrayDynamicIndexing"};
     }
-    VkPhysicalDeviceSubgroupProperties subgroup{};
-    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
-    VkPhysicalDeviceProperties2 properties2{};
-    properties2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-    properties2.pNext = &subgroup;
-    vkGetPhysicalDeviceProperties2(info.physical_device, &properties2);
-    if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
-        !(subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT)) {
+    if (!vk::has_compute_subgroup_arithmetic(info.physical_device)) {
         return Error{ErrorCode::vulkan, "renderer: the device lacks subgroup arithmetic in compute shaders"};
     }
     const uint32_t buffers_needed = 1 + 2 * kMaxRendererFonts;

@@ -22,6 +22,10 @@ Error vulkan_error(std::string_view call, VkResult result);
 std::optional<uint32_t> find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, uint32_t type_bits,
                                          VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred);
 
+// True when compute shaders on the device may use subgroup arithmetic (subgroupAdd, subgroupMax,
+// ...): the rasterizer and the tile compositor both do.
+bool has_compute_subgroup_arithmetic(VkPhysicalDevice physical_device);
+
 // "1.3.230".
 std::string version_string(uint32_t version);
 

@@ -3,6 +3,7 @@
 // over a non-uniform background, per channel; bit-identical images for shuffled submission;
 // coplanar ties by paint order; overflowing tiles taking the layered way; the caller's rect.
 #include "composite_fixture.hpp"
+#include "gpu_tools.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/vulkan_context.hpp>
@@ -185,19 +186,7 @@ void composite_tiles(Compositor& compositor, const Scene& scene, std::span<const
 // Draws `glyphs` into the target inside a dynamic-rendering pass that loads what it holds.
 void composite_draw(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs, Target& t) {
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
-        VkRenderingAttachmentInfo attachment{};
-        attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-        attachment.imageView = t.image.view();
-        attachment.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
-        attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-        attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-        VkRenderingInfo rendering{};
-        rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
-        rendering.renderArea = {{0, 0}, {t.width, t.height}};
-        rendering.layerCount = 1;
-        rendering.colorAttachmentCount = 1;
-        rendering.pColorAttachments = &attachment;
-        vkCmdBeginRendering(cb, &rendering);
+        tools::begin_rendering_over(cb, t.image.view(), {{0, 0}, {t.width, t.height}});
         const Status s = compositor.record_draw(cb, glyphs, scene.renderer->atlas_view(), {{0, 0}, {kWidth, kHeight}});
         EXPECT_TRUE(s) << (s ? "" : s.error().message);
         vkCmdEndRendering(cb);

@@ -493,19 +493,7 @@ struct Bench {
                 s = compositor.record(cb, renderer.drawn(), renderer.atlas_view(), target);
             }
         } else if (run.mode == crisp::CompositeMode::draw) {
-            VkRenderingAttachmentInfo attachment{};
-            attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-            attachment.imageView = image.view();
-            attachment.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
-            attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-            attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-            VkRenderingInfo rendering{};
-            rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
-            rendering.renderArea = rect;
-            rendering.layerCount = 1;
-            rendering.colorAttachmentCount = 1;
-            rendering.pColorAttachments = &attachment;
-            vkCmdBeginRendering(cb, &rendering);
+            crisp::tools::begin_rendering_over(cb, image.view(), rect);
             s = compositor.record_draw(cb, renderer.drawn(), renderer.atlas_view(), rect);
             vkCmdEndRendering(cb);
         } else {

@@ -546,19 +546,7 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
                 const crisp::CompositeTarget target{image->view(), kFormat, VK_FORMAT_UNDEFINED, {width, height}, rect};
                 return compositor.record(command_buffer, renderer.drawn(), renderer.atlas_view(), target);
             }
-            VkRenderingAttachmentInfo attachment{};
-            attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-            attachment.imageView = image->view();
-            attachment.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
-            attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-            attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-            VkRenderingInfo rendering{};
-            rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
-            rendering.renderArea = rect;
-            rendering.layerCount = 1;
-            rendering.colorAttachmentCount = 1;
-            rendering.pColorAttachments = &attachment;
-            vkCmdBeginRendering(command_buffer, &rendering);
+            crisp::tools::begin_rendering_over(command_buffer, image->view(), rect);
             crisp::Status recorded = compositor.record_draw(command_buffer, renderer.drawn(), renderer.atlas_view(), rect);
             vkCmdEndRendering(command_buffer);
             return recorded;

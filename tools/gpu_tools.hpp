@@ -49,6 +49,25 @@ inline Result<HeadlessContext> create_context(HeadlessContextOptions options, bo
     return Error{context.error().code, first + "; without format-less storage images: " + context.error().message};
 }
 
+// Begins dynamic rendering into one colour attachment, `view` in GENERAL layout, keeping what it
+// holds (loadOp LOAD) and storing the result: where crisp's draw path composites, as an
+// application's render pass would. End it with vkCmdEndRendering.
+inline void begin_rendering_over(VkCommandBuffer command_buffer, VkImageView view, const VkRect2D& area) {
+    VkRenderingAttachmentInfo attachment{};
+    attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+    attachment.imageView = view;
+    attachment.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+    attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    VkRenderingInfo rendering{};
+    rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+    rendering.renderArea = area;
+    rendering.layerCount = 1;
+    rendering.colorAttachmentCount = 1;
+    rendering.pColorAttachments = &attachment;
+    vkCmdBeginRendering(command_buffer, &rendering);
+}
+
 // The GPU time between two points of a command buffer, from a pool of two timestamp queries.
 // Move-only; destroy it before its context.
 class GpuTimer {
