@@ -1,7 +1,7 @@
 // Adds point samples of glyph outlines into the atlas accumulators.
 //
-// Each workgroup takes 64 texels of one glyph (the work items tile the dispatch), each invocation
-// one texel. For every sample it places one point per colour channel inside that channel's
+// Each workgroup takes 64 texels of one glyph (the work items tile the dispatch; an item covers a
+// part of a glyph's rect, or a range of that part's texels), each invocation one texel. For every sample it places one point per colour channel inside that channel's
 // subpixel rectangle (the R2 sequence, continued across frames), casts a ray towards +x from each
 // and counts the nonzero winding number over the curves of the bands the subgroup touches, using
 // Lengyel's root classification. A covered sample adds kRasterCoverageOne to its channel.
@@ -115,10 +115,13 @@ void main() {
     if (workgroup >= pc.workgroup_count) return;
     RasterItem item = items[find_item(workgroup)];
     uint local = (workgroup - item.first_workgroup) * kRasterWorkgroupSize + gl_LocalInvocationIndex;
-    if (local >= item.width * item.height) return;
+    if (local >= item.texel_count) return;
+    local += item.first_texel;
     uint tx = local % item.width;
     uint ty = local / item.width;
     ivec2 texel = ivec2(item.atlas_x + tx, item.atlas_y + ty);
+    tx += item.part_x;  // from here on, texels of the glyph rect
+    ty += item.part_y;
     uvec4 sums = item.first_sample == 0u ? uvec4(0u) : imageLoad(atlas, texel);
     uint font = item.font;
 

@@ -76,6 +76,10 @@ struct RasterItem {
     uint font;             // index into the per-font buffer arrays
     uint first_sample;     // index of the first sample to add; 0: start from empty accumulators
     uint sample_count;     // samples to add
+    uint part_x;           // texel (0, 0) of the work is texel (part_x, part_y) of the glyph rect
+    uint part_y;
+    uint first_texel;      // the work's texels, row-major over width x height
+    uint texel_count;
     uint first_workgroup;  // this item's first workgroup; the items' ranges tile the dispatch
 };
 
@@ -236,7 +240,7 @@ struct TilePushConstants {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RasterItem) == 72);
+static_assert(sizeof(RasterItem) == 88);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
 static_assert(offsetof(TileHeader, layered_dispatch_x) == kTileLayeredDispatchOffset);
 static_assert(kTileScanBlock == kTileScanInvocations * kTileScanPerInvocation);
@@ -246,7 +250,7 @@ static_assert(sizeof(CompositeQuad) == 64);
 static_assert(offsetof(CompositeQuad, color) == 48);
 static_assert(sizeof(CompositePushConstants) == 64);
 static_assert(offsetof(CompositePushConstants, width) == 16);
-static_assert(offsetof(RasterItem, first_workgroup) == 68);
+static_assert(offsetof(RasterItem, first_workgroup) == 84);
 static_assert(sizeof(RasterPushConstants) == 64);
 static_assert(offsetof(RasterPushConstants, item_count) == 48);
 static_assert(sizeof(SelftestPushConstants) == 8);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cassert>
+#include <cmath>
 #include <string>
 
 namespace crisp {
@@ -261,79 +262,118 @@ uint32_t GlyphAtlas::make_room(uint32_t bit_count) {
 }
 
 AtlasLookup GlyphAtlas::acquire(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample) {
-    AtlasLookup lookup;
-    if (width == 0 || height == 0) return lookup;
+    return acquire(key, width, height, curve_tests_per_sample, TexelRect{0, 0, width, height});
+}
 
-    uint32_t id = kNoAtlasEntry;
+AtlasLookup GlyphAtlas::acquire(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample,
+                                const TexelRect& visible) {
+    const uint32_t x0 = std::min(visible.x, width), y0 = std::min(visible.y, height);
+    const uint32_t x1 = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{visible.x} + visible.width, width));
+    const uint32_t y1 = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{visible.y} + visible.height, height));
+    if (x0 >= x1 || y0 >= y1) return {};
+
     if (const auto found = ids_by_key_.find(key); found != ids_by_key_.end()) {
-        id = found->second;
-        assert(slots_[id].entry.width == width && slots_[id].entry.height == height && "equal keys need equal rects");
-        pin(id);
-        ++frame_counters_.hits;
-        ++total_counters_.hits;
-    } else {
-        // Cells per axis, rounded up to powers of two; then the block is made square or 1:2 tall
-        // (the shapes an aligned run of the transposed Z-order can take).
-        const uint64_t need_x = std::bit_ceil((uint64_t{width} + kAtlasCellSize - 1) / kAtlasCellSize);
-        const uint64_t need_y = std::bit_ceil((uint64_t{height} + kAtlasCellSize - 1) / kAtlasCellSize);
-        const uint64_t block_y = std::max(need_x, need_y);
-        const uint64_t block_x = std::max(need_x, block_y / 2);
-        if (block_x > cells_x_ || block_y > cells_y_) {
-            lookup.status = AtlasStatus::too_large;
-            ++frame_counters_.failed_too_large;
-            ++total_counters_.failed_too_large;
-            return lookup;
-        }
-        const auto bit_count = static_cast<uint32_t>(block_x * block_y);
-        uint32_t first_bit = find_block(bit_count);
-        if (first_bit == kNotFound) first_bit = make_room(bit_count);
-        if (first_bit == kNotFound) {
-            lookup.status = AtlasStatus::atlas_full;
-            ++frame_counters_.failed_full;
-            ++total_counters_.failed_full;
-            return lookup;
-        }
-
-        if (!free_ids_.empty()) {
-            id = free_ids_.back();
-            free_ids_.pop_back();
-        } else {
-            id = static_cast<uint32_t>(slots_.size());
-            slots_.emplace_back();
-        }
+        const uint32_t id = found->second;
         Slot& slot = slots_[id];
-        slot = Slot{};
-        // The lowest index of an aligned run has the run's low bits clear: its top-left cell.
-        const CellCoord cell = n_order_decode(first_bit);
-        slot.entry.key = key;
-        slot.entry.x = cell.x * kAtlasCellSize;
-        slot.entry.y = cell.y * kAtlasCellSize;
-        slot.entry.width = width;
-        slot.entry.height = height;
-        slot.entry.block_width = static_cast<uint32_t>(block_x) * kAtlasCellSize;
-        slot.entry.block_height = static_cast<uint32_t>(block_y) * kAtlasCellSize;
-        slot.entry.curve_tests_per_sample = curve_tests_per_sample;
-        slot.entry.last_used_frame = frame_;
-        slot.first_bit = first_bit;
-        slot.bit_count = bit_count;
-        slot.resident = true;
-        mark_cells(first_bit, bit_count, true);
-        set_range(pinned_words_, first_bit, bit_count, true);
-        pinned_ids_.push_back(id);
-        lru_push_front(id);
-        ids_by_key_.emplace(key, id);
-        ++frame_counters_.allocations;
-        ++total_counters_.allocations;
+        assert(slot.entry.width == width && slot.entry.height == height && "equal keys need equal rects");
+        const TexelRect& held = slot.entry.part;
+        const bool holds = x0 >= held.x && y0 >= held.y && x1 <= held.x + held.width && y1 <= held.y + held.height;
+        if (holds || pinned(slot)) {
+            pin(id);
+            ++frame_counters_.hits;
+            ++total_counters_.hits;
+            return lookup_of(id);
+        }
+        evict(id);
+        ++frame_counters_.parts_replaced;
+        ++total_counters_.parts_replaced;
     }
+    // The part held: the visible texels and a margin, unless that is the whole rect anyway.
+    TexelRect part;
+    part.x = x0 > kAtlasPartMargin ? x0 - kAtlasPartMargin : 0;
+    part.y = y0 > kAtlasPartMargin ? y0 - kAtlasPartMargin : 0;
+    part.width = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{x1} + kAtlasPartMargin, width) - part.x);
+    part.height = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{y1} + kAtlasPartMargin, height) - part.y);
+    return place(key, width, height, curve_tests_per_sample, part);
+}
 
+AtlasLookup GlyphAtlas::lookup_of(uint32_t id) const {
     const AtlasEntry& entry = slots_[id].entry;
+    AtlasLookup lookup;
     lookup.status = AtlasStatus::placed;
     lookup.entry = id;
     lookup.x = entry.x;
     lookup.y = entry.y;
     lookup.width = entry.width;
     lookup.height = entry.height;
+    lookup.part = entry.part;
     return lookup;
+}
+
+AtlasLookup GlyphAtlas::place(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample,
+                              const TexelRect& part) {
+    AtlasLookup lookup;
+    // Cells per axis, rounded up to powers of two; then the block is made square or 1:2 tall
+    // (the shapes an aligned run of the transposed Z-order can take).
+    const uint64_t need_x = std::bit_ceil((uint64_t{part.width} + kAtlasCellSize - 1) / kAtlasCellSize);
+    const uint64_t need_y = std::bit_ceil((uint64_t{part.height} + kAtlasCellSize - 1) / kAtlasCellSize);
+    const uint64_t block_y = std::max(need_x, need_y);
+    const uint64_t block_x = std::max(need_x, block_y / 2);
+    if (block_x > cells_x_ || block_y > cells_y_) {
+        lookup.status = AtlasStatus::too_large;
+        ++frame_counters_.failed_too_large;
+        ++total_counters_.failed_too_large;
+        return lookup;
+    }
+    const auto bit_count = static_cast<uint32_t>(block_x * block_y);
+    uint32_t first_bit = find_block(bit_count);
+    if (first_bit == kNotFound) first_bit = make_room(bit_count);
+    if (first_bit == kNotFound) {
+        lookup.status = AtlasStatus::atlas_full;
+        ++frame_counters_.failed_full;
+        ++total_counters_.failed_full;
+        return lookup;
+    }
+
+    uint32_t id = kNoAtlasEntry;
+    if (!free_ids_.empty()) {
+        id = free_ids_.back();
+        free_ids_.pop_back();
+    } else {
+        id = static_cast<uint32_t>(slots_.size());
+        slots_.emplace_back();
+    }
+    Slot& slot = slots_[id];
+    slot = Slot{};
+    // The lowest index of an aligned run has the run's low bits clear: its top-left cell.
+    const CellCoord cell = n_order_decode(first_bit);
+    slot.entry.key = key;
+    slot.entry.x = cell.x * kAtlasCellSize;
+    slot.entry.y = cell.y * kAtlasCellSize;
+    slot.entry.width = width;
+    slot.entry.height = height;
+    slot.entry.part = part;
+    slot.entry.block_width = static_cast<uint32_t>(block_x) * kAtlasCellSize;
+    slot.entry.block_height = static_cast<uint32_t>(block_y) * kAtlasCellSize;
+    slot.entry.curve_tests_per_sample = curve_tests_per_sample;
+    const uint64_t rect_texels = uint64_t{width} * height, part_texels = uint64_t{part.width} * part.height;
+    if (part_texels < rect_texels) {
+        const double scaled = std::ceil(static_cast<double>(curve_tests_per_sample) * static_cast<double>(part_texels) /
+                                        static_cast<double>(rect_texels));
+        slot.entry.curve_tests_per_sample = std::min(curve_tests_per_sample, static_cast<uint64_t>(scaled));
+    }
+    slot.entry.last_used_frame = frame_;
+    slot.first_bit = first_bit;
+    slot.bit_count = bit_count;
+    slot.resident = true;
+    mark_cells(first_bit, bit_count, true);
+    set_range(pinned_words_, first_bit, bit_count, true);
+    pinned_ids_.push_back(id);
+    lru_push_front(id);
+    ids_by_key_.emplace(key, id);
+    ++frame_counters_.allocations;
+    ++total_counters_.allocations;
+    return lookup_of(id);
 }
 
 // The samples an entry wants this frame: enough to reach its ramp's running total (so a glyph
@@ -344,6 +384,62 @@ uint32_t GlyphAtlas::share(const Slot& slot) const {
     if (slot.served_frames < ramp_totals_.size() && ramp_totals_[slot.served_frames] > samples)
         want = ramp_totals_[slot.served_frames] - samples;
     return static_cast<uint32_t>(std::min<uint64_t>(want, config_.max_samples - samples));
+}
+
+// Counts a work item: its samples once they cover the whole part, its cost at once.
+void GlyphAtlas::count_work(const RasterWork& work) {
+    const bool finishes = work.first_texel + work.texel_count == work.width * work.height;
+    if (finishes) {
+        frame_counters_.samples += work.sample_count;
+        total_counters_.samples += work.sample_count;
+    }
+    if (work.texel_count < work.width * work.height) {
+        ++frame_counters_.split_pieces;
+        ++total_counters_.split_pieces;
+    }
+    frame_counters_.curve_tests = add_saturating(frame_counters_.curve_tests, work.curve_tests);
+    total_counters_.curve_tests = add_saturating(total_counters_.curve_tests, work.curve_tests);
+}
+
+// One sample of an entry that no frame's budget pays for, in pieces of texels: the texels that
+// `allowance` pays for (at the cost per texel rounded up), continuing where the last piece stopped.
+// When not even one texel fits, the entry gets one texel anyway if `force` (a budget overrun),
+// else nothing. Returns the curve tests spent.
+uint64_t GlyphAtlas::schedule_split(uint32_t id, uint64_t allowance, bool force) {
+    Slot& slot = slots_[id];
+    AtlasEntry& entry = slot.entry;
+    const uint64_t texels = uint64_t{entry.part.width} * entry.part.height;
+    const uint64_t per_texel = std::max<uint64_t>((entry.curve_tests_per_sample + texels - 1) / texels, 1);
+    uint64_t count = std::min(texels - entry.split_texels_done, allowance / per_texel);
+    const bool overrun = count == 0 && force;
+    if (count == 0 && !overrun) return 0;
+    if (overrun) count = 1;
+    RasterWork& work = work_.emplace_back();
+    work.entry = id;
+    work.key = entry.key;
+    work.x = entry.x;
+    work.y = entry.y;
+    work.width = entry.part.width;
+    work.height = entry.part.height;
+    work.part_x = entry.part.x;
+    work.part_y = entry.part.y;
+    work.first_texel = entry.split_texels_done;
+    work.texel_count = static_cast<uint32_t>(count);
+    work.first_sample = entry.samples;
+    work.sample_count = 1;
+    work.curve_tests = count * per_texel;
+    entry.split_texels_done += work.texel_count;
+    if (entry.split_texels_done == texels) {  // the last piece: the sample is whole
+        entry.split_texels_done = 0;
+        entry.samples += 1;
+        ++slot.served_frames;
+    }
+    count_work(work);
+    if (overrun) {
+        ++frame_counters_.budget_overruns;
+        ++total_counters_.budget_overruns;
+    }
+    return work.curve_tests;
 }
 
 std::span<const RasterWork> GlyphAtlas::schedule() {
@@ -365,26 +461,35 @@ std::span<const RasterWork> GlyphAtlas::schedule() {
     std::rotate(old_begin, std::lower_bound(old_begin, waiting_ids_.end(), cursor_), waiting_ids_.end());
 
     uint64_t budget_left = config_.frame_budget;
+    // Split entries share at most half the budget while others wait, and the rest of it after.
+    uint64_t split_left = std::max<uint64_t>(config_.frame_budget / 2, 1);
+    split_ids_.clear();
     bool cursor_moved = false;
     for (size_t i = 0; i < waiting_ids_.size(); ++i) {
         const uint32_t id = waiting_ids_[i];
         Slot& slot = slots_[id];
         const bool is_old = i >= new_count;
-        const uint32_t wanted = share(slot);
         const uint64_t cost = slot.entry.curve_tests_per_sample;
-        uint64_t count = cost == 0 ? wanted : std::min<uint64_t>(wanted, budget_left / cost);
-        bool overrun = false;
-        if (count == 0) {
-            if (!work_.empty()) {
-                // Strict turns: an entry that cannot be served ends the frame rather than let
-                // cheaper ones behind it go first, and the next frame's round starts with it.
-                if (is_old && !cursor_moved) cursor_ = id;
-                break;
+        if (cost > config_.frame_budget || slot.entry.split_texels_done > 0) {
+            const uint64_t spent = schedule_split(id, std::min(budget_left, split_left), false);
+            budget_left -= spent;
+            split_left -= std::min(split_left, spent);
+            if (slot.entry.split_texels_done > 0 || spent == 0) {
+                split_ids_.push_back(id);
+                if (is_old && !cursor_moved) {
+                    cursor_ = id;
+                    cursor_moved = true;
+                }
             }
-            // Even one sample exceeds the whole budget: take it anyway, alone, or this glyph
-            // could never be drawn.
-            count = 1;
-            overrun = true;
+            continue;
+        }
+        const uint32_t wanted = share(slot);
+        uint64_t count = cost == 0 ? wanted : std::min<uint64_t>(wanted, budget_left / cost);
+        if (count == 0) {
+            // Strict turns: an entry that cannot be served ends the frame rather than let
+            // cheaper ones behind it go first, and the next frame's round starts with it.
+            if (is_old && !cursor_moved) cursor_ = id;
+            break;
         }
 
         RasterWork& work = work_.emplace_back();
@@ -392,37 +497,34 @@ std::span<const RasterWork> GlyphAtlas::schedule() {
         work.key = slot.entry.key;
         work.x = slot.entry.x;
         work.y = slot.entry.y;
-        work.width = slot.entry.width;
-        work.height = slot.entry.height;
+        work.width = slot.entry.part.width;
+        work.height = slot.entry.part.height;
+        work.part_x = slot.entry.part.x;
+        work.part_y = slot.entry.part.y;
+        work.texel_count = work.width * work.height;
         work.first_sample = slot.entry.samples;
         work.sample_count = static_cast<uint32_t>(count);
+        work.curve_tests = count * cost;  // <= budget_left
         slot.entry.samples += work.sample_count;
         ++slot.served_frames;
-
-        const uint64_t tests = count * cost;  // <= budget_left, or one sample when overrunning
-        budget_left = overrun ? 0 : budget_left - tests;
-        frame_counters_.samples += count;
-        total_counters_.samples += count;
-        frame_counters_.curve_tests = add_saturating(frame_counters_.curve_tests, tests);
-        total_counters_.curve_tests = add_saturating(total_counters_.curve_tests, tests);
-        if (overrun) {
-            ++frame_counters_.budget_overruns;
-            ++total_counters_.budget_overruns;
-            // Move on, or an entry no budget can afford would take every frame until it is done.
-            if (is_old && !cursor_moved) cursor_ = id + 1;
-            break;
-        }
+        budget_left -= work.curve_tests;
+        count_work(work);
         if (is_old && count < wanted && !cursor_moved) {
             cursor_ = id;
             cursor_moved = true;
         }
     }
+    // What the others left goes to the split entries, in the same order. Each of them got no
+    // piece yet or is inside a sample, so a piece never overlaps one given this frame. An entry
+    // that no budget pays one texel for gets one texel alone, as an overrun.
+    for (uint32_t id : split_ids_) budget_left -= schedule_split(id, budget_left, work_.empty());
     return work_;
 }
 
 void GlyphAtlas::invalidate_samples() {
     for (Slot& slot : slots_) {
         slot.entry.samples = 0;
+        slot.entry.split_texels_done = 0;
         slot.served_frames = 0;
     }
 }

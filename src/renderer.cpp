@@ -72,12 +72,70 @@ struct Renderer::State {
         uint32_t entry = kNoAtlasEntry;
     };
     std::vector<Pending> pending;  // draw()n this frame, before record() knows their samples
+    struct Clipped {
+        GlyphInstance glyph;
+        TexelRect part;  // visible texels of its rect
+    };
+    std::vector<Clipped> clipped;  // draw()n partly visible, acquired in record()
+    std::unordered_map<GlyphKey, TexelRect, GlyphKeyHash> clipped_parts;  // scratch: bounding parts
     std::vector<DrawnGlyph> drawn;
     std::vector<gpu::RasterItem> item_data;
     RendererStats stats;
     bool converged = true;
 
     explicit State(GlyphAtlas glyph_atlas) : atlas(std::move(glyph_atlas)) {}
+
+    // Finds or places `glyph` with `part` of its rect visible and adds it to the pending glyphs.
+    void acquire(const GlyphInstance& glyph, const TexelRect& part) {
+        if (glyph.width == 0 || glyph.height == 0) return;
+        const auto slot = font_slot.find(glyph.key.font);
+        if (slot == font_slot.end()) {
+            ++stats.unknown_fonts;
+            ++stats.skipped_glyphs;
+            return;
+        }
+        const FontAsset& asset = fonts[slot->second].font->asset();
+        if (glyph.key.glyph >= asset.glyphs.size()) {
+            ++stats.skipped_glyphs;
+            return;
+        }
+        // Only a glyph the atlas may place anew needs its cost: a new one, or one held in part.
+        uint64_t cost = 0;
+        const AtlasEntry* resident = atlas.entry(atlas.find(glyph.key));
+        if (!resident || resident->part.width != resident->width || resident->part.height != resident->height)
+            cost = curve_tests_per_sample(asset, asset.glyphs[glyph.key.glyph], glyph.key);
+        const AtlasLookup lookup = atlas.acquire(glyph.key, glyph.width, glyph.height, cost, part);
+        if (lookup.status == AtlasStatus::placed) {
+            DrawnGlyph placed{glyph, lookup.x, lookup.y, 0, lookup.part.x, lookup.part.y};
+            placed.instance.x += static_cast<int32_t>(lookup.part.x);
+            placed.instance.y += static_cast<int32_t>(lookup.part.y);
+            placed.instance.width = lookup.part.width;
+            placed.instance.height = lookup.part.height;
+            pending.push_back({placed, lookup.entry});
+        } else if (lookup.status == AtlasStatus::atlas_full || lookup.status == AtlasStatus::too_large) {
+            ++stats.failed_glyphs;
+            ++stats.skipped_glyphs;
+        }
+    }
+
+    // Acquires the glyphs drawn in part, each glyph once for the bounding box of its parts.
+    void acquire_clipped() {
+        if (clipped.empty()) return;
+        clipped_parts.clear();
+        for (const Clipped& c : clipped) {
+            auto [it, added] = clipped_parts.try_emplace(c.glyph.key, c.part);
+            if (added) continue;
+            TexelRect& box = it->second;
+            const uint32_t x1 = std::max(box.x + box.width, c.part.x + c.part.width);
+            const uint32_t y1 = std::max(box.y + box.height, c.part.y + c.part.height);
+            box.x = std::min(box.x, c.part.x);
+            box.y = std::min(box.y, c.part.y);
+            box.width = x1 - box.x;
+            box.height = y1 - box.y;
+        }
+        for (const Clipped& c : clipped) acquire(c.glyph, clipped_parts.at(c.glyph.key));
+        clipped.clear();
+    }
     ~State();
     Status make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, GpuBuffer& out);
     void free_buffer(GpuBuffer& buffer);
@@ -314,6 +372,7 @@ void Renderer::begin_frame() {
     State& s = *state_;
     s.atlas.begin_frame();
     s.pending.clear();
+    s.clipped.clear();
     s.drawn.clear();
     s.stats = {};
     s.converged = true;
@@ -321,35 +380,37 @@ void Renderer::begin_frame() {
 
 void Renderer::draw(std::span<const GlyphInstance> glyphs) {
     State& s = *state_;
+    for (const GlyphInstance& glyph : glyphs) s.acquire(glyph, TexelRect{0, 0, glyph.width, glyph.height});
+}
+
+void Renderer::draw(std::span<const GlyphInstance> glyphs, const VkRect2D& visible) {
+    State& s = *state_;
+    const int64_t vx0 = visible.offset.x, vy0 = visible.offset.y;
+    const int64_t vx1 = vx0 + visible.extent.width, vy1 = vy0 + visible.extent.height;
     for (const GlyphInstance& glyph : glyphs) {
         if (glyph.width == 0 || glyph.height == 0) continue;
-        const auto slot = s.font_slot.find(glyph.key.font);
-        if (slot == s.font_slot.end()) {
-            ++s.stats.unknown_fonts;
-            ++s.stats.skipped_glyphs;
+        // The visible texels of the glyph's rect.
+        const int64_t x0 = std::max<int64_t>(vx0 - glyph.x, 0), y0 = std::max<int64_t>(vy0 - glyph.y, 0);
+        const int64_t x1 = std::min<int64_t>(vx1 - glyph.x, glyph.width);
+        const int64_t y1 = std::min<int64_t>(vy1 - glyph.y, glyph.height);
+        if (x0 >= x1 || y0 >= y1) {
+            ++s.stats.culled_glyphs;
             continue;
         }
-        const FontAsset& asset = s.fonts[slot->second].font->asset();
-        if (glyph.key.glyph >= asset.glyphs.size()) {
-            ++s.stats.skipped_glyphs;
-            continue;
-        }
-        uint64_t cost = 0;
-        if (s.atlas.find(glyph.key) == kNoAtlasEntry) {  // only a new glyph needs its cost
-            cost = curve_tests_per_sample(asset, asset.glyphs[glyph.key.glyph], glyph.key);
-        }
-        const AtlasLookup lookup = s.atlas.acquire(glyph.key, glyph.width, glyph.height, cost);
-        if (lookup.status == AtlasStatus::placed) {
-            s.pending.push_back({DrawnGlyph{glyph, lookup.x, lookup.y, 0}, lookup.entry});
-        } else if (lookup.status == AtlasStatus::atlas_full || lookup.status == AtlasStatus::too_large) {
-            ++s.stats.failed_glyphs;
-            ++s.stats.skipped_glyphs;
+        const TexelRect part{static_cast<uint32_t>(x0), static_cast<uint32_t>(y0), static_cast<uint32_t>(x1 - x0),
+                             static_cast<uint32_t>(y1 - y0)};
+        if (part.width == glyph.width && part.height == glyph.height) {
+            s.acquire(glyph, part);
+        } else {
+            ++s.stats.clipped_glyphs;
+            s.clipped.push_back({glyph, part});
         }
     }
 }
 
 Status Renderer::record(VkCommandBuffer command_buffer) {
     State& s = *state_;
+    s.acquire_clipped();
     const std::span<const RasterWork> work = s.atlas.schedule();
 
     // Drawn glyphs: those whose texels hold samples once this frame's work has run.
@@ -436,13 +497,17 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         item.font = slot->second;
         item.first_sample = w.first_sample;
         item.sample_count = w.sample_count;
+        item.part_x = w.part_x;
+        item.part_y = w.part_y;
+        item.first_texel = w.first_texel;
+        item.texel_count = w.texel_count;
         item.first_workgroup = workgroups;
-        workgroups += (w.width * w.height + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
+        workgroups += (w.texel_count + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
         s.item_data.push_back(item);
-        s.stats.samples += w.sample_count;
     }
     s.stats.work_items = static_cast<uint32_t>(s.item_data.size());
     s.stats.workgroups = workgroups;
+    s.stats.samples = s.atlas.stats().frame.samples;
     s.stats.curve_tests = s.atlas.stats().frame.curve_tests;
 
     VkMemoryBarrier before{};

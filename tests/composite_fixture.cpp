@@ -78,7 +78,7 @@ Scene render_scene(const std::vector<TextRun>& runs, const char* layout_name, fl
     Renderer& r = *scene.renderer;
     for (int frame = 0; frame < 200; ++frame) {
         r.begin_frame();
-        r.draw(glyphs);
+        r.draw(glyphs, VkRect2D{{0, 0}, {kWidth, kHeight}});
         EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(r.record(cb)); }));
         if (r.converged()) break;
     }

@@ -500,7 +500,18 @@ TEST_P(AtlasRandomized, NeverOverlapsAndEvictsLeastRecentlyUsed) {
         build_grid(grid);
         const std::span<const RasterWork> work = atlas.schedule();
         uint64_t tests = 0;
-        for (const RasterWork& item : work) tests += uint64_t{item.sample_count} * (1 + item.width * item.height);
+        for (const RasterWork& item : work) {
+            const AtlasEntry* entry = atlas.entry(item.entry);
+            ASSERT_NE(entry, nullptr);
+            const uint64_t cost = 1 + uint64_t{entry->width} * entry->height;
+            const uint64_t texels = uint64_t{item.width} * item.height;
+            if (item.texel_count == texels)
+                EXPECT_EQ(item.curve_tests, item.sample_count * cost);
+            else  // a piece of a split sample
+                EXPECT_EQ(item.curve_tests, item.texel_count * ((cost + texels - 1) / texels));
+            EXPECT_LE(uint64_t{item.first_texel} + item.texel_count, texels);
+            tests += item.curve_tests;
+        }
         if (atlas.stats().frame.budget_overruns == 0)
             EXPECT_LE(tests, 5000u);
         else
@@ -732,33 +743,156 @@ TEST(AtlasSchedule, BudgetNeverExceededAndNoGlyphStarves) {
     EXPECT_EQ(atlas.stats().total.budget_overruns, 0u);
 }
 
-TEST(AtlasSchedule, GlyphsDearerThanTheBudgetTakeTurns) {
-    GlyphAtlas atlas = make_atlas(256, 256, 100);
-    std::vector<uint32_t> samples(4, 0);
-    for (uint32_t frame = 0; frame < 40; ++frame) {
+TEST(AtlasSchedule, GlyphsDearerThanTheBudgetAreSplitIntoPieces) {
+    constexpr uint64_t kBudget = 100;
+    GlyphAtlas atlas = make_atlas(256, 256, kBudget);
+    // Three 20 x 20 glyphs whose one sample costs 10 to 12 budgets (3 curve tests per texel),
+    // and one cheap glyph.
+    const uint64_t costs[4] = {1000, 1100, 1200, 10};
+    std::vector<uint32_t> samples(4, 0), texels_done(4, 0);
+    uint32_t cheap_frames_served = 0;
+    for (uint32_t frame = 0; frame < 300; ++frame) {
         atlas.begin_frame();
         std::vector<uint32_t> ids;
-        // Three glyphs no budget can afford, and one that fits.
-        for (uint32_t i = 0; i < 3; ++i) ids.push_back(atlas.acquire(key_of(i), 20, 20, 1000 + i).entry);
-        ids.push_back(atlas.acquire(key_of(3), 20, 20, 10).entry);
-        const std::span<const RasterWork> work = atlas.schedule();
-        ASSERT_FALSE(work.empty());
-        const AtlasStats stats = atlas.stats();
-        if (stats.frame.budget_overruns == 1) {
-            ASSERT_EQ(work.size(), 1u);  // the forced sample is alone
-            EXPECT_EQ(work[0].sample_count, 1u);
-        } else {
-            EXPECT_LE(stats.frame.curve_tests, 100u);
+        for (uint32_t i = 0; i < 4; ++i) ids.push_back(atlas.acquire(key_of(i), 20, 20, costs[i]).entry);
+        uint64_t tests = 0;
+        bool cheap_served = false;
+        for (const RasterWork& item : atlas.schedule()) {
+            const auto i = static_cast<size_t>(std::find(ids.begin(), ids.end(), item.entry) - ids.begin());
+            ASSERT_LT(i, 4u);
+            ASSERT_EQ(item.first_sample, samples[i]);
+            tests += item.curve_tests;
+            if (i == 3) {
+                EXPECT_EQ(item.texel_count, 400u);
+                EXPECT_EQ(item.curve_tests, item.sample_count * costs[3]);
+                samples[i] += item.sample_count;
+                cheap_served = true;
+                continue;
+            }
+            // A piece of one sample that starts where the last one stopped.
+            EXPECT_EQ(item.sample_count, 1u);
+            EXPECT_EQ(item.first_texel, texels_done[i]);
+            EXPECT_GT(item.texel_count, 0u);
+            EXPECT_EQ(item.curve_tests, item.texel_count * ((costs[i] + 399) / 400));
+            texels_done[i] += item.texel_count;
+            ASSERT_LE(texels_done[i], 400u);
+            if (texels_done[i] == 400) {
+                texels_done[i] = 0;
+                ++samples[i];
+            }
         }
-        for (const RasterWork& item : work)
-            samples[static_cast<size_t>(std::find(ids.begin(), ids.end(), item.entry) - ids.begin())] +=
-                item.sample_count;
-        if (frame >= 12) {
-            for (uint32_t i = 0; i < 4; ++i)
-                EXPECT_GE(samples[i], (frame - 4) / 5) << "glyph " << i << " frame " << frame;
+        // The budget holds and is spent but for less than a texel's worth or the cheap glyph's.
+        EXPECT_LE(tests, kBudget) << "frame " << frame;
+        EXPECT_EQ(atlas.stats().frame.curve_tests, tests);
+        EXPECT_GT(tests, kBudget - costs[3]) << "frame " << frame;
+        for (uint32_t i = 0; i < 4; ++i) EXPECT_EQ(atlas.entry(ids[i])->samples, samples[i]);
+        // Split glyphs never take more than half while the cheap one waits: it is served
+        // every frame until it is done.
+        if (samples[3] < 512 || cheap_served) {
+            EXPECT_TRUE(cheap_served) << "frame " << frame;
+            ++cheap_frames_served;
         }
     }
-    EXPECT_GT(atlas.stats().total.budget_overruns, 20u);
+    EXPECT_EQ(atlas.stats().total.budget_overruns, 0u);
+    EXPECT_EQ(cheap_frames_served, 300u);
+    // Every split glyph progresses: 300 frames pay for about 300 * 100 tests, less what the
+    // cheap glyph takes; each sample of a split glyph costs 1200 to 1200.
+    for (uint32_t i = 0; i < 3; ++i) EXPECT_GE(samples[i], 3u) << "glyph " << i;
+    EXPECT_GT(atlas.stats().total.split_pieces, 300u);
+}
+
+TEST(AtlasSchedule, ATexelDearerThanTheBudgetIsForcedAlone) {
+    AtlasConfig config;
+    config.width = config.height = 256;
+    config.frame_budget = 2;
+    config.max_samples = 4;
+    config.ramp = {2};
+    GlyphAtlas atlas = make_atlas(config);
+    // 3 curve tests per texel of one sample and a budget of 2: the dear glyph can only ever get a
+    // texel as an overrun, in a frame it has to itself (once the cheap glyph holds its 4 samples).
+    uint32_t dear_texels = 0, alone_frames = 0;
+    for (uint32_t frame = 0; frame < 20; ++frame) {
+        atlas.begin_frame();
+        const uint32_t dear = atlas.acquire(key_of(1), 4, 4, 48).entry;
+        const uint32_t cheap = atlas.acquire(key_of(2), 4, 4, 1).entry;
+        const std::span<const RasterWork> work = atlas.schedule();
+        const uint64_t overruns = atlas.stats().frame.budget_overruns;
+        if (samples_for(work, cheap) > 0) {
+            EXPECT_EQ(samples_for(work, dear), 0u);
+            EXPECT_EQ(overruns, 0u);
+            EXPECT_LE(atlas.stats().frame.curve_tests, 2u);
+            continue;
+        }
+        ++alone_frames;
+        ASSERT_EQ(work.size(), 1u);
+        EXPECT_EQ(work[0].entry, dear);
+        EXPECT_EQ(work[0].texel_count, 1u);
+        EXPECT_EQ(work[0].first_texel, dear_texels % 16);
+        EXPECT_EQ(overruns, 1u);
+        ++dear_texels;
+        EXPECT_EQ(atlas.entry(dear)->samples, dear_texels / 16);
+    }
+    EXPECT_GE(alone_frames, 17u);
+    EXPECT_EQ(atlas.stats().total.budget_overruns, alone_frames);
+    EXPECT_EQ(atlas.entry(atlas.find(key_of(1)))->samples, 1u);  // 16 texels made one whole sample
+}
+
+TEST(Atlas, VisiblePartsAreHeldWithAMarginAndReplacedWhenLeft) {
+    GlyphAtlas atlas = make_atlas(256, 256);
+    // A 2000 x 1000 glyph rect is far too large for the atlas; 100 x 50 of it is visible.
+    const TexelRect visible{900, 400, 100, 50};
+    AtlasLookup lookup = atlas.acquire(key_of(1), 2000, 1000, 2000000, visible);
+    ASSERT_EQ(lookup.status, AtlasStatus::placed);
+    EXPECT_EQ(lookup.width, 2000u);
+    EXPECT_EQ(lookup.height, 1000u);
+    const uint32_t m = kAtlasPartMargin;
+    EXPECT_EQ(lookup.part.x, 900 - m);
+    EXPECT_EQ(lookup.part.y, 400 - m);
+    EXPECT_EQ(lookup.part.width, 100 + 2 * m);
+    EXPECT_EQ(lookup.part.height, 50 + 2 * m);
+    const AtlasEntry* entry = atlas.entry(lookup.entry);
+    ASSERT_NE(entry, nullptr);
+    EXPECT_EQ(entry->block_width, 256u);  // the part's block (9 x 6 cells, rounded up); the
+    EXPECT_EQ(entry->block_height, 256u);  // rect's would be 2048 x 2048
+    // Its cost is the part's share of the rect's: 132 x 82 of 2000 x 1000 texels, rounded up.
+    EXPECT_EQ(entry->curve_tests_per_sample, (2000000ull * 132 * 82 + 1999999) / 2000000);
+    const std::span<const RasterWork> work = atlas.schedule();
+    ASSERT_EQ(work.size(), 1u);
+    EXPECT_EQ(work[0].part_x, 900 - m);
+    EXPECT_EQ(work[0].part_y, 400 - m);
+    EXPECT_EQ(work[0].width, 132u);
+    EXPECT_EQ(work[0].texel_count, 132u * 82u);
+
+    // Scrolled within the margin: a hit that keeps the samples.
+    atlas.begin_frame();
+    lookup = atlas.acquire(key_of(1), 2000, 1000, 0, TexelRect{890, 395, 100, 50});
+    EXPECT_EQ(atlas.stats().frame.hits, 1u);
+    EXPECT_EQ(atlas.entry(lookup.entry)->samples, 8u);
+    // Asked again in the same frame for a part it does not hold: pinned entries never move.
+    lookup = atlas.acquire(key_of(1), 2000, 1000, 0, TexelRect{0, 0, 10, 10});
+    EXPECT_EQ(lookup.part.x, 900 - m);
+    EXPECT_EQ(atlas.stats().frame.parts_replaced, 0u);
+
+    // Next frame, scrolled past the margin: placed anew with the new part and no samples.
+    atlas.begin_frame();
+    lookup = atlas.acquire(key_of(1), 2000, 1000, 2000000, TexelRect{0, 0, 10, 10});
+    ASSERT_EQ(lookup.status, AtlasStatus::placed);
+    EXPECT_EQ(lookup.part.x, 0u);
+    EXPECT_EQ(lookup.part.width, 10 + m);
+    EXPECT_EQ(atlas.entry(lookup.entry)->samples, 0u);
+    EXPECT_EQ(atlas.stats().frame.parts_replaced, 1u);
+    // The whole rect asked for while a part is held: too large for this atlas, and the part is gone.
+    atlas.begin_frame();
+    EXPECT_EQ(atlas.acquire(key_of(1), 2000, 1000, 2000000).status, AtlasStatus::too_large);
+    EXPECT_EQ(atlas.find(key_of(1)), kNoAtlasEntry);
+    // Nothing visible: nothing placed.
+    EXPECT_EQ(atlas.acquire(key_of(2), 20, 20, 1, TexelRect{20, 0, 5, 5}).status, AtlasStatus::empty);
+    // A visible part within the margin of the rect's edges is the whole rect.
+    lookup = atlas.acquire(key_of(3), 20, 20, 1, TexelRect{2, 3, 10, 10});
+    EXPECT_EQ(lookup.part.x, 0u);
+    EXPECT_EQ(lookup.part.width, 20u);
+    EXPECT_EQ(lookup.part.height, 20u);
+    EXPECT_EQ(atlas.entry(lookup.entry)->curve_tests_per_sample, 1u);
 }
 
 TEST(Atlas, IsAMovableValue) {

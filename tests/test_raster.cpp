@@ -37,16 +37,9 @@ Fixture& fixture() {
 
 using test::Texel;
 
-// Renders `text` until it converges and returns the atlas texels.
-std::vector<Texel> render(Renderer& renderer, const TextLayout& layout, uint32_t& frames) {
+// Reads the whole atlas back.
+std::vector<Texel> read_atlas(const Renderer& renderer) {
     HeadlessContext& context = *fixture().context;
-    frames = 0;
-    do {
-        renderer.begin_frame();
-        renderer.draw(layout.glyphs);
-        EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer.record(cb)); }));
-        ++frames;
-    } while (!renderer.converged() && frames < 1000);
     const AtlasConfig& config = renderer.atlas().config();
     const VkDeviceSize bytes = VkDeviceSize{config.width} * config.height * sizeof(Texel);
     auto readback = context.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
@@ -58,6 +51,27 @@ std::vector<Texel> render(Renderer& renderer, const TextLayout& layout, uint32_t
     std::vector<Texel> texels(config.width * config.height);
     std::memcpy(texels.data(), data->data(), bytes);
     return texels;
+}
+
+// Renders frames of `draw` (which calls the renderer's draw()) until the text converges, at
+// most `max_frames`, calling `check` after each frame; returns the atlas texels.
+template <typename Draw, typename Check>
+std::vector<Texel> render(Renderer& renderer, uint32_t& frames, uint32_t max_frames, Draw&& draw, Check&& check) {
+    HeadlessContext& context = *fixture().context;
+    frames = 0;
+    do {
+        renderer.begin_frame();
+        draw();
+        EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer.record(cb)); }));
+        check();
+        ++frames;
+    } while (!renderer.converged() && frames < max_frames);
+    return read_atlas(renderer);
+}
+
+// Renders `layout` until it converges and returns the atlas texels.
+std::vector<Texel> render(Renderer& renderer, const TextLayout& layout, uint32_t& frames) {
+    return render(renderer, frames, 1000, [&] { renderer.draw(layout.glyphs); }, [] {});
 }
 
 // The float positions the shader computes for sample n of texel (tx, ty), channel c.
@@ -83,9 +97,10 @@ struct Comparison {
 // Compares every texel of every drawn glyph with the CPU reference: double-precision banded
 // winding at the shader's float sample positions. A differing texel is explained when one of
 // its samples lies within kEdge em of the outline (the winding changes within that distance).
-Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, uint32_t samples) {
+Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, uint32_t samples,
+                   const Font* font = nullptr) {
     constexpr double kEdge = 2e-5;  // em: 1/50 px at 1000 px per em
-    const FontAsset& asset = fixture().font->asset();
+    const FontAsset& asset = (font ? font : fixture().font.get())->asset();
     const uint32_t width = renderer.atlas().config().width;
     Comparison result;
     for (const DrawnGlyph& d : renderer.drawn()) {
@@ -102,7 +117,8 @@ Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, u
                     uint32_t hits = 0;
                     for (uint32_t n = 0; n < samples; ++n) {
                         float x = 0, y = 0;
-                        gpu_sample(map, renderer.subpixel_layout().channels[static_cast<size_t>(c)], tx, ty, n, x, y);
+                        gpu_sample(map, renderer.subpixel_layout().channels[static_cast<size_t>(c)],
+                                   tx + d.part_x, ty + d.part_y, n, x, y);
                         const double xd = x, yd = y;
                         const bool hit = winding_number_banded<double>(asset, glyph, xd, yd) != 0;
                         hits += hit;
@@ -268,6 +284,124 @@ TEST(Raster, TwoRenderersOnTwoContextsWorkSideBySide) {
     EXPECT_EQ(mine->drawn().size(), other->drawn().size());
     const ValidationMessages messages = second->validation_messages();
     EXPECT_EQ(messages.errors + messages.warnings, 0u);
+    expect_no_validation_messages();
+}
+
+// Issue 13: one glyph whose single sample costs several frame budgets is rasterized in pieces of
+// texels, each frame within the budget, and converges on the reference like any other.
+TEST(Raster, AGlyphDearerThanTheBudgetIsSplitAcrossFrames) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    BakeOptions bake;
+    bake.all_glyphs = false;
+    bake.codepoints = decode_utf8("H");
+    auto baked = bake_font_file(CRISP_MANY_CURVES_FONT, bake);
+    ASSERT_TRUE(baked) << baked.error().message;
+    auto font = Font::create(std::move(baked->asset), 2);
+    ASSERT_TRUE(font);
+    const Font* fonts[] = {&*font};
+    TextStyle style;
+    style.size = 24.0f;
+    auto layout = layout_text(fonts, "H", style, LayoutOptions{.origin_x = 1.25f, .origin_y = 24.0f});
+    ASSERT_TRUE(layout);
+    ASSERT_EQ(layout->glyphs.size(), 1u);
+    const GlyphInstance& glyph = layout->glyphs[0];
+    const uint64_t cost =
+        curve_tests_per_sample(font->asset(), font->asset().glyphs[glyph.key.glyph], glyph.key);
+
+    constexpr uint32_t kSamples = 4;
+    const HeadlessContext& context = *f.context;
+    RendererCreateInfo info = renderer_create_info(context);
+    info.atlas.width = info.atlas.height = 256;
+    info.atlas.max_samples = kSamples;
+    info.atlas.ramp = {};
+    info.atlas.frame_budget = cost / 6;  // one sample takes at least six frames
+    auto renderer = Renderer::create(info);
+    ASSERT_TRUE(renderer) << renderer.error().message;
+    ASSERT_TRUE(renderer->add_font(*font));
+    uint32_t frames = 0;
+    uint64_t pieces = 0;
+    const std::vector<Texel> texels = render(
+        *renderer, frames, 100, [&] { renderer->draw(layout->glyphs); },
+        [&] {
+            const AtlasStats stats = renderer->atlas().stats();
+            EXPECT_LE(renderer->stats().curve_tests, info.atlas.frame_budget);
+            EXPECT_EQ(stats.frame.budget_overruns, 0u);
+            pieces += stats.frame.split_pieces;
+        });
+    ASSERT_TRUE(renderer->converged()) << "not converged after " << frames << " frames";
+    // Four samples of six budgets or more each, and no more frames than the pieces need.
+    EXPECT_GE(frames, 4u * 6u);
+    EXPECT_LE(frames, 4u * 7u);
+    EXPECT_GE(pieces, frames);  // a piece or two every frame
+    const Comparison result = compare(*renderer, texels, kSamples, &*font);
+    EXPECT_GT(result.covered, 0u);
+    EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
+    expect_no_validation_messages();
+}
+
+// Issue 13: a 2000 px glyph on a 200 x 200 target gets work only for what can be seen, fits an
+// atlas too small for the whole of it, and its visible texels match the reference.
+TEST(Raster, OnlyTheVisiblePartOfAHugeGlyphIsRasterized) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    const Font* fonts[] = {f.font.get()};
+    TextStyle style;
+    style.size = 2000.0f;
+    // The pen far left: the target sees texels (900, 460) to (1100, 660) of the 1114 x 1461
+    // rect, the left edge of the H's right stem and the paper beside it.
+    auto layout = layout_text(fonts, "H", style, LayoutOptions{.origin_x = -1095.0f, .origin_y = 1000.0f});
+    ASSERT_TRUE(layout);
+    ASSERT_EQ(layout->glyphs.size(), 1u);
+    ASSERT_GT(layout->glyphs[0].width, 1000u);
+
+    constexpr uint32_t kSamples = 16;
+    RendererCreateInfo info = renderer_create_info(*f.context);
+    info.atlas.width = info.atlas.height = 512;  // the whole rect would need 2048 x 2048
+    info.atlas.max_samples = kSamples;
+    auto renderer = Renderer::create(info);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*f.font));
+    const VkRect2D visible{{0, 0}, {200, 200}};
+
+    // Drawn whole, it does not fit.
+    renderer->begin_frame();
+    renderer->draw(layout->glyphs);
+    EXPECT_EQ(renderer->stats().failed_glyphs, 1u);
+
+    uint32_t frames = 0;
+    const std::vector<Texel> texels = render(
+        *renderer, frames, 20, [&] { renderer->draw(layout->glyphs, visible); },
+        [&] {
+            EXPECT_EQ(renderer->stats().failed_glyphs, 0u);
+            EXPECT_EQ(renderer->stats().clipped_glyphs, 1u);
+            // Work for the visible 200 x 200 texels and the margin around them, no more.
+            const uint32_t side = 200 + 2 * kAtlasPartMargin;
+            EXPECT_LE(renderer->stats().workgroups, (side * side + 63) / 64);
+        });
+    ASSERT_TRUE(renderer->converged());
+    EXPECT_EQ(frames, 5u);  // 8 + 4 + 2 + 1 + 1 samples
+    ASSERT_EQ(renderer->drawn().size(), 1u);
+    const DrawnGlyph& drawn = renderer->drawn()[0];
+    // The drawn part covers the target and lies within the margin of it.
+    EXPECT_LE(drawn.instance.x, 0);
+    EXPECT_LE(drawn.instance.y, 0);
+    EXPECT_GE(drawn.instance.x + static_cast<int32_t>(drawn.instance.width), 200);
+    EXPECT_GE(drawn.instance.y + static_cast<int32_t>(drawn.instance.height), 200);
+    EXPECT_LE(drawn.instance.width, 200 + 2 * kAtlasPartMargin);
+    EXPECT_EQ(drawn.instance.x, layout->glyphs[0].x + static_cast<int32_t>(drawn.part_x));
+    const Comparison result = compare(*renderer, texels, kSamples);
+    EXPECT_GT(result.covered, 1000u);                         // ink is visible...
+    EXPECT_LT(result.covered, 3 * result.texels - 1000u);     // ...and so is paper
+    EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
+
+    // Wholly off the target: culled, no work.
+    renderer->begin_frame();
+    renderer->draw(layout->glyphs, VkRect2D{{-5000, 0}, {100, 100}});
+    EXPECT_EQ(renderer->stats().culled_glyphs, 1u);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    EXPECT_EQ(renderer->stats().work_items, 0u);
+    EXPECT_TRUE(renderer->drawn().empty());
     expect_no_validation_messages();
 }
 

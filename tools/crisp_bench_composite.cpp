@@ -237,6 +237,7 @@ double unit(std::mt19937& rng) {
 struct Scene {
     std::vector<crisp::GlyphInstance> glyphs;  // layer after layer: the submission order
     uint64_t rect_texels = 0;                  // sum of the rects' areas: no more fragments than this
+    VkRect2D visible{};                        // the target: what the renderer rasterizes
 };
 
 // N copies of a screen of prose, one per layer, each shifted by a fractional offset, with its own
@@ -244,6 +245,7 @@ struct Scene {
 // order; each layer is one depth plane and numbers its paint orders from 0.
 Scene make_scene(const Args& args, const crisp::Font& font, const std::string& text, uint32_t layers, float alpha) {
     Scene scene;
+    scene.visible = VkRect2D{{0, 0}, {args.width, args.height}};
     std::mt19937 rng(1000u + layers);
     std::vector<uint32_t> depth_rank(layers);
     for (uint32_t i = 0; i < layers; ++i) depth_rank[i] = i;
@@ -280,7 +282,7 @@ Scene make_scene(const Args& args, const crisp::Font& font, const std::string& t
 uint32_t converge(crisp::HeadlessContext& context, crisp::Renderer& renderer, const Scene& scene) {
     for (uint32_t f = 0; f < kMaxConvergeFrames; ++f) {
         renderer.begin_frame();
-        renderer.draw(scene.glyphs);
+        renderer.draw(scene.glyphs, scene.visible);
         const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
             if (crisp::Status s = renderer.record(cb); !s) fail(s.error().message);
         });
@@ -581,7 +583,7 @@ struct Bench {
             // idle gaps between frames short; the frame run puts it in, with its CPU side.
             if (run.with_renderer) {
                 renderer.begin_frame();
-                renderer.draw(scene.glyphs);
+                renderer.draw(scene.glyphs, scene.visible);
             }
             const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
                 if (!is_reference(run)) clear_target(cb, run, params);

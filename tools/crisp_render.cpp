@@ -733,7 +733,7 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
         }
         const auto frame_start = std::chrono::steady_clock::now();
         renderer.begin_frame();
-        renderer.draw(job.glyphs);
+        renderer.draw(job.glyphs, VkRect2D{{0, 0}, {job.scene.width, job.scene.height}});
         crisp::Status recorded;
         const crisp::Status submitted = context.submit_and_wait(
             [&](VkCommandBuffer command_buffer) { recorded = renderer.record(command_buffer); });

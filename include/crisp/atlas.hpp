@@ -51,6 +51,10 @@ inline constexpr uint32_t kAtlasMaxSamples = 65536;
 
 inline constexpr uint32_t kNoAtlasEntry = 0xFFFFFFFFu;
 
+// A glyph acquired with a visible part holds that part grown by this many texels per side
+// (within its rect), so that text scrolled by a little keeps its entry and its samples.
+inline constexpr uint32_t kAtlasPartMargin = kAtlasCellSize;
+
 struct AtlasConfig {
     // Atlas image size in texels: each a power of two from kAtlasMinSize to kAtlasMaxSize.
     // Width and height may differ; blocks are never wider than tall, so in a wide atlas the
@@ -81,34 +85,54 @@ enum class AtlasStatus : uint8_t {
 // Short stable name of a status ("atlas_full"), for logs and JSON.
 const char* atlas_status_name(AtlasStatus status);
 
+// A rectangle of texels within a glyph's rect: (0, 0) is the rect's top-left texel.
+struct TexelRect {
+    uint32_t x = 0;
+    uint32_t y = 0;
+    uint32_t width = 0;
+    uint32_t height = 0;
+};
+
 struct AtlasLookup {
     AtlasStatus status = AtlasStatus::empty;
     uint32_t entry = kNoAtlasEntry;  // id of the entry while it stays resident; kNoAtlasEntry unless placed
-    uint32_t x = 0;                  // texel of the rect's top-left corner in the atlas
+    uint32_t x = 0;                  // texel of the part's top-left corner in the atlas
     uint32_t y = 0;
     uint32_t width = 0;  // the glyph rect, texels
     uint32_t height = 0;
+    TexelRect part;  // the part of the glyph rect the entry holds (the whole rect unless clipped)
 };
 
 // A resident glyph, read-only.
 struct AtlasEntry {
     GlyphKey key;
-    uint32_t x = 0;  // texel of the block's (and the rect's) top-left corner
+    uint32_t x = 0;  // texel of the block's (and the part's) top-left corner
     uint32_t y = 0;
     uint32_t width = 0;  // the glyph rect, texels
     uint32_t height = 0;
-    uint32_t block_width = 0;   // the cells the entry owns, texels: width and height rounded up
-    uint32_t block_height = 0;  // to powers of two of cells, height = width or 2 * width
+    // The part of the rect the entry holds: the whole rect, or for a glyph acquired with a
+    // visible part, that part grown by up to kAtlasPartMargin texels per side.
+    TexelRect part;
+    uint32_t block_width = 0;   // the cells the entry owns, texels: the part rounded up to
+    uint32_t block_height = 0;  // powers of two of cells, height = width or 2 * width
+    // One sample over the part: the acquire()d cost of the whole rect scaled by the part's share
+    // of its texels (rounded up).
     uint64_t curve_tests_per_sample = 0;
-    // Samples in the rect's accumulators, counting those of this frame's schedule() once it ran.
+    // Samples every texel of the part holds, counting those of this frame's schedule() once it
+    // ran. Texels of a split sample already done hold one more (see RasterWork).
     uint32_t samples = 0;
-    uint64_t last_used_frame = 0;  // frame() when last acquired
+    uint32_t split_texels_done = 0;  // texels of the part that hold the split sample in progress
+    uint64_t last_used_frame = 0;    // frame() when last acquired
 };
 
 // Samples the rasterizer adds to one entry this frame: sample indices first_sample to
-// first_sample + sample_count - 1 of each texel of the rect at (x, y), width x height.
+// first_sample + sample_count - 1 of texels first_texel to first_texel + texel_count - 1 (row
+// major) of the entry's part, width x height texels at (x, y) in the atlas and at (part_x, part_y)
+// in the glyph rect. Usually the work covers the whole part; a glyph whose one sample costs more
+// than the whole frame budget gets its sample in pieces of texels over several frames (a split
+// sample), and its entry counts the sample once the last piece is scheduled.
 // first_sample == 0 means the accumulators hold nothing of this glyph (a new entry, reused cells,
-// or invalidate_samples()): the rasterizer must clear the rect before adding.
+// or invalidate_samples()): the rasterizer must clear each texel before adding.
 struct RasterWork {
     uint32_t entry = 0;
     GlyphKey key;
@@ -116,8 +140,13 @@ struct RasterWork {
     uint32_t y = 0;
     uint32_t width = 0;
     uint32_t height = 0;
+    uint32_t part_x = 0;
+    uint32_t part_y = 0;
+    uint32_t first_texel = 0;
+    uint32_t texel_count = 0;
     uint32_t first_sample = 0;
     uint32_t sample_count = 0;
+    uint64_t curve_tests = 0;  // the atlas's estimate of this work's cost, counted in the budget
 };
 
 struct AtlasCounters {
@@ -128,7 +157,9 @@ struct AtlasCounters {
     uint64_t failed_too_large = 0;  // acquire() calls answered too_large
     uint64_t samples = 0;           // samples scheduled
     uint64_t curve_tests = 0;       // curve tests scheduled (samples times each entry's cost)
-    uint64_t budget_overruns = 0;   // frames whose single forced sample exceeded the budget
+    uint64_t budget_overruns = 0;   // frames whose single forced texel sample exceeded the budget
+    uint64_t split_pieces = 0;      // work items that hold part of a split sample
+    uint64_t parts_replaced = 0;    // entries placed anew because the visible part left the held one
 };
 
 struct AtlasStats {
@@ -172,16 +203,32 @@ public:
     // schedule(): the glyph is pinned but gets samples from the next frame on.
     AtlasLookup acquire(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample);
 
+    // The same for a glyph of which only `visible` (texels of its rect; clipped to the rect) can
+    // reach the target: the entry holds that part grown by kAtlasPartMargin per side, and only
+    // its texels get samples. A resident entry whose part contains `visible` is a hit; one whose
+    // part does not is evicted and placed anew with the new part (its samples are lost, and so is the entry
+    // when the new part does not fit: counted in parts_replaced) unless it is pinned this frame: a pinned entry never moves, and the
+    // lookup returns it as it is (lookup.part says what it holds). Callers that draw one glyph
+    // several times in a frame should acquire it once with the bounding box of the visible parts.
+    // `visible` empty after clipping: status empty, nothing changes.
+    AtlasLookup acquire(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample,
+                        const TexelRect& visible);
+
     // Decides this frame's samples and returns the work list; call once per frame after every
     // acquire(). Only entries pinned this frame and short of max_samples get samples: first the
     // new ones (0 samples) in acquire order, then the rest in turn from a cursor that rotates
     // over entry ids across frames, so with a steady set of glyphs none starves. An entry whose
     // share does not fit the rest of the budget gets the samples that fit; the first entry that
-    // gets none ends the frame's list. The budget is never exceeded, except when the first entry
-    // waiting cannot afford one sample: it gets one sample anyway and nothing else is scheduled
-    // that frame (counted as a budget overrun), so every glyph can be drawn.
+    // gets none ends the frame's list. An entry whose single sample costs more than the whole
+    // budget is split: it gets the texels of one sample that its allowance pays for (at the cost
+    // per texel rounded up), continued from where it stopped in later frames. Split entries share
+    // at most half the budget while other entries wait, and whatever the others leave, so a
+    // pathological glyph neither stalls the rest nor starves. The budget is never exceeded,
+    // except when nothing else is scheduled and the first split entry cannot afford one sample of
+    // a single texel: it gets that texel anyway (counted as a budget overrun), so every glyph
+    // can be drawn.
     // The entries' sample counts include the returned work at once. A glyph still at 0 samples
-    // after schedule() has nothing in its rect (possibly another glyph's old accumulators): do
+    // after schedule() has nothing in its part (possibly another glyph's old accumulators): do
     // not draw it this frame. Calling schedule() again in the same frame returns the same list.
     // The span stays valid until the next begin_frame().
     std::span<const RasterWork> schedule();
@@ -231,6 +278,11 @@ private:
     uint32_t make_room(uint32_t bit_count);
     void evict(uint32_t id);
     uint32_t share(const Slot& slot) const;
+    AtlasLookup lookup_of(uint32_t id) const;
+    AtlasLookup place(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample,
+                      const TexelRect& part);
+    uint64_t schedule_split(uint32_t id, uint64_t allowance, bool force);
+    void count_work(const RasterWork& work);
 
     AtlasConfig config_;
     uint32_t cells_x_ = 0;
@@ -253,6 +305,7 @@ private:
     uint64_t frame_ = 0;
     std::vector<uint32_t> pinned_ids_;   // pinned this frame, in acquire order
     std::vector<uint32_t> waiting_ids_;  // scratch for schedule()
+    std::vector<uint32_t> split_ids_;    // scratch for schedule(): split entries short of their piece
     uint32_t cursor_ = 0;                // entry id the next frame's round starts at
     bool scheduled_ = false;
     std::vector<RasterWork> work_;

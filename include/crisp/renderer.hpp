@@ -60,11 +60,17 @@ class HeadlessContext;
 RendererCreateInfo renderer_create_info(const HeadlessContext& context);
 
 // A glyph drawn this frame whose rect holds samples: where its texels are in the atlas.
+// A glyph drawn clipped (draw() with a visible rect) holds only a part of its rect: `instance`
+// then describes that part (x, y, width and height narrowed to it), and part_x, part_y say where
+// the part starts in the glyph's whole rect.
 struct DrawnGlyph {
     GlyphInstance instance;
-    uint32_t atlas_x = 0;  // texel of the rect's top-left corner in the atlas image
+    uint32_t atlas_x = 0;  // texel of the (part's) top-left corner in the atlas image
     uint32_t atlas_y = 0;
-    uint32_t samples = 0;  // samples its texels hold once this frame's work has run
+    uint32_t samples = 0;  // samples every texel holds once this frame's work has run (texels of
+                           // a split sample in progress hold one more)
+    uint32_t part_x = 0;
+    uint32_t part_y = 0;
 };
 
 struct RendererStats {
@@ -72,10 +78,13 @@ struct RendererStats {
     uint32_t skipped_glyphs = 0;  // not drawable this frame: no samples yet, atlas full or too large
     uint32_t failed_glyphs = 0;   // atlas_full or too_large this frame (also in atlas().stats())
     uint32_t unknown_fonts = 0;   // instances whose FontId was never added
+    uint32_t culled_glyphs = 0;   // instances wholly outside draw()'s visible rect
+    uint32_t clipped_glyphs = 0;  // instances partly outside it: only their visible part is rasterized
     uint32_t work_items = 0;      // glyphs given samples this frame
     uint32_t workgroups = 0;      // compute workgroups dispatched
     uint64_t samples = 0;         // samples scheduled this frame (all channels count once)
-    uint64_t curve_tests = 0;     // the atlas's estimate of this frame's curve tests
+    uint64_t curve_tests = 0;     // the atlas's estimate of this frame's curve tests (at most the
+                                  // atlas frame_budget, or one texel's sample)
     uint64_t upload_bytes = 0;    // bytes copied into GPU buffers while recording this frame
 };
 
@@ -115,6 +124,15 @@ public:
     // of unknown fonts and glyphs the atlas cannot hold are counted in stats() and skipped, never
     // a crash.
     void draw(std::span<const GlyphInstance> glyphs);
+
+    // The same for a target of which only `visible` can be seen, in the glyphs' pixel space (for
+    // the compositor: {{0, 0}, CompositeTarget::rect.extent}). A glyph wholly outside it is not
+    // drawn (culled_glyphs); one partly outside gets samples only for its visible part and a
+    // margin (kAtlasPartMargin texels a side; clipped_glyphs), so a 2000 px glyph on a 200 px
+    // target costs what 200 px of it cost, and fits an atlas too small for all of it. The part
+    // is decided in record(), over all of the frame's draws of the same glyph. An empty
+    // `visible` culls everything.
+    void draw(std::span<const GlyphInstance> glyphs, const VkRect2D& visible);
 
     // Records this frame's work into `command_buffer` (which must be recording, outside a render
     // pass, on a queue of RendererCreateInfo::queue_family): pending font uploads, the work list,
