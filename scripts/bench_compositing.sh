@@ -23,7 +23,7 @@ case $3 in
     # their CPU reference alone takes minutes.
     run gpu-3840x2160 --canvas 3840,2160 --layers 1,4 --alphas 0.9 --frames 100
     run gpu-1920x1080-32 --canvas 1920,1080 --layers 32 --alphas 0.9 --frames 100 \
-      --modes tiled,tiled-rebin,tiled-rgba8,frame,draw,exact,wboit,unsorted,layered-8
+      --modes tiled,tiled-rebin,tiled-rgba8,frame,draw,exact,wboit,unsorted
     ;;
   lavapipe)
     run lavapipe-512x256 --canvas 512,256 --layers 1,4,32 --alphas 0.9 --frames 10
