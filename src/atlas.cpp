@@ -388,6 +388,14 @@ uint32_t GlyphAtlas::share(const Slot& slot) const {
 
 // Counts a work item: its samples once they cover the whole part, its cost at once.
 void GlyphAtlas::count_work(const RasterWork& work) {
+    if (std::none_of(undo_.begin(), undo_.end(), [&](const Undo& u) { return u.id == work.entry; })) {
+        // The entry's state before this item: the item's first sample, and the texels done
+        // before it (for a piece that finished its sample the entry has moved on since).
+        const Slot& slot = slots_[work.entry];
+        const bool finished = slot.entry.samples != work.first_sample;
+        undo_.push_back({work.entry, work.first_sample, work.first_texel,
+                         finished ? slot.served_frames - 1 : slot.served_frames});
+    }
     const bool finishes = work.first_texel + work.texel_count == work.width * work.height;
     if (finishes) {
         frame_counters_.samples += work.sample_count;
@@ -445,6 +453,8 @@ uint64_t GlyphAtlas::schedule_split(uint32_t id, uint64_t allowance, bool force)
 std::span<const RasterWork> GlyphAtlas::schedule() {
     if (scheduled_) return work_;
     scheduled_ = true;
+    undo_.clear();
+    undo_cursor_ = cursor_;
 
     // New entries first, in acquire order: they have nothing to show yet.
     waiting_ids_.clear();
@@ -519,6 +529,26 @@ std::span<const RasterWork> GlyphAtlas::schedule() {
     // that no budget pays one texel for gets one texel alone, as an overrun.
     for (uint32_t id : split_ids_) budget_left -= schedule_split(id, budget_left, work_.empty());
     return work_;
+}
+
+void GlyphAtlas::abandon_frame() {
+    if (!scheduled_) return;
+    for (const Undo& u : undo_) {
+        Slot& slot = slots_[u.id];
+        if (!slot.resident) continue;
+        slot.entry.samples = u.samples;
+        slot.entry.split_texels_done = u.split_texels_done;
+        slot.served_frames = u.served_frames;
+    }
+    undo_.clear();
+    cursor_ = undo_cursor_;
+    work_.clear();
+    total_counters_.samples -= frame_counters_.samples;
+    total_counters_.curve_tests -= std::min(total_counters_.curve_tests, frame_counters_.curve_tests);
+    total_counters_.split_pieces -= frame_counters_.split_pieces;
+    total_counters_.budget_overruns -= frame_counters_.budget_overruns;
+    frame_counters_.samples = frame_counters_.curve_tests = 0;
+    frame_counters_.split_pieces = frame_counters_.budget_overruns = 0;
 }
 
 void GlyphAtlas::invalidate_samples() {

@@ -95,6 +95,7 @@ Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::spa
     writes[1].pBufferInfo = &quad_info;
     vkUpdateDescriptorSets(ref_.device, 2, writes, 0, nullptr);
     ++frame_;
+    recorded_ = true;
     if (quads.empty()) return uint64_t{0};
 
     gpu::CompositePushConstants push{};

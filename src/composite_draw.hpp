@@ -31,6 +31,12 @@ public:
     // Returns the bytes of quads uploaded.
     Result<uint64_t> record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
                             VkImageView atlas_view, const VkRect2D& rect);
+    // Takes back the last record() (its command buffer will not be submitted): the frame does
+    // not count towards frames in flight.
+    void abandon_frame() {
+        if (recorded_) --frame_;
+        recorded_ = false;
+    }
 
 private:
     struct Slot {
@@ -44,6 +50,7 @@ private:
     VkPipeline pipeline_ = VK_NULL_HANDLE;
     std::vector<Slot> slots_;
     uint64_t frame_ = 0;
+    bool recorded_ = false;  // record() since the last abandon_frame()
 };
 
 }  // namespace crisp::composite

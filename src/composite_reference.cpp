@@ -199,13 +199,6 @@ Status ReferenceCompositor::create(const vk::DeviceRef& device, const Compositor
     frames_in_flight = info.frames_in_flight;
     VkPhysicalDeviceProperties properties{};
     vkGetPhysicalDeviceProperties(info.physical_device, &properties);
-    VkPhysicalDeviceFeatures features{};
-    vkGetPhysicalDeviceFeatures(info.physical_device, &features);
-    if (!features.fragmentStoresAndAtomics || !features.dualSrcBlend) {
-        return Error{ErrorCode::vulkan,
-                     std::string("compositor: ") + properties.deviceName + " lacks " +
-                         (!features.fragmentStoresAndAtomics ? "fragmentStoresAndAtomics" : "dualSrcBlend")};
-    }
     VkFormatProperties format{};
     vkGetPhysicalDeviceFormatProperties(info.physical_device, kTargetFormat, &format);
     const VkFormatFeatureFlags needed = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
@@ -284,6 +277,14 @@ Status ReferenceCompositor::create_pipelines() {
         if (!m.result) return m.result.error();
     }
     return {};
+}
+
+void ReferenceCompositor::abandon_frame() {
+    if (!recorded) return;
+    recorded = false;
+    --frame;
+    slots[frame % frames_in_flight].pending = false;  // its stats will never be written
+    target_initialized = target_was_initialized;
 }
 
 void ReferenceCompositor::read_back_stats(FrameSlot& slot, CompositorStats& stats) {
@@ -591,6 +592,8 @@ Status ReferenceCompositor::record(VkCommandBuffer command_buffer, std::span<con
     write_descriptors(slot, atlas_view);
 
     const gpu::CompositePushConstants push = push_constants(params);
+    target_was_initialized = target_initialized;
+    recorded = true;
     record_target_init(command_buffer);
     const uint64_t buffer_bytes = record_clears(command_buffer, params.mode);
     record_passes(command_buffer, slot, params.mode, *compute, push);

@@ -29,6 +29,8 @@ public:
                   const CompositeParams& params, CompositorStats& stats);
     void record_target_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const;
     const vk::DeviceImage& target() const { return target_; }
+    // Takes back the last record() (its command buffer will not be submitted).
+    void abandon_frame();
 
 private:
     struct FrameSlot {
@@ -74,6 +76,8 @@ private:
 
     vk::DeviceImage target_;
     bool target_initialized = false;
+    bool target_was_initialized = false;  // before the last record()
+    bool recorded = false;                // record() since the last abandon_frame()
 
     vk::DeviceBuffer accumulators;  // kWboitWords (the most either mode uses) words per pixel
     vk::DeviceBuffer nodes;         // exact mode's pool; a stand-in of 16 bytes when there is none

@@ -260,6 +260,15 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const s
     vk::memory_barrier(cb, compute, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
+void TileCompositor::abandon_frame() {
+    if (!recorded_) return;
+    recorded_ = false;
+    --frame_;
+    Slot& slot = slots_[frame_ % slots_.size()];
+    slot.pending = false;
+    if (last_binned_) slot.bins_valid = false;
+}
+
 Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
                                         VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
                                         uint64_t& measured_frame, bool& reused) {
@@ -305,6 +314,8 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     ++frame_;
     slot.pending = true;
     slot.frame = frame_;
+    recorded_ = true;
+    last_binned_ = !reused;
     return quads.size_bytes() + tile_words(tiles) * kWord + pairs * kWord +
            header_words(tiles) * kWord;
 }

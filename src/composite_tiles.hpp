@@ -84,6 +84,10 @@ public:
     Result<uint64_t> record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
                             VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
                             uint64_t& measured_frame, bool& reused);
+    // Takes back the last record() (its command buffer will not be submitted): the slot's bins,
+    // if that record() binned, no longer count as holding its quads, its counts are not read,
+    // and the frame does not count towards frames in flight.
+    void abandon_frame();
 
 private:
     struct Slot {
@@ -116,6 +120,8 @@ private:
     std::array<std::array<VkPipeline, 2>, kTileVariants.size()> tile_pipelines_{};  // exact, layered pass
     std::vector<Slot> slots_;
     uint64_t frame_ = 0;
+    bool recorded_ = false;       // record() since the last abandon_frame()
+    bool last_binned_ = false;    // the last record() binned anew
 };
 
 }  // namespace crisp::composite

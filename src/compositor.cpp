@@ -5,8 +5,10 @@
 #include "composite_quads.hpp"
 #include "composite_reference.hpp"
 #include "composite_tiles.hpp"
+#include "vk_features.hpp"
 
 #include <crisp/compositor.hpp>
+#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -133,6 +135,8 @@ struct Compositor::State {
     CompositorStats stats;
     std::vector<std::string> warnings;
     std::vector<gpu::CompositeQuad> quads;
+    enum class Last { none, tiles, draw, reference };
+    Last last = Last::none;  // the path of the last record call, until abandon_frame()
 
     void take(const composite::TileCounts& counts, uint64_t frame);
 };
@@ -153,19 +157,48 @@ Compositor::Compositor(Compositor&&) noexcept = default;
 Compositor& Compositor::operator=(Compositor&&) noexcept = default;
 Compositor::~Compositor() = default;
 
+CompositorCreateInfo compositor_create_info(const HeadlessContext& context) {
+    CompositorCreateInfo info;
+    info.physical_device = context.physical_device();
+    info.device = context.device();
+    info.allocator = context.allocation_callbacks();
+    info.enabled_features = context.enabled_features();
+    return info;
+}
+
 Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     if (Status s = check_create_info(info); !s) return s.error();
+    Result<vk::DeviceFeatures> enabled = vk::read_enabled_features(info.enabled_features, "compositor");
+    if (!enabled) return enabled.error();
+    const VkPhysicalDeviceFeatures& core = enabled->features2.features;
+    // What each asked-for path needs, against what the device was created with.
+    const auto lacks = [](const char* path, const char* feature) {
+        return Error{ErrorCode::vulkan, std::string("compositor: ") + path + " needs " + feature +
+                                            ", and the device was created without it (add_crisp_features() enables it)"};
+    };
+    if (info.draw_format != VK_FORMAT_UNDEFINED && !enabled->vulkan13.dynamicRendering) {
+        return lacks("the draw path (draw_format)", "dynamicRendering");
+    }
+    if (info.draw_format != VK_FORMAT_UNDEFINED && !core.dualSrcBlend) {
+        return lacks("the draw path (draw_format)", "dualSrcBlend");
+    }
+    if (info.reference_modes && !core.fragmentStoresAndAtomics) {
+        return lacks("the reference modes", "fragmentStoresAndAtomics");
+    }
+    if (info.reference_modes && !core.dualSrcBlend) return lacks("the reference modes", "dualSrcBlend");
+    const bool storage_without_format =
+        core.shaderStorageImageReadWithoutFormat && core.shaderStorageImageWriteWithoutFormat;
     auto state = std::make_unique<State>();
     state->ref.device = info.device;
     state->ref.allocator = info.allocator;
     vkGetPhysicalDeviceMemoryProperties(info.physical_device, &state->ref.memory_properties);
-    state->storage_without_format = info.storage_without_format;
+    state->storage_without_format = storage_without_format;
     composite::TileConfig tiles;
     tiles.physical_device = info.physical_device;
     tiles.frames_in_flight = info.frames_in_flight;
     tiles.layers = info.tile_layers;
     tiles.capacity = info.tile_capacity;
-    tiles.storage_without_format = info.storage_without_format;
+    tiles.storage_without_format = storage_without_format;
     tiles.reuse_static_bins = info.reuse_static_bins;
     if (Status s = state->tiles.create(state->ref, tiles); !s) return s.error();
     if (!std::any_of(std::begin(kTileTargetFormats), std::end(kTileTargetFormats),
@@ -215,6 +248,7 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
         s.tiles.record(command_buffer, s.quads, atlas_view, tile_target, counts, measured_frame, reused);
     if (!bytes) return bytes.error();
     if (measured_frame != 0) s.take(counts, measured_frame);
+    s.last = State::Last::tiles;
     s.stats.mode = CompositeMode::tiled;
     s.stats.path = QuadPath::compute;
     s.stats.quads = static_cast<uint32_t>(s.quads.size());
@@ -222,6 +256,24 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     s.stats.buffer_bytes = *bytes;
     s.stats.bins_reused = reused;
     return {};
+}
+
+void Compositor::abandon_frame() {
+    State& s = *state_;
+    switch (s.last) {
+        case State::Last::tiles:
+            s.tiles.abandon_frame();
+            break;
+        case State::Last::draw:
+            s.draw->abandon_frame();
+            break;
+        case State::Last::reference:
+            s.reference->abandon_frame();
+            break;
+        case State::Last::none:
+            break;
+    }
+    s.last = State::Last::none;
 }
 
 Status Compositor::record_draw(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
@@ -238,6 +290,7 @@ Status Compositor::record_draw(VkCommandBuffer command_buffer, std::span<const D
     composite::sort_front_to_back(glyphs, rect.extent.width, rect.extent.height, s.quads);
     Result<uint64_t> bytes = s.draw->record(command_buffer, s.quads, atlas_view, rect);
     if (!bytes) return bytes.error();
+    s.last = State::Last::draw;
     s.stats.mode = CompositeMode::draw;
     s.stats.path = QuadPath::raster;
     s.stats.quads = static_cast<uint32_t>(s.quads.size());
@@ -248,7 +301,9 @@ Status Compositor::record_draw(VkCommandBuffer command_buffer, std::span<const D
 Status Compositor::record_reference(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
                                     VkImageView atlas_view, const CompositeParams& params) {
     if (!state_->reference) return no_reference_modes();
-    return state_->reference->record(command_buffer, glyphs, atlas_view, params, state_->stats);
+    Status status = state_->reference->record(command_buffer, glyphs, atlas_view, params, state_->stats);
+    if (status) state_->last = State::Last::reference;
+    return status;
 }
 
 bool Compositor::supports_target_format(VkFormat format, VkFormat view_format) const {

@@ -1,4 +1,5 @@
 #include "shared.h"
+#include "vk_features.hpp"
 #include "vk_resources.hpp"
 
 #include <crisp/renderer.hpp>
@@ -30,6 +31,7 @@ struct GpuFont {
     GpuBuffer staging;  // host-visible, points then bands; freed once copied and done
     VkDeviceSize points_bytes = 0;
     bool uploaded = false;
+    VkBuffer retired_staging = VK_NULL_HANDLE;  // the staging buffer the last upload retired
 };
 
 struct Retired {
@@ -80,6 +82,12 @@ struct Renderer::State {
     std::unordered_map<GlyphKey, TexelRect, GlyphKeyHash> clipped_parts;  // scratch: bounding parts
     std::vector<DrawnGlyph> drawn;
     std::vector<gpu::RasterItem> item_data;
+    // What record() committed, so that abandon_frame() can take it back.
+    struct Undo {
+        bool recorded = false;
+        bool atlas_was_initialized = false;
+        std::vector<uint32_t> uploaded_fonts;  // slots whose staging went to `retired` this frame
+    } undo;
     RendererStats stats;
     bool converged = true;
 
@@ -248,6 +256,7 @@ RendererCreateInfo renderer_create_info(const HeadlessContext& context) {
     info.physical_device = context.physical_device();
     info.device = context.device();
     info.queue_family = context.queue_family();
+    info.enabled_features = context.enabled_features();
     info.allocator = context.allocation_callbacks();
     return info;
 }
@@ -276,10 +285,12 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
         return Error{ErrorCode::vulkan, std::string("renderer: ") + properties.deviceName + " offers Vulkan " +
                                             vk::version_string(properties.apiVersion) + "; crisp needs 1.2"};
     }
-    VkPhysicalDeviceFeatures features{};
-    vkGetPhysicalDeviceFeatures(info.physical_device, &features);
-    if (!features.shaderStorageBufferArrayDynamicIndexing) {
-        return Error{ErrorCode::vulkan, "renderer: the device lacks shaderStorageBufferArrayDynamicIndexing"};
+    Result<vk::DeviceFeatures> enabled = vk::read_enabled_features(info.enabled_features, "renderer");
+    if (!enabled) return enabled.error();
+    if (!enabled->features2.features.shaderStorageBufferArrayDynamicIndexing) {
+        return Error{ErrorCode::vulkan,
+                     "renderer: the device was created without shaderStorageBufferArrayDynamicIndexing (enable it; "
+                     "add_crisp_features() does)"};
     }
     if (!vk::has_compute_subgroup_arithmetic(info.physical_device)) {
         return Error{ErrorCode::vulkan, "renderer: the device lacks subgroup arithmetic in compute shaders"};
@@ -368,8 +379,31 @@ const SubpixelLayout& Renderer::subpixel_layout() const {
     return state_->layout;
 }
 
+void Renderer::abandon_frame() {
+    State& s = *state_;
+    if (!s.undo.recorded) return;
+    s.undo.recorded = false;
+    s.atlas.abandon_frame();
+    s.atlas_initialized = s.undo.atlas_was_initialized;
+    // The fonts' uploads go back to waiting, with their staging buffers.
+    for (uint32_t index : s.undo.uploaded_fonts) {
+        GpuFont& font = s.fonts[index];
+        const auto retired = std::find_if(s.retired.begin(), s.retired.end(), [&](const Retired& r) {
+            return r.frame == s.frame - 1 && r.buffer.buffer == font.retired_staging;
+        });
+        if (retired == s.retired.end()) continue;
+        font.staging = retired->buffer;
+        font.uploaded = false;
+        s.retired.erase(retired);
+    }
+    --s.frame;  // an abandoned frame does not count towards frames_in_flight
+    s.drawn.clear();
+    s.converged = false;
+}
+
 void Renderer::begin_frame() {
     State& s = *state_;
+    s.undo.recorded = false;
     s.atlas.begin_frame();
     s.pending.clear();
     s.clipped.clear();
@@ -428,6 +462,9 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     }
 
     // Free what the GPU is done with, upload new fonts.
+    s.undo.recorded = true;
+    s.undo.atlas_was_initialized = s.atlas_initialized;
+    s.undo.uploaded_fonts.clear();
     const uint64_t frame = s.frame++;
     std::erase_if(s.retired, [&](Retired& r) {
         if (r.frame + s.frames_in_flight > frame) return false;
@@ -437,6 +474,7 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     bool uploaded = false;
     for (GpuFont& font : s.fonts) {
         if (font.uploaded) continue;
+        s.undo.uploaded_fonts.push_back(static_cast<uint32_t>(&font - s.fonts.data()));
         if (font.points_bytes) {
             const VkBufferCopy copy{0, 0, font.points_bytes};
             vkCmdCopyBuffer(command_buffer, font.staging.buffer, font.points.buffer, 1, &copy);
@@ -448,6 +486,7 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         }
         s.stats.upload_bytes += font.points_bytes + real_bands;
         font.uploaded = true;
+        font.retired_staging = font.staging.buffer;
         s.retired.push_back({font.staging, frame});
         font.staging = {};
         uploaded = true;

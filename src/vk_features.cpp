@@ -201,6 +201,39 @@ Result<DeviceFeatures> copy_required_features(const VkPhysicalDeviceFeatures2* c
     return required;
 }
 
+Result<DeviceFeatures> read_enabled_features(const VkPhysicalDeviceFeatures2* chain, const char* who) {
+    if (chain == nullptr || chain->sType != VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2) {
+        return Error{ErrorCode::invalid_argument,
+                     std::string(who) + ": enabled_features must point at the VkPhysicalDeviceFeatures2 chain the "
+                                        "device was created with (crisp checks what the device enabled, not what "
+                                        "the GPU offers)"};
+    }
+    DeviceFeatures enabled;
+    enabled.features2.features = chain->features;
+    for (auto* next = static_cast<const VkBaseInStructure*>(chain->pNext); next != nullptr; next = next->pNext) {
+        switch (next->sType) {
+            case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES:
+                copy_members(enabled.vulkan11, next);
+                break;
+            case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES:
+                copy_members(enabled.vulkan12, next);
+                break;
+            case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES:
+                copy_members(enabled.vulkan13, next);
+                break;
+            case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES: {
+                VkPhysicalDeviceDynamicRenderingFeatures dynamic{};
+                std::memcpy(&dynamic, next, sizeof(dynamic));
+                if (dynamic.dynamicRendering) enabled.vulkan13.dynamicRendering = VK_TRUE;
+                break;
+            }
+            default:
+                break;  // an extension's structure: not crisp's business
+        }
+    }
+    return enabled;
+}
+
 DeviceFeatures query_features(VkPhysicalDevice device, bool with_vulkan13) {
     DeviceFeatures offered;
     vkGetPhysicalDeviceFeatures2(device, offered.link(with_vulkan13));

@@ -34,6 +34,13 @@ struct DeviceFeatures {
 // or Vulkan 1.3 features asked for with an api_version below 1.3.
 Result<DeviceFeatures> copy_required_features(const VkPhysicalDeviceFeatures2* chain, uint32_t api_version);
 
+// The features a device was created with, read from the chain its VkDeviceCreateInfo held (it
+// starts with a VkPhysicalDeviceFeatures2): the Vulkan 1.1/1.2/1.3 feature structures and
+// VkPhysicalDeviceDynamicRenderingFeatures are read, any other structure is skipped (an engine's
+// chain holds extension structures too). invalid_argument for a null chain or one that does not
+// start with a VkPhysicalDeviceFeatures2; `who` names the caller in the message.
+Result<DeviceFeatures> read_enabled_features(const VkPhysicalDeviceFeatures2* chain, const char* who);
+
 // The features `device` offers. Vulkan 1.3 features are queried only when with_vulkan13 (the
 // instance and the device are both 1.3 or newer); otherwise they read as absent.
 DeviceFeatures query_features(VkPhysicalDevice device, bool with_vulkan13);

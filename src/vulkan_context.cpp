@@ -240,6 +240,8 @@ struct HeadlessContext::State {
     VkDriverId driver_id = VK_DRIVER_ID_MAX_ENUM;
     uint32_t driver_version = 0;
     uint32_t api_version = 0;
+    vk::DeviceFeatures enabled;  // what the device was created with
+    VkPhysicalDeviceFeatures2* enabled_chain = nullptr;
     VkPhysicalDeviceProperties properties{};
     VkPhysicalDeviceMemoryProperties memory_properties{};
     VkPhysicalDeviceSubgroupProperties subgroup{};
@@ -446,6 +448,8 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
         result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateDevice", result);
     }
+    state->enabled = required;
+    state->enabled_chain = state->enabled.link(true);
     vkGetDeviceQueue(state->device, state->queue_family, 0, &state->queue);
 
     VkCommandPoolCreateInfo pool_info{};
@@ -490,6 +494,10 @@ VkDevice HeadlessContext::device() const {
 }
 uint32_t HeadlessContext::queue_family() const {
     return state_->queue_family;
+}
+
+const VkPhysicalDeviceFeatures2* HeadlessContext::enabled_features() const {
+    return state_->enabled_chain;
 }
 VkQueue HeadlessContext::queue() const {
     return state_->queue;

@@ -124,9 +124,7 @@ Scene render_scene(const std::vector<TextRun>& runs, const char* layout_name, fl
 
 CompositorCreateInfo compositor_info() {
     Fixture& f = fixture();
-    CompositorCreateInfo info;
-    info.physical_device = f.context->physical_device();
-    info.device = f.context->device();
+    CompositorCreateInfo info = compositor_create_info(*f.context);
     info.width = kWidth;
     info.height = kHeight;
     info.reference_modes = true;

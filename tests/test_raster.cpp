@@ -3,6 +3,8 @@
 #include "test_support.hpp"
 
 #include <crisp/bake.hpp>
+#include <crisp/compositor.hpp>
+#include <crisp/device_features.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
@@ -403,6 +405,72 @@ TEST(Raster, OnlyTheVisiblePartOfAHugeGlyphIsRasterized) {
     EXPECT_EQ(renderer->stats().work_items, 0u);
     EXPECT_TRUE(renderer->drawn().empty());
     expect_no_validation_messages();
+}
+
+// Issue 9: crisp checks what the device was created with, not what the GPU offers. lavapipe
+// offers every feature crisp uses; a device created without them must be refused, clearly.
+TEST(Raster, FeaturesAreCheckedAgainstTheDeviceAsCreated) {
+    HeadlessContextOptions options;
+    options.validation = true;
+    options.api_version = VK_API_VERSION_1_3;
+    auto bare = HeadlessContext::create(options);  // no features enabled at all
+    ASSERT_TRUE(bare) << bare.error().message;
+    RendererCreateInfo info = renderer_create_info(*bare);
+    auto refused = Renderer::create(info);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::vulkan);
+    EXPECT_NE(refused.error().message.find("created without shaderStorageBufferArrayDynamicIndexing"),
+              std::string::npos)
+        << refused.error().message;
+    info.enabled_features = nullptr;
+    EXPECT_EQ(Renderer::create(info).error().code, ErrorCode::invalid_argument);
+
+    CompositorCreateInfo compositor = compositor_create_info(*bare);
+    EXPECT_TRUE(Compositor::create(compositor));  // the tile path needs nothing more
+    compositor.draw_format = VK_FORMAT_R8G8B8A8_UNORM;
+    auto no_draw = Compositor::create(compositor);
+    ASSERT_FALSE(no_draw);
+    EXPECT_NE(no_draw.error().message.find("dynamicRendering"), std::string::npos) << no_draw.error().message;
+    compositor.draw_format = VK_FORMAT_UNDEFINED;
+    compositor.reference_modes = true;
+    compositor.width = compositor.height = 8;
+    auto no_reference = Compositor::create(compositor);
+    ASSERT_FALSE(no_reference);
+    EXPECT_NE(no_reference.error().message.find("fragmentStoresAndAtomics"), std::string::npos);
+    compositor.enabled_features = nullptr;
+    EXPECT_EQ(Compositor::create(compositor).error().code, ErrorCode::invalid_argument);
+
+    // add_crisp_features fills in a chain; a device made from it is accepted by every part.
+    VkPhysicalDeviceVulkan13Features vulkan13{};
+    vulkan13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    const Status no_room = add_crisp_features(bare->physical_device(), features, {.draw_path = true});
+    ASSERT_FALSE(no_room);  // no structure to hold dynamicRendering
+    EXPECT_EQ(no_room.error().code, ErrorCode::invalid_argument);
+    EXPECT_FALSE(features.features.shaderStorageBufferArrayDynamicIndexing);  // unchanged
+    features.pNext = &vulkan13;
+    ASSERT_TRUE(add_crisp_features(bare->physical_device(), features,
+                                   {.draw_path = true, .reference_modes = true, .storage_without_format = false}));
+    EXPECT_TRUE(features.features.shaderStorageBufferArrayDynamicIndexing);
+    EXPECT_TRUE(features.features.dualSrcBlend);
+    EXPECT_TRUE(features.features.fragmentStoresAndAtomics);
+    EXPECT_TRUE(vulkan13.dynamicRendering);
+    EXPECT_FALSE(features.features.shaderStorageImageWriteWithoutFormat);
+    options.required_features = &features;
+    auto full = HeadlessContext::create(options);
+    ASSERT_TRUE(full) << full.error().message;
+    EXPECT_TRUE(Renderer::create(renderer_create_info(*full)));
+    compositor = compositor_create_info(*full);
+    compositor.draw_format = VK_FORMAT_R8G8B8A8_UNORM;
+    compositor.reference_modes = true;
+    compositor.width = compositor.height = 8;
+    auto made = Compositor::create(compositor);
+    EXPECT_TRUE(made) << made.error().message;
+    for (HeadlessContext* context : {&*bare, &*full}) {
+        const ValidationMessages messages = context->validation_messages();
+        EXPECT_EQ(messages.errors + messages.warnings, 0u);
+    }
 }
 
 }  // namespace

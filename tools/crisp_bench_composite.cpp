@@ -900,9 +900,7 @@ int main(int argc, char** argv) {
                            " nodes per pixel (64, or maxStorageBufferRange) below the " + std::to_string(wanted) +
                            " the rects could need");
             }
-            crisp::CompositorCreateInfo compositor_info;
-            compositor_info.physical_device = context->physical_device();
-            compositor_info.device = context->device();
+            crisp::CompositorCreateInfo compositor_info = crisp::compositor_create_info(*context);
             compositor_info.width = args.width;
             compositor_info.height = args.height;
             compositor_info.frames_in_flight = kFramesInFlight;

@@ -510,12 +510,8 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
     const bool draw = args.composite == crisp::CompositeMode::draw;
     constexpr VkFormat kFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
     const uint32_t width = job.scene.width, height = job.scene.height;
-    crisp::CompositorCreateInfo info;
-    info.physical_device = context.physical_device();
-    info.device = context.device();
-    info.allocator = context.allocation_callbacks();
+    crisp::CompositorCreateInfo info = crisp::compositor_create_info(context);
     info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
-    info.storage_without_format = out.storage_without_format;
     if (draw) info.draw_format = kFormat;
     crisp::Result<crisp::Compositor> created = crisp::Compositor::create(info);
     if (!created) {
@@ -573,10 +569,7 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
     if (args.composite == crisp::CompositeMode::tiled || args.composite == crisp::CompositeMode::draw) {
         return composite_into_image(context, renderer, args, job, report);
     }
-    crisp::CompositorCreateInfo info;
-    info.physical_device = context.physical_device();
-    info.device = context.device();
-    info.allocator = context.allocation_callbacks();
+    crisp::CompositorCreateInfo info = crisp::compositor_create_info(context);
     info.width = job.scene.width;
     info.height = job.scene.height;
     info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements

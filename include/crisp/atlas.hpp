@@ -233,6 +233,14 @@ public:
     // The span stays valid until the next begin_frame().
     std::span<const RasterWork> schedule();
 
+    // Takes back this frame's schedule() when its work will never run (the renderer's frame was
+    // dropped): every entry it gave work gets back its sample count, its split-sample progress and
+    // its place in the ramp, the turn cursor goes back, and the work list empties; the counters
+    // forget the frame's samples and curve tests. Entries placed or evicted by acquire() stay as
+    // they are (a placed entry keeps 0 samples and is cleared by its next work). Without a
+    // schedule() this frame it does nothing.
+    void abandon_frame();
+
     // Forgets every resident entry's samples (after a subpixel layout change, for example): each
     // restarts its ramp at sample 0, and its next work item clears the rect. Entries stay resident.
     // Work already returned by schedule() this frame stays valid to execute.
@@ -309,6 +317,14 @@ private:
     uint32_t cursor_ = 0;                // entry id the next frame's round starts at
     bool scheduled_ = false;
     std::vector<RasterWork> work_;
+    struct Undo {
+        uint32_t id = 0;
+        uint32_t samples = 0;
+        uint32_t split_texels_done = 0;
+        uint32_t served_frames = 0;
+    };
+    std::vector<Undo> undo_;  // the entries' state before this frame's schedule()
+    uint32_t undo_cursor_ = 0;
     AtlasCounters frame_counters_;
     AtlasCounters total_counters_;
 };

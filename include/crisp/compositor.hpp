@@ -77,11 +77,13 @@ struct CompositorCreateInfo {
     VkDevice device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
     uint32_t frames_in_flight = 2;  // 1 to 8
+    // Required: the feature chain `device` was created with, as RendererCreateInfo::enabled_features.
+    // What each path needs is checked against it, never against what the GPU offers.
+    const VkPhysicalDeviceFeatures2* enabled_features = nullptr;
 
-    // ---- The tile path (record()). It needs no device feature beyond the renderer's.
-    // Say whether the device was created with shaderStorageImageReadWithoutFormat and
-    // shaderStorageImageWriteWithoutFormat: B8G8R8A8_UNORM targets need them.
-    bool storage_without_format = false;
+    // ---- The tile path (record()). It needs no device feature beyond the renderer's; where the
+    // device was created with shaderStorageImageReadWithoutFormat and
+    // shaderStorageImageWriteWithoutFormat it also takes B8G8R8A8_UNORM views.
     // Quads a tile's list holds in workgroup memory (8 bytes each): a power of two, 4 to
     // kMaxTileCapacity. A longer list takes the layered way with K = tile_layers.
     uint32_t tile_capacity = 256;
@@ -93,8 +95,8 @@ struct CompositorCreateInfo {
     bool reuse_static_bins = true;
 
     // ---- The draw path (record_draw()): the colour attachment format of the caller's render
-    // pass; VK_FORMAT_UNDEFINED makes no draw pipeline. The device must have dynamicRendering and
-    // dualSrcBlend enabled, and the format must blend. Blending is linear only where the format
+    // pass; VK_FORMAT_UNDEFINED makes no draw pipeline. The device must have been created with
+    // dynamicRendering and dualSrcBlend, and the format must blend. Blending is linear only where the format
     // is _SRGB or floating point.
     VkFormat draw_format = VK_FORMAT_UNDEFINED;
 
@@ -109,6 +111,12 @@ struct CompositorCreateInfo {
     // 0 makes no pool and the exact mode unavailable. At most 64.
     uint32_t exact_nodes_per_pixel = 16;
 };
+
+class HeadlessContext;
+
+// A CompositorCreateInfo for the objects `context` made (physical device, device, allocator,
+// enabled features), the rest at its defaults. For tools and tests; an engine fills in its own.
+CompositorCreateInfo compositor_create_info(const HeadlessContext& context);
 
 // How the quad passes of the wboit and exact reference modes run (unsorted is always rasterized:
 // it needs the blend unit's submission order).
@@ -235,6 +243,15 @@ public:
     // nothing.
     Status record_reference(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
                             VkImageView atlas_view, const CompositeParams& params);
+
+    // Takes back the most recent record(), record_draw() or record_reference() when its command
+    // buffer will not be submitted (a dropped frame): the bins it made do not count as made, its
+    // statistics are not waited for, the reference target's first layout change is recorded
+    // again, and it does not count towards frames_in_flight. Call it before the next record
+    // call and discard the command buffer unsubmitted; only the most recent call can be taken
+    // back, and a second abandon_frame() does nothing. (Renderer::abandon_frame() is the same for
+    // the renderer; a dropped frame needs both.)
+    void abandon_frame();
 
     // True when record() can composite into an image of `format` seen through a view of
     // `view_format` (VK_FORMAT_UNDEFINED: the same format).

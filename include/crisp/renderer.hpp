@@ -2,7 +2,8 @@
 // adding R2-distributed point samples per subpixel channel for as long as a glyph stays on screen.
 //
 // A Renderer is created from the caller's Vulkan objects and records its work into command buffers
-// the caller gives; it never submits on its own. A frame:
+// the caller gives; it never submits on its own. A frame whose command buffer is not submitted
+// after all must be abandoned (abandon_frame()). A frame:
 //
 //     renderer.begin_frame();
 //     renderer.draw(layout.glyphs);             // any number of times: acquires atlas entries
@@ -44,6 +45,13 @@ struct RendererCreateInfo {
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkDevice device = VK_NULL_HANDLE;
     uint32_t queue_family = 0;  // the family of the queue the caller submits crisp's work on
+    // Required: the feature chain `device` was created with (the VkPhysicalDeviceFeatures2 its
+    // VkDeviceCreateInfo::pNext held; with pEnabledFeatures, a VkPhysicalDeviceFeatures2 holding
+    // those). crisp checks its needs against it, not against what the GPU offers: a feature the
+    // GPU has but the device did not enable is not there. Vulkan 1.1/1.2/1.3 feature structures
+    // in the chain are read, others skipped; read during create() only. add_crisp_features()
+    // (device_features.hpp) fills one in before device creation.
+    const VkPhysicalDeviceFeatures2* enabled_features = nullptr;
     const VkAllocationCallbacks* allocator = nullptr;
     uint32_t frames_in_flight = 2;  // 1 to 8
     AtlasConfig atlas;              // max_samples at most kMaxRendererSamples
@@ -139,6 +147,16 @@ public:
     // one compute dispatch, and a barrier that makes the atlas readable. Call once per frame after
     // the draws. Errors (ErrorCode::vulkan) leave the command buffer without crisp's commands.
     Status record(VkCommandBuffer command_buffer);
+
+    // Takes back what record() committed for a frame that will never be submitted (a swapchain out
+    // of date, a minimized window, any frame an engine drops): font uploads wait for the next
+    // record(), the atlas image's first layout change is recorded again, and the atlas forgets the
+    // samples and the turn this frame scheduled (see GlyphAtlas::abandon_frame). Call it after
+    // record() and before the next begin_frame(), and discard the command buffer unsubmitted. The
+    // abandoned frame does not count towards frames_in_flight. Without a record() since
+    // begin_frame() it does nothing. A frame neither abandoned nor submitted is a programmer error:
+    // its samples count as if they were in the atlas image, and their texels stay wrong.
+    void abandon_frame();
 
     // The glyphs draw()n this frame that hold samples once this frame's work has run, with their
     // atlas positions (valid after record()).

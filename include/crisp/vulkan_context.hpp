@@ -166,6 +166,10 @@ public:
     VkPhysicalDevice physical_device() const;
     VkDevice device() const;
     uint32_t queue_family() const;
+    // The feature chain the device was created with (exactly what required_features asked for),
+    // for RendererCreateInfo::enabled_features and CompositorCreateInfo::enabled_features. Valid
+    // while the context lives.
+    const VkPhysicalDeviceFeatures2* enabled_features() const;
     VkQueue queue() const;
     // crisp uses the driver's allocator: always nullptr, passed wherever Vulkan takes one.
     const VkAllocationCallbacks* allocation_callbacks() const { return nullptr; }

@@ -1,0 +1,41 @@
+// crisp: the Vulkan device features crisp's parts need, for an engine that creates its own device.
+//
+// crisp checks what the device was created with (RendererCreateInfo::enabled_features,
+// CompositorCreateInfo::enabled_features), never what the GPU merely offers. Before vkCreateDevice,
+// add_crisp_features() turns on what the parts an engine uses need in the chain it passes:
+//
+//     VkPhysicalDeviceVulkan13Features vulkan13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+//     VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &vulkan13};
+//     ... the engine's own features ...
+//     crisp::add_crisp_features(physical_device, features, {.draw_path = true});
+//     device_info.pNext = &features;                    // then vkCreateDevice
+//     renderer_info.enabled_features = &features;       // and the same chain for crisp
+#pragma once
+
+#include <crisp/result.hpp>
+
+#include <vulkan/vulkan.h>
+
+namespace crisp {
+
+// The parts of crisp a device is made for. The renderer and the compositor's tile path are always
+// counted in.
+struct CrispFeatureNeeds {
+    bool draw_path = false;        // Compositor::record_draw: dynamicRendering, dualSrcBlend
+    bool reference_modes = false;  // Compositor::record_reference: fragmentStoresAndAtomics, dualSrcBlend
+    // B8G8R8A8_UNORM storage views for the tile path: shaderStorageImageRead/WriteWithoutFormat,
+    // turned on only where the GPU offers both (they are optional: the tile path works without).
+    bool storage_without_format = false;
+};
+
+// Sets, in `features` and in the VkPhysicalDeviceVulkan13Features or
+// VkPhysicalDeviceDynamicRenderingFeatures of its pNext chain, every feature `needs` asks for,
+// leaving whatever else the chain enables as it is; it never allocates into the chain. Errors:
+// invalid_argument when `features` is not a VkPhysicalDeviceFeatures2, or the draw path is asked
+// for and the chain holds no structure with dynamicRendering (link a
+// VkPhysicalDeviceVulkan13Features); vulkan when the GPU lacks a required feature (named), in
+// which case `features` is unchanged.
+Status add_crisp_features(VkPhysicalDevice physical_device, VkPhysicalDeviceFeatures2& features,
+                          const CrispFeatureNeeds& needs = {});
+
+}  // namespace crisp
