@@ -27,6 +27,7 @@ Fixture& fixture() {
         VkPhysicalDeviceFeatures2 features{};
         features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
         features.pNext = &vulkan12;
+        features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;  // the renderer
         features.features.fragmentStoresAndAtomics = VK_TRUE;
         features.features.dualSrcBlend = VK_TRUE;
         HeadlessContextOptions options;

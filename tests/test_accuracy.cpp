@@ -23,9 +23,7 @@ namespace {
 
 HeadlessContext* context() {
     static std::unique_ptr<HeadlessContext> made = [] {
-        HeadlessContextOptions options;
-        options.validation = true;
-        auto created = HeadlessContext::create(options);
+        auto created = test::create_renderer_context();
         return created ? std::make_unique<HeadlessContext>(std::move(*created)) : nullptr;
     }();
     return made.get();

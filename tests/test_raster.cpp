@@ -27,9 +27,7 @@ struct Fixture {
 Fixture& fixture() {
     static Fixture f = [] {
         Fixture made;
-        HeadlessContextOptions options;
-        options.validation = true;
-        auto context = HeadlessContext::create(options);
+        auto context = test::create_renderer_context();
         if (context) made.context = std::make_unique<HeadlessContext>(std::move(*context));
         made.font = test::bake_test_font("Hg@&1");
         return made;
@@ -257,9 +255,7 @@ namespace {
 TEST(Raster, TwoRenderersOnTwoContextsWorkSideBySide) {
     Fixture& f = fixture();
     ASSERT_TRUE(f.context);
-    HeadlessContextOptions options;
-    options.validation = true;
-    auto second = HeadlessContext::create(options);
+    auto second = test::create_renderer_context();
     ASSERT_TRUE(second) << second.error().message;
     RendererCreateInfo info = renderer_create_info(*second);
     info.atlas.width = info.atlas.height = 256;

@@ -3,6 +3,7 @@
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
+#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <cstddef>
@@ -45,6 +46,17 @@ inline std::unique_ptr<Font> bake_test_font(std::string_view text, FontId id = 1
     if (!baked) return nullptr;
     auto font = Font::create(std::move(baked->asset), id);
     return font ? std::make_unique<Font>(std::move(*font)) : nullptr;
+}
+
+// A context with the validation layer on whose device was created with what crisp's renderer
+// needs (shaderStorageBufferArrayDynamicIndexing): crisp checks the device as created.
+inline Result<HeadlessContext> create_renderer_context(HeadlessContextOptions options = {}) {
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;
+    options.validation = true;
+    options.required_features = &features;  // read during create() only
+    return HeadlessContext::create(options);
 }
 
 inline std::vector<std::byte> read_file(const std::string& path) {
