@@ -20,6 +20,10 @@ packages=(
   python3-fonttools                      # tests derive a 16384 units-per-em font from DejaVu Sans
   fonts-noto-cjk                         # tests: a CJK collection (.ttc, CFF, 1000 units per em)
   fonts-cantarell                        # tests: a CFF face with 1000 units per em
+  libglfw3-dev                           # the layout editor's window and input
+  xvfb xauth                             # the layout editor test: a virtual X display (xvfb-run)
+  xdotool                                # the layout editor test: scripted mouse and keys
+  x11-apps                               # the layout editor test: xwd, screenshots of the display
 )
 
 missing=()

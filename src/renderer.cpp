@@ -1,4 +1,5 @@
 #include "shared.h"
+#include "vk_barriers.hpp"
 #include "vk_features.hpp"
 #include "vk_resources.hpp"
 
@@ -493,18 +494,8 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     }
 
     if (!s.atlas_initialized) {
-        VkImageMemoryBarrier to_general{};
-        to_general.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-        to_general.srcAccessMask = 0;
-        to_general.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-        to_general.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-        to_general.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-        to_general.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_general.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_general.image = s.atlas_image.image;
-        to_general.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
-                             0, nullptr, 0, nullptr, 1, &to_general);
+        vk::image_barrier(command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                          VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);
         s.atlas_initialized = true;
     }
 

@@ -20,4 +20,22 @@ inline void memory_barrier(VkCommandBuffer command_buffer, VkPipelineStageFlags 
     vkCmdPipelineBarrier(command_buffer, source, destination, 0, 1, &barrier, 0, nullptr, 0, nullptr);
 }
 
+// A layout change of a whole single-level, single-layer colour image, with the same access
+// ordering as memory_barrier.
+inline void image_barrier(VkCommandBuffer command_buffer, VkImage image, VkImageLayout from, VkImageLayout to,
+                          VkPipelineStageFlags source, VkAccessFlags source_access, VkPipelineStageFlags destination,
+                          VkAccessFlags destination_access) {
+    VkImageMemoryBarrier barrier{};
+    barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    barrier.srcAccessMask = source_access;
+    barrier.dstAccessMask = destination_access;
+    barrier.oldLayout = from;
+    barrier.newLayout = to;
+    barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.image = image;
+    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(command_buffer, source, destination, 0, 0, nullptr, 0, nullptr, 1, &barrier);
+}
+
 }  // namespace crisp::vk

@@ -1,0 +1,173 @@
+#!/usr/bin/env bash
+# layout_editor_test.sh EDITOR CRISP_RENDER CRISP_BAKE SOURCE_DIR WORK_DIR: runs crisp-layout-editor
+# under Xvfb on whatever Vulkan device there is (lavapipe in CI) with the validation layer on, and
+# drives it with xdotool: pick the bgr preset, drag the red rectangle's bottom edge up 24 screen
+# pixels, nudge it one step left, undo and redo the nudge, type 0.125 into its y0 field, save
+# (Ctrl+S), quit (Ctrl+Q). Checks that the saved JSON is exactly bgr with those edits, that
+# crisp-render accepts it, that the editor exits 0 (so the validation layer stayed silent), and
+# that screenshots of the display before and after the edit show the preview, the magnified pixel
+# and the magnified rendered pixels, each not blank and each changed by the edit. Also: a bad
+# --layout file is reported (not fatal) and the --screenshot mode writes a PNG of the window.
+set -uo pipefail
+editor=$1 render=$2 bake=$3 source=$4 work=$5
+
+if [ "${LAYOUT_EDITOR_TEST_INNER:-}" != 1 ]; then
+  for tool in xvfb-run xdotool xwd python3; do
+    command -v "$tool" >/dev/null || { echo "FAIL: $tool is missing (scripts/setup.sh installs it)" >&2; exit 1; }
+  done
+  rm -rf "$work" && mkdir -p "$work"
+  LAYOUT_EDITOR_TEST_INNER=1 exec xvfb-run -a -s "-screen 0 1280x800x24" bash "$0" "$@"
+fi
+
+cd "$work"
+failures=0
+fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+geometry=$("$editor" --print-geometry) || { echo "FAIL: --print-geometry" >&2; exit 1; }
+echo "$geometry" >geometry.json
+# Window pixel coordinates of a widget's centre: center NAME (a preset or a command).
+center() {
+  python3 -c 'import json,sys; g=json.load(open("geometry.json")); n=sys.argv[1]
+r=g["presets"].get(n) or g["commands"][n]; print(int(r[0]+r[2]/2), int(r[1]+r[3]/2))' "$1"
+}
+shot() { xwd -root -silent >"$1" || fail "xwd $1"; }
+
+# ---- The --screenshot mode: a PNG of the window after N frames.
+"$editor" --validation --frames 3 --screenshot shot.png 2>screenshot.err
+code=$?
+[ "$code" -eq 0 ] || fail "--screenshot: exit $code: $(head -c 600 screenshot.err)"
+python3 -c 'import sys; d=open("shot.png","rb").read(); sys.exit(not (d[:8]==b"\x89PNG\r\n\x1a\n" and
+int.from_bytes(d[16:20],"big")==1280 and int.from_bytes(d[20:24],"big")==800))' ||
+  fail "--screenshot did not write a 1280 x 800 PNG"
+
+# ---- A bad layout file: reported (stderr and window), the editor still runs; exit 0.
+printf '{"r": [0, 0, 0.3, 1], "g": [0.3, 0, 0.6], "b": [0.6, 0, 1, 1]}' >bad.json
+"$editor" --validation --layout bad.json --frames 2 2>bad.err
+code=$?
+[ "$code" -eq 0 ] || fail "bad --layout: exit $code, want 0 (the error is shown, not fatal)"
+grep -q 'bad.json' bad.err && grep -q 'g' bad.err || fail "bad --layout: stderr lacks the reader's error: $(cat bad.err)"
+
+# ---- The scripted session.
+printf '{"name": "start", "r": [0, 0, 0.25, 1], "g": [0.25, 0, 0.75, 1], "b": [0.75, 0, 1, 1]}' >start.json
+"$editor" --validation --layout start.json --save-to saved.json 2>editor.err &
+pid=$!
+window=$(timeout 60 xdotool search --sync --name '^crisp layout editor$' | head -n1)
+[ -n "$window" ] || { fail "no editor window"; kill "$pid"; exit 1; }
+# Frames take a while on lavapipe: let text converge a little before the first screenshot.
+sleep 6
+shot before.xwd
+xdotool windowfocus --sync "$window" 2>/dev/null || true
+read -r bx by < <(center bgr)
+xdotool mousemove "$bx" "$by" click 1
+sleep 1
+# The red rectangle of bgr spans x 2/3..1: its bottom edge at the centre of that span.
+read -r ex ey < <(python3 -c 'import json; g=json.load(open("geometry.json")); o=g["pixel_origin"]; s=g["pixel_scale"]
+print(int(o[0] + s * 5 / 6), int(o[1] + s))')
+xdotool mousemove "$ex" "$ey" mousedown 1
+sleep 0.3
+xdotool mousemove "$ex" $((ey - 12))
+sleep 0.3
+xdotool mousemove "$ex" $((ey - 24))
+sleep 0.3
+xdotool mouseup 1
+sleep 0.5
+xdotool key Left
+sleep 0.5
+xdotool key ctrl+z
+sleep 0.5
+xdotool key ctrl+y
+sleep 0.5
+# Type an exact number: red's top edge to 0.125.
+read -r fx fy < <(python3 -c 'import json; r=json.load(open("geometry.json"))["fields"]["r.y0"]
+print(int(r[0] + r[2] / 2), int(r[1] + r[3] / 2))')
+xdotool mousemove "$fx" "$fy" click 1
+sleep 0.5
+xdotool type --delay 50 0.125
+xdotool key Return
+sleep 0.5
+xdotool key ctrl+s
+for _ in $(seq 1 60); do [ -f saved.json ] && break; sleep 0.5; done
+[ -f saved.json ] || fail "Ctrl+S wrote no saved.json"
+sleep 6
+shot after.xwd
+xdotool key ctrl+q
+for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
+if kill -0 "$pid" 2>/dev/null; then
+  fail "the editor did not quit on Ctrl+Q"
+  kill "$pid"
+fi
+wait "$pid"
+code=$?
+[ "$code" -eq 0 ] || fail "the editor exited $code (4: the validation layer spoke): $(head -c 1500 editor.err)"
+grep -q 'validation' editor.err && fail "validation messages: $(grep validation editor.err | head -5)"
+
+# ---- The saved layout: bgr, red's bottom edge 24 steps up, red one step left, red's
+# top edge typed to 0.125, nothing else.
+python3 - saved.json geometry.json <<'PY' || fail "saved layout"
+import json, sys
+saved = json.load(open(sys.argv[1]))
+step = json.load(open(sys.argv[2]))["edit_step"]
+third, two_thirds = 1 / 3, 2 / 3
+want = {"name": "bgr-edited",
+        "r": [two_thirds - step, 0.125, 1 - step, 1 - 24 * step],
+        "g": [third, 0, two_thirds, 1],
+        "b": [0, 0, third, 1]}
+assert saved["name"] == want["name"], saved
+for channel in "rgb":
+    got, expected = saved[channel], want[channel]
+    assert len(got) == 4 and all(abs(a - b) < 1e-5 for a, b in zip(got, expected)), (channel, got, expected)
+print("saved layout as expected:", json.dumps(saved))
+PY
+"$bake" "$source/fonts/DejaVuSans.ttf" --text "Hi" -o dejavu.crisp -q || fail "crisp-bake"
+"$render" --font dejavu.crisp --text "Hi" --size 20 --origin 4,24 --canvas 48,32 --samples 16 \
+  --layout saved.json -o render.png 2>render.err || fail "crisp-render refused the saved layout: $(cat render.err)"
+
+# ---- Screenshots: each region present (not blank) and changed by the edit.
+python3 - before.xwd after.xwd geometry.json <<'PY' || fail "screenshots"
+import json, struct, sys
+
+def read_xwd(path):
+    data = open(path, "rb").read()
+    header = struct.unpack(">25I", data[:100])
+    header_size, width, height = header[0], header[4], header[5]
+    bits_per_pixel, bytes_per_line, byte_order = header[11], header[12], header[7]
+    ncolors = header[19]
+    assert bits_per_pixel == 32, bits_per_pixel
+    pixels = data[header_size + 12 * ncolors:]
+    masks = header[15:18]
+    def at(x, y):
+        off = y * bytes_per_line + 4 * x
+        value = int.from_bytes(pixels[off:off + 4], "little" if byte_order == 0 else "big")
+        return tuple((value & m) >> (m & -m).bit_length() - 1 for m in masks)
+    return width, height, at
+
+g = json.load(open(sys.argv[3]))
+w0, h0, before = read_xwd(sys.argv[1])
+w1, h1, after = read_xwd(sys.argv[2])
+assert (w0, h0) == (w1, h1) == tuple(g["window"]), (w0, h0, w1, h1)
+
+def region(name):
+    x, y, w, h = (int(v) for v in g[name])
+    return [(px, py) for py in range(y, y + h, 2) for px in range(x, x + w, 2)]
+
+def changed(name):
+    # A sample changed by the edit: some channel moved by more than converging samples move it.
+    points = region(name)
+    count = sum(1 for x, y in points if max(abs(a - b) for a, b in zip(before(x, y), after(x, y))) > 40)
+    return count, len(points)
+
+for name in ("magnified_pixel", "preview", "rendered_pixels"):
+    for label, image in (("before", before), ("after", after)):
+        distinct = len(set(image(x, y) for x, y in region(name)))
+        assert distinct > 20, f"{name} {label}: only {distinct} colours: blank?"
+# The preview's paragraphs (not its moving line, which changes every frame) and both magnified views.
+for name in ("magnified_pixel", "preview_paragraphs", "rendered_pixels"):
+    count, total = changed(name)
+    assert count > total // 500, f"{name}: only {count} of {total} samples changed after the edit"
+    print(f"{name}: {count} of {total} samples changed")
+PY
+
+if [ "$failures" -ne 0 ]; then
+  echo "$failures check(s) failed; files in $work" >&2
+  exit 1
+fi
+echo "layout editor: all checks passed"

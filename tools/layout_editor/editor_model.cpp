@@ -1,0 +1,160 @@
+#include "editor_model.hpp"
+
+#include <crisp/glyph.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace crisp::editor {
+namespace {
+
+constexpr float kLow = -static_cast<float>(kGlyphPadding);
+constexpr float kHigh = 1.0f + static_cast<float>(kGlyphPadding);
+
+float snap(float value) { return std::round(value / kEditStep) * kEditStep; }
+
+float& coordinate_ref(SampleRect& rect, int coordinate) {
+    switch (coordinate) {
+        case 0: return rect.x0;
+        case 1: return rect.y0;
+        case 2: return rect.x1;
+        default: return rect.y1;
+    }
+}
+
+// Moves [lo, hi] by `delta`, stopping at the bounds; the size stays.
+void shift_span(float& lo, float& hi, float delta) {
+    delta = std::clamp(delta, kLow - lo, kHigh - hi);
+    lo += delta;
+    hi += delta;
+}
+
+}  // namespace
+
+float rect_coordinate(const SampleRect& rect, int coordinate) {
+    switch (coordinate) {
+        case 0: return rect.x0;
+        case 1: return rect.y0;
+        case 2: return rect.x1;
+        default: return rect.y1;
+    }
+}
+
+LayoutModel::LayoutModel(SubpixelLayout initial) : layout_(std::move(initial)), saved_(layout_) {}
+
+void LayoutModel::select(int channel) {
+    if (channel >= 0 && channel < 3) selected_ = channel;
+}
+
+void LayoutModel::push_undo() {
+    undo_.push_back(layout_);
+    redo_.clear();
+}
+
+void LayoutModel::changed() { ++revision_; }
+
+void LayoutModel::rename_if_preset() {
+    const auto names = subpixel_preset_names();
+    if (std::find(names.begin(), names.end(), layout_.name) != names.end()) layout_.name += "-edited";
+}
+
+Status LayoutModel::set_coordinate(int channel, int coordinate, float value) {
+    if (channel < 0 || channel > 2 || coordinate < 0 || coordinate > 3) {
+        return Error{ErrorCode::invalid_argument, "no such channel or coordinate"};
+    }
+    SubpixelLayout next = layout_;
+    coordinate_ref(next.channels[static_cast<size_t>(channel)], coordinate) = value;
+    if (Status status = validate_subpixel_layout(next); !status) return status;
+    if (next == layout_) return {};
+    push_undo();
+    layout_ = std::move(next);
+    rename_if_preset();
+    changed();
+    return {};
+}
+
+void LayoutModel::nudge(int dx_steps, int dy_steps) {
+    SampleRect rect = layout_.channels[static_cast<size_t>(selected_)];
+    shift_span(rect.x0, rect.x1, static_cast<float>(dx_steps) * kEditStep);
+    shift_span(rect.y0, rect.y1, static_cast<float>(dy_steps) * kEditStep);
+    if (rect == layout_.channels[static_cast<size_t>(selected_)]) return;
+    push_undo();
+    layout_.channels[static_cast<size_t>(selected_)] = rect;
+    rename_if_preset();
+    changed();
+}
+
+void LayoutModel::begin_drag(int channel, Handle handle) {
+    if (channel < 0 || channel > 2) return;
+    selected_ = channel;
+    drag_channel_ = channel;
+    drag_handle_ = handle;
+    drag_start_ = layout_.channels[static_cast<size_t>(channel)];
+    drag_before_ = layout_;
+}
+
+void LayoutModel::drag_to(float dx, float dy) {
+    if (drag_channel_ < 0) return;
+    dx = snap(dx);
+    dy = snap(dy);
+    SampleRect rect = drag_start_;
+    switch (drag_handle_) {
+        case Handle::left: rect.x0 = std::clamp(rect.x0 + dx, kLow, rect.x1 - kMinRectSize); break;
+        case Handle::right: rect.x1 = std::clamp(rect.x1 + dx, rect.x0 + kMinRectSize, kHigh); break;
+        case Handle::top: rect.y0 = std::clamp(rect.y0 + dy, kLow, rect.y1 - kMinRectSize); break;
+        case Handle::bottom: rect.y1 = std::clamp(rect.y1 + dy, rect.y0 + kMinRectSize, kHigh); break;
+        case Handle::body:
+            shift_span(rect.x0, rect.x1, dx);
+            shift_span(rect.y0, rect.y1, dy);
+            break;
+    }
+    SampleRect& current = layout_.channels[static_cast<size_t>(drag_channel_)];
+    if (rect == current) return;
+    current = rect;
+    changed();
+}
+
+void LayoutModel::end_drag() {
+    if (drag_channel_ < 0) return;
+    drag_channel_ = -1;
+    if (layout_ == drag_before_) return;
+    undo_.push_back(drag_before_);
+    redo_.clear();
+    rename_if_preset();
+}
+
+Status LayoutModel::apply_preset(std::string_view name) {
+    Result<SubpixelLayout> preset = subpixel_preset(name);
+    if (!preset) return preset.error();
+    return replace(*preset);
+}
+
+Status LayoutModel::replace(const SubpixelLayout& layout) {
+    if (Status status = validate_subpixel_layout(layout); !status) return status;
+    if (layout == layout_) return {};
+    push_undo();
+    layout_ = layout;
+    changed();
+    return {};
+}
+
+bool LayoutModel::undo() {
+    if (undo_.empty()) return false;
+    redo_.push_back(std::move(layout_));
+    layout_ = std::move(undo_.back());
+    undo_.pop_back();
+    changed();
+    return true;
+}
+
+bool LayoutModel::redo() {
+    if (redo_.empty()) return false;
+    undo_.push_back(std::move(layout_));
+    layout_ = std::move(redo_.back());
+    redo_.pop_back();
+    changed();
+    return true;
+}
+
+}  // namespace crisp::editor

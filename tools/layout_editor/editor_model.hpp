@@ -1,0 +1,88 @@
+// crisp-layout-editor: the edited subpixel layout, the selected channel and the undo history.
+// No window, no GPU: tests/test_layout_editor_model.cpp drives it directly.
+#pragma once
+
+#include <crisp/result.hpp>
+#include <crisp/subpixel.hpp>
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace crisp::editor {
+
+// One step of a nudge or a drag, in pixel units: one screen pixel of the magnified pixel view
+// (kMagnifiedPixelScale screen pixels per pixel), so a drag and an arrow key move by the same grid.
+inline constexpr float kEditStep = 1.0f / 96.0f;
+// The smallest width or height a rectangle can be dragged or nudged to.
+inline constexpr float kMinRectSize = kEditStep;
+
+// What a drag grabs: one edge of a channel's rectangle, or the whole rectangle.
+enum class Handle : uint8_t { left, top, right, bottom, body };
+
+// The four numbers of a SampleRect by index: 0 x0, 1 y0, 2 x1, 3 y1.
+float rect_coordinate(const SampleRect& rect, int coordinate);
+
+class LayoutModel {
+public:
+    explicit LayoutModel(SubpixelLayout initial);
+
+    const SubpixelLayout& layout() const { return layout_; }
+    // Counts every change of the layout (edits, undo, redo, presets, loads): the renderer
+    // restarts its sample schedule when it moves.
+    uint64_t revision() const { return revision_; }
+
+    int selected() const { return selected_; }
+    void select(int channel);  // 0 red, 1 green, 2 blue; others are ignored
+
+    // Sets one coordinate (see rect_coordinate) of a channel to a typed number. Refused
+    // (invalid_argument, the layout unchanged) when the result fails validate_subpixel_layout;
+    // the message is crisp's.
+    Status set_coordinate(int channel, int coordinate, float value);
+
+    // Moves the selected rectangle by (dx, dy) edit steps, stopping at the bounds
+    // [-kGlyphPadding, 1 + kGlyphPadding]. One undo step.
+    void nudge(int dx_steps, int dy_steps);
+
+    // A drag: begin_drag() remembers the rectangle, drag_to() moves the grabbed edge (or the
+    // whole rectangle) by (dx, dy) pixels from where it was at begin_drag(), snapped to
+    // kEditStep, kept within the bounds and at least kMinRectSize wide and tall; end_drag() makes
+    // the whole drag one undo step (none when nothing changed).
+    void begin_drag(int channel, Handle handle);
+    void drag_to(float dx, float dy);
+    void end_drag();
+    bool dragging() const { return drag_channel_ >= 0; }
+
+    // Replaces the layout with a preset (subpixel_preset's error for an unknown name) or with a
+    // loaded layout (validated first). One undo step each.
+    Status apply_preset(std::string_view name);
+    Status replace(const SubpixelLayout& layout);
+
+    bool can_undo() const { return !undo_.empty(); }
+    bool can_redo() const { return !redo_.empty(); }
+    bool undo();
+    bool redo();
+
+    // Whether the layout differs from the last one marked saved (at construction, or mark_saved()).
+    bool modified() const { return layout_ != saved_; }
+    void mark_saved() { saved_ = layout_; }
+
+private:
+    void push_undo();
+    void changed();
+    // A preset's name no longer describes an edited copy of it: "rgb" becomes "rgb-edited".
+    void rename_if_preset();
+
+    SubpixelLayout layout_;
+    SubpixelLayout saved_;
+    std::vector<SubpixelLayout> undo_;
+    std::vector<SubpixelLayout> redo_;
+    uint64_t revision_ = 0;
+    int selected_ = 0;
+    int drag_channel_ = -1;
+    Handle drag_handle_ = Handle::body;
+    SampleRect drag_start_{};
+    SubpixelLayout drag_before_;
+};
+
+}  // namespace crisp::editor

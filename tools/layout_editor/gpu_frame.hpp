@@ -1,0 +1,74 @@
+// crisp-layout-editor: one frame on the GPU. The CPU-drawn canvas is uploaded into an RGBA8
+// image, crisp's renderers rasterize the interface's text (gray layout) and the preview's text
+// (the edited layout), crisp's compositors composite both into the image (the tile path), and the
+// image is copied back (for the magnified view and screenshots) and blitted to the swapchain.
+// One frame in flight: wait() before touching the canvas or reading the previous frame.
+#pragma once
+
+#include "vulkan_window.hpp"
+
+#include "vk_resources.hpp"
+
+#include <crisp/compositor.hpp>
+#include <crisp/renderer.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+
+namespace crisp::editor {
+
+// The preview's sample schedule: a few samples a frame, so an edit is seen converging.
+inline constexpr uint32_t kPreviewMaxSamples = 256;
+
+class GpuFrame {
+public:
+    // The canvas is window.width() x window.height(). `font` must outlive the GpuFrame.
+    static Result<std::unique_ptr<GpuFrame>> create(VulkanWindow& window, const Font& font,
+                                                    const SubpixelLayout& preview_layout);
+    GpuFrame(const GpuFrame&) = delete;
+    GpuFrame& operator=(const GpuFrame&) = delete;
+    // Waits for the device, then destroys crisp's objects and its own.
+    ~GpuFrame();
+
+    // Waits for the frame in flight, if any; then the canvas may be written and previous_frame()
+    // and gpu_milliseconds() describe it.
+    Status wait();
+    std::span<uint8_t> canvas();
+    // The last completed frame as shown (RGBA8, sRGB, top row first); empty before the first.
+    std::span<const uint8_t> previous_frame() const;
+    // GPU time of the last completed frame; nullopt without timestamps.
+    std::optional<double> gpu_milliseconds() const { return gpu_ms_; }
+
+    // Restarts the preview's sample schedule with a new layout (crisp's error when invalid).
+    Status set_preview_layout(const SubpixelLayout& layout);
+
+    // Records and submits one frame into the acquired swapchain image.
+    Status render(const VulkanWindow::Acquired& target, std::span<const GlyphInstance> interface_glyphs,
+                  std::span<const GlyphInstance> preview_glyphs);
+
+    const Renderer& preview_renderer() const { return *preview_renderer_; }
+
+private:
+    explicit GpuFrame(VulkanWindow& window);
+
+    VulkanWindow& window_;
+    vk::DeviceRef device_;
+    vk::DeviceImage canvas_;
+    vk::DeviceBuffer upload_;
+    vk::DeviceBuffer readback_;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
+    VkFence fence_ = VK_NULL_HANDLE;
+    VkQueryPool timestamps_ = VK_NULL_HANDLE;
+    bool in_flight_ = false;
+    bool has_previous_ = false;
+    std::optional<double> gpu_ms_;
+    std::optional<Renderer> interface_renderer_;
+    std::optional<Renderer> preview_renderer_;
+    std::optional<Compositor> interface_compositor_;
+    std::optional<Compositor> preview_compositor_;
+};
+
+}  // namespace crisp::editor

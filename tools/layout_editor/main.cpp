@@ -1,0 +1,324 @@
+// crisp-layout-editor: fit subpixel anti-aliasing to a monitor, live (docs/layout-editor.md).
+#include "editor_model.hpp"
+#include "editor_view.hpp"
+#include "gpu_frame.hpp"
+#include "vulkan_window.hpp"
+
+#include "cli.hpp"
+#include "image_io.hpp"
+
+#include <crisp/bake.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/subpixel.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using namespace crisp::editor;
+
+// Exit codes (also in --help and docs/layout-editor.md).
+constexpr int kExitOk = 0;
+constexpr int kExitUsage = 1;
+constexpr int kExitFont = 2;
+constexpr int kExitVulkan = 3;
+constexpr int kExitValidation = 4;
+constexpr int kExitScreenshot = 5;
+
+constexpr const char* kUsage = R"(Usage: crisp-layout-editor [options]
+
+Shows a subpixel layout (the sample rectangle of each colour channel within a pixel) magnified,
+lets you drag, nudge and type its rectangles, and previews text rendered by crisp with it.
+
+Options:
+  --layout FILE|PRESET  start from a layout file (JSON, docs/subpixel.md) or a preset (gray, rgb,
+                        bgr, vrgb, vbgr, qd-oled, woled, pentile); default rgb. A file that does
+                        not load is reported in the window and the editor starts from rgb.
+  --save-to FILE        where Save (Ctrl+S) writes; default: the --layout file
+  --font FILE           the font for all text (TrueType/OpenType); default: DejaVu Sans
+  --frames N            quit after N frames
+  --screenshot PATH     with --frames: write the window's last frame as a PNG, then quit
+  --validation          turn on VK_LAYER_KHRONOS_validation; any warning or error it reports
+                        makes the exit code 4 (also: CRISP_VALIDATION=1 in the environment)
+  --print-geometry      print the widgets' positions as JSON and quit (for scripted input)
+  --help                this text
+
+Exit codes: 0 success; 1 bad command line; 2 the font could not be loaded; 3 no window or no
+Vulkan device (or a Vulkan failure); 4 the validation layer reported a message; 5 the screenshot
+could not be written.
+)";
+
+struct Args {
+    std::string layout = "rgb";
+    std::string save_to;
+    std::string font = CRISP_EDITOR_DEFAULT_FONT;
+    uint64_t frames = 0;  // 0: until the window closes
+    std::string screenshot;
+    bool validation = false;
+    bool print_geometry = false;
+};
+
+[[noreturn]] void usage_error(const std::string& message) {
+    std::fprintf(stderr, "crisp-layout-editor: %s (see --help)\n", crisp::cli::printable(message).c_str());
+    std::exit(kExitUsage);
+}
+
+Args parse_args(int argc, char** argv) {
+    Args args;
+    const char* env = std::getenv("CRISP_VALIDATION");
+    args.validation = env && std::strcmp(env, "0") != 0 && env[0] != '\0';
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view arg = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) usage_error(std::string(arg) + " needs a value");
+            return argv[++i];
+        };
+        if (arg == "--help" || arg == "-h") {
+            std::fputs(kUsage, stdout);
+            std::exit(kExitOk);
+        } else if (arg == "--layout") {
+            args.layout = value();
+        } else if (arg == "--save-to") {
+            args.save_to = value();
+        } else if (arg == "--font") {
+            args.font = value();
+        } else if (arg == "--frames") {
+            const std::string text = value();
+            std::string why;
+            const std::optional<uint64_t> frames = crisp::cli::parse_number<uint64_t>(text, &why);
+            if (!frames || *frames == 0) usage_error("--frames " + text + ": " + (frames ? "must be at least 1" : why));
+            args.frames = *frames;
+        } else if (arg == "--screenshot") {
+            args.screenshot = value();
+        } else if (arg == "--validation") {
+            args.validation = true;
+        } else if (arg == "--print-geometry") {
+            args.print_geometry = true;
+        } else {
+            usage_error("unknown argument " + std::string(arg));
+        }
+    }
+    if (!args.screenshot.empty() && args.frames == 0) usage_error("--screenshot needs --frames N");
+    return args;
+}
+
+// The characters the editor's text uses: printable ASCII, the em dash and a few more.
+std::vector<uint32_t> editor_codepoints() {
+    std::vector<uint32_t> codepoints;
+    for (uint32_t c = 0x20; c < 0x7F; ++c) codepoints.push_back(c);
+    for (uint32_t c : {0x00D7u, 0x2013u, 0x2014u, 0x2026u, 0xFFFDu}) codepoints.push_back(c);
+    return codepoints;
+}
+
+std::optional<crisp::Font> load_font(const std::string& path) {
+    crisp::BakeOptions options;
+    options.codepoints = editor_codepoints();
+    options.all_glyphs = false;
+    options.allow_failed = true;
+    crisp::Result<crisp::BakeResult> baked = crisp::bake_font_file(path, options);
+    if (!baked) {
+        std::fprintf(stderr, "crisp-layout-editor: --font %s: %s\n", crisp::cli::printable(path).c_str(),
+                     baked.error().message.c_str());
+        return std::nullopt;
+    }
+    crisp::Result<crisp::Font> font = crisp::Font::create(std::move(baked->asset), 1);
+    if (!font) {
+        std::fprintf(stderr, "crisp-layout-editor: --font %s: %s\n", crisp::cli::printable(path).c_str(),
+                     font.error().message.c_str());
+        return std::nullopt;
+    }
+    return std::move(*font);
+}
+
+// The text of one frame as glyph instances, for the interface's renderer and the preview's.
+struct FrameText {
+    std::vector<crisp::GlyphInstance> interface_glyphs;
+    std::vector<crisp::GlyphInstance> preview_glyphs;
+    // Paint orders of moving preview text: it never converges, so the status line leaves it out.
+    std::vector<std::pair<uint32_t, uint32_t>> moving;
+};
+
+void lay_out(crisp::Layouter& layouter, const crisp::Font& font, const std::vector<TextItem>& items, FrameText& out,
+             std::vector<std::string>& errors) {
+    out.interface_glyphs.clear();
+    out.preview_glyphs.clear();
+    out.moving.clear();
+    const crisp::Font* fonts[] = {&font};
+    crisp::TextLayout layout;
+    uint32_t paint_order = 0;
+    for (const TextItem& item : items) {
+        crisp::TextStyle style;
+        style.size = item.size;
+        style.color[0] = static_cast<float>(item.color.r) / 255.0f;
+        style.color[1] = static_cast<float>(item.color.g) / 255.0f;
+        style.color[2] = static_cast<float>(item.color.b) / 255.0f;
+        crisp::LayoutOptions options;
+        options.origin_x = item.x;
+        options.origin_y = item.y;
+        options.wrap_width = item.wrap_width;
+        options.first_paint_order = paint_order;
+        if (crisp::Status status = layouter.layout(fonts, item.text, style, options, layout); !status) {
+            errors.push_back(status.error().message);
+            continue;
+        }
+        if (item.moving) out.moving.emplace_back(paint_order, layout.next_paint_order);
+        paint_order = layout.next_paint_order;
+        auto& target = item.preview ? out.preview_glyphs : out.interface_glyphs;
+        target.insert(target.end(), layout.glyphs.begin(), layout.glyphs.end());
+    }
+}
+
+FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
+    FrameStats stats;
+    stats.frame = frame;
+    stats.target_samples = kPreviewMaxSamples;
+    stats.gpu_ms = gpu.gpu_milliseconds().value_or(-1.0);
+    stats.atlas_occupancy = gpu.preview_renderer().atlas().stats().occupancy;
+    bool first = true;
+    for (const crisp::DrawnGlyph& glyph : gpu.preview_renderer().drawn()) {
+        const uint32_t order = glyph.instance.paint_order;
+        const bool moving = std::any_of(text.moving.begin(), text.moving.end(),
+                                        [&](const auto& range) { return order >= range.first && order < range.second; });
+        if (moving) continue;
+        stats.min_samples = first ? glyph.samples : std::min(stats.min_samples, glyph.samples);
+        stats.max_samples = first ? glyph.samples : std::max(stats.max_samples, glyph.samples);
+        first = false;
+        ++stats.glyphs;
+    }
+    return stats;
+}
+
+bool write_screenshot(const std::string& path, std::span<const uint8_t> rgba, uint32_t width, uint32_t height) {
+    std::vector<float> pixels(size_t{width} * height * 3);
+    for (size_t i = 0; i < size_t{width} * height; ++i) {
+        for (size_t c = 0; c < 3; ++c) pixels[i * 3 + c] = crisp::srgb_to_linear(static_cast<float>(rgba[i * 4 + c]) / 255.0f);
+    }
+    if (crisp::Status status = crisp::write_png_srgb8(path, width, height, 3, pixels); !status) {
+        std::fprintf(stderr, "crisp-layout-editor: --screenshot: %s\n", status.error().message.c_str());
+        return false;
+    }
+    return true;
+}
+
+// The window's life: returns the exit code. Everything Vulkan is gone when it returns, except the
+// window, whose validation count the caller reads.
+int run(const Args& args, VulkanWindow& window, const crisp::Font& font, LayoutModel& model, EditorView& view) {
+    crisp::Result<std::unique_ptr<GpuFrame>> created = GpuFrame::create(window, font, model.layout());
+    if (!created) {
+        std::fprintf(stderr, "crisp-layout-editor: Vulkan: %s\n", created.error().message.c_str());
+        return kExitVulkan;
+    }
+    GpuFrame& gpu = **created;
+    crisp::Layouter layouter;
+    std::vector<TextItem> items;
+    FrameText text;
+    uint64_t applied_revision = model.revision();
+    uint64_t frame = 0;
+    while (!window.should_close() && !view.quit_requested()) {
+        if (crisp::Status status = gpu.wait(); !status) {
+            std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
+            return kExitVulkan;
+        }
+        if (args.frames != 0 && frame >= args.frames) break;
+        const FrameStats stats = measure(gpu, text, frame);
+        for (const InputEvent& event : window.poll_events()) view.handle(event);
+        if (model.revision() != applied_revision) {
+            applied_revision = model.revision();
+            if (crisp::Status status = gpu.set_preview_layout(model.layout()); !status) {
+                view.report(status.error().message, true);
+            }
+        }
+        crisp::Result<VulkanWindow::Acquired> acquired = window.acquire();
+        if (!acquired) {
+            std::fprintf(stderr, "crisp-layout-editor: %s\n", acquired.error().message.c_str());
+            return kExitVulkan;
+        }
+        if (acquired->image == VK_NULL_HANDLE) continue;  // the swapchain was rebuilt
+        Canvas canvas(gpu.canvas(), window.width(), window.height());
+        items.clear();
+        view.draw(canvas, gpu.previous_frame(), stats, items);
+        std::vector<std::string> errors;
+        lay_out(layouter, font, items, text, errors);
+        for (const std::string& error : errors) view.report("Text layout: " + error, true);
+        if (crisp::Status status = gpu.render(*acquired, text.interface_glyphs, text.preview_glyphs); !status) {
+            std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
+            return kExitVulkan;
+        }
+        if (crisp::Status status = window.present(*acquired); !status) {
+            std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
+            return kExitVulkan;
+        }
+        ++frame;
+    }
+    if (crisp::Status status = gpu.wait(); !status) {
+        std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
+        return kExitVulkan;
+    }
+    if (!args.screenshot.empty() &&
+        !write_screenshot(args.screenshot, gpu.previous_frame(), window.width(), window.height())) {
+        return kExitScreenshot;
+    }
+    return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Args args = parse_args(argc, argv);
+    if (args.print_geometry) {
+        std::printf("%s\n", EditorView::geometry_json().c_str());
+        return kExitOk;
+    }
+
+    // The starting layout: a preset by name, else a file. A file that fails to load is reported
+    // in the window, and the editor starts from rgb with the file still chosen for saving.
+    std::string path = args.save_to;
+    std::optional<std::string> load_error;
+    crisp::SubpixelLayout initial = *crisp::subpixel_preset("rgb");
+    if (crisp::Result<crisp::SubpixelLayout> preset = crisp::subpixel_preset(args.layout); preset) {
+        initial = *preset;
+    } else {
+        if (path.empty()) path = args.layout;
+        crisp::Result<crisp::SubpixelLayout> loaded = crisp::load_subpixel_layout_file(args.layout);
+        if (loaded) {
+            initial = *loaded;
+        } else {
+            load_error = loaded.error().message;
+            std::fprintf(stderr, "crisp-layout-editor: --layout: %s\n", loaded.error().message.c_str());
+        }
+    }
+    LayoutModel model(initial);
+    EditorView view(model, path);
+    if (load_error) view.report("Load failed: " + *load_error, true);
+
+    std::optional<crisp::Font> font = load_font(args.font);
+    if (!font) return kExitFont;
+
+    WindowOptions window_options;
+    window_options.width = kWindowWidth;
+    window_options.height = kWindowHeight;
+    window_options.validation = args.validation;
+    crisp::Result<std::unique_ptr<VulkanWindow>> window = VulkanWindow::create(window_options);
+    if (!window) {
+        std::fprintf(stderr, "crisp-layout-editor: %s\n", window.error().message.c_str());
+        return kExitVulkan;
+    }
+    const int code = run(args, **window, *font, model, view);
+    const uint32_t messages = (*window)->validation_messages();
+    window->reset();  // the instance's teardown is validated too
+    if (code != kExitOk) return code;
+    if (messages > 0) {
+        std::fprintf(stderr, "crisp-layout-editor: the validation layer reported %u message(s)\n", messages);
+        return kExitValidation;
+    }
+    return kExitOk;
+}

@@ -1,0 +1,115 @@
+// crisp-layout-editor: the GLFW window, the Vulkan instance, device and swapchain behind it, and
+// the window's input as an ordered list of events.
+#pragma once
+
+#include <crisp/result.hpp>
+
+#include <vulkan/vulkan.h>
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+struct GLFWwindow;
+
+namespace crisp::editor {
+
+// One input event, in the order the window system delivered it. Positions are window pixels.
+struct InputEvent {
+    enum class Kind : uint8_t { mouse_move, mouse_down, mouse_up, key, character };
+    Kind kind = Kind::mouse_move;
+    double x = 0.0, y = 0.0;  // the cursor, for every kind
+    int button = 0;           // GLFW_MOUSE_BUTTON_*
+    int key = 0;              // GLFW_KEY_* (key presses and repeats only)
+    int mods = 0;             // GLFW_MOD_*
+    uint32_t codepoint = 0;   // character
+};
+
+struct WindowOptions {
+    uint32_t width = 1280;
+    uint32_t height = 800;
+    std::string title = "crisp layout editor";
+    // VK_LAYER_KHRONOS_validation with a messenger that counts its warnings and errors.
+    bool validation = false;
+};
+
+// Owns the window and every Vulkan object the program makes outside crisp. Destroying it waits
+// for the device to be idle. Not copyable or movable (GLFW keeps a pointer to it).
+class VulkanWindow {
+public:
+    // Errors (ErrorCode::vulkan): no display, no Vulkan driver or surface support, the validation
+    // layer asked for and missing, no device with what crisp's renderer needs and presentation.
+    static Result<std::unique_ptr<VulkanWindow>> create(const WindowOptions& options);
+    VulkanWindow(const VulkanWindow&) = delete;
+    VulkanWindow& operator=(const VulkanWindow&) = delete;
+    ~VulkanWindow();
+
+    VkInstance instance() const { return instance_; }
+    VkPhysicalDevice physical_device() const { return physical_device_; }
+    VkDevice device() const { return device_; }
+    uint32_t queue_family() const { return queue_family_; }
+    VkQueue queue() const { return queue_; }
+    const VkPhysicalDeviceProperties& properties() const { return properties_; }
+    const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_properties_; }
+    bool storage_without_format() const { return storage_without_format_; }
+    // The feature chain the device was created with, for crisp's create infos.
+    const VkPhysicalDeviceFeatures2* enabled_features() const { return &features_; }
+    uint32_t timestamp_valid_bits() const { return timestamp_valid_bits_; }
+    uint32_t width() const { return options_.width; }
+    uint32_t height() const { return options_.height; }
+
+    bool should_close() const;
+    // Polls the window system and returns the events since the last call, oldest first.
+    std::vector<InputEvent> poll_events();
+
+    // The swapchain image to draw into next, or nullopt-like (image == VK_NULL_HANDLE) when the
+    // swapchain had to be rebuilt and the frame should be skipped. `ready` is signalled when the
+    // image may be written.
+    struct Acquired {
+        VkImage image = VK_NULL_HANDLE;
+        uint32_t index = 0;
+        VkSemaphore ready = VK_NULL_HANDLE;     // wait on it before writing the image
+        VkSemaphore rendered = VK_NULL_HANDLE;  // signal it when the image is done
+    };
+    Result<Acquired> acquire();
+    // Presents an acquired image once `rendered` is signalled; rebuilds the swapchain when it is
+    // out of date.
+    Status present(const Acquired& acquired);
+    VkFormat swapchain_format() const { return swapchain_format_; }
+
+    // Warnings and errors the validation layer reported so far.
+    uint32_t validation_messages() const { return validation_messages_.load(); }
+
+private:
+    VulkanWindow() = default;
+    Status create_swapchain();
+    void destroy_swapchain();
+    friend struct WindowCallbacks;
+
+    WindowOptions options_;
+    GLFWwindow* window_ = nullptr;
+    VkInstance instance_ = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+    VkSurfaceKHR surface_ = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
+    VkPhysicalDeviceProperties properties_{};
+    VkPhysicalDeviceMemoryProperties memory_properties_{};
+    bool storage_without_format_ = false;
+    VkPhysicalDeviceFeatures2 features_{};  // as the device was created with them
+    uint32_t timestamp_valid_bits_ = 0;
+    VkDevice device_ = VK_NULL_HANDLE;
+    uint32_t queue_family_ = 0;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
+    VkFormat swapchain_format_ = VK_FORMAT_UNDEFINED;
+    std::vector<VkImage> swapchain_images_;
+    std::vector<VkSemaphore> rendered_;  // one per swapchain image
+    VkSemaphore image_ready_ = VK_NULL_HANDLE;
+    std::vector<InputEvent> events_;
+    double cursor_x_ = 0.0, cursor_y_ = 0.0;
+    std::atomic<uint32_t> validation_messages_{0};
+};
+
+}  // namespace crisp::editor
