@@ -578,6 +578,8 @@ AtlasStats GlyphAtlas::stats() const {
     AtlasStats stats;
     stats.usable_cells = usable_cells_;
     stats.used_cells = used_cells_;
+    for (size_t w = 0; w < pinned_words_.size(); ++w)
+        stats.pinned_cells += static_cast<uint32_t>(std::popcount(pinned_words_[w] & ~permanent_words_[w]));
     stats.occupancy = static_cast<float>(used_cells_) / static_cast<float>(usable_cells_);
     stats.resident_glyphs = static_cast<uint32_t>(ids_by_key_.size());
     stats.pinned_glyphs = static_cast<uint32_t>(pinned_ids_.size());

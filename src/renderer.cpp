@@ -92,6 +92,20 @@ struct Renderer::State {
     RendererStats stats;
     bool converged = true;
 
+    // Subpixel steps per pixel of each level of coarsening (kSubpixelSteps: the layout's own).
+    static constexpr std::array<uint32_t, 3> kLevelSteps = {kSubpixelSteps, 4, 1};
+    // Frames whose glyphs take under a quarter of the atlas before the steps get finer again.
+    static constexpr uint32_t kCalmFrames = 120;
+    struct Request {
+        GlyphInstance glyph;
+        bool has_visible = false;
+        VkRect2D visible{};
+    };
+    std::vector<Request> requests;  // this frame's draw()n instances, as asked
+    size_t level = 0;               // index into kLevelSteps
+    uint32_t calm_frames = 0;
+    uint32_t atlas_full = 0;  // instances refused as atlas_full this frame
+
     explicit State(GlyphAtlas glyph_atlas) : atlas(std::move(glyph_atlas)) {}
 
     // Finds or places `glyph` with `part` of its rect visible and adds it to the pending glyphs.
@@ -108,12 +122,7 @@ struct Renderer::State {
             ++stats.skipped_glyphs;
             return;
         }
-        // Only a glyph the atlas may place anew needs its cost: a new one, or one held in part.
-        uint64_t cost = 0;
-        const AtlasEntry* resident = atlas.entry(atlas.find(glyph.key));
-        if (!resident || resident->part.width != resident->width || resident->part.height != resident->height)
-            cost = curve_tests_per_sample(asset, asset.glyphs[glyph.key.glyph], glyph.key);
-        const AtlasLookup lookup = atlas.acquire(glyph.key, glyph.width, glyph.height, cost, part);
+        const AtlasLookup lookup = place(asset, glyph, part);
         if (lookup.status == AtlasStatus::placed) {
             DrawnGlyph placed{glyph, lookup.x, lookup.y, 0, lookup.part.x, lookup.part.y};
             placed.instance.x += static_cast<int32_t>(lookup.part.x);
@@ -124,6 +133,102 @@ struct Renderer::State {
         } else if (lookup.status == AtlasStatus::atlas_full || lookup.status == AtlasStatus::too_large) {
             ++stats.failed_glyphs;
             ++stats.skipped_glyphs;
+            if (lookup.status == AtlasStatus::atlas_full) ++atlas_full;
+        }
+    }
+
+    // Finds or places one instance whose `part` is visible.
+    AtlasLookup place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part) {
+        // Only a glyph the atlas may place anew needs its cost: a new one, or one held in part.
+        uint64_t cost = 0;
+        const AtlasEntry* resident = atlas.entry(atlas.find(glyph.key));
+        if (!resident || resident->part.width != resident->width || resident->part.height != resident->height)
+            cost = curve_tests_per_sample(asset, asset.glyphs[glyph.key.glyph], glyph.key);
+        return atlas.acquire(glyph.key, glyph.width, glyph.height, cost, part);
+    }
+
+    // `glyph` with its pen moved to the nearest of `steps` subpixel positions per pixel: its key,
+    // rect and position follow, its pen moves by at most half a step.
+    GlyphInstance coarsened(const GlyphInstance& glyph, uint32_t steps) const {
+        if (steps >= kSubpixelSteps) return glyph;
+        const auto slot = font_slot.find(glyph.key.font);
+        if (slot == font_slot.end()) return glyph;
+        const FontAsset& asset = fonts[slot->second].font->asset();
+        if (glyph.key.glyph >= asset.glyphs.size()) return glyph;
+        const GlyphRecord& record = asset.glyphs[glyph.key.glyph];
+        const GlyphRect rect = glyph_rect(record, glyph.key);
+        GlyphInstance out = glyph;
+        int32_t carry[2] = {0, 0};
+        uint8_t* offsets[2] = {&out.key.subpixel_x, &out.key.subpixel_y};
+        for (int axis = 0; axis < 2; ++axis) {
+            const uint32_t grid = kSubpixelSteps / steps;
+            const uint32_t rounded = (*offsets[axis] + grid / 2) / grid * grid;
+            carry[axis] = rounded >= kSubpixelSteps ? 1 : 0;
+            *offsets[axis] = static_cast<uint8_t>(rounded % kSubpixelSteps);
+        }
+        if (out.key == glyph.key) return glyph;
+        const GlyphRect moved = glyph_rect(record, out.key);
+        out.x = glyph.x - rect.x + carry[0] + moved.x;
+        out.y = glyph.y - rect.y + carry[1] + moved.y;
+        out.width = moved.width;
+        out.height = moved.height;
+        return out;
+    }
+
+    // One draw()n instance: at the frame's subpixel steps, then culled, acquired whole, or kept
+    // for acquire_clipped() with its visible part.
+    void request(const GlyphInstance& asked, const VkRect2D* visible) {
+        const GlyphInstance glyph = coarsened(asked, kLevelSteps[level]);
+        if (glyph.key != asked.key) ++stats.coarsened_glyphs;
+        if (!visible) {
+            acquire(glyph, TexelRect{0, 0, glyph.width, glyph.height});
+            return;
+        }
+        if (glyph.width == 0 || glyph.height == 0) return;
+        // The visible texels of the glyph's rect.
+        const int64_t vx0 = visible->offset.x, vy0 = visible->offset.y;
+        const int64_t vx1 = vx0 + visible->extent.width, vy1 = vy0 + visible->extent.height;
+        const int64_t x0 = std::max<int64_t>(vx0 - glyph.x, 0), y0 = std::max<int64_t>(vy0 - glyph.y, 0);
+        const int64_t x1 = std::min<int64_t>(vx1 - glyph.x, glyph.width);
+        const int64_t y1 = std::min<int64_t>(vy1 - glyph.y, glyph.height);
+        if (x0 >= x1 || y0 >= y1) {
+            ++stats.culled_glyphs;
+            return;
+        }
+        const TexelRect part{static_cast<uint32_t>(x0), static_cast<uint32_t>(y0), static_cast<uint32_t>(x1 - x0),
+                             static_cast<uint32_t>(y1 - y0)};
+        if (part.width == glyph.width && part.height == glyph.height) {
+            acquire(glyph, part);
+        } else {
+            ++stats.clipped_glyphs;
+            clipped.push_back({glyph, part});
+        }
+    }
+
+    // After the frame's draws: where the atlas had no room for some glyph, the frame starts over
+    // with every glyph at the next coarser subpixel steps (a quarter pixel, then a whole one), as
+    // long as there is a coarser one; the steps stay coarse until the atlas has been mostly empty
+    // for a while. A visible glyph is dropped only when even whole-pixel positions do not fit.
+    void settle_requests() {
+        acquire_clipped();
+        while (atlas_full > 0 && level + 1 < kLevelSteps.size()) {
+            ++level;
+            calm_frames = 0;
+            atlas.begin_frame();
+            pending.clear();
+            clipped.clear();
+            const uint32_t unknown = stats.unknown_fonts;
+            stats = {};
+            stats.unknown_fonts = unknown;
+            atlas_full = 0;
+            for (const Request& r : requests) request(r.glyph, r.has_visible ? &r.visible : nullptr);
+            acquire_clipped();
+        }
+        stats.subpixel_steps = kLevelSteps[level];
+        const AtlasStats now = atlas.stats();
+        if (level > 0 && atlas_full == 0 && now.pinned_cells < now.usable_cells / 4 && ++calm_frames >= kCalmFrames) {
+            --level;  // from the next frame on
+            calm_frames = 0;
         }
     }
 
@@ -408,6 +513,8 @@ void Renderer::begin_frame() {
     s.atlas.begin_frame();
     s.pending.clear();
     s.clipped.clear();
+    s.requests.clear();
+    s.atlas_full = 0;
     s.drawn.clear();
     s.stats = {};
     s.converged = true;
@@ -415,37 +522,23 @@ void Renderer::begin_frame() {
 
 void Renderer::draw(std::span<const GlyphInstance> glyphs) {
     State& s = *state_;
-    for (const GlyphInstance& glyph : glyphs) s.acquire(glyph, TexelRect{0, 0, glyph.width, glyph.height});
+    for (const GlyphInstance& glyph : glyphs) {
+        s.requests.push_back({glyph, false, {}});
+        s.request(glyph, nullptr);
+    }
 }
 
 void Renderer::draw(std::span<const GlyphInstance> glyphs, const VkRect2D& visible) {
     State& s = *state_;
-    const int64_t vx0 = visible.offset.x, vy0 = visible.offset.y;
-    const int64_t vx1 = vx0 + visible.extent.width, vy1 = vy0 + visible.extent.height;
     for (const GlyphInstance& glyph : glyphs) {
-        if (glyph.width == 0 || glyph.height == 0) continue;
-        // The visible texels of the glyph's rect.
-        const int64_t x0 = std::max<int64_t>(vx0 - glyph.x, 0), y0 = std::max<int64_t>(vy0 - glyph.y, 0);
-        const int64_t x1 = std::min<int64_t>(vx1 - glyph.x, glyph.width);
-        const int64_t y1 = std::min<int64_t>(vy1 - glyph.y, glyph.height);
-        if (x0 >= x1 || y0 >= y1) {
-            ++s.stats.culled_glyphs;
-            continue;
-        }
-        const TexelRect part{static_cast<uint32_t>(x0), static_cast<uint32_t>(y0), static_cast<uint32_t>(x1 - x0),
-                             static_cast<uint32_t>(y1 - y0)};
-        if (part.width == glyph.width && part.height == glyph.height) {
-            s.acquire(glyph, part);
-        } else {
-            ++s.stats.clipped_glyphs;
-            s.clipped.push_back({glyph, part});
-        }
+        s.requests.push_back({glyph, true, visible});
+        s.request(glyph, &visible);
     }
 }
 
 Status Renderer::record(VkCommandBuffer command_buffer) {
     State& s = *state_;
-    s.acquire_clipped();
+    s.settle_requests();
     const std::span<const RasterWork> work = s.atlas.schedule();
 
     // Drawn glyphs: those whose texels hold samples once this frame's work has run.

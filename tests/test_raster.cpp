@@ -15,6 +15,8 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <tuple>
+#include <set>
 
 namespace crisp {
 namespace {
@@ -467,6 +469,81 @@ TEST(Raster, FeaturesAreCheckedAgainstTheDeviceAsCreated) {
         const ValidationMessages messages = context->validation_messages();
         EXPECT_EQ(messages.errors + messages.warnings, 0u);
     }
+}
+
+// Issue 9: a full atlas must not make visible text vanish. Lines of the same letters at many
+// subpixel offsets want far more entries than a 16-cell atlas holds; the glyphs that find no room
+// are drawn at quarter-pixel, then whole-pixel, positions whose entries they share.
+TEST(Raster, AFullAtlasDrawsGlyphsCoarserRatherThanDroppingThem) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    RendererCreateInfo info = renderer_create_info(*f.context);
+    info.atlas.width = info.atlas.height = 64;  // 16 cells of 16 x 16 texels
+    info.atlas.max_samples = 8;
+    auto renderer = Renderer::create(info);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*f.font));
+    const Font* fonts[] = {f.font.get()};
+    std::vector<GlyphInstance> glyphs;
+    for (int line = 0; line < 6; ++line) {
+        TextStyle style;
+        style.size = 11.0f;
+        LayoutOptions options;
+        options.origin_x = 1.0f + 0.137f * static_cast<float>(line);
+        options.origin_y = 12.0f + 13.29f * static_cast<float>(line);
+        auto layout = layout_text(fonts, "Hg@&1Hg", style, options);
+        ASSERT_TRUE(layout);
+        glyphs.insert(glyphs.end(), layout->glyphs.begin(), layout->glyphs.end());
+    }
+    std::set<GlyphKey, bool (*)(const GlyphKey&, const GlyphKey&)> keys([](const GlyphKey& a, const GlyphKey& b) {
+        return std::tie(a.glyph, a.subpixel_x, a.subpixel_y) < std::tie(b.glyph, b.subpixel_x, b.subpixel_y);
+    });
+    for (const GlyphInstance& g : glyphs) keys.insert(g.key);
+    ASSERT_GT(keys.size(), 16u);  // more glyphs than cells
+
+    renderer->begin_frame();
+    renderer->draw(glyphs);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    const RendererStats& stats = renderer->stats();
+    EXPECT_EQ(stats.failed_glyphs, 0u);
+    EXPECT_GT(stats.coarsened_glyphs, 0u);
+    EXPECT_GT(renderer->atlas().stats().total.failed_full, 0u);  // the atlas did refuse them
+    EXPECT_LT(stats.subpixel_steps, kSubpixelSteps);
+    ASSERT_EQ(renderer->drawn().size(), glyphs.size());  // every one drawn, none skipped
+    // Each drawn glyph is the one asked for, at its own key or at a coarser one within half a
+    // quarter pixel of it.
+    for (size_t i = 0; i < glyphs.size(); ++i) {
+        const GlyphInstance& asked = glyphs[i];
+        const GlyphInstance& drawn = renderer->drawn()[i].instance;
+        EXPECT_EQ(drawn.key.glyph, asked.key.glyph);
+        if (drawn.key == asked.key) continue;
+        EXPECT_EQ(drawn.key.subpixel_x % 64, 0);
+        const GlyphRect asked_rect = glyph_rect(f.font->asset().glyphs[asked.key.glyph], asked.key);
+        const GlyphRect drawn_rect = glyph_rect(f.font->asset().glyphs[drawn.key.glyph], drawn.key);
+        const double asked_pen = asked.x - asked_rect.x + asked.key.subpixel_x / 256.0;
+        const double drawn_pen = drawn.x - drawn_rect.x + drawn.key.subpixel_x / 256.0;
+        EXPECT_LE(std::abs(drawn_pen - asked_pen), 0.5 + 1e-9);  // whole pixel at worst
+    }
+    // The next frame keeps the coarse steps: nothing is refused, nothing restarts.
+    const uint64_t refused = renderer->atlas().stats().total.failed_full;
+    renderer->begin_frame();
+    renderer->draw(glyphs);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    EXPECT_EQ(renderer->atlas().stats().total.failed_full, refused);
+    EXPECT_EQ(renderer->drawn().size(), glyphs.size());
+    // Once the atlas has stayed nearly empty (one glyph on screen), the steps get fine again.
+    const std::span<const GlyphInstance> one(glyphs.data(), 1);
+    for (int frame = 0; frame < 241 && renderer->stats().subpixel_steps != kSubpixelSteps; ++frame) {
+        renderer->begin_frame();
+        renderer->draw(one);
+        ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    }
+    renderer->begin_frame();
+    renderer->draw(one);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    EXPECT_EQ(renderer->stats().subpixel_steps, kSubpixelSteps);
+    EXPECT_EQ(renderer->drawn()[0].instance.key, glyphs[0].key);
+    expect_no_validation_messages();
 }
 
 }  // namespace

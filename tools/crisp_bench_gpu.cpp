@@ -183,12 +183,16 @@ int main(int argc, char** argv) {
     }
 
     const crisp::AtlasStats& atlas = renderer->atlas().stats();
+    const crisp::RendererStats& last = renderer->stats();
     std::printf(
         "Device: %s, driver %s (%s). Canvas %ux%u, %s at %.4g px, layout %s%s, %zu glyphs on screen, "
-        "%u atlas entries.\n\n",
+        "%u atlas entries (%ux%u atlas, %u of %u cells). Last frame: %u glyphs drawn, %u failed, %u at "
+        "coarser subpixel steps (%u per pixel).\n\n",
         context->device_name().c_str(), context->driver_name().c_str(), context->driver_info().c_str(), args.width,
         args.height, args.font.c_str(), static_cast<double>(args.size), layout->name.c_str(),
-        args.no_shared_rows ? " (roots per channel)" : "", screen.size(), atlas.resident_glyphs);
+        args.no_shared_rows ? " (roots per channel)" : "", screen.size(), atlas.resident_glyphs,
+        renderer->atlas().config().width, renderer->atlas().config().height, atlas.used_cells, atlas.usable_cells,
+        last.drawn_glyphs, last.failed_glyphs, last.coarsened_glyphs, last.subpixel_steps);
     std::printf(
         "| frame | samples per glyph added | glyphs refined | curve tests (estimate) | GPU ms | "
         "curve tests per second |\n|---:|---:|---:|---:|---:|---:|\n");

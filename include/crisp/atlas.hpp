@@ -165,6 +165,7 @@ struct AtlasCounters {
 struct AtlasStats {
     uint32_t usable_cells = 0;  // cells inside the atlas
     uint32_t used_cells = 0;    // cells owned by resident entries
+    uint32_t pinned_cells = 0;  // cells owned by entries acquired this frame
     float occupancy = 0.0f;     // used_cells / usable_cells
     uint32_t resident_glyphs = 0;
     uint32_t pinned_glyphs = 0;    // acquired this frame

@@ -84,7 +84,17 @@ struct DrawnGlyph {
 struct RendererStats {
     uint32_t drawn_glyphs = 0;    // draw()n glyphs with outlines this frame
     uint32_t skipped_glyphs = 0;  // not drawable this frame: no samples yet, atlas full or too large
-    uint32_t failed_glyphs = 0;   // atlas_full or too_large this frame (also in atlas().stats())
+    uint32_t failed_glyphs = 0;   // not drawn: too_large, or atlas_full even at whole-pixel positions
+                                  // (atlas().stats() counts every refused request)
+    // Instances drawn at a coarser subpixel position than their layout's because the atlas had no
+    // room for all of them (see subpixel_steps): the pen moves by at most half a step.
+    uint32_t coarsened_glyphs = 0;
+    // The subpixel steps per pixel glyphs were drawn at this frame (after record()): kSubpixelSteps
+    // (the layouts' own), or 4 or 1 after a frame the atlas could not hold at the finer steps. A
+    // frame that finds the atlas full starts over at the next coarser steps, so visible glyphs are
+    // not dropped; the steps get finer again once the frames' glyphs have taken under a quarter of
+    // the atlas for 120 frames.
+    uint32_t subpixel_steps = kSubpixelSteps;
     uint32_t unknown_fonts = 0;   // instances whose FontId was never added
     uint32_t culled_glyphs = 0;   // instances wholly outside draw()'s visible rect
     uint32_t clipped_glyphs = 0;  // instances partly outside it: only their visible part is rasterized
@@ -128,9 +138,11 @@ public:
     // Starts a frame: unpins the atlas and forgets last frame's drawn glyphs.
     void begin_frame();
 
-    // Draws glyph instances this frame: finds or places each in the atlas and pins it. Instances
-    // of unknown fonts and glyphs the atlas cannot hold are counted in stats() and skipped, never
-    // a crash.
+    // Draws glyph instances this frame: finds or places each in the atlas and pins it (the
+    // instances are copied). Where the atlas has no room for every glyph of the frame, record()
+    // starts the frame over at coarser subpixel steps (RendererStats::subpixel_steps) rather than
+    // drop any. Instances of unknown fonts, glyphs too large for the atlas and glyphs that do not
+    // fit even at whole-pixel positions are counted in stats() and skipped, never a crash.
     void draw(std::span<const GlyphInstance> glyphs);
 
     // The same for a target of which only `visible` can be seen, in the glyphs' pixel space (for
