@@ -94,8 +94,10 @@ struct Renderer::State {
 
     // Subpixel steps per pixel of each level of coarsening (kSubpixelSteps: the layout's own).
     static constexpr std::array<uint32_t, 3> kLevelSteps = {kSubpixelSteps, 4, 1};
-    // Frames whose glyphs take under a quarter of the atlas before the steps get finer again.
+    // Frames whose glyphs take under a quarter of the atlas before the steps get finer again; the
+    // wait doubles each time finer steps did not fit after all (up to kMaxCalmFrames).
     static constexpr uint32_t kCalmFrames = 120;
+    static constexpr uint32_t kMaxCalmFrames = 120u << 6;
     struct Request {
         GlyphInstance glyph;
         bool has_visible = false;
@@ -104,6 +106,8 @@ struct Renderer::State {
     std::vector<Request> requests;  // this frame's draw()n instances, as asked
     size_t level = 0;               // index into kLevelSteps
     uint32_t calm_frames = 0;
+    uint32_t calm_needed = kCalmFrames;
+    bool just_refined = false;  // the level went down at the end of the last frame
     uint32_t atlas_full = 0;  // instances refused as atlas_full this frame
 
     explicit State(GlyphAtlas glyph_atlas) : atlas(std::move(glyph_atlas)) {}
@@ -212,6 +216,8 @@ struct Renderer::State {
     void settle_requests() {
         acquire_clipped();
         while (atlas_full > 0 && level + 1 < kLevelSteps.size()) {
+            if (just_refined) calm_needed = std::min(calm_needed * 2, kMaxCalmFrames);  // it did not fit
+            just_refined = false;
             ++level;
             calm_frames = 0;
             atlas.begin_frame();
@@ -225,10 +231,12 @@ struct Renderer::State {
             acquire_clipped();
         }
         stats.subpixel_steps = kLevelSteps[level];
+        just_refined = false;
         const AtlasStats now = atlas.stats();
-        if (level > 0 && atlas_full == 0 && now.pinned_cells < now.usable_cells / 4 && ++calm_frames >= kCalmFrames) {
+        if (level > 0 && atlas_full == 0 && now.pinned_cells < now.usable_cells / 4 && ++calm_frames >= calm_needed) {
             --level;  // from the next frame on
             calm_frames = 0;
+            just_refined = true;
         }
     }
 

@@ -93,7 +93,8 @@ struct RendererStats {
     // (the layouts' own), or 4 or 1 after a frame the atlas could not hold at the finer steps. A
     // frame that finds the atlas full starts over at the next coarser steps, so visible glyphs are
     // not dropped; the steps get finer again once the frames' glyphs have taken under a quarter of
-    // the atlas for 120 frames.
+    // the atlas for 120 frames (twice as long each time the finer steps then did not fit, up to
+    // 7680 frames).
     uint32_t subpixel_steps = kSubpixelSteps;
     uint32_t unknown_fonts = 0;   // instances whose FontId was never added
     uint32_t culled_glyphs = 0;   // instances wholly outside draw()'s visible rect
