@@ -2,6 +2,8 @@
 // between them and the host.
 #include "vk_resources.hpp"
 
+#include "vk_barriers.hpp"
+
 #include "embedded_shaders.hpp"
 
 #include <crisp/vulkan_context.hpp>
@@ -254,6 +256,9 @@ Result<VkShaderModule> create_embedded_shader(const DeviceRef& device, std::stri
 
 namespace {
 
+using vk::image_barrier;
+using vk::memory_barrier;
+
 bool is_depth_or_stencil(VkFormat format) {
     switch (format) {
         case VK_FORMAT_D16_UNORM:
@@ -284,33 +289,6 @@ VkImageSubresourceRange color_range() {
     range.levelCount = 1;
     range.layerCount = 1;
     return range;
-}
-
-// Orders every earlier write on the queue (shaders, transfers, earlier submissions) before the
-// accesses in `dst_stage`/`dst_access`.
-void memory_barrier(VkCommandBuffer commands, VkPipelineStageFlags src_stage, VkAccessFlags src_access,
-                    VkPipelineStageFlags dst_stage, VkAccessFlags dst_access) {
-    VkMemoryBarrier barrier{};
-    barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-    barrier.srcAccessMask = src_access;
-    barrier.dstAccessMask = dst_access;
-    vkCmdPipelineBarrier(commands, src_stage, dst_stage, 0, 1, &barrier, 0, nullptr, 0, nullptr);
-}
-
-void image_barrier(VkCommandBuffer commands, VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
-                   VkPipelineStageFlags src_stage, VkAccessFlags src_access, VkPipelineStageFlags dst_stage,
-                   VkAccessFlags dst_access) {
-    VkImageMemoryBarrier barrier{};
-    barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-    barrier.srcAccessMask = src_access;
-    barrier.dstAccessMask = dst_access;
-    barrier.oldLayout = old_layout;
-    barrier.newLayout = new_layout;
-    barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    barrier.image = image;
-    barrier.subresourceRange = color_range();
-    vkCmdPipelineBarrier(commands, src_stage, dst_stage, 0, 0, nullptr, 0, nullptr, 1, &barrier);
 }
 
 VkBufferImageCopy whole_image_copy(VkExtent2D extent) {
