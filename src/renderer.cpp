@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <unordered_map>
@@ -99,9 +100,10 @@ struct Renderer::State {
     static constexpr uint32_t kCalmFrames = 120;
     static constexpr uint32_t kMaxCalmFrames = 120u << 6;
     struct Request {
-        GlyphInstance glyph;
+        GlyphInstance glyph;  // moved, recoloured and at its depth as the draw's options asked
         bool has_visible = false;
         VkRect2D visible{};
+        uint32_t steps = kSubpixelSteps;  // the finest subpixel steps it may take (moving text: fewer)
     };
     std::vector<Request> requests;  // this frame's draw()n instances, as asked
     size_t level = 0;               // index into kLevelSteps
@@ -109,6 +111,18 @@ struct Renderer::State {
     uint32_t calm_needed = kCalmFrames;
     bool just_refined = false;  // the level went down at the end of the last frame
     uint32_t atlas_full = 0;  // instances refused as atlas_full this frame
+    uint32_t unplaceable = 0;  // instances draw() could not move (a pen out of range)
+
+    // Where each named draw (DrawOptions::id) was, to tell moving text from static text.
+    struct Motion {
+        double pen_x = 0.0, pen_y = 0.0;  // its first glyph's pen, offset included
+        uint64_t moved = 0;               // the frame its pen last changed (0: never seen move)
+        uint64_t seen = 0;                // the frame it was last drawn
+    };
+    std::unordered_map<uint64_t, Motion> motions;
+    uint64_t frames_begun = 0;  // begin_frame() calls, the clock of `motions`
+    // Named draws not seen for this many frames are forgotten.
+    static constexpr uint64_t kForgetMotionFrames = 256;
 
     explicit State(GlyphAtlas glyph_atlas) : atlas(std::move(glyph_atlas)) {}
 
@@ -181,8 +195,8 @@ struct Renderer::State {
 
     // One draw()n instance: at the frame's subpixel steps, then culled, acquired whole, or kept
     // for acquire_clipped() with its visible part.
-    void request(const GlyphInstance& asked, const VkRect2D* visible) {
-        const GlyphInstance glyph = coarsened(asked, kLevelSteps[level]);
+    void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps) {
+        const GlyphInstance glyph = coarsened(asked, std::min(kLevelSteps[level], steps));
         if (glyph.key != asked.key) ++stats.coarsened_glyphs;
         if (!visible) {
             acquire(glyph, TexelRect{0, 0, glyph.width, glyph.height});
@@ -223,11 +237,13 @@ struct Renderer::State {
             atlas.begin_frame();
             pending.clear();
             clipped.clear();
-            const uint32_t unknown = stats.unknown_fonts;
+            // The requests count again; what draw() counted before them stays.
+            const uint32_t moving = stats.moving_glyphs;
             stats = {};
-            stats.unknown_fonts = unknown;
+            stats.moving_glyphs = moving;
+            stats.skipped_glyphs = unplaceable;
             atlas_full = 0;
-            for (const Request& r : requests) request(r.glyph, r.has_visible ? &r.visible : nullptr);
+            for (const Request& r : requests) request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps);
             acquire_clipped();
         }
         stats.subpixel_steps = kLevelSteps[level];
@@ -238,6 +254,56 @@ struct Renderer::State {
             calm_frames = 0;
             just_refined = true;
         }
+    }
+
+    // `glyph` with its pen moved by (dx, dy) pixels: its key's subpixel offsets, rect and position
+    // follow on each axis that moves. False when the new pen is not finite or out of range.
+    bool moved(GlyphInstance& glyph, double dx, double dy) const {
+        if (dx == 0.0 && dy == 0.0) return true;
+        const auto slot = font_slot.find(glyph.key.font);
+        if (slot == font_slot.end()) return true;  // acquire() counts it
+        const FontAsset& asset = fonts[slot->second].font->asset();
+        if (glyph.key.glyph >= asset.glyphs.size()) return true;
+        const GlyphRecord& record = asset.glyphs[glyph.key.glyph];
+        const GlyphRect old_rect = glyph_rect(record, glyph.key);
+        const double pens[2] = {static_cast<double>(glyph.pen_x) + dx, static_cast<double>(glyph.pen_y) + dy};
+        int32_t whole[2] = {glyph.x - old_rect.x, glyph.y - old_rect.y};
+        uint8_t* offsets[2] = {&glyph.key.subpixel_x, &glyph.key.subpixel_y};
+        const double deltas[2] = {dx, dy};
+        for (int axis = 0; axis < 2; ++axis) {
+            if (deltas[axis] == 0.0) continue;
+            constexpr double kMaxPen = 16777216.0;  // 2^24 px
+            if (!(std::abs(pens[axis]) <= kMaxPen)) return false;
+            double base = std::floor(pens[axis]);
+            double step = std::round((pens[axis] - base) * kSubpixelSteps);
+            if (step >= kSubpixelSteps) {
+                base += 1.0;
+                step = 0.0;
+            }
+            whole[axis] = static_cast<int32_t>(base);
+            *offsets[axis] = static_cast<uint8_t>(step);
+        }
+        const GlyphRect rect = glyph_rect(record, glyph.key);
+        glyph.x = whole[0] + rect.x;
+        glyph.y = whole[1] + rect.y;
+        glyph.width = rect.width;
+        glyph.height = rect.height;
+        glyph.pen_x = static_cast<float>(pens[0]);
+        glyph.pen_y = static_cast<float>(pens[1]);
+        return true;
+    }
+
+    // Whether the named draw whose first glyph's pen is (x, y) this frame moved lately.
+    bool moving(uint64_t id, double x, double y) {
+        auto [it, added] = motions.try_emplace(id, Motion{x, y, 0, frames_begun});
+        Motion& m = it->second;
+        if (!added && (m.pen_x != x || m.pen_y != y)) {
+            m.moved = frames_begun;
+            m.pen_x = x;
+            m.pen_y = y;
+        }
+        m.seen = frames_begun;
+        return m.moved != 0 && frames_begun - m.moved < kMotionSettleFrames;
     }
 
     // Acquires the glyphs drawn in part, each glyph once for the bounding box of its parts.
@@ -517,12 +583,17 @@ void Renderer::abandon_frame() {
 
 void Renderer::begin_frame() {
     State& s = *state_;
+    ++s.frames_begun;
+    if (s.frames_begun % State::kForgetMotionFrames == 0) {
+        std::erase_if(s.motions, [&](const auto& m) { return s.frames_begun - m.second.seen > State::kForgetMotionFrames; });
+    }
     s.undo.recorded = false;
     s.atlas.begin_frame();
     s.pending.clear();
     s.clipped.clear();
     s.requests.clear();
     s.atlas_full = 0;
+    s.unplaceable = 0;
     s.drawn.clear();
     s.stats = {};
     s.converged = true;
@@ -531,16 +602,57 @@ void Renderer::begin_frame() {
 void Renderer::draw(std::span<const GlyphInstance> glyphs) {
     State& s = *state_;
     for (const GlyphInstance& glyph : glyphs) {
-        s.requests.push_back({glyph, false, {}});
-        s.request(glyph, nullptr);
+        s.requests.push_back({glyph, false, {}, kSubpixelSteps});
+        s.request(glyph, nullptr, kSubpixelSteps);
     }
 }
 
 void Renderer::draw(std::span<const GlyphInstance> glyphs, const VkRect2D& visible) {
     State& s = *state_;
     for (const GlyphInstance& glyph : glyphs) {
-        s.requests.push_back({glyph, true, visible});
-        s.request(glyph, &visible);
+        s.requests.push_back({glyph, true, visible, kSubpixelSteps});
+        s.request(glyph, &visible, kSubpixelSteps);
+    }
+}
+
+void Renderer::draw(std::span<const GlyphInstance> glyphs, const DrawOptions& options) {
+    State& s = *state_;
+    if (glyphs.empty()) return;
+    const double dx = static_cast<double>(options.offset_x), dy = static_cast<double>(options.offset_y);
+    if (!std::isfinite(dx) || !std::isfinite(dy)) {
+        const auto count = static_cast<uint32_t>(std::min<size_t>(glyphs.size(), UINT32_MAX));
+        s.stats.skipped_glyphs += count;
+        s.unplaceable += count;
+        return;
+    }
+    float color[4] = {};
+    if (options.color) {
+        for (int c = 0; c < 4; ++c) {
+            const float v = (*options.color)[static_cast<size_t>(c)];
+            color[c] = v == v ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+            if (c < 3) color[c] = srgb_to_linear(color[c]);
+        }
+    }
+    uint32_t steps = kSubpixelSteps;
+    if (options.id != 0) {
+        const GlyphInstance& first = glyphs.front();
+        if (s.moving(options.id, static_cast<double>(first.pen_x) + dx, static_cast<double>(first.pen_y) + dy)) {
+            steps = kMovingSubpixelSteps;
+            s.stats.moving_glyphs += static_cast<uint32_t>(std::min<size_t>(glyphs.size(), UINT32_MAX));
+        }
+    }
+    const VkRect2D* visible = options.visible ? &*options.visible : nullptr;
+    for (const GlyphInstance& asked : glyphs) {
+        GlyphInstance glyph = asked;
+        if (!s.moved(glyph, dx, dy)) {
+            ++s.stats.skipped_glyphs;
+            ++s.unplaceable;
+            continue;
+        }
+        if (options.color) std::copy(std::begin(color), std::end(color), std::begin(glyph.color));
+        if (options.depth) glyph.depth = *options.depth;
+        s.requests.push_back({glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps});
+        s.request(glyph, visible, steps);
     }
 }
 

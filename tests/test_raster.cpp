@@ -12,7 +12,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <memory>
 #include <tuple>
@@ -543,6 +545,132 @@ TEST(Raster, AFullAtlasDrawsGlyphsCoarserRatherThanDroppingThem) {
     ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
     EXPECT_EQ(renderer->stats().subpixel_steps, kSubpixelSteps);
     EXPECT_EQ(renderer->drawn()[0].instance.key, glyphs[0].key);
+    expect_no_validation_messages();
+}
+
+TEST(Raster, DrawOptionsMoveRecolourAndSetDepthWithoutALayout) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    auto renderer = make_renderer(*subpixel_preset("rgb"), 8);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*f.font));
+    const Font* fonts[] = {f.font.get()};
+    TextStyle style;
+    style.size = 13.0f;
+    LayoutOptions at_origin;
+    at_origin.origin_x = 5.0f;
+    at_origin.origin_y = 20.0f;
+    auto layout = layout_text(fonts, "Hg@&1", style, at_origin);
+    ASSERT_TRUE(layout);
+    // The same text laid out where the offset puts it (offsets exact in binary).
+    LayoutOptions moved_origin = at_origin;
+    moved_origin.origin_x += 3.25f;
+    moved_origin.origin_y += 0.5f;
+    auto moved = layout_text(fonts, "Hg@&1", style, moved_origin);
+    ASSERT_TRUE(moved);
+
+    DrawOptions options;
+    options.offset_x = 3.25f;
+    options.offset_y = 0.5f;
+    options.color = std::array<float, 4>{1.0f, 0.5f, std::nanf(""), 2.0f};
+    options.depth = 0.25f;
+    renderer->begin_frame();
+    renderer->draw(layout->glyphs, options);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    ASSERT_EQ(renderer->drawn().size(), moved->glyphs.size());
+    for (size_t i = 0; i < moved->glyphs.size(); ++i) {
+        const GlyphInstance& want = moved->glyphs[i];
+        const GlyphInstance& got = renderer->drawn()[i].instance;
+        EXPECT_EQ(got.key, want.key) << i;
+        EXPECT_EQ(got.x, want.x) << i;
+        EXPECT_EQ(got.y, want.y) << i;
+        EXPECT_EQ(got.width, want.width) << i;
+        EXPECT_EQ(got.height, want.height) << i;
+        EXPECT_EQ(got.color[0], 1.0f);
+        EXPECT_EQ(got.color[1], srgb_to_linear(0.5f));
+        EXPECT_EQ(got.color[2], 0.0f);  // NaN reads as 0
+        EXPECT_EQ(got.color[3], 1.0f);  // clamped
+        EXPECT_EQ(got.depth, 0.25f);
+        EXPECT_EQ(got.paint_order, want.paint_order);
+    }
+    // A zero offset keeps the layout's glyphs as they are; a non-finite one draws nothing.
+    renderer->begin_frame();
+    renderer->draw(layout->glyphs, DrawOptions{});
+    DrawOptions broken;
+    broken.offset_x = std::numeric_limits<float>::infinity();
+    renderer->draw(layout->glyphs, broken);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    ASSERT_EQ(renderer->drawn().size(), layout->glyphs.size());
+    for (size_t i = 0; i < layout->glyphs.size(); ++i) {
+        EXPECT_EQ(renderer->drawn()[i].instance.key, layout->glyphs[i].key);
+        EXPECT_EQ(renderer->drawn()[i].instance.x, layout->glyphs[i].x);
+        EXPECT_EQ(renderer->drawn()[i].instance.depth, layout->glyphs[i].depth);
+    }
+    EXPECT_EQ(renderer->stats().skipped_glyphs, layout->glyphs.size());
+    expect_no_validation_messages();
+}
+
+// A label gliding 0.37 px a frame: with a name it takes quarter-pixel steps and keeps gathering
+// samples in a few entries; without one, each frame needs new entries that never get past their
+// first samples. At rest it returns to the fine steps.
+TEST(Raster, MovingTextTakesCoarserStepsAndKeepsConverging) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    const Font* fonts[] = {f.font.get()};
+    TextStyle style;
+    style.size = 13.0f;
+    LayoutOptions origin;
+    origin.origin_x = 4.0f;
+    origin.origin_y = 16.0f;
+    auto label = layout_text(fonts, "Hg", style, origin);
+    ASSERT_TRUE(label);
+    ASSERT_EQ(label->glyphs.size(), 2u);
+    constexpr int kFrames = 40;
+    struct Run {
+        std::set<GlyphKey, bool (*)(const GlyphKey&, const GlyphKey&)> keys{
+            [](const GlyphKey& a, const GlyphKey& b) {
+                return std::tie(a.glyph, a.subpixel_x, a.subpixel_y) < std::tie(b.glyph, b.subpixel_x, b.subpixel_y);
+            }};
+        uint32_t last_samples = 0;
+        uint32_t moving = 0;
+    };
+    const auto run = [&](uint64_t id, Renderer& renderer, int frames, float speed, float start) {
+        Run result;
+        for (int frame = 0; frame < frames; ++frame) {
+            DrawOptions options;
+            options.offset_x = start + speed * static_cast<float>(frame);
+            options.id = id;
+            renderer.begin_frame();
+            renderer.draw(label->glyphs, options);
+            EXPECT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer.record(cb)); }));
+            for (const DrawnGlyph& d : renderer.drawn()) result.keys.insert(d.instance.key);
+            result.last_samples = renderer.drawn().empty() ? 0 : renderer.drawn()[0].samples;
+            result.moving += renderer.stats().moving_glyphs;
+        }
+        return result;
+    };
+    auto named = make_renderer(*subpixel_preset("rgb"), 256);
+    auto anonymous = make_renderer(*subpixel_preset("rgb"), 256);
+    ASSERT_TRUE(named && anonymous);
+    ASSERT_TRUE(named->add_font(*f.font));
+    ASSERT_TRUE(anonymous->add_font(*f.font));
+    const Run with_id = run(7, *named, kFrames, 0.37f, 0.0f);
+    const Run without = run(0, *anonymous, kFrames, 0.37f, 0.0f);
+    EXPECT_LE(with_id.keys.size(), 2u * (kMovingSubpixelSteps + 1));  // + its first, static frame
+    EXPECT_GE(without.keys.size(), 2u * (kFrames - 1));
+    EXPECT_EQ(with_id.moving, 2u * (kFrames - 1));  // all but the first frame, when it was first seen
+    EXPECT_EQ(without.moving, 0u);
+    EXPECT_GT(with_id.last_samples, 2 * without.last_samples);
+    // At rest for kMotionSettleFrames frames, the label is static again: its layout's fine steps.
+    const float rest = 0.37f * kFrames;
+    const Run resting = run(7, *named, kMotionSettleFrames + 1, 0.0f, rest);
+    const Run still = run(0, *anonymous, 1, 0.0f, rest);
+    ASSERT_EQ(named->drawn().size(), 2u);
+    ASSERT_EQ(anonymous->drawn().size(), 2u);
+    for (size_t i = 0; i < 2; ++i) EXPECT_EQ(named->drawn()[i].instance.key, anonymous->drawn()[i].instance.key);
+    EXPECT_EQ(still.moving, 0u);
+    EXPECT_EQ(named->stats().moving_glyphs, 0u);
+    EXPECT_GT(resting.moving, 0u);  // the first rest frames still count as moving
     expect_no_validation_messages();
 }
 

@@ -28,7 +28,9 @@
 
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <memory>
+#include <optional>
 #include <span>
 
 namespace crisp {
@@ -60,6 +62,39 @@ struct RendererCreateInfo {
     // once for all three. Off only to measure what it saves.
     bool shared_row_roots = true;
 };
+
+// How one draw() call shows its glyphs, without a new layout: where, in which colour, at which depth,
+// and whether they move. Every field at its default draws the glyphs as laid out.
+struct DrawOptions {
+    // Pixels added to every glyph's pen (y down). A label that follows an object is drawn again
+    // with a new offset, not laid out again: the glyphs' subpixel positions and rects follow (at
+    // kSubpixelSteps per pixel, coarser where the frame or motion says so). A zero offset keeps the
+    // layout's positions and keys as they are, so a snapped layout stays snapped under whole-pixel
+    // offsets. Non-finite offsets, or pens moved beyond 2^24 px, draw nothing (skipped_glyphs).
+    float offset_x = 0.0f;
+    float offset_y = 0.0f;
+    // A colour for every glyph instead of its layout's: sRGB, straight alpha, as TextStyle::color
+    // (clamped to [0, 1]; NaN reads as 0). A hover colour is a draw option, not a layout.
+    std::optional<std::array<float, 4>> color;
+    // A depth for every glyph instead of its layout's (for world-space labels:
+    // depth_from_view_projection()). Not finite: the compositor clamps it, as any depth.
+    std::optional<float> depth;
+    // Where the glyphs can be seen, as draw(glyphs, visible); nullopt: everywhere.
+    std::optional<VkRect2D> visible;
+    // The caller's name for what these glyphs are (a label, a list row), the same every frame; 0
+    // for none. The renderer remembers where each named draw's first glyph was: a draw whose text
+    // moved within the last kMotionSettleFrames frames is moving text, and its glyphs take
+    // quarter-pixel subpixel steps (kMovingSubpixelSteps), so that a label gliding a fraction of a
+    // pixel a frame reuses at most 4 x 4 atlas entries per glyph and keeps gathering samples
+    // instead of starting over in a new entry every frame. Once it rests, it returns to the fine
+    // steps. Counted in RendererStats::moving_glyphs.
+    uint64_t id = 0;
+};
+
+// Subpixel steps per pixel of moving text (DrawOptions::id).
+inline constexpr uint32_t kMovingSubpixelSteps = 4;
+// Frames a named draw must rest before its text counts as static again.
+inline constexpr uint32_t kMotionSettleFrames = 8;
 
 class HeadlessContext;
 
@@ -96,6 +131,7 @@ struct RendererStats {
     // the atlas for 120 frames (twice as long each time the finer steps then did not fit, up to
     // 7680 frames).
     uint32_t subpixel_steps = kSubpixelSteps;
+    uint32_t moving_glyphs = 0;   // instances of moving named draws (DrawOptions::id), at kMovingSubpixelSteps
     uint32_t unknown_fonts = 0;   // instances whose FontId was never added
     uint32_t culled_glyphs = 0;   // instances wholly outside draw()'s visible rect
     uint32_t clipped_glyphs = 0;  // instances partly outside it: only their visible part is rasterized
@@ -154,6 +190,11 @@ public:
     // is decided in record(), over all of the frame's draws of the same glyph. An empty
     // `visible` culls everything.
     void draw(std::span<const GlyphInstance> glyphs, const VkRect2D& visible);
+
+    // The same with per-draw options: an offset, a colour, a depth, a visible rect and a name that
+    // lets moving text take coarser subpixel steps (see DrawOptions). drawn() reports the glyphs
+    // as drawn: moved, recoloured (in linear colour, as GlyphInstance::color) and at their depth.
+    void draw(std::span<const GlyphInstance> glyphs, const DrawOptions& options);
 
     // Records this frame's work into `command_buffer` (which must be recording, outside a render
     // pass, on a queue of RendererCreateInfo::queue_family): pending font uploads, the work list,
