@@ -74,7 +74,7 @@ Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::spa
         // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
         vk::destroy_buffer(ref_, slot.quads);
         if (Status s = vk::create_buffer(ref_, std::max<VkDeviceSize>(256, std::bit_ceil(bytes)),
-                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, slot.quads);
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "draw quads", slot.quads);
             !s) {
             return s.error();
         }

@@ -73,10 +73,12 @@ Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadP
     info.layout = desc.layout;
     info.renderPass = desc.render_pass;
     VkPipeline pipeline = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateGraphicsPipelines(device.device, VK_NULL_HANDLE, 1, &info, device.allocator, &pipeline);
+    if (VkResult r =
+            vkCreateGraphicsPipelines(device.device, device.pipeline_cache, 1, &info, device.allocator, &pipeline);
         r != VK_SUCCESS) {
         return vk::vulkan_error(std::string("vkCreateGraphicsPipelines (") + desc.what + ")", r);
     }
+    vk::name_object(device, VK_OBJECT_TYPE_PIPELINE, pipeline, desc.what);
     return pipeline;
 }
 

@@ -116,7 +116,7 @@ Status ReferenceCompositor::create_buffers(const CompositorCreateInfo& info, std
                                             std::to_string(accumulator_bytes) +
                                             " bytes, above maxStorageBufferRange (" + std::to_string(range) + ")"};
     }
-    if (Status s = vk::create_buffer(ref, accumulator_bytes, storage, false, accumulators); !s) return s;
+    if (Status s = vk::create_buffer(ref, accumulator_bytes, storage, false, "reference accumulators", accumulators); !s) return s;
     const VkDeviceSize node_bytes = gpu::kCompositeNodeWords * kWord;
     VkDeviceSize wanted_nodes = VkDeviceSize{pixels} * info.exact_nodes_per_pixel;
     if (wanted_nodes * node_bytes > range) {
@@ -127,12 +127,12 @@ Status ReferenceCompositor::create_buffers(const CompositorCreateInfo& info, std
     }
     node_capacity = static_cast<uint32_t>(std::min<VkDeviceSize>(wanted_nodes, 0xFFFFFFFEu));
     if (Status s = vk::create_buffer(ref, std::max<VkDeviceSize>(node_capacity, 1) * node_bytes,
-                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, nodes);
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "exact node pool", nodes);
         !s) {
         return s;
     }
     if (Status s = vk::create_buffer(ref, gpu::kStatWords * kWord, storage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false,
-                                     stats_words);
+                                     "reference statistics", stats_words);
         !s) {
         return s;
     }
@@ -249,7 +249,8 @@ Status ReferenceCompositor::create_descriptors() {
         FrameSlot& slot = slots[i];
         slot.set = descriptors.sets[i];
         if (Status s =
-                vk::create_buffer(ref, gpu::kStatWords * kWord, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, slot.stats);
+                vk::create_buffer(ref, gpu::kStatWords * kWord, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true,
+                                  "reference statistics readback", slot.stats);
             !s) {
             return s;
         }
@@ -330,7 +331,8 @@ Status ReferenceCompositor::upload(vk::DeviceBuffer& buffer, uint32_t& capacity,
         capacity = 0;
         const uint32_t grown = std::max<uint32_t>(64, std::bit_ceil(std::max(count, 1u)));
         if (Status s =
-                vk::create_buffer(ref, VkDeviceSize{grown} * size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, buffer);
+                vk::create_buffer(ref, VkDeviceSize{grown} * size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
+                                  "reference quads", buffer);
             !s) {
             return s;
         }

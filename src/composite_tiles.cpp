@@ -137,11 +137,12 @@ bool TileCompositor::supports(VkFormat format, VkFormat view_format) const {
 }
 
 Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage,
-                            bool host_visible) {
+                            bool host_visible, const char* what) {
     if (buffer.buffer && buffer.size >= bytes) return {};
     // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
     vk::destroy_buffer(ref_, buffer);
-    return vk::create_buffer(ref_, std::max<VkDeviceSize>(256, std::bit_ceil(bytes)), usage, host_visible, buffer);
+    return vk::create_buffer(ref_, std::max<VkDeviceSize>(256, std::bit_ceil(bytes)), usage, host_visible, what,
+                             buffer);
 }
 
 Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles,
@@ -149,12 +150,12 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
     constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     constexpr VkBufferUsageFlags transfer = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     const VkDeviceSize quad_bytes = quads.size_bytes();
-    if (Status s = grow(slot.quads, quad_bytes, storage, true); !s) return s;
-    if (Status s = grow(slot.tiles, tile_words(tiles) * kWord, storage | transfer, false); !s) return s;
-    if (Status s = grow(slot.bins, pairs * kWord, storage, false); !s) return s;
+    if (Status s = grow(slot.quads, quad_bytes, storage, true, "tile quads"); !s) return s;
+    if (Status s = grow(slot.tiles, tile_words(tiles) * kWord, storage | transfer, false, "tile counts"); !s) return s;
+    if (Status s = grow(slot.bins, pairs * kWord, storage, false, "tile bins"); !s) return s;
     // Host-visible, so that the host reads the frame's counts straight from it once the frame is done.
     if (Status s = grow(slot.header, header_words(tiles) * kWord,
-                        storage | transfer | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true);
+                        storage | transfer | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true, "tile header");
         !s) {
         return s;
     }

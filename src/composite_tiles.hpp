@@ -104,7 +104,8 @@ private:
         bool bins_valid = false;
     };
 
-    Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible);
+    Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
+                const char* what);
     Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
     void write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view);
     void record_binning(VkCommandBuffer command_buffer, const gpu::TilePushConstants& push);

@@ -189,9 +189,7 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     const bool storage_without_format =
         core.shaderStorageImageReadWithoutFormat && core.shaderStorageImageWriteWithoutFormat;
     auto state = std::make_unique<State>();
-    state->ref.device = info.device;
-    state->ref.allocator = info.allocator;
-    vkGetPhysicalDeviceMemoryProperties(info.physical_device, &state->ref.memory_properties);
+    state->ref = vk::make_device_ref(info.physical_device, info.device, info.allocator, info.pipeline_cache);
     state->storage_without_format = storage_without_format;
     composite::TileConfig tiles;
     tiles.physical_device = info.physical_device;

@@ -10,8 +10,10 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace crisp {
@@ -47,7 +49,7 @@ struct Renderer::State {
     VkDevice device = VK_NULL_HANDLE;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
-    VkPhysicalDeviceMemoryProperties memory_properties{};
+    vk::DeviceRef ref;  // device, allocator, memory properties, pipeline cache, debug names
     VkDeviceSize max_storage_buffer_range = 0;
     uint32_t frames_in_flight = 2;
     bool shared_row_roots = true;
@@ -84,11 +86,22 @@ struct Renderer::State {
     std::unordered_map<GlyphKey, TexelRect, GlyphKeyHash> clipped_parts;  // scratch: bounding parts
     std::vector<DrawnGlyph> drawn;
     std::vector<gpu::RasterItem> item_data;
-    // What record() committed, so that abandon_frame() can take it back.
+    struct Motion {
+        double pen_x = 0.0, pen_y = 0.0;  // a named draw's first glyph's pen, offset included
+        uint64_t moved = 0;               // the frame its pen last changed (0: never seen move)
+        uint64_t seen = 0;                // the frame it was last drawn
+    };
+    // What the frame committed, so that abandon_frame() can take it back.
     struct Undo {
         bool recorded = false;
         bool atlas_was_initialized = false;
         std::vector<uint32_t> uploaded_fonts;  // slots whose staging went to `retired` this frame
+        // The named draws this frame changed, as they were before it (nullopt: new this frame).
+        std::vector<std::pair<uint64_t, std::optional<Motion>>> motions;
+        // The subpixel-step level and its clock as they were at begin_frame().
+        size_t level = 0;
+        uint32_t calm_frames = 0, calm_needed = 0;
+        bool just_refined = false;
     } undo;
     RendererStats stats;
     bool converged = true;
@@ -114,11 +127,6 @@ struct Renderer::State {
     uint32_t unplaceable = 0;  // instances draw() could not move (a pen out of range)
 
     // Where each named draw (DrawOptions::id) was, to tell moving text from static text.
-    struct Motion {
-        double pen_x = 0.0, pen_y = 0.0;  // its first glyph's pen, offset included
-        uint64_t moved = 0;               // the frame its pen last changed (0: never seen move)
-        uint64_t seen = 0;                // the frame it was last drawn
-    };
     std::unordered_map<uint64_t, Motion> motions;
     uint64_t frames_begun = 0;  // begin_frame() calls, the clock of `motions`
     // Named draws not seen for this many frames are forgotten.
@@ -127,7 +135,9 @@ struct Renderer::State {
     explicit State(GlyphAtlas glyph_atlas) : atlas(std::move(glyph_atlas)) {}
 
     // Finds or places `glyph` with `part` of its rect visible and adds it to the pending glyphs.
-    void acquire(const GlyphInstance& glyph, const TexelRect& part) {
+    // `shown` (within `part`; nullptr: all the atlas holds) is what drawn() reports of it: a
+    // clipped glyph shows only its visible texels, though the atlas holds a margin around them.
+    void acquire(const GlyphInstance& glyph, const TexelRect& part, const TexelRect* shown = nullptr) {
         if (glyph.width == 0 || glyph.height == 0) return;
         const auto slot = font_slot.find(glyph.key.font);
         if (slot == font_slot.end()) {
@@ -142,11 +152,20 @@ struct Renderer::State {
         }
         const AtlasLookup lookup = place(asset, glyph, part);
         if (lookup.status == AtlasStatus::placed) {
-            DrawnGlyph placed{glyph, lookup.x, lookup.y, 0, lookup.part.x, lookup.part.y};
-            placed.instance.x += static_cast<int32_t>(lookup.part.x);
-            placed.instance.y += static_cast<int32_t>(lookup.part.y);
-            placed.instance.width = lookup.part.width;
-            placed.instance.height = lookup.part.height;
+            const TexelRect& held = lookup.part;
+            TexelRect show = held;
+            if (shown) {  // the visible texels, within what the atlas holds
+                const uint32_t x0 = std::max(shown->x, held.x), y0 = std::max(shown->y, held.y);
+                const uint32_t x1 = std::min(shown->x + shown->width, held.x + held.width);
+                const uint32_t y1 = std::min(shown->y + shown->height, held.y + held.height);
+                if (x0 >= x1 || y0 >= y1) return;
+                show = {x0, y0, x1 - x0, y1 - y0};
+            }
+            DrawnGlyph placed{glyph, lookup.x + (show.x - held.x), lookup.y + (show.y - held.y), 0, show.x, show.y};
+            placed.instance.x += static_cast<int32_t>(show.x);
+            placed.instance.y += static_cast<int32_t>(show.y);
+            placed.instance.width = show.width;
+            placed.instance.height = show.height;
             pending.push_back({placed, lookup.entry});
         } else if (lookup.status == AtlasStatus::atlas_full || lookup.status == AtlasStatus::too_large) {
             ++stats.failed_glyphs;
@@ -297,6 +316,11 @@ struct Renderer::State {
     bool moving(uint64_t id, double x, double y) {
         auto [it, added] = motions.try_emplace(id, Motion{x, y, 0, frames_begun});
         Motion& m = it->second;
+        if (added) {
+            undo.motions.emplace_back(id, std::nullopt);
+        } else if (m.seen != frames_begun) {  // its first draw this frame
+            undo.motions.emplace_back(id, m);
+        }
         if (!added && (m.pen_x != x || m.pen_y != y)) {
             m.moved = frames_begun;
             m.pen_x = x;
@@ -321,11 +345,12 @@ struct Renderer::State {
             box.width = x1 - box.x;
             box.height = y1 - box.y;
         }
-        for (const Clipped& c : clipped) acquire(c.glyph, clipped_parts.at(c.glyph.key));
+        for (const Clipped& c : clipped) acquire(c.glyph, clipped_parts.at(c.glyph.key), &c.part);
         clipped.clear();
     }
     ~State();
-    Status make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, GpuBuffer& out);
+    Status make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, const char* what,
+                       GpuBuffer& out);
     void free_buffer(GpuBuffer& buffer);
     Status create_objects();
     void write_descriptors(VkDescriptorSet set);
@@ -342,23 +367,24 @@ Renderer::State::~State() {
     free_buffer(items);
     free_buffer(dummy);
     if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
-    vk::destroy_descriptor_sets({device, allocator, memory_properties}, descriptors);
+    vk::destroy_descriptor_sets(ref, descriptors);
     if (shader) vkDestroyShaderModule(device, shader, allocator);
-    vk::destroy_image({device, allocator, memory_properties}, atlas_image);
+    vk::destroy_image(ref, atlas_image);
 }
 
-Status Renderer::State::make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, GpuBuffer& out) {
-    return vk::create_buffer({device, allocator, memory_properties}, size, usage, host_visible, out);
+Status Renderer::State::make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, const char* what,
+                                    GpuBuffer& out) {
+    return vk::create_buffer(ref, size, usage, host_visible, what, out);
 }
 
 void Renderer::State::free_buffer(GpuBuffer& buffer) {
-    vk::destroy_buffer({device, allocator, memory_properties}, buffer);
+    vk::destroy_buffer(ref, buffer);
 }
 
 Status Renderer::State::create_objects() {
     // The atlas image.
     const AtlasConfig& config = atlas.config();
-    if (Status s = vk::create_image({device, allocator, memory_properties}, kAtlasFormat, config.width, config.height,
+    if (Status s = vk::create_image(ref, kAtlasFormat, config.width, config.height,
                                     VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
                                         VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                                     "atlas", atlas_image);
@@ -369,14 +395,15 @@ Status Renderer::State::create_objects() {
     // Work items: an entry takes at least one cell, so a frame never has more items than cells.
     item_capacity = atlas.stats().usable_cells;
     if (Status s = make_buffer(VkDeviceSize{item_capacity} * sizeof(gpu::RasterItem),
-                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, items);
+                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, "work items",
+                               items);
         !s) {
         return s;
     }
-    if (Status s = make_buffer(16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, dummy); !s) return s;
+    if (Status s = make_buffer(16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "empty font slot", dummy); !s) return s;
 
     // The pipeline.
-    Result<VkShaderModule> module = vk::create_embedded_shader({device, allocator, memory_properties}, "raster.comp");
+    Result<VkShaderModule> module = vk::create_embedded_shader(ref, "raster.comp");
     if (!module) return module.error();
     shader = *module;
     const VkDescriptorSetLayoutBinding bindings[] = {
@@ -386,7 +413,7 @@ Status Renderer::State::create_objects() {
         {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kMaxRendererFonts, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
     };
     // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
-    const vk::DeviceRef ref{device, allocator, memory_properties};
+    const vk::DeviceRef refref;
     if (Status s =
             vk::create_descriptor_sets(ref, bindings, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(gpu::RasterPushConstants),
                                        frames_in_flight, "renderer", descriptors);
@@ -496,7 +523,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     state->frames_in_flight = info.frames_in_flight;
     state->shared_row_roots = info.shared_row_roots;
     state->max_storage_buffer_range = properties.limits.maxStorageBufferRange;
-    vkGetPhysicalDeviceMemoryProperties(info.physical_device, &state->memory_properties);
+    state->ref = vk::make_device_ref(info.physical_device, info.device, info.allocator, info.pipeline_cache);
     state->layout = std::move(layout);
     if (Status s = state->create_objects(); !s) return s.error();
     return Renderer(std::move(state));
@@ -531,9 +558,12 @@ Status Renderer::add_font(const Font& font) {
     gpu.font = &font;
     gpu.points_bytes = points_bytes;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    Status status = s.make_buffer(points_bytes, usage, false, gpu.points);
-    if (status) status = s.make_buffer(bands_bytes, usage, false, gpu.bands);
-    if (status) status = s.make_buffer(points_bytes + bands_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, gpu.staging);
+    Status status = s.make_buffer(points_bytes, usage, false, "font curve points", gpu.points);
+    if (status) status = s.make_buffer(bands_bytes, usage, false, "font bands", gpu.bands);
+    if (status) {
+        status = s.make_buffer(points_bytes + bands_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "font staging",
+                               gpu.staging);
+    }
     if (!status) {
         s.free_buffer(gpu.points);
         s.free_buffer(gpu.bands);
@@ -565,6 +595,20 @@ void Renderer::abandon_frame() {
     s.undo.recorded = false;
     s.atlas.abandon_frame();
     s.atlas_initialized = s.undo.atlas_was_initialized;
+    // Motion and the subpixel-step level go back to what they were, as if the frame never began.
+    for (auto it = s.undo.motions.rbegin(); it != s.undo.motions.rend(); ++it) {
+        if (it->second) {
+            s.motions[it->first] = *it->second;
+        } else {
+            s.motions.erase(it->first);
+        }
+    }
+    s.undo.motions.clear();
+    --s.frames_begun;
+    s.level = s.undo.level;
+    s.calm_frames = s.undo.calm_frames;
+    s.calm_needed = s.undo.calm_needed;
+    s.just_refined = s.undo.just_refined;
     // The fonts' uploads go back to waiting, with their staging buffers.
     for (uint32_t index : s.undo.uploaded_fonts) {
         GpuFont& font = s.fonts[index];
@@ -588,6 +632,11 @@ void Renderer::begin_frame() {
         std::erase_if(s.motions, [&](const auto& m) { return s.frames_begun - m.second.seen > State::kForgetMotionFrames; });
     }
     s.undo.recorded = false;
+    s.undo.motions.clear();
+    s.undo.level = s.level;
+    s.undo.calm_frames = s.calm_frames;
+    s.undo.calm_needed = s.calm_needed;
+    s.undo.just_refined = s.just_refined;
     s.atlas.begin_frame();
     s.pending.clear();
     s.clipped.clear();

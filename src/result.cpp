@@ -18,6 +18,8 @@ const char* error_code_name(ErrorCode code) {
             return "asset_invalid";
         case ErrorCode::asset_version:
             return "asset_version";
+        case ErrorCode::device_lost:
+            return "device_lost";
         case ErrorCode::vulkan:
             return "vulkan";
     }

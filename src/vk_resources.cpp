@@ -19,7 +19,8 @@ namespace crisp {
 namespace vk {
 
 Error vulkan_error(std::string_view call, VkResult result) {
-    return Error{ErrorCode::vulkan, std::string(call) + " failed: " + vk_result_name(result)};
+    const ErrorCode code = result == VK_ERROR_DEVICE_LOST ? ErrorCode::device_lost : ErrorCode::vulkan;
+    return Error{code, std::string(call) + " failed: " + vk_result_name(result)};
 }
 
 std::optional<uint32_t> find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, uint32_t type_bits,
@@ -51,16 +52,40 @@ std::string version_string(uint32_t version) {
            std::to_string(VK_API_VERSION_PATCH(version));
 }
 
+DeviceRef make_device_ref(VkPhysicalDevice physical_device, VkDevice device, const VkAllocationCallbacks* allocator,
+                          VkPipelineCache pipeline_cache) {
+    DeviceRef ref;
+    ref.device = device;
+    ref.allocator = allocator;
+    ref.pipeline_cache = pipeline_cache;
+    vkGetPhysicalDeviceMemoryProperties(physical_device, &ref.memory_properties);
+    ref.set_object_name = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+        vkGetDeviceProcAddr(device, "vkSetDebugUtilsObjectNameEXT"));
+    return ref;
+}
+
+void name_object(const DeviceRef& device, VkObjectType type, uint64_t handle, std::string_view what) {
+    if (!device.set_object_name || handle == 0) return;
+    const std::string name = "crisp " + std::string(what);
+    VkDebugUtilsObjectNameInfoEXT info{};
+    info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT;
+    info.objectType = type;
+    info.objectHandle = handle;
+    info.pObjectName = name.c_str();
+    device.set_object_name(device.device, &info);  // a failed name changes nothing crisp does
+}
+
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
-                     DeviceBuffer& out) {
+                     const char* what, DeviceBuffer& out) {
     out = {};
+    const std::string suffix = std::string(" (") + what + ")";
     VkBufferCreateInfo info{};
     info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
     info.size = std::max<VkDeviceSize>(size, 16);
     info.usage = usage;
     info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     if (VkResult r = vkCreateBuffer(device.device, &info, device.allocator, &out.buffer); r != VK_SUCCESS) {
-        return vulkan_error("vkCreateBuffer", r);
+        return vulkan_error("vkCreateBuffer" + suffix, r);
     }
     out.size = info.size;
     VkMemoryRequirements requirements{};
@@ -74,7 +99,7 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
     const auto type = find_memory_type(device.memory_properties, requirements.memoryTypeBits, required, preferred);
     if (!type) {
         destroy_buffer(device, out);
-        return Error{ErrorCode::vulkan, "no memory type for a buffer of " + std::to_string(size) + " bytes"};
+        return Error{ErrorCode::vulkan, "no memory type for a buffer of " + std::to_string(size) + " bytes" + suffix};
     }
     VkMemoryAllocateInfo allocate{};
     allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
@@ -82,15 +107,17 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
     allocate.memoryTypeIndex = *type;
     if (VkResult r = vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory); r != VK_SUCCESS) {
         destroy_buffer(device, out);
-        return vulkan_error("vkAllocateMemory", r);
+        return vulkan_error("vkAllocateMemory" + suffix, r);
     }
     vkBindBufferMemory(device.device, out.buffer, out.memory, 0);
     if (host_visible) {
         if (VkResult r = vkMapMemory(device.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped); r != VK_SUCCESS) {
             destroy_buffer(device, out);
-            return vulkan_error("vkMapMemory", r);
+            return vulkan_error("vkMapMemory" + suffix, r);
         }
     }
+    name_object(device, VK_OBJECT_TYPE_BUFFER, out.buffer, what);
+    name_object(device, VK_OBJECT_TYPE_DEVICE_MEMORY, out.memory, what);
     return {};
 }
 
@@ -146,6 +173,9 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
         destroy_image(device, out);
         return vulkan_error("vkCreateImageView" + suffix, r);
     }
+    name_object(device, VK_OBJECT_TYPE_IMAGE, out.image, what);
+    name_object(device, VK_OBJECT_TYPE_DEVICE_MEMORY, out.memory, what);
+    name_object(device, VK_OBJECT_TYPE_IMAGE_VIEW, out.view, what);
     return {};
 }
 
@@ -210,6 +240,10 @@ Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescrip
     if (VkResult r = vkAllocateDescriptorSets(device.device, &allocate, out.sets.data()); r != VK_SUCCESS) {
         return failed("vkAllocateDescriptorSets", r);
     }
+    name_object(device, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, out.set_layout, what);
+    name_object(device, VK_OBJECT_TYPE_PIPELINE_LAYOUT, out.pipeline_layout, what);
+    name_object(device, VK_OBJECT_TYPE_DESCRIPTOR_POOL, out.pool, what);
+    for (VkDescriptorSet set : out.sets) name_object(device, VK_OBJECT_TYPE_DESCRIPTOR_SET, set, what);
     return {};
 }
 
@@ -231,10 +265,12 @@ Result<VkPipeline> create_compute_pipeline(const DeviceRef& device, VkShaderModu
     info.stage.pSpecializationInfo = specialization;
     info.layout = layout;
     VkPipeline pipeline = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateComputePipelines(device.device, VK_NULL_HANDLE, 1, &info, device.allocator, &pipeline);
+    if (VkResult r =
+            vkCreateComputePipelines(device.device, device.pipeline_cache, 1, &info, device.allocator, &pipeline);
         r != VK_SUCCESS) {
         return vulkan_error(std::string("vkCreateComputePipelines (") + what + ")", r);
     }
+    name_object(device, VK_OBJECT_TYPE_PIPELINE, pipeline, what);
     return pipeline;
 }
 
@@ -249,6 +285,7 @@ Result<VkShaderModule> create_embedded_shader(const DeviceRef& device, std::stri
     if (VkResult r = vkCreateShaderModule(device.device, &info, device.allocator, &module); r != VK_SUCCESS) {
         return vulkan_error("vkCreateShaderModule (" + std::string(name) + ")", r);
     }
+    name_object(device, VK_OBJECT_TYPE_SHADER_MODULE, module, name);
     return module;
 }
 

@@ -14,7 +14,8 @@
 
 namespace crisp::vk {
 
-// ErrorCode::vulkan with "`call` failed: VK_ERROR_..." as the message.
+// ErrorCode::vulkan (ErrorCode::device_lost for VK_ERROR_DEVICE_LOST) with "`call` failed:
+// VK_ERROR_..." as the message.
 Error vulkan_error(std::string_view call, VkResult result);
 
 // The index of a memory type allowed by `type_bits` (VkMemoryRequirements::memoryTypeBits) that
@@ -42,12 +43,28 @@ struct DeviceRef {
     VkDevice device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
     VkPhysicalDeviceMemoryProperties memory_properties{};
+    VkPipelineCache pipeline_cache = VK_NULL_HANDLE;  // the caller's, or none
+    // vkSetDebugUtilsObjectNameEXT where the instance has VK_EXT_debug_utils, else null.
+    PFN_vkSetDebugUtilsObjectNameEXT set_object_name = nullptr;
 };
 
-// Makes `out` (at least 16 bytes): device-local, or host-visible and coherent and mapped. On
-// failure `out` is left empty and the error names the call.
+// A DeviceRef for `device`: its memory properties, the debug-utils naming function when the
+// instance enabled VK_EXT_debug_utils, and the caller's pipeline cache.
+DeviceRef make_device_ref(VkPhysicalDevice physical_device, VkDevice device, const VkAllocationCallbacks* allocator,
+                          VkPipelineCache pipeline_cache);
+
+// Names `handle` "crisp <what>" for debuggers and the validation layer; nothing without
+// VK_EXT_debug_utils.
+void name_object(const DeviceRef& device, VkObjectType type, uint64_t handle, std::string_view what);
+template <typename Handle>
+void name_object(const DeviceRef& device, VkObjectType type, Handle handle, std::string_view what) {
+    name_object(device, type, reinterpret_cast<uint64_t>(handle), what);
+}
+
+// Makes `out` (at least 16 bytes): device-local, or host-visible and coherent and mapped, named
+// `what`. On failure `out` is left empty and the error names the call and `what`.
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
-                     DeviceBuffer& out);
+                     const char* what, DeviceBuffer& out);
 // Frees both objects (either may be null) and empties `buffer`.
 void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer);
 

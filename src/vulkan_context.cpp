@@ -233,6 +233,7 @@ struct HeadlessContext::State {
     VkCommandBuffer command_buffer = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
     bool recording = false;  // catches submit_and_wait called from inside its own record callback
+    bool lost = false;       // a submission or wait returned VK_ERROR_DEVICE_LOST
 
     std::string device_name;
     std::string driver_name;
@@ -545,6 +546,7 @@ ValidationMessages HeadlessContext::validation_messages() const {
 Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {
     State& s = *state_;
     assert(!s.recording && "submit_and_wait called from inside its own record callback");
+    if (s.lost) return Error{ErrorCode::device_lost, "the device was lost earlier: make a new context"};
     // Leaves the command buffer reusable even if `record` throws.
     struct RecordingGuard {
         State& s;
@@ -572,9 +574,11 @@ Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &s.command_buffer;
     if (VkResult result = vkQueueSubmit(s.queue, 1, &submit, s.fence); result != VK_SUCCESS) {
+        s.lost = result == VK_ERROR_DEVICE_LOST;
         return vk::vulkan_error("vkQueueSubmit", result);
     }
     if (VkResult result = vkWaitForFences(s.device, 1, &s.fence, VK_TRUE, UINT64_MAX); result != VK_SUCCESS) {
+        s.lost = result == VK_ERROR_DEVICE_LOST;
         return vk::vulkan_error("vkWaitForFences", result);
     }
     if (VkResult result = vkResetFences(s.device, 1, &s.fence); result != VK_SUCCESS) {

@@ -674,5 +674,90 @@ TEST(Raster, MovingTextTakesCoarserStepsAndKeepsConverging) {
     expect_no_validation_messages();
 }
 
+// A draw's visible rect clips its glyphs to the pixel: drawn() reports only texels inside it (the
+// atlas holds a margin around them, which the compositor must not show).
+TEST(Raster, DrawnGlyphsStayInsideTheVisibleRect) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    auto renderer = make_renderer(*subpixel_preset("rgb"), 8);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*f.font));
+    const Font* fonts[] = {f.font.get()};
+    TextStyle style;
+    style.size = 24.0f;
+    auto layout = layout_text(fonts, "Hg@&1", style, LayoutOptions{.origin_x = 3.0f, .origin_y = 30.0f});
+    ASSERT_TRUE(layout);
+    // A box through the middle of the line: every glyph is cut above and below.
+    const VkRect2D box{{10, 18}, {60, 7}};
+    DrawOptions options;
+    options.visible = box;
+    renderer->begin_frame();
+    renderer->draw(layout->glyphs, options);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    ASSERT_FALSE(renderer->drawn().empty());
+    uint64_t shown = 0;
+    for (const DrawnGlyph& d : renderer->drawn()) {
+        const GlyphInstance& g = d.instance;
+        EXPECT_GE(g.x, box.offset.x);
+        EXPECT_GE(g.y, box.offset.y);
+        EXPECT_LE(g.x + static_cast<int32_t>(g.width), box.offset.x + static_cast<int32_t>(box.extent.width));
+        EXPECT_LE(g.y + static_cast<int32_t>(g.height), box.offset.y + static_cast<int32_t>(box.extent.height));
+        shown += uint64_t{g.width} * g.height;
+    }
+    // ... and nothing inside it is lost: the shown texels are the glyphs' rects within the box.
+    uint64_t expected = 0;
+    for (const GlyphInstance& g : layout->glyphs) {
+        const int64_t w = std::min<int64_t>(int64_t{g.x} + g.width, 70) - std::max<int64_t>(g.x, 10);
+        const int64_t h = std::min<int64_t>(int64_t{g.y} + g.height, 25) - std::max<int64_t>(g.y, 18);
+        if (w > 0 && h > 0) expected += static_cast<uint64_t>(w * h);
+    }
+    EXPECT_EQ(shown, expected);
+    expect_no_validation_messages();
+}
+
+// Dropped frames do not advance the motion clock: a label that comes to rest while frames are
+// dropped is moving or static at the same submitted frames as in the run that dropped none.
+TEST(Raster, DroppedFramesDoNotCountTowardsALabelsRest) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    HeadlessContext& context = *f.context;
+    const Font* fonts[] = {f.font.get()};
+    TextStyle style;
+    style.size = 13.0f;
+    auto label = layout_text(fonts, "Hg", style, LayoutOptions{.origin_x = 4.0f, .origin_y = 16.0f});
+    ASSERT_TRUE(label);
+    test::UnsubmittedCommandBuffer dropped(context);
+    ASSERT_TRUE(dropped.ok());
+
+    // Moves for 4 submitted frames, then rests; returns moving_glyphs of each submitted frame.
+    const auto run = [&](bool drop) {
+        auto renderer = make_renderer(*subpixel_preset("rgb"), 64);
+        EXPECT_TRUE(renderer && renderer->add_font(*f.font));
+        std::vector<uint32_t> moving;
+        for (uint32_t frame = 0; frame < 4 + kMotionSettleFrames + 2; ++frame) {
+            DrawOptions options;
+            options.offset_x = 0.37f * static_cast<float>(std::min(frame, 4u));
+            options.id = 3;
+            if (drop) {  // each frame is first recorded once and dropped
+                renderer->begin_frame();
+                renderer->draw(label->glyphs, options);
+                EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
+                renderer->abandon_frame();
+            }
+            renderer->begin_frame();
+            renderer->draw(label->glyphs, options);
+            EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
+            moving.push_back(renderer->stats().moving_glyphs);
+        }
+        return moving;
+    };
+    const std::vector<uint32_t> kept = run(false);
+    const std::vector<uint32_t> with_drops = run(true);
+    EXPECT_EQ(kept, with_drops);
+    EXPECT_GT(kept[4], 0u);       // still moving just after it stopped
+    EXPECT_EQ(kept.back(), 0u);   // at rest in the end
+    expect_no_validation_messages();
+}
+
 }  // namespace
 }  // namespace crisp

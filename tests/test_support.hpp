@@ -96,4 +96,46 @@ private:
     std::filesystem::path path_;
 };
 
+// A command buffer from a pool of its own, for frames a test records and never submits (dropped
+// frames). record() begins it, runs `commands`, ends it; drop() resets it for the next frame.
+class UnsubmittedCommandBuffer {
+public:
+    explicit UnsubmittedCommandBuffer(const HeadlessContext& context) : device_(context.device()) {
+        VkCommandPoolCreateInfo pool_info{};
+        pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+        pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+        pool_info.queueFamilyIndex = context.queue_family();
+        ok_ = vkCreateCommandPool(device_, &pool_info, nullptr, &pool_) == VK_SUCCESS;
+        VkCommandBufferAllocateInfo allocate{};
+        allocate.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+        allocate.commandPool = pool_;
+        allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+        allocate.commandBufferCount = 1;
+        ok_ = ok_ && vkAllocateCommandBuffers(device_, &allocate, &buffer_) == VK_SUCCESS;
+    }
+    UnsubmittedCommandBuffer(const UnsubmittedCommandBuffer&) = delete;
+    UnsubmittedCommandBuffer& operator=(const UnsubmittedCommandBuffer&) = delete;
+    ~UnsubmittedCommandBuffer() {
+        if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);  // frees the buffer
+    }
+    bool ok() const { return ok_; }
+
+    // True when every call succeeded.
+    template <typename Commands>
+    bool record_and_drop(Commands&& commands) {
+        VkCommandBufferBeginInfo begin{};
+        begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+        if (vkBeginCommandBuffer(buffer_, &begin) != VK_SUCCESS) return false;
+        commands(buffer_);
+        const bool ended = vkEndCommandBuffer(buffer_) == VK_SUCCESS;
+        return vkResetCommandBuffer(buffer_, 0) == VK_SUCCESS && ended;
+    }
+
+private:
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    VkCommandBuffer buffer_ = VK_NULL_HANDLE;
+    bool ok_ = false;
+};
+
 }  // namespace crisp::test

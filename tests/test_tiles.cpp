@@ -698,20 +698,8 @@ std::vector<std::byte> run_with_drops(const std::vector<bool>& drops, uint32_t& 
     }
     if (layouts.size() != 4) return {};
 
-    // A command pool of the test's own, for frames that are recorded and never submitted.
-    VkCommandPoolCreateInfo pool_info{};
-    pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
-    pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    pool_info.queueFamilyIndex = context.queue_family();
-    VkCommandPool pool = VK_NULL_HANDLE;
-    EXPECT_EQ(vkCreateCommandPool(context.device(), &pool_info, nullptr, &pool), VK_SUCCESS);
-    VkCommandBufferAllocateInfo allocate{};
-    allocate.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-    allocate.commandPool = pool;
-    allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    allocate.commandBufferCount = 1;
-    VkCommandBuffer dropped = VK_NULL_HANDLE;
-    EXPECT_EQ(vkAllocateCommandBuffers(context.device(), &allocate, &dropped), VK_SUCCESS);
+    test::UnsubmittedCommandBuffer dropped(context);
+    EXPECT_TRUE(dropped.ok());
 
     const auto record = [&](VkCommandBuffer cb) {
         EXPECT_TRUE(renderer->record(cb));
@@ -730,14 +718,9 @@ std::vector<std::byte> run_with_drops(const std::vector<bool>& drops, uint32_t& 
             EXPECT_TRUE(context.upload(t.image, t.initial, VK_IMAGE_LAYOUT_GENERAL));
         }
         if (scripted && drops[i]) {
-            VkCommandBufferBeginInfo begin{};
-            begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-            EXPECT_EQ(vkBeginCommandBuffer(dropped, &begin), VK_SUCCESS);
-            record(dropped);
-            EXPECT_EQ(vkEndCommandBuffer(dropped), VK_SUCCESS);
+            EXPECT_TRUE(dropped.record_and_drop(record));
             renderer->abandon_frame();
             compositor->abandon_frame();
-            EXPECT_EQ(vkResetCommandBuffer(dropped, 0), VK_SUCCESS);
             continue;
         }
         EXPECT_TRUE(context.submit_and_wait(record));
@@ -749,8 +732,6 @@ std::vector<std::byte> run_with_drops(const std::vector<bool>& drops, uint32_t& 
     renderer->draw(layouts[0].glyphs, VkRect2D{{0, 0}, {kWidth, kHeight}});
     EXPECT_TRUE(context.submit_and_wait(record));
     EXPECT_TRUE(renderer->converged());
-    vkFreeCommandBuffers(context.device(), pool, 1, &dropped);
-    vkDestroyCommandPool(context.device(), pool, nullptr);
     return read_target(t);
 }
 

@@ -5,7 +5,11 @@
 
 #include "embedded_shaders.hpp"
 #include "shared.h"
+#include "test_support.hpp"
 #include "vk_resources.hpp"
+
+#include <crisp/compositor.hpp>
+#include <crisp/renderer.hpp>
 
 #include <gtest/gtest.h>
 
@@ -697,6 +701,66 @@ TEST_F(VulkanTest, ResourcesMove) {
     EXPECT_EQ(image->handle(), VK_NULL_HANDLE);
     EXPECT_NE(other.handle(), VK_NULL_HANDLE);
     expect_no_validation_messages(context);
+}
+
+// crisp's objects carry debug names ("crisp <what>") where the instance has VK_EXT_debug_utils,
+// so that the validation layer and debuggers say whose object a message is about.
+TEST_F(VulkanTest, ObjectsAreNamedForTheValidationLayer) {
+    CRISP_CREATE_CONTEXT(context, validated_options());
+    const vk::DeviceRef ref = vk::make_device_ref(context.physical_device(), context.device(), nullptr, VK_NULL_HANDLE);
+    ASSERT_NE(ref.set_object_name, nullptr);
+    vk::DeviceBuffer buffer;
+    ASSERT_TRUE(vk::create_buffer(ref, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "probe", buffer));
+    // A fill into a buffer made without TRANSFER_DST: the layer reports it, naming the buffer.
+    // (The submission may succeed or fail on the invalid command; only the message counts.)
+    static_cast<void>(
+        context.submit_and_wait([&](VkCommandBuffer cb) { vkCmdFillBuffer(cb, buffer.buffer, 0, 16, 0); }));
+    vk::destroy_buffer(ref, buffer);
+    const ValidationMessages messages = context.validation_messages();
+    EXPECT_GE(messages.errors, 1u);
+    EXPECT_TRUE(std::any_of(messages.recent.begin(), messages.recent.end(), [](const std::string& message) {
+        return message.find("crisp probe") != std::string::npos;
+    })) << describe(messages);
+}
+
+// Pipelines go through the caller's cache. lavapipe's caches hold no data to count, so the test
+// hands the renderer and the compositor a cache of another device: the validation layer then
+// reports each pipeline made through it, which it could not if crisp ignored the cache.
+TEST_F(VulkanTest, PipelinesGoThroughTheCallersCache) {
+    auto made = test::create_renderer_context();
+    ASSERT_TRUE(made) << made.error().message;
+    HeadlessContext& context = *made;
+    CRISP_CREATE_CONTEXT(other, validated_options());
+    VkPipelineCacheCreateInfo cache_info{};
+    cache_info.sType = VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO;
+    VkPipelineCache foreign = VK_NULL_HANDLE;
+    ASSERT_EQ(vkCreatePipelineCache(other.device(), &cache_info, nullptr, &foreign), VK_SUCCESS);
+    const auto cache_reports = [&] {
+        const ValidationMessages messages = context.validation_messages();
+        return std::count_if(messages.recent.begin(), messages.recent.end(), [](const std::string& message) {
+            return message.find("pipelineCache") != std::string::npos;
+        });
+    };
+    {
+        RendererCreateInfo renderer_info = renderer_create_info(context);
+        renderer_info.pipeline_cache = foreign;
+        auto renderer = Renderer::create(renderer_info);
+        EXPECT_GE(cache_reports(), 1) << describe(context.validation_messages());
+        const auto after_renderer = cache_reports();
+        CompositorCreateInfo compositor_info = compositor_create_info(context);
+        compositor_info.pipeline_cache = foreign;
+        auto compositor = Compositor::create(compositor_info);
+        EXPECT_GT(cache_reports(), after_renderer) << describe(context.validation_messages());
+    }
+    vkDestroyPipelineCache(other.device(), foreign, nullptr);
+}
+
+TEST(VulkanErrors, DeviceLossIsItsOwnErrorCode) {
+    const Error lost = vk::vulkan_error("vkQueueSubmit", VK_ERROR_DEVICE_LOST);
+    EXPECT_EQ(lost.code, ErrorCode::device_lost);
+    EXPECT_STREQ(error_code_name(lost.code), "device_lost");
+    EXPECT_NE(lost.message.find("VK_ERROR_DEVICE_LOST"), std::string::npos);
+    EXPECT_EQ(vk::vulkan_error("vkQueueSubmit", VK_ERROR_OUT_OF_DEVICE_MEMORY).code, ErrorCode::vulkan);
 }
 
 }  // namespace

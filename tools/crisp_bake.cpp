@@ -349,6 +349,7 @@ int exit_code_for(crisp::ErrorCode code) {
         case crisp::ErrorCode::asset_invalid:
         case crisp::ErrorCode::asset_version:
         case crisp::ErrorCode::vulkan:
+        case crisp::ErrorCode::device_lost:
             return kExitInternal;
     }
     return kExitInternal;

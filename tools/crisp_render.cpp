@@ -355,7 +355,8 @@ std::string json_uint(uint64_t v) {
 // ---- Rendering
 
 int exit_code_for_vulkan(const crisp::Error& error) {
-    return error.code == crisp::ErrorCode::vulkan ? kExitVulkan : kExitInternal;
+    const bool vulkan = error.code == crisp::ErrorCode::vulkan || error.code == crisp::ErrorCode::device_lost;
+    return vulkan ? kExitVulkan : kExitInternal;
 }
 
 // The atlas block a rect takes (see atlas.hpp): cells rounded up to powers of two per axis, then

@@ -76,6 +76,8 @@ struct CompositorCreateInfo {
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkDevice device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
+    // The caller's pipeline cache, as RendererCreateInfo::pipeline_cache. Optional.
+    VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
     uint32_t frames_in_flight = 2;  // 1 to 8
     // Required: the feature chain `device` was created with, as RendererCreateInfo::enabled_features.
     // What each path needs is checked against it, never against what the GPU offers.

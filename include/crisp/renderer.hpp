@@ -55,6 +55,9 @@ struct RendererCreateInfo {
     // (device_features.hpp) fills one in before device creation.
     const VkPhysicalDeviceFeatures2* enabled_features = nullptr;
     const VkAllocationCallbacks* allocator = nullptr;
+    // The caller's pipeline cache: crisp creates its pipelines through it (at create() only), so
+    // that a program that saves the cache's data starts without compiling them again. Optional.
+    VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
     uint32_t frames_in_flight = 2;  // 1 to 8
     AtlasConfig atlas;              // max_samples at most kMaxRendererSamples
     SubpixelLayout layout;          // default: rgb
@@ -103,9 +106,11 @@ class HeadlessContext;
 RendererCreateInfo renderer_create_info(const HeadlessContext& context);
 
 // A glyph drawn this frame whose rect holds samples: where its texels are in the atlas.
-// A glyph drawn clipped (draw() with a visible rect) holds only a part of its rect: `instance`
-// then describes that part (x, y, width and height narrowed to it), and part_x, part_y say where
-// the part starts in the glyph's whole rect.
+// A glyph drawn clipped (draw() with a visible rect) shows only the texels inside that rect:
+// `instance` then describes that part (x, y, width and height narrowed to it), and part_x, part_y
+// say where the part starts in the glyph's whole rect. The compositor draws exactly that, so a
+// draw's visible rect clips its text to the pixel (the atlas holds a margin around the part, so
+// that text scrolling within the rect keeps its samples).
 struct DrawnGlyph {
     GlyphInstance instance;
     uint32_t atlas_x = 0;  // texel of the (part's) top-left corner in the atlas image

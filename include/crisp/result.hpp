@@ -22,6 +22,10 @@ enum class ErrorCode {
     asset_invalid,     // an asset failed validation; the message names the fault
     asset_version,     // an asset of a version this build does not read
     vulkan,            // a Vulkan call failed, or a required version, feature or extension is missing
+    // A Vulkan call returned VK_ERROR_DEVICE_LOST. Nothing made on the device works again: wait
+    // for nothing more, destroy crisp's objects (their destructors only destroy and free, which
+    // a lost device allows), then the device, and make new ones (docs/integration.md).
+    device_lost,
 };
 
 // Short stable name of a code ("asset_invalid"), for logs and JSON.

@@ -197,7 +197,9 @@ public:
 
     // Records commands with `record` into a one-time command buffer, submits it to the queue and
     // waits for it to finish. Work submitted earlier on this context has finished too when it
-    // returns, but its writes are only visible to `record` after a barrier.
+    // returns, but its writes are only visible to `record` after a barrier. Errors: vulkan for a
+    // failed call; device_lost when the submission or the wait lost the device, and for every
+    // later call (the context is then good only for destruction).
     Status submit_and_wait(const std::function<void(VkCommandBuffer)>& record);
 
     // A buffer of `size` bytes (> 0) with its own memory. For upload and readback buffers the

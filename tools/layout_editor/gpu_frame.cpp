@@ -14,10 +14,6 @@ using vk::create_image;
 using vk::destroy_buffer;
 using vk::destroy_image;
 
-Error vulkan_failure(const char* call, VkResult result) {
-    return Error{ErrorCode::vulkan, std::string(call) + " failed: " + vk_result_name(result)};
-}
-
 using vk::image_barrier;
 
 AtlasConfig atlas_config(uint32_t size) {
@@ -62,10 +58,14 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
         !s) {
         return s.error();
     }
-    if (Status s = create_buffer(self->device_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, self->upload_); !s) {
+    if (Status s = create_buffer(self->device_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "editor upload",
+                                 self->upload_);
+        !s) {
         return s.error();
     }
-    if (Status s = create_buffer(self->device_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, self->readback_); !s) {
+    if (Status s = create_buffer(self->device_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "editor readback",
+                                 self->readback_);
+        !s) {
         return s.error();
     }
     VkCommandPoolCreateInfo pool_info{};
@@ -73,7 +73,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
     pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     pool_info.queueFamilyIndex = window.queue_family();
     if (VkResult r = vkCreateCommandPool(window.device(), &pool_info, nullptr, &self->pool_); r != VK_SUCCESS) {
-        return vulkan_failure("vkCreateCommandPool", r);
+        return vk::vulkan_error("vkCreateCommandPool", r);
     }
     VkCommandBufferAllocateInfo allocate{};
     allocate.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
@@ -81,12 +81,12 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
     allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     allocate.commandBufferCount = 1;
     if (VkResult r = vkAllocateCommandBuffers(window.device(), &allocate, &self->command_buffer_); r != VK_SUCCESS) {
-        return vulkan_failure("vkAllocateCommandBuffers", r);
+        return vk::vulkan_error("vkAllocateCommandBuffers", r);
     }
     VkFenceCreateInfo fence_info{};
     fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
     if (VkResult r = vkCreateFence(window.device(), &fence_info, nullptr, &self->fence_); r != VK_SUCCESS) {
-        return vulkan_failure("vkCreateFence", r);
+        return vk::vulkan_error("vkCreateFence", r);
     }
     if (window.timestamp_valid_bits() > 0) {
         VkQueryPoolCreateInfo query_info{};
@@ -94,7 +94,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
         query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
         query_info.queryCount = 2;
         if (VkResult r = vkCreateQueryPool(window.device(), &query_info, nullptr, &self->timestamps_); r != VK_SUCCESS) {
-            return vulkan_failure("vkCreateQueryPool", r);
+            return vk::vulkan_error("vkCreateQueryPool", r);
         }
     }
 
@@ -141,7 +141,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
 Status GpuFrame::wait() {
     if (!in_flight_) return {};
     if (VkResult r = vkWaitForFences(device_.device, 1, &fence_, VK_TRUE, UINT64_MAX); r != VK_SUCCESS) {
-        return vulkan_failure("vkWaitForFences", r);
+        return vk::vulkan_error("vkWaitForFences", r);
     }
     vkResetFences(device_.device, 1, &fence_);
     in_flight_ = false;
@@ -258,7 +258,7 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
     image_barrier(cb, target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
                   VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0);
     if (timestamps_) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, 1);
-    if (VkResult r = vkEndCommandBuffer(cb); r != VK_SUCCESS) return vulkan_failure("vkEndCommandBuffer", r);
+    if (VkResult r = vkEndCommandBuffer(cb); r != VK_SUCCESS) return vk::vulkan_error("vkEndCommandBuffer", r);
 
     const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
     VkSubmitInfo submit{};
@@ -271,7 +271,7 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
     submit.signalSemaphoreCount = 1;
     submit.pSignalSemaphores = &target.rendered;
     if (VkResult r = vkQueueSubmit(window_.queue(), 1, &submit, fence_); r != VK_SUCCESS) {
-        return vulkan_failure("vkQueueSubmit", r);
+        return vk::vulkan_error("vkQueueSubmit", r);
     }
     in_flight_ = true;
     return {};

@@ -1,5 +1,7 @@
 #include "vulkan_window.hpp"
 
+#include "vk_resources.hpp"
+
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
 
@@ -12,10 +14,6 @@
 
 namespace crisp::editor {
 namespace {
-
-Error vulkan_failure(const char* call, VkResult result) {
-    return Error{ErrorCode::vulkan, std::string(call) + " failed: " + vk_result_name(result)};
-}
 
 VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                      VkDebugUtilsMessageTypeFlagsEXT,
@@ -131,14 +129,14 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
     instance_info.enabledLayerCount = static_cast<uint32_t>(layers.size());
     instance_info.ppEnabledLayerNames = layers.data();
     if (VkResult r = vkCreateInstance(&instance_info, nullptr, &self->instance_); r != VK_SUCCESS) {
-        return vulkan_failure("vkCreateInstance", r);
+        return vk::vulkan_error("vkCreateInstance", r);
     }
     if (options.validation) {
         auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
             vkGetInstanceProcAddr(self->instance_, "vkCreateDebugUtilsMessengerEXT"));
         if (!create_messenger) return Error{ErrorCode::vulkan, "vkCreateDebugUtilsMessengerEXT is missing"};
         if (VkResult r = create_messenger(self->instance_, &messenger, nullptr, &self->messenger_); r != VK_SUCCESS) {
-            return vulkan_failure("vkCreateDebugUtilsMessengerEXT", r);
+            return vk::vulkan_error("vkCreateDebugUtilsMessengerEXT", r);
         }
     }
 
@@ -155,7 +153,7 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
     glfwSetKeyCallback(self->window_, WindowCallbacks::key);
     glfwSetCharCallback(self->window_, WindowCallbacks::character);
     if (VkResult r = glfwCreateWindowSurface(self->instance_, self->window_, nullptr, &self->surface_); r != VK_SUCCESS) {
-        return vulkan_failure("glfwCreateWindowSurface", r);
+        return vk::vulkan_error("glfwCreateWindowSurface", r);
     }
 
     // The device: the first with a queue family that computes, draws and presents, at Vulkan 1.2
@@ -220,14 +218,14 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
     device_info.enabledExtensionCount = 1;
     device_info.ppEnabledExtensionNames = device_extensions;
     if (VkResult r = vkCreateDevice(self->physical_device_, &device_info, nullptr, &self->device_); r != VK_SUCCESS) {
-        return vulkan_failure("vkCreateDevice", r);
+        return vk::vulkan_error("vkCreateDevice", r);
     }
     vkGetDeviceQueue(self->device_, self->queue_family_, 0, &self->queue_);
 
     VkSemaphoreCreateInfo semaphore_info{};
     semaphore_info.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
     if (VkResult r = vkCreateSemaphore(self->device_, &semaphore_info, nullptr, &self->image_ready_); r != VK_SUCCESS) {
-        return vulkan_failure("vkCreateSemaphore", r);
+        return vk::vulkan_error("vkCreateSemaphore", r);
     }
     if (Status status = self->create_swapchain(); !status) return status.error();
     return self;
@@ -282,7 +280,7 @@ Status VulkanWindow::create_swapchain() {
     info.oldSwapchain = swapchain_;
     VkSwapchainKHR created = VK_NULL_HANDLE;
     if (VkResult r = vkCreateSwapchainKHR(device_, &info, nullptr, &created); r != VK_SUCCESS) {
-        return vulkan_failure("vkCreateSwapchainKHR", r);
+        return vk::vulkan_error("vkCreateSwapchainKHR", r);
     }
     destroy_swapchain();
     swapchain_ = created;
@@ -295,7 +293,7 @@ Status VulkanWindow::create_swapchain() {
     rendered_.assign(count, VK_NULL_HANDLE);
     for (VkSemaphore& semaphore : rendered_) {
         if (VkResult r = vkCreateSemaphore(device_, &semaphore_info, nullptr, &semaphore); r != VK_SUCCESS) {
-            return vulkan_failure("vkCreateSemaphore", r);
+            return vk::vulkan_error("vkCreateSemaphore", r);
         }
     }
     return {};
@@ -345,7 +343,7 @@ Result<VulkanWindow::Acquired> VulkanWindow::acquire() {
         if (Status status = create_swapchain(); !status) return status.error();
         return acquired;
     }
-    if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR) return vulkan_failure("vkAcquireNextImageKHR", r);
+    if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR) return vk::vulkan_error("vkAcquireNextImageKHR", r);
     acquired.image = swapchain_images_[acquired.index];
     acquired.ready = image_ready_;
     acquired.rendered = rendered_[acquired.index];
@@ -362,7 +360,7 @@ Status VulkanWindow::present(const Acquired& acquired) {
     info.pImageIndices = &acquired.index;
     const VkResult r = vkQueuePresentKHR(queue_, &info);
     if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) return create_swapchain();
-    if (r != VK_SUCCESS) return vulkan_failure("vkQueuePresentKHR", r);
+    if (r != VK_SUCCESS) return vk::vulkan_error("vkQueuePresentKHR", r);
     return {};
 }
 
