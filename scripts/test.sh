@@ -21,7 +21,7 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 echo "== fuzz targets (libFuzzer, clang, ASan + UBSan)"
 if [ ! -f build-fuzz/CMakeCache.txt ]; then
   CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCRISP_FUZZ=ON \
-    -DCRISP_BUILD_TESTS=OFF -DCRISP_BUILD_TOOLS=OFF -DCRISP_INSTALL=OFF >/dev/null
+    -DCRISP_BUILD_TESTS=OFF -DCRISP_BUILD_TOOLS=OFF -DCRISP_BUILD_EXAMPLES=OFF -DCRISP_INSTALL=OFF >/dev/null
 fi
 cmake --build build-fuzz -j "$jobs"
 seconds=${CRISP_FUZZ_SECONDS:-20}

@@ -1,0 +1,55 @@
+// crisp-engine-example's command line: one table gives both --help and the parsing.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace engine {
+
+// Exit codes (also in --help).
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitUsage = 1;
+inline constexpr int kExitFont = 2;
+inline constexpr int kExitVulkan = 3;
+inline constexpr int kExitValidation = 4;
+inline constexpr int kExitOutput = 5;
+
+struct ResizeAt {
+    uint64_t frame = 0;  // before presented frame `frame` (0-based) is drawn
+    uint32_t width = 0;
+    uint32_t height = 0;
+};
+
+struct MinimizeAt {
+    uint64_t frame = 0;
+    uint32_t polls = 0;  // event polls (10 ms each) before the window is restored
+};
+
+struct Options {
+    uint64_t frames = 0;  // presented frames before exiting; 0: until the window closes
+    uint32_t width = 960;
+    uint32_t height = 540;
+    std::string screenshot;  // PNG of the last presented frame
+    std::string report;      // JSON: what happened, and where text was drawn
+    std::string font;
+    bool validation = false;
+    uint32_t drop_every = 0;  // every Nth frame is recorded, then abandoned
+    std::vector<ResizeAt> resizes;
+    std::vector<MinimizeAt> minimizes;
+    bool help = false;
+};
+
+// The parsed command line, or a message for a person (the caller prints it and exits kExitUsage).
+// `default_font` is used unless --font is given.
+struct ParseResult {
+    Options options;
+    std::optional<std::string> error;
+};
+ParseResult parse_options(int argc, const char* const* argv, const std::string& default_font);
+
+// The --help text.
+std::string usage();
+
+}  // namespace engine

@@ -1,0 +1,62 @@
+#include "report.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace engine {
+namespace {
+
+const char* format_name(VkFormat format) {
+    switch (format) {
+        case VK_FORMAT_B8G8R8A8_SRGB:
+            return "B8G8R8A8_SRGB";
+        case VK_FORMAT_R8G8B8A8_SRGB:
+            return "R8G8B8A8_SRGB";
+        case VK_FORMAT_A8B8G8R8_SRGB_PACK32:
+            return "A8B8G8R8_SRGB_PACK32";
+        default:
+            return "other";
+    }
+}
+
+// Box names are the example's own ASCII constants: no escaping is needed.
+void write_box(std::ostream& out, const TextBox& box) {
+    out << "    {\"name\": \"" << box.name << "\", \"x\": " << box.x << ", \"y\": " << box.y
+        << ", \"width\": " << box.width << ", \"height\": " << box.height;
+    if (box.name.rfind("label:", 0) == 0) {
+        out << ", \"hovered\": " << (box.hovered ? "true" : "false") << ", \"anchor\": [" << box.anchor_x << ", "
+            << box.anchor_y << "]";
+    }
+    out << "}";
+}
+
+}  // namespace
+
+crisp::Status write_report(const std::string& path, const RunReport& report, uint32_t validation_messages) {
+    std::ostringstream out;
+    out << "{\n  \"presented\": " << report.presented << ",\n  \"dropped\": " << report.dropped
+        << ",\n  \"out_of_date\": " << report.out_of_date << ",\n  \"recreations\": " << report.recreations
+        << ",\n  \"minimized_polls\": " << report.minimized_polls << ",\n  \"resizes\": " << report.resizes
+        << ",\n  \"width\": " << report.extent.width << ",\n  \"height\": " << report.extent.height
+        << ",\n  \"swapchain_format\": \"" << format_name(report.swapchain_format)
+        << "\",\n  \"validation_messages\": " << validation_messages << ",\n  \"text\": [\n";
+    for (size_t i = 0; i < report.boxes.size(); ++i) {
+        write_box(out, report.boxes[i]);
+        out << (i + 1 < report.boxes.size() ? ",\n" : "\n");
+    }
+    out << "  ]\n}\n";
+    const std::string temporary = path + ".partial";
+    {
+        std::ofstream file(temporary, std::ios::binary);
+        file << out.str();
+        if (!file.flush()) return crisp::Error{crisp::ErrorCode::io, path + ": cannot write " + temporary};
+    }
+    std::error_code error;
+    std::filesystem::rename(temporary, path, error);
+    if (error) return crisp::Error{crisp::ErrorCode::io, path + ": " + error.message()};
+    return {};
+}
+
+}  // namespace engine

@@ -1,0 +1,290 @@
+#include "text_overlay.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace engine {
+namespace {
+
+// The HUD: a panel at the top left of the window, in pixels.
+constexpr float kHudX = 12.0f, kHudY = 12.0f, kHudWidth = 262.0f, kPadding = 12.0f;
+constexpr float kTitleSize = 17.0f, kBodySize = 13.0f, kCounterSize = 12.0f, kRowSize = 12.0f, kLabelSize = 15.0f;
+constexpr float kRowHeight = 17.0f;
+constexpr uint32_t kVisibleRows = 5;
+// Rows glide up by a fraction of a pixel per frame: they never sit on whole pixels for long.
+constexpr float kScrollPerFrame = 0.37f;
+// Labels: the gap between a label's background and the point it marks, and the background's margin.
+constexpr float kStem = 10.0f, kLabelMargin = 4.0f;
+
+// DrawOptions::id: each label and each row keeps its name from frame to frame.
+constexpr uint64_t kLabelId = 1;
+constexpr uint64_t kRowId = 100;
+// Paint orders: each text its own range (the HUD's texts do not overlap, so any order would do).
+constexpr uint32_t kCounterPaintOrder = 10000;
+constexpr uint32_t kRowPaintOrder = 20000, kRowPaintOrders = 256;  // per row
+constexpr uint32_t kLabelPaintOrder = 40000;
+
+// Text colours are sRGB (as crisp takes them); panel colours are linear (the scene target's).
+constexpr std::array<float, 4> kWhite = {1.0f, 1.0f, 1.0f, 1.0f};
+constexpr std::array<float, 4> kBodyColor = {0.80f, 0.84f, 0.90f, 1.0f};
+constexpr std::array<float, 4> kCounterColor = {0.55f, 0.90f, 0.62f, 1.0f};
+constexpr std::array<float, 4> kRowColor = {0.88f, 0.86f, 0.78f, 1.0f};
+constexpr std::array<float, 4> kLabelColor = {0.94f, 0.95f, 0.97f, 1.0f};
+constexpr std::array<float, 4> kHoverColor = {1.0f, 0.78f, 0.22f, 1.0f};
+constexpr std::array<float, 4> kHudPanel = {0.004f, 0.005f, 0.009f, 0.80f};
+constexpr std::array<float, 4> kListPanel = {0.0f, 0.0f, 0.0f, 0.45f};
+constexpr std::array<float, 4> kLabelPanel = {0.003f, 0.004f, 0.007f, 0.72f};
+constexpr std::array<float, 4> kHoverPanel = {0.10f, 0.05f, 0.0f, 0.85f};
+constexpr std::array<float, 4> kMarker = {0.9f, 0.9f, 0.9f, 0.9f};
+
+constexpr const char* kParagraph =
+    "The labels are laid out once and moved every frame by a draw option, at their depth from the "
+    "camera; the one nearest the centre takes its hover colour the same way. crisp composites all "
+    "text into the engine's HDR target before the blit to the swapchain.";
+constexpr std::array<const char*, 10> kRows = {
+    "01   Iron ore \xC3\x97 12",      "02   Copper wire \xC3\x97 3",  "03   Glass lens \xC3\x97 1",
+    "04   Quartz crystal \xC3\x97 7", "05   Spring steel \xC3\x97 2", "06   Brass gear \xC3\x97 16",
+    "07   Lamp oil \xC3\x97 4",       "08   Silk thread \xC3\x97 30", "09   Cedar plank \xC3\x97 9",
+    "10   Tin plate \xC3\x97 5",
+};
+
+crisp::TextStyle style(float size, const std::array<float, 4>& color) {
+    crisp::TextStyle out;
+    out.size = size;
+    std::copy(color.begin(), color.end(), out.color);
+    out.depth = 0.0f;  // the HUD is nearest; labels take their depth as a draw option
+    return out;
+}
+
+crisp::LayoutOptions at(float x, float y, uint32_t first_paint_order, float wrap_width = 0.0f) {
+    crisp::LayoutOptions out;
+    out.origin_x = x;
+    out.origin_y = y;
+    out.wrap_width = wrap_width;
+    out.first_paint_order = first_paint_order;
+    return out;
+}
+
+}  // namespace
+
+TextOverlay::TextOverlay(crisp::Font font) : font_(std::move(font)) {}
+
+crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& device, crisp::Font font) {
+    std::unique_ptr<TextOverlay> self(new TextOverlay(std::move(font)));
+    crisp::RendererCreateInfo renderer_info;
+    renderer_info.instance = device.instance();
+    renderer_info.physical_device = device.physical_device();
+    renderer_info.device = device.device();
+    renderer_info.queue_family = device.queue_family();
+    renderer_info.enabled_features = device.enabled_features();
+    renderer_info.frames_in_flight = kFramesInFlight;
+    renderer_info.atlas.width = 1024;  // a HUD and a few labels use a few percent of it
+    renderer_info.atlas.height = 1024;
+    crisp::Result<crisp::Renderer> renderer = crisp::Renderer::create(renderer_info);
+    if (!renderer) return renderer.error();
+    self->renderer_.emplace(std::move(*renderer));
+    if (crisp::Status s = self->renderer_->add_font(self->font_); !s) return s.error();
+
+    crisp::CompositorCreateInfo compositor_info;
+    compositor_info.physical_device = device.physical_device();
+    compositor_info.device = device.device();
+    compositor_info.enabled_features = device.enabled_features();
+    compositor_info.frames_in_flight = kFramesInFlight;
+    crisp::Result<crisp::Compositor> compositor = crisp::Compositor::create(compositor_info);
+    if (!compositor) return compositor.error();
+    self->compositor_.emplace(std::move(*compositor));
+    if (!self->compositor_->supports_target_format(kSceneColorFormat)) {
+        return crisp::Error{crisp::ErrorCode::vulkan, "crisp's compositor cannot store to R16G16B16A16_SFLOAT here"};
+    }
+    if (crisp::Status s = self->lay_out_static(); !s) return s.error();
+    return self;
+}
+
+crisp::Status TextOverlay::lay_out(std::string_view text, const crisp::TextStyle& text_style,
+                                   const crisp::LayoutOptions& options, crisp::TextLayout& out) {
+    const crisp::Font* fonts[] = {&font_};
+    return layouter_.layout(fonts, text, text_style, options, out);
+}
+
+// The HUD's text that never changes is laid out where it is drawn; the rows and labels, which
+// move, at the origin: draw options place them each frame.
+crisp::Status TextOverlay::lay_out_static() {
+    const float x = kHudX + kPadding, wrap = kHudWidth - 2.0f * kPadding;
+    const float ascender = font_.ascender();
+    float y = kHudY + kPadding;
+    crisp::Status s =
+        lay_out("crisp in a small engine", style(kTitleSize, kWhite), at(x, y + ascender * kTitleSize, 0), title_);
+    y = title_.y + title_.height + 4.0f;
+    if (s)
+        s = lay_out(kParagraph, style(kBodySize, kBodyColor),
+                    at(x, y + ascender * kBodySize, title_.next_paint_order, wrap), paragraph_);
+    y = paragraph_.y + paragraph_.height + 6.0f;
+    counter_y_ = y + ascender * kCounterSize;
+    y += 2.0f * font_.line_height() * kCounterSize + 6.0f;  // the counter's two lines
+    list_box_ = {x, std::round(y), wrap, kVisibleRows * kRowHeight, kListPanel};
+    list_clip_ = {{static_cast<int32_t>(list_box_.x), static_cast<int32_t>(list_box_.y)},
+                  {static_cast<uint32_t>(list_box_.width), static_cast<uint32_t>(list_box_.height)}};
+    hud_ = {kHudX, kHudY, kHudWidth, list_box_.y + list_box_.height + kPadding - kHudY, kHudPanel};
+    rows_.resize(kRows.size());
+    for (uint32_t i = 0; s && i < kRows.size(); ++i) {
+        s = lay_out(kRows[i], style(kRowSize, kRowColor), at(0, 0, kRowPaintOrder + i * kRowPaintOrders), rows_[i]);
+    }
+    for (uint32_t i = 0; s && i < kShapeCount; ++i) {
+        s = lay_out(kShapeNames[i], style(kLabelSize, kLabelColor), at(0, 0, kLabelPaintOrder + i * 64), labels_[i]);
+    }
+    return s;
+}
+
+const OverlayFrame& TextOverlay::draw(uint64_t frame, VkExtent2D extent, const SceneState& scene) {
+    renderer_->begin_frame();
+    composited_ = false;
+    frame_.panels.assign({hud_, list_box_});
+    frame_.boxes.clear();
+    draw_hud(frame, extent);
+    draw_list(frame);
+    draw_labels(extent, scene);
+    return frame_;
+}
+
+TextBox TextOverlay::box_of(const char* name, const crisp::TextLayout& layout, float dx, float dy) const {
+    TextBox box;
+    box.name = name;
+    box.x = layout.x + dx;
+    box.y = layout.y + dy;
+    box.width = layout.width;
+    box.height = layout.height;
+    return box;
+}
+
+void TextOverlay::draw_hud(uint64_t frame, VkExtent2D extent) {
+    renderer_->draw(title_.glyphs);
+    renderer_->draw(paragraph_.glyphs);
+    // Text that changes every frame is laid out every frame: the Layouter keeps its buffers.
+    char text[160];
+    if (have_stats_) {
+        std::snprintf(text, sizeof(text), "frame %llu   %u \xC3\x97 %u\n%u glyphs drawn, %u moving",
+                      static_cast<unsigned long long>(frame), extent.width, extent.height, last_submitted_.drawn_glyphs,
+                      last_submitted_.moving_glyphs);
+    } else {
+        std::snprintf(text, sizeof(text), "frame %llu   %u \xC3\x97 %u", static_cast<unsigned long long>(frame),
+                      extent.width, extent.height);
+    }
+    if (lay_out(text, style(kCounterSize, kCounterColor), at(kHudX + kPadding, counter_y_, kCounterPaintOrder),
+                counter_)) {
+        renderer_->draw(counter_.glyphs);
+    }
+    frame_.boxes.push_back({"hud", hud_.x, hud_.y, hud_.width, hud_.height, false, 0.0f, 0.0f});
+    frame_.boxes.push_back(box_of("paragraph", paragraph_, 0.0f, 0.0f));
+    frame_.boxes.push_back(box_of("counter", counter_, 0.0f, 0.0f));
+}
+
+// The rows scroll up through the list box and wrap around; each keeps the layout it was given
+// at start-up, and crisp clips it to the box.
+void TextOverlay::draw_list(uint64_t frame) {
+    // In doubles, and wrapped once per cycle, so that the rows keep their fractions however long
+    // the program runs.
+    const double speed = static_cast<double>(kScrollPerFrame);
+    const double cycle_frames = static_cast<double>(rows_.size()) * static_cast<double>(kRowHeight) / speed;
+    const auto scroll = static_cast<float>(std::fmod(static_cast<double>(frame), cycle_frames) * speed);
+    const float cycle = static_cast<float>(rows_.size()) * kRowHeight;
+    const float baseline = 3.0f + font_.ascender() * kRowSize;
+    for (size_t i = 0; i < rows_.size(); ++i) {
+        const float unwrapped = static_cast<float>(i) * kRowHeight - scroll;
+        float top = unwrapped - std::floor(unwrapped / cycle) * cycle;
+        if (top > cycle - kRowHeight) top -= cycle;  // leaving at the top, not yet back at the bottom
+        crisp::DrawOptions options;
+        options.offset_x = list_box_.x + 8.0f;
+        options.offset_y = list_box_.y + top + baseline;
+        options.visible = list_clip_;
+        options.id = kRowId + i;
+        renderer_->draw(rows_[i].glyphs, options);
+    }
+    frame_.boxes.push_back({"list", list_box_.x, list_box_.y, list_box_.width, list_box_.height, false, 0.0f, 0.0f});
+}
+
+void TextOverlay::draw_labels(VkExtent2D extent, const SceneState& scene) {
+    struct Placed {
+        size_t shape = 0;
+        float x = 0.0f, y = 0.0f;  // the anchor on screen
+        float depth = 0.0f;
+    };
+    std::vector<Placed> placed;
+    const float width = static_cast<float>(extent.width), height = static_cast<float>(extent.height);
+    for (size_t i = 0; i < kShapeCount; ++i) {
+        const Vec3 anchor = scene.label_anchors[i];
+        const float position[3] = {anchor.x, anchor.y, anchor.z};
+        // nullopt behind the eye or past the far plane: no label.
+        const std::optional<float> depth = crisp::depth_from_view_projection(scene.view_projection.m.data(), position);
+        if (!depth) continue;
+        const std::array<float, 4> clip = transform_point(scene.view_projection, anchor);
+        placed.push_back(
+            {i, (clip[0] / clip[3] + 1.0f) * 0.5f * width, (clip[1] / clip[3] + 1.0f) * 0.5f * height, *depth});
+    }
+    // Hover: the label nearest the centre of the scene's part of the window.
+    const float centre_x = (hud_right() + width) / 2.0f, centre_y = height / 2.0f;
+    size_t hovered = kShapeCount;
+    float nearest = std::numeric_limits<float>::infinity();
+    for (const Placed& p : placed) {
+        const float d = std::hypot(p.x - centre_x, p.y - centre_y);
+        if (d < nearest) nearest = d, hovered = p.shape;
+    }
+    // Far to near, so that nearer backgrounds cover farther ones (crisp orders the text by depth).
+    std::sort(placed.begin(), placed.end(), [](const Placed& a, const Placed& b) { return a.depth > b.depth; });
+    for (const Placed& p : placed) {
+        const crisp::TextLayout& label = labels_[p.shape];
+        const bool hover = p.shape == hovered;
+        crisp::DrawOptions options;
+        options.offset_x = p.x - label.width / 2.0f - label.x;
+        options.offset_y = p.y - kStem - kLabelMargin - (label.y + label.height);
+        if (hover) options.color = kHoverColor;
+        options.depth = p.depth;
+        options.id = kLabelId + p.shape;
+        renderer_->draw(label.glyphs, options);
+
+        TextBox box = box_of("label", label, options.offset_x, options.offset_y);
+        box.name = std::string("label:") + kShapeNames[p.shape];
+        box.hovered = hover;
+        box.anchor_x = p.x;
+        box.anchor_y = p.y;
+        frame_.boxes.push_back(box);
+        frame_.panels.push_back({std::round(box.x - kLabelMargin), std::round(box.y - kLabelMargin),
+                                 std::round(box.width + 2.0f * kLabelMargin),
+                                 std::round(box.height + 2.0f * kLabelMargin), hover ? kHoverPanel : kLabelPanel});
+        frame_.panels.push_back({std::round(p.x) - 1.0f, std::round(box.y + box.height + kLabelMargin), 2.0f,
+                                 std::round(kStem - kLabelMargin), kMarker});
+        frame_.panels.push_back({std::round(p.x) - 3.0f, std::round(p.y) - 3.0f, 6.0f, 6.0f, kMarker});
+    }
+}
+
+crisp::Status TextOverlay::record_rasterization(VkCommandBuffer command_buffer) {
+    return renderer_->record(command_buffer);
+}
+
+crisp::Status TextOverlay::record_composite(VkCommandBuffer command_buffer, const RenderTargets& targets) {
+    crisp::CompositeTarget target;
+    target.view = targets.color.view.get();
+    target.format = kSceneColorFormat;
+    target.extent = targets.color.extent;
+    target.rect = {{0, 0}, targets.color.extent};
+    crisp::Status status = compositor_->record(command_buffer, renderer_->drawn(), renderer_->atlas_view(), target);
+    composited_ = status.ok();
+    return status;
+}
+
+// The renderer's abandon_frame() knows its frame (begin_frame() starts one); the compositor's takes
+// back its most recent record(), which, where this frame's failed or never came, was the last
+// submitted frame's: so it is called only for a record() of this frame.
+void TextOverlay::abandon_frame() {
+    renderer_->abandon_frame();
+    if (composited_) compositor_->abandon_frame();
+    composited_ = false;
+}
+
+void TextOverlay::frame_submitted() {
+    last_submitted_ = renderer_->stats();
+    have_stats_ = true;
+}
+
+}  // namespace engine

@@ -1,0 +1,103 @@
+// Everything the example does with crisp: one font, one Renderer (the glyph atlas and its
+// rasterizer) and one Compositor (the tile path), the HUD and the world-space labels. This is the
+// part of the example an engine programmer copies; docs/integration.md walks through it.
+//
+// A frame, in order (App::record_frame):
+//   draw()                 renderer.begin_frame(), layouts of what changed, renderer.draw()s
+//   record_rasterization() renderer.record(cb): uploads and the rasterizer's compute dispatch
+//   ... the engine's scene pass, which also draws the panels draw() returned ...
+//   record_composite()     compositor.record(cb, ...) into the scene target, in GENERAL
+//   frame_submitted() or abandon_frame()
+#pragma once
+
+#include "device.hpp"
+#include "scene.hpp"
+#include "swapchain.hpp"
+
+#include <crisp/compositor.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/renderer.hpp>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace engine {
+
+// Where a piece of text was drawn this frame, in window pixels (for --report and its test).
+struct TextBox {
+    std::string name;  // "hud", "paragraph", "counter", "list", "label:Cube", ...
+    float x = 0.0f, y = 0.0f, width = 0.0f, height = 0.0f;
+    bool hovered = false;                    // labels: drawn in the hover colour
+    float anchor_x = 0.0f, anchor_y = 0.0f;  // labels: the projected point they point at
+};
+
+// What one frame of text needs from the scene pass (panels under the text), and where it went.
+struct OverlayFrame {
+    std::vector<Panel> panels;
+    std::vector<TextBox> boxes;
+};
+
+class TextOverlay {
+public:
+    // Creates the renderer and compositor on `device` (whose feature chain crisp checks) and lays
+    // out the text that never changes. Errors: crisp's, when the device lacks what it needs or the
+    // compositor cannot store to the scene target's format.
+    static crisp::Result<std::unique_ptr<TextOverlay>> create(const Device& device, crisp::Font font);
+    TextOverlay(const TextOverlay&) = delete;
+    TextOverlay& operator=(const TextOverlay&) = delete;
+
+    // The HUD's right edge in window pixels: the scene is centred in the rest.
+    float hud_right() const { return hud_.x + hud_.width; }
+
+    // Starts crisp's frame and issues this frame's draws: the HUD's static text, its counter (laid
+    // out again every frame), the list rows (moved and clipped to the list box), and one label
+    // per shape (moved to its projected anchor, at its depth, hover colour as a draw option).
+    const OverlayFrame& draw(uint64_t frame, VkExtent2D extent, const SceneState& scene);
+    // renderer.record(): outside any render pass, before anything reads the atlas.
+    crisp::Status record_rasterization(VkCommandBuffer command_buffer);
+    // compositor.record() into `targets.color`, which must be in GENERAL with the scene pass's
+    // writes visible to compute shader reads and writes. Its writes are at COMPUTE_SHADER.
+    crisp::Status record_composite(VkCommandBuffer command_buffer, const RenderTargets& targets);
+    // The frame recorded since draw() will never be submitted: take it back in crisp's objects.
+    void abandon_frame();
+    // The frame was submitted: its renderer statistics go into the next frames' counter line.
+    void frame_submitted();
+    // What the last draw() drew.
+    const OverlayFrame& frame() const { return frame_; }
+
+private:
+    explicit TextOverlay(crisp::Font font);
+    crisp::Status lay_out_static();
+    crisp::Status lay_out(std::string_view text, const crisp::TextStyle& style, const crisp::LayoutOptions& options,
+                          crisp::TextLayout& out);
+    void draw_hud(uint64_t frame, VkExtent2D extent);
+    void draw_list(uint64_t frame);
+    void draw_labels(VkExtent2D extent, const SceneState& scene);
+    TextBox box_of(const char* name, const crisp::TextLayout& layout, float dx, float dy) const;
+
+    crisp::Font font_;  // declared before the renderer, which keeps a pointer to it
+    std::optional<crisp::Renderer> renderer_;
+    std::optional<crisp::Compositor> compositor_;
+    crisp::Layouter layouter_;
+    Panel hud_;
+    Panel list_box_;
+    VkRect2D list_clip_{};  // the list box in whole pixels: the rows' visible rect (crisp clips to it)
+    crisp::TextLayout title_;
+    crisp::TextLayout paragraph_;
+    crisp::TextLayout counter_;  // laid out again every frame
+    float counter_y_ = 0.0f;
+    std::vector<crisp::TextLayout> rows_;
+    std::array<crisp::TextLayout, kShapeCount> labels_;
+    crisp::RendererStats last_submitted_{};
+    bool have_stats_ = false;
+    OverlayFrame frame_;
+    bool composited_ = false;                 // the compositor recorded this frame
+};
+
+}  // namespace engine
