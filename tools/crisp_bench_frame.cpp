@@ -1,0 +1,794 @@
+// crisp-bench-frame: the CPU time one frame of a game's UI text costs on the calling thread. Eight
+// labels (health, ammo, a name, coordinates, an FPS counter, ...) are laid out once; every frame
+// three of them get a new string and are laid out again with a Layouter, all eight are drawn with
+// DrawOptions, and the renderer's and the compositor's (tile path) record() fill the frame's command
+// buffer, with 2 frames in flight. Timed with a steady clock, per phase, and with the thread's CPU
+// clock: begin_frame() through the end of compositor.record(). Prints Markdown
+// (docs/benchmarks-cpu.md); --json-out writes JSON too.
+#include "cli.hpp"
+#include "gpu_tools.hpp"
+#include "json.hpp"
+#include "vk_barriers.hpp"
+#include "vk_resources.hpp"
+
+#include <crisp/bake.hpp>
+#include <crisp/compositor.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/renderer.hpp>
+#include <crisp/vulkan_context.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr uint32_t kFramesInFlight = 2;
+
+// The CPU time the calling thread has run, in µs: unlike the steady clock it stops while the
+// thread waits for a core, so another process (or lavapipe's own threads) taking the core does
+// not count.
+double thread_cpu_us() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e6 + static_cast<double>(t.tv_nsec) * 1e-3;
+}
+constexpr VkFormat kTargetFormat = VK_FORMAT_R8G8B8A8_UNORM;
+
+[[noreturn]] void fail(const std::string& message) {
+    std::fprintf(stderr, "crisp-bench-frame: %s\n", message.c_str());
+    std::exit(1);
+}
+
+// ---- Options: one table gives both --help and the parsing.
+
+struct Args {
+    std::string font = "fonts/DejaVuSans.ttf";
+    std::string device;
+    uint32_t width = 1920, height = 1080;
+    float size = 16.0f;
+    uint32_t warmup = 100;
+    uint32_t frames = 1000;
+    std::vector<std::string> variants = {"static", "changed", "moving"};
+    std::string json_out;
+    bool validate = false;
+};
+
+[[noreturn]] void refuse(const std::string& message) {
+    std::fprintf(stderr, "crisp-bench-frame: %s (--help lists the options)\n", message.c_str());
+    std::exit(2);
+}
+
+template <class T>
+T number(std::string_view option, const std::string& text, T low, T high) {
+    std::string why;
+    const std::optional<T> value = crisp::cli::parse_number<T>(text, &why);
+    if (!value) refuse(std::string(option) + ": '" + crisp::cli::printable(text) + "' " + why);
+    if (!(*value >= low && *value <= high)) {
+        char range[64];
+        std::snprintf(range, sizeof range, "%.10g..%.10g", static_cast<double>(low), static_cast<double>(high));
+        refuse(std::string(option) + " must be in " + range);
+    }
+    return *value;
+}
+
+std::vector<std::string> split(const std::string& list, char separator) {
+    std::vector<std::string> parts;
+    size_t begin = 0;
+    while (true) {
+        const size_t end = list.find(separator, begin);
+        parts.push_back(list.substr(begin, end == std::string::npos ? std::string::npos : end - begin));
+        if (end == std::string::npos) return parts;
+        begin = end + 1;
+    }
+}
+
+struct Option {
+    const char* name;
+    const char* value;  // what follows the option in --help; nullptr for a flag
+    const char* help;   // lines after the first are indented under it
+    void (*apply)(Args& args, const std::string& value);
+};
+
+const Option kOptions[] = {
+    {"--font", "PATH", "a font file, baked at start (default fonts/DejaVuSans.ttf, from the repository root)",
+     [](Args& a, const std::string& v) { a.font = v; }},
+    {"--size", "PX", "pixels per em of every label (default 16)",
+     [](Args& a, const std::string& v) { a.size = number<float>("--size", v, 4.0f, 256.0f); }},
+    {"--canvas", "WxH", "the RGBA8 storage image composited into (default 1920x1080)",
+     [](Args& a, const std::string& v) {
+         const std::vector<std::string> sides = split(v, 'x');
+         if (sides.size() != 2) refuse("--canvas: '" + crisp::cli::printable(v) + "' is not WxH");
+         a.width = number<uint32_t>("--canvas", sides[0], 64, 16384);
+         a.height = number<uint32_t>("--canvas", sides[1], 64, 16384);
+     }},
+    {"--warmup", "N", "untimed frames per variant first (default 100)",
+     [](Args& a, const std::string& v) { a.warmup = number<uint32_t>("--warmup", v, 0, 1000000); }},
+    {"--frames", "N", "timed frames per variant (default 1000)",
+     [](Args& a, const std::string& v) { a.frames = number<uint32_t>("--frames", v, 1, 1000000); }},
+    {"--variants", "LIST",
+     "comma-separated, from static (nothing changes), changed (3 strings laid out\n"
+     "again every frame) and moving (as changed, and every label moves every frame)\n"
+     "(default static,changed,moving)",
+     [](Args& a, const std::string& v) { a.variants = split(v, ','); }},
+    {"--device", "TEXT", "pick a device whose name contains TEXT",
+     [](Args& a, const std::string& v) { a.device = v; }},
+    {"--json-out", "FILE", "also write the results as JSON to FILE",
+     [](Args& a, const std::string& v) { a.json_out = v; }},
+    {"--validate", nullptr, "turn the validation layer on (to check the tool; the times then mean little)",
+     [](Args& a, const std::string&) { a.validate = true; }},
+};
+
+void print_usage(std::FILE* out) {
+    std::fprintf(out,
+                 "usage: crisp-bench-frame [options]\n"
+                 "Measures the CPU time of one frame of UI text on the calling thread: 8 labels laid out once,\n"
+                 "3 of them laid out again every frame, all 8 drawn with DrawOptions, then Renderer::record and\n"
+                 "Compositor::record (the tile path) into per-frame command buffers, 2 frames in flight. Timed:\n"
+                 "begin_frame() through the end of compositor.record(); not timed: vkBegin/EndCommandBuffer,\n"
+                 "submits and fence waits. Prints Markdown tables (median, p90, p99, max per phase).\n\n");
+    constexpr int kColumn = 18;
+    for (const Option& o : kOptions) {
+        const std::string head = std::string(o.name) + (o.value ? std::string(" ") + o.value : "");
+        std::fprintf(out, "  %-*s", kColumn, head.c_str());
+        for (const char* c = o.help; *c; ++c) {
+            std::fputc(*c, out);
+            if (*c == '\n') std::fprintf(out, "  %-*s", kColumn, "");
+        }
+        std::fputc('\n', out);
+    }
+    std::fprintf(out, "  %-*s%s\n", kColumn, "-h, --help", "this text");
+}
+
+Args parse(int argc, char** argv) {
+    Args args;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg == "--help" || arg == "-h") {
+            print_usage(stdout);
+            std::exit(0);
+        }
+        const Option* option = nullptr;
+        for (const Option& o : kOptions) {
+            if (arg == o.name) option = &o;
+        }
+        if (!option) refuse("unknown option '" + crisp::cli::printable(arg) + "'");
+        if (option->value && i + 1 >= argc) refuse(arg + " needs a value (" + option->value + ")");
+        option->apply(args, option->value ? argv[++i] : "");
+    }
+    return args;
+}
+
+// ---- The scene
+
+// What a label shows. The counters change every frame in the changed and moving variants.
+enum class Counter { none, position, fps, clock };
+
+struct LabelSpec {
+    const char* text;  // counters: written by write_counter instead
+    float x, y;        // the first pen, on the baseline, as fractions of the canvas
+    Counter counter;
+};
+
+constexpr std::array<LabelSpec, 8> kLabels = {{
+    {"Health 100", 0.02f, 0.05f, Counter::none},
+    {"Ammo 30/90", 0.88f, 0.95f, Counter::none},
+    {"Ada Lovelace", 0.47f, 0.40f, Counter::none},
+    {nullptr, 0.02f, 0.95f, Counter::position},
+    {nullptr, 0.92f, 0.05f, Counter::fps},
+    {nullptr, 0.45f, 0.05f, Counter::clock},
+    {"Quest: find the lighthouse keeper", 0.02f, 0.10f, Counter::none},
+    {"Press E to open the door", 0.42f, 0.70f, Counter::none},
+}};
+
+// A counter's text at `frame` (a 60 Hz clock), into `out`.
+std::string_view write_counter(Counter counter, uint64_t frame, std::array<char, 64>& out) {
+    const double t = static_cast<double>(frame);
+    int n = 0;
+    switch (counter) {
+        case Counter::position:
+            n = std::snprintf(out.data(), out.size(), "X %.2f  Y %.2f  Z %.2f", 1024.25 + 0.37 * t,
+                              64.0 + 2.0 * std::sin(0.05 * t), -311.75 - 0.21 * t);
+            break;
+        case Counter::fps:
+            n = std::snprintf(out.data(), out.size(), "FPS %.1f", 144.0 + 20.0 * std::sin(0.1 * t));
+            break;
+        case Counter::clock: {
+            const uint64_t ms = frame * 1000 / 60;
+            n = std::snprintf(out.data(), out.size(), "Time %02llu:%02llu.%03llu",
+                              static_cast<unsigned long long>(ms / 60000 % 100),
+                              static_cast<unsigned long long>(ms / 1000 % 60), static_cast<unsigned long long>(ms % 1000));
+            break;
+        }
+        case Counter::none:
+            break;
+    }
+    return {out.data(), static_cast<size_t>(std::clamp(n, 0, static_cast<int>(out.size()) - 1))};
+}
+
+struct Variant {
+    const char* name;
+    const char* description;
+    bool change_strings;
+    bool move;
+};
+
+constexpr Variant kVariants[] = {
+    {"static", "8 labels, nothing changes", false, false},
+    {"changed", "3 of the 8 strings change every frame and are laid out again", true, false},
+    {"moving", "as changed, and all 8 labels move every frame (offsets, named draws)", true, true},
+};
+
+// The 8 labels' text and layouts, kept from frame to frame as an engine keeps them.
+struct Labels {
+    std::array<crisp::LayoutOptions, kLabels.size()> placement;
+    std::array<std::array<char, 64>, kLabels.size()> counter_text{};
+    std::array<std::string_view, kLabels.size()> text;
+    std::array<crisp::TextLayout, kLabels.size()> laid;
+    std::vector<size_t> counters;  // the labels whose text changes
+
+    Labels(uint32_t width, uint32_t height) {
+        for (size_t i = 0; i < kLabels.size(); ++i) {
+            placement[i].origin_x = kLabels[i].x * static_cast<float>(width);
+            placement[i].origin_y = kLabels[i].y * static_cast<float>(height);
+            if (kLabels[i].counter == Counter::none) {
+                text[i] = kLabels[i].text;
+            } else {
+                counters.push_back(i);
+            }
+        }
+        write_counters(0);
+    }
+    void write_counters(uint64_t frame) {
+        for (size_t i : counters) text[i] = write_counter(kLabels[i].counter, frame, counter_text[i]);
+    }
+    void lay_out(crisp::Layouter& layouter, std::span<const crisp::Font* const> fonts, const crisp::TextStyle& style,
+                 size_t i) {
+        if (crisp::Status s = layouter.layout(fonts, text[i], style, placement[i], laid[i]); !s) fail(s.error().message);
+    }
+};
+
+// What a label draws with this frame: where a moving label is (a fraction of a pixel further
+// every frame, within a few pixels), the health's warning colour, the name's world-space depth.
+crisp::DrawOptions draw_options(size_t label, uint64_t frame, bool move, const VkRect2D& visible) {
+    crisp::DrawOptions options;
+    options.id = label + 1;
+    options.visible = visible;
+    if (move) {
+        const double t = static_cast<double>(frame), phase = static_cast<double>(label);
+        options.offset_x = static_cast<float>(6.0 * std::sin(0.05 * t + phase));
+        options.offset_y = static_cast<float>(3.0 * std::cos(0.037 * t + phase));
+    }
+    if (label == 0) options.color = std::array<float, 4>{1.0f, 0.35f, 0.25f, 1.0f};
+    if (label == 2) options.depth = 0.25f;
+    return options;
+}
+
+// ---- Frames in flight: per-frame command buffers and fences, as an engine keeps them.
+
+class FrameSlots {
+public:
+    static crisp::Result<FrameSlots> create(const crisp::HeadlessContext& context) {
+        FrameSlots slots;
+        slots.device_ = context.device();
+        slots.queue_ = context.queue();
+        VkCommandPoolCreateInfo pool_info{};
+        pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+        pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+        pool_info.queueFamilyIndex = context.queue_family();
+        if (VkResult r = vkCreateCommandPool(slots.device_, &pool_info, nullptr, &slots.pool_); r != VK_SUCCESS) {
+            return failure("vkCreateCommandPool", r);
+        }
+        VkCommandBufferAllocateInfo allocate{};
+        allocate.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+        allocate.commandPool = slots.pool_;
+        allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+        allocate.commandBufferCount = kFramesInFlight;
+        if (VkResult r = vkAllocateCommandBuffers(slots.device_, &allocate, slots.command_buffers_.data());
+            r != VK_SUCCESS) {
+            return failure("vkAllocateCommandBuffers", r);
+        }
+        VkFenceCreateInfo fence_info{};
+        fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+        fence_info.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+        for (VkFence& fence : slots.fences_) {
+            if (VkResult r = vkCreateFence(slots.device_, &fence_info, nullptr, &fence); r != VK_SUCCESS) {
+                return failure("vkCreateFence", r);
+            }
+        }
+        return slots;
+    }
+    FrameSlots(FrameSlots&& other) noexcept { *this = std::move(other); }
+    FrameSlots& operator=(FrameSlots&& other) noexcept {
+        std::swap(device_, other.device_);
+        std::swap(queue_, other.queue_);
+        std::swap(pool_, other.pool_);
+        std::swap(command_buffers_, other.command_buffers_);
+        std::swap(fences_, other.fences_);
+        return *this;
+    }
+    FrameSlots(const FrameSlots&) = delete;
+    FrameSlots& operator=(const FrameSlots&) = delete;
+    ~FrameSlots() {
+        if (!device_) return;
+        (void)wait_all();
+        for (VkFence fence : fences_) {
+            if (fence) vkDestroyFence(device_, fence, nullptr);
+        }
+        if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
+    }
+
+    // Waits for the last submission of `frame`'s slot, then begins its command buffer.
+    crisp::Result<VkCommandBuffer> begin(uint64_t frame) {
+        const size_t slot = frame % kFramesInFlight;
+        if (VkResult r = vkWaitForFences(device_, 1, &fences_[slot], VK_TRUE, UINT64_MAX); r != VK_SUCCESS) {
+            return failure("vkWaitForFences", r);
+        }
+        if (VkResult r = vkResetFences(device_, 1, &fences_[slot]); r != VK_SUCCESS) return failure("vkResetFences", r);
+        const VkCommandBuffer cb = command_buffers_[slot];
+        if (VkResult r = vkResetCommandBuffer(cb, 0); r != VK_SUCCESS) return failure("vkResetCommandBuffer", r);
+        VkCommandBufferBeginInfo begin_info{};
+        begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+        begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        if (VkResult r = vkBeginCommandBuffer(cb, &begin_info); r != VK_SUCCESS) {
+            return failure("vkBeginCommandBuffer", r);
+        }
+        return cb;
+    }
+
+    // Ends `frame`'s command buffer and submits it with its slot's fence.
+    crisp::Status submit(uint64_t frame) {
+        const size_t slot = frame % kFramesInFlight;
+        if (VkResult r = vkEndCommandBuffer(command_buffers_[slot]); r != VK_SUCCESS) {
+            return failure("vkEndCommandBuffer", r);
+        }
+        VkSubmitInfo submit_info{};
+        submit_info.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+        submit_info.commandBufferCount = 1;
+        submit_info.pCommandBuffers = &command_buffers_[slot];
+        if (VkResult r = vkQueueSubmit(queue_, 1, &submit_info, fences_[slot]); r != VK_SUCCESS) {
+            return failure("vkQueueSubmit", r);
+        }
+        return {};
+    }
+
+    // Waits until every submitted frame has completed.
+    crisp::Status wait_all() {
+        if (VkResult r = vkWaitForFences(device_, kFramesInFlight, fences_.data(), VK_TRUE, UINT64_MAX);
+            r != VK_SUCCESS) {
+            return failure("vkWaitForFences", r);
+        }
+        return {};
+    }
+
+private:
+    FrameSlots() = default;
+    static crisp::Error failure(const char* call, VkResult r) {
+        return crisp::Error{crisp::ErrorCode::vulkan, std::string(call) + " failed: " + crisp::vk_result_name(r)};
+    }
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    std::array<VkCommandBuffer, kFramesInFlight> command_buffers_{};
+    std::array<VkFence, kFramesInFlight> fences_{};
+};
+
+// ---- Measuring
+
+// The timed phases of a frame, in order.
+enum Phase : size_t { kLayout, kDraws, kRendererRecord, kCompositorRecord, kPhaseCount };
+constexpr std::array<const char*, kPhaseCount> kPhaseNames = {
+    "begin_frame + 3 layouts", "8 draws", "renderer.record", "compositor.record"};
+constexpr std::array<const char*, kPhaseCount> kPhaseKeys = {"layout", "draws", "renderer_record",
+                                                             "compositor_record"};
+
+struct Summary {
+    double median = 0.0, p90 = 0.0, p99 = 0.0, max = 0.0, mean = 0.0;
+};
+
+// Nearest-rank percentiles of `values` (not empty).
+Summary summarize(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    const auto rank = [&](double p) {
+        const auto r = static_cast<size_t>(std::ceil(p * static_cast<double>(values.size())));
+        return values[std::clamp<size_t>(r, 1, values.size()) - 1];
+    };
+    Summary s;
+    s.median = rank(0.5);
+    s.p90 = rank(0.9);
+    s.p99 = rank(0.99);
+    s.max = values.back();
+    for (double v : values) s.mean += v;
+    s.mean /= static_cast<double>(values.size());
+    return s;
+}
+
+struct VariantResult {
+    const Variant* variant = nullptr;
+    std::array<std::vector<double>, kPhaseCount> phase_us;  // per timed frame
+    std::vector<double> total_us;
+    std::vector<double> thread_cpu_us;  // the same region's thread CPU time
+    std::vector<double> total_us_with_work, total_us_without_work;  // by whether the frame had raster work
+    // Per timed frame, summed: what the renderer and the compositor did.
+    uint64_t drawn_glyphs = 0;
+    uint64_t moving_glyphs = 0;
+    uint64_t work_items = 0;
+    uint32_t frames_with_work = 0;
+    uint32_t frames_bins_reused = 0;
+    uint64_t quads = 0;
+    size_t label_glyphs = 0;  // glyph instances of the 8 labels in the first frame
+};
+
+struct Bench {
+    const Args& args;
+    crisp::HeadlessContext& context;
+    const crisp::Font& font;
+    FrameSlots& slots;
+    const crisp::Image& target;
+
+    // One variant: a new renderer and compositor, the labels laid out, warm-up frames, timed frames.
+    VariantResult run(const Variant& variant) {
+        crisp::RendererCreateInfo renderer_info = crisp::renderer_create_info(context);
+        renderer_info.frames_in_flight = kFramesInFlight;
+        auto renderer = crisp::Renderer::create(renderer_info);
+        if (!renderer) fail(renderer.error().message);
+        if (crisp::Status s = renderer->add_font(font); !s) fail(s.error().message);
+        crisp::CompositorCreateInfo compositor_info = crisp::compositor_create_info(context);
+        compositor_info.frames_in_flight = kFramesInFlight;
+        auto compositor = crisp::Compositor::create(compositor_info);
+        if (!compositor) fail(compositor.error().message);
+        if (!compositor->supports_target_format(kTargetFormat)) fail("the device cannot store to R8G8B8A8_UNORM");
+
+        const crisp::Font* fonts[] = {&font};
+        crisp::TextStyle style;
+        style.size = args.size;
+        style.color[0] = style.color[1] = style.color[2] = 0.95f;
+        const VkRect2D visible{{0, 0}, {args.width, args.height}};
+        const crisp::CompositeTarget composite_target{target.view(), kTargetFormat, VK_FORMAT_UNDEFINED,
+                                                      visible.extent, visible};
+        crisp::Layouter layouter;
+        Labels labels(args.width, args.height);
+        for (size_t i = 0; i < kLabels.size(); ++i) labels.lay_out(layouter, fonts, style, i);
+
+        VariantResult result;
+        result.variant = &variant;
+        for (const crisp::TextLayout& l : labels.laid) result.label_glyphs += l.glyphs.size();
+        for (std::vector<double>& v : result.phase_us) v.reserve(args.frames);
+        result.total_us.reserve(args.frames);
+        result.thread_cpu_us.reserve(args.frames);
+        std::array<crisp::DrawOptions, kLabels.size()> options;
+        const uint64_t frame_count = uint64_t{args.warmup} + args.frames;
+        for (uint64_t frame = 0; frame < frame_count; ++frame) {
+            crisp::Result<VkCommandBuffer> cb = slots.begin(frame);
+            if (!cb) fail(cb.error().message);
+            // The caller's side, untimed: last frame's compositing into the target before this
+            // frame's, the new strings and the labels' draw options.
+            crisp::vk::memory_barrier(*cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, crisp::vk::kShaderAccess,
+                                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, crisp::vk::kShaderAccess);
+            if (variant.change_strings) labels.write_counters(frame);
+            for (size_t i = 0; i < kLabels.size(); ++i) options[i] = draw_options(i, frame, variant.move, visible);
+
+            std::array<Clock::time_point, kPhaseCount + 1> stamps;
+            const double cpu_start = thread_cpu_us();
+            stamps[0] = Clock::now();
+            renderer->begin_frame();
+            if (variant.change_strings) {
+                for (size_t i : labels.counters) labels.lay_out(layouter, fonts, style, i);
+            }
+            stamps[1] = Clock::now();
+            for (size_t i = 0; i < kLabels.size(); ++i) renderer->draw(labels.laid[i].glyphs, options[i]);
+            stamps[2] = Clock::now();
+            if (crisp::Status s = renderer->record(*cb); !s) fail(s.error().message);
+            stamps[3] = Clock::now();
+            if (crisp::Status s = compositor->record(*cb, renderer->drawn(), renderer->atlas_view(), composite_target);
+                !s) {
+                fail(s.error().message);
+            }
+            stamps[4] = Clock::now();
+            const double cpu_end = thread_cpu_us();
+
+            if (crisp::Status s = slots.submit(frame); !s) fail(s.error().message);
+            if (frame < args.warmup) continue;
+            double total = 0.0;
+            for (size_t p = 0; p < kPhaseCount; ++p) {
+                const double us = std::chrono::duration<double, std::micro>(stamps[p + 1] - stamps[p]).count();
+                result.phase_us[p].push_back(us);
+                total += us;
+            }
+            result.total_us.push_back(total);
+            result.thread_cpu_us.push_back(cpu_end - cpu_start);
+            const crisp::RendererStats& stats = renderer->stats();
+            (stats.work_items > 0 ? result.total_us_with_work : result.total_us_without_work).push_back(total);
+            result.drawn_glyphs += stats.drawn_glyphs;
+            result.moving_glyphs += stats.moving_glyphs;
+            result.work_items += stats.work_items;
+            result.frames_with_work += stats.work_items > 0 ? 1u : 0u;
+            result.frames_bins_reused += compositor->stats().bins_reused ? 1u : 0u;
+            result.quads += compositor->stats().quads;
+        }
+        // The renderer and the compositor go once the GPU is done with them.
+        if (crisp::Status s = slots.wait_all(); !s) fail(s.error().message);
+        return result;
+    }
+};
+
+// ---- Output
+
+struct Header {
+    std::string device, driver, api, cpu, build;
+    double cpu_clock_read_us = 0.0;  // what one thread_cpu_us() call costs
+};
+
+// The mean cost of reading the thread CPU clock, in µs.
+double thread_cpu_clock_cost_us() {
+    constexpr int kReads = 10000;
+    const Clock::time_point start = Clock::now();
+    double sink = 0.0;
+    for (int i = 0; i < kReads; ++i) sink += thread_cpu_us();
+    const double us = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+    return sink > 0.0 ? us / kReads : 0.0;
+}
+
+// The first "model name" of /proc/cpuinfo; "unknown" where there is none.
+std::string cpu_model() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("model name", 0) != 0) continue;
+        const size_t colon = line.find(':');
+        if (colon != std::string::npos) return line.substr(std::min(colon + 2, line.size()));
+    }
+    return "unknown";
+}
+
+std::string build_description() {
+    std::string build = CRISP_BENCH_BUILD_TYPE[0] ? CRISP_BENCH_BUILD_TYPE : "no CMAKE_BUILD_TYPE";
+#ifdef __OPTIMIZE__
+    build += ", optimized";
+#else
+    build += ", NOT optimized";
+#endif
+#ifdef NDEBUG
+    build += ", assertions off";
+#else
+    build += ", assertions on";
+#endif
+#if defined(__clang__)
+    build += ", Clang " __clang_version__;
+#elif defined(__GNUC__)
+    build += ", GCC " __VERSION__;
+#endif
+    return build;
+}
+
+double per_frame(uint64_t sum, uint32_t frames) {
+    return static_cast<double>(sum) / static_cast<double>(frames);
+}
+
+// The median as a table cell, "-" for no frames.
+std::string median_cell(const std::vector<double>& values) {
+    if (values.empty()) return "-";
+    char cell[32];
+    std::snprintf(cell, sizeof cell, "%.1f", summarize(values).median);
+    return cell;
+}
+
+void print_summary_cells(const Summary& s) {
+    std::printf("%.1f | %.1f | %.1f | %.1f | %.1f |", s.median, s.p90, s.p99, s.max, s.mean);
+}
+
+void print_markdown(const Args& args, const Header& header, const std::vector<VariantResult>& results) {
+    std::printf("Device: %s, driver %s; Vulkan %s. CPU: %s, %u hardware threads. Build: %s.\n\n", header.device.c_str(),
+                header.driver.c_str(), header.api.c_str(), header.cpu.c_str(), std::thread::hardware_concurrency(),
+                header.build.c_str());
+    std::printf(
+        "Scene: 8 labels of %s at %g px (%zu glyphs), each laid out once; drawn with DrawOptions (offset, a colour, "
+        "a depth, the target as the visible rect, an id per label) into a %ux%u R8G8B8A8_UNORM storage image by the "
+        "tile path; %u frames in flight. Changing labels: coordinates, an FPS counter and a clock.\n",
+        args.font.c_str(), static_cast<double>(args.size), results.empty() ? size_t{0} : results[0].label_glyphs,
+        args.width, args.height, kFramesInFlight);
+    std::printf(
+        "Timed on the calling thread with std::chrono::steady_clock: begin_frame() through the end of "
+        "compositor.record(); not timed: writing the strings, vkBeginCommandBuffer, vkEndCommandBuffer, barriers, "
+        "vkQueueSubmit and fence waits. CPU time: the thread's CPU time over the same region "
+        "(CLOCK_THREAD_CPUTIME_ID), which leaves out time the thread waited for a core; one reading of that clock "
+        "(%.2f µs) falls in the region. Per variant a new renderer and compositor, %u warm-up frames, then %u timed "
+        "frames.%s\n",
+        header.cpu_clock_read_us, args.warmup, args.frames,
+        args.validate ? " The validation layer was on: these times are not the library's." : "");
+
+    std::printf(
+        "\n| variant | median µs | p90 µs | p99 µs | max µs | mean µs | CPU time: median µs | p99 µs | max µs |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (const VariantResult& r : results) {
+        std::printf("| %s: %s | ", r.variant->name, r.variant->description);
+        print_summary_cells(summarize(r.total_us));
+        const Summary cpu = summarize(r.thread_cpu_us);
+        std::printf(" %.1f | %.1f | %.1f |\n", cpu.median, cpu.p99, cpu.max);
+    }
+
+    std::printf("\nWhere the time goes:\n\n| variant | phase | median µs | p90 µs | p99 µs | max µs | mean µs |\n"
+                "|---|---|---:|---:|---:|---:|---:|\n");
+    for (const VariantResult& r : results) {
+        for (size_t p = 0; p < kPhaseCount; ++p) {
+            std::printf("| %s | %s | ", r.variant->name, kPhaseNames[p]);
+            print_summary_cells(summarize(r.phase_us[p]));
+            std::printf("\n");
+        }
+    }
+
+    std::printf(
+        "\nWhat the renderer and the compositor did, per timed frame:\n\n"
+        "| variant | glyphs drawn | moving glyphs | frames with raster work | raster work items | "
+        "frames with bins reused | quads | median µs, frames with raster work | median µs, frames without |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (const VariantResult& r : results) {
+        std::printf("| %s | %.1f | %.1f | %u of %u | %.2f | %u of %u | %.1f | %s | %s |\n", r.variant->name,
+                    per_frame(r.drawn_glyphs, args.frames), per_frame(r.moving_glyphs, args.frames), r.frames_with_work,
+                    args.frames, per_frame(r.work_items, args.frames), r.frames_bins_reused, args.frames,
+                    per_frame(r.quads, args.frames), median_cell(r.total_us_with_work).c_str(),
+                    median_cell(r.total_us_without_work).c_str());
+    }
+}
+
+using NumberField = std::pair<const char*, double>;
+
+// A JSON object of named numbers.
+void append_numbers(std::string& out, std::span<const NumberField> fields) {
+    out += "{";
+    for (size_t i = 0; i < fields.size(); ++i) {
+        out += i ? ", " : "";
+        out += crisp::json::quote(fields[i].first) + ": ";
+        crisp::json::append_number(out, fields[i].second);
+    }
+    out += "}";
+}
+
+void append_summary(std::string& out, const Summary& s) {
+    const NumberField fields[] = {
+        {"median", s.median}, {"p90", s.p90}, {"p99", s.p99}, {"max", s.max}, {"mean", s.mean}};
+    append_numbers(out, fields);
+}
+
+std::string to_json(const Args& args, const Header& header, const std::vector<VariantResult>& results) {
+    using crisp::json::quote;
+    std::string out = "{\n  \"tool\": \"crisp-bench-frame\",\n";
+    out += "  \"device\": " + quote(header.device) + ",\n  \"driver\": " + quote(header.driver) + ",\n";
+    out += "  \"api_version\": " + quote(header.api) + ",\n  \"cpu\": " + quote(header.cpu) + ",\n";
+    out += "  \"hardware_threads\": " + std::to_string(std::thread::hardware_concurrency()) + ",\n";
+    out += "  \"thread_cpu_clock_read_us\": ";
+    crisp::json::append_number(out, header.cpu_clock_read_us);
+    out += ",\n  \"build\": " + quote(header.build) + ",\n  \"font\": " + quote(args.font) + ",\n  \"size\": ";
+    crisp::json::append_number(out, static_cast<double>(args.size));
+    out += ",\n  \"canvas\": [" + std::to_string(args.width) + ", " + std::to_string(args.height) + "],\n";
+    out += "  \"frames_in_flight\": " + std::to_string(kFramesInFlight) + ",\n";
+    out += "  \"warmup_frames\": " + std::to_string(args.warmup) + ",\n";
+    out += "  \"timed_frames\": " + std::to_string(args.frames) + ",\n";
+    out += std::string("  \"validation\": ") + (args.validate ? "true" : "false") + ",\n  \"variants\": [\n";
+    for (size_t v = 0; v < results.size(); ++v) {
+        const VariantResult& r = results[v];
+        out += "    {\"name\": " + quote(r.variant->name) + ", \"description\": " + quote(r.variant->description);
+        out += ", \"label_glyphs\": " + std::to_string(r.label_glyphs) + ",\n     \"total_us\": ";
+        append_summary(out, summarize(r.total_us));
+        out += ",\n     \"thread_cpu_us\": ";
+        append_summary(out, summarize(r.thread_cpu_us));
+        for (size_t p = 0; p < kPhaseCount; ++p) {
+            out += ",\n     \"" + std::string(kPhaseKeys[p]) + "_us\": ";
+            append_summary(out, summarize(r.phase_us[p]));
+        }
+        const NumberField per_frame_fields[] = {
+            {"drawn_glyphs", per_frame(r.drawn_glyphs, args.frames)},
+            {"moving_glyphs", per_frame(r.moving_glyphs, args.frames)},
+            {"work_items", per_frame(r.work_items, args.frames)},
+            {"quads", per_frame(r.quads, args.frames)},
+        };
+        out += ",\n     \"per_frame\": ";
+        append_numbers(out, per_frame_fields);
+        out += ",\n     \"frames_with_raster_work\": " + std::to_string(r.frames_with_work);
+        if (!r.total_us_with_work.empty()) {
+            out += ", \"total_us_frames_with_raster_work\": ";
+            append_summary(out, summarize(r.total_us_with_work));
+        }
+        if (!r.total_us_without_work.empty()) {
+            out += ", \"total_us_frames_without_raster_work\": ";
+            append_summary(out, summarize(r.total_us_without_work));
+        }
+        out += ", \"frames_with_bins_reused\": " + std::to_string(r.frames_bins_reused);
+        out += ",\n     \"frame_us\": [";
+        for (size_t f = 0; f < r.total_us.size(); ++f) {
+            if (f) out += ", ";
+            crisp::json::append_number(out, std::round(r.total_us[f] * 1000.0) / 1000.0);
+        }
+        out += v + 1 < results.size() ? "]},\n" : "]}\n";
+    }
+    out += "  ]\n}\n";
+    return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Args args = parse(argc, argv);
+    std::vector<const Variant*> variants;
+    for (const std::string& name : args.variants) {
+        const auto* found = std::find_if(std::begin(kVariants), std::end(kVariants),
+                                         [&](const Variant& v) { return name == v.name; });
+        if (found == std::end(kVariants)) refuse("--variants: unknown variant '" + crisp::cli::printable(name) + "'");
+        variants.push_back(found);
+    }
+
+    crisp::HeadlessContextOptions context_options;
+    context_options.validation = args.validate;
+    context_options.device_name_contains = args.device;
+    bool storage_without_format = false;  // the RGBA8 target needs no format-less storage
+    auto context = crisp::tools::create_context(context_options, storage_without_format);
+    if (!context) fail(context.error().message);
+
+    crisp::BakeOptions bake;  // the labels are ASCII
+    bake.all_glyphs = false;
+    for (uint32_t c = 0x20; c < 0x7F; ++c) bake.codepoints.push_back(c);
+    auto baked = crisp::bake_font_file(args.font, bake);
+    if (!baked) {
+        const std::string& why = baked.error().message;  // an unreadable file's names it
+        fail(why.find(args.font) != std::string::npos ? why : crisp::cli::printable(args.font) + ": " + why);
+    }
+    auto font = crisp::Font::create(std::move(baked->asset), 1);
+    if (!font) fail(crisp::cli::printable(args.font) + ": " + font.error().message);
+
+    crisp::ImageDesc target_desc;
+    target_desc.format = kTargetFormat;
+    target_desc.width = args.width;
+    target_desc.height = args.height;
+    target_desc.usage = VK_IMAGE_USAGE_STORAGE_BIT;
+    auto target = context->create_image(target_desc);
+    if (!target) fail(target.error().message);
+    const crisp::Status to_general = context->submit_and_wait([&](VkCommandBuffer cb) {
+        crisp::vk::image_barrier(cb, target->handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                                 VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                 crisp::vk::kShaderAccess);
+    });
+    if (!to_general) fail(to_general.error().message);
+    auto slots = FrameSlots::create(*context);
+    if (!slots) fail(slots.error().message);
+
+    Bench bench{args, *context, *font, *slots, *target};
+    std::vector<VariantResult> results;
+    for (const Variant* variant : variants) results.push_back(bench.run(*variant));
+
+    Header header;
+    header.device = context->device_name();
+    header.driver = context->driver_name() + " (" + context->driver_info() + ")";
+    header.api = crisp::vk::version_string(context->api_version());
+    header.cpu = cpu_model();
+    header.build = build_description();
+    header.cpu_clock_read_us = thread_cpu_clock_cost_us();
+    print_markdown(args, header, results);
+    if (!args.json_out.empty()) {
+        std::ofstream out(args.json_out, std::ios::binary);
+        out << to_json(args, header, results);
+        if (!out.flush()) fail("cannot write " + crisp::cli::printable(args.json_out));
+    }
+    const crisp::ValidationMessages messages = context->validation_messages();
+    if (messages.errors + messages.warnings > 0) {
+        std::fprintf(stderr, "validation: %u errors, %u warnings\n", messages.errors, messages.warnings);
+        for (const std::string& m : messages.recent) std::fprintf(stderr, "%s\n", m.c_str());
+        return 1;
+    }
+    return 0;
+}
