@@ -26,11 +26,11 @@ layout(std430, set = 0, binding = 1) readonly buffer Items {
 
 layout(std430, set = 0, binding = 2) readonly buffer Points {
     vec2 points[];
-} fonts_points[kRasterMaxFonts];
+} fonts_points[kRasterFontPages];
 
 layout(std430, set = 0, binding = 3) readonly buffer Bands {
     uint words[];
-} fonts_bands[kRasterMaxFonts];
+} fonts_bands[kRasterFontPages];
 
 // Below this |a| (em) the curve is treated as a line: t = c / 2b.
 const float kLinearEpsilon = 1.0 / 65536.0;

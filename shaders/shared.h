@@ -53,7 +53,7 @@ CRISP_CONSTANT(uint, kRasterWorkgroupSize, 64u);
 CRISP_CONSTANT(uint, kRasterCoverageOne, 64u);
 // Storage buffers of curve points and of band bitsets, one each per font: with the work items
 // 17 storage buffers, within the 32 per stage that lavapipe and desktop drivers offer.
-CRISP_CONSTANT(uint, kRasterMaxFonts, 8u);
+CRISP_CONSTANT(uint, kRasterFontPages, 8u);  // font pages, each several fonts' points and bands
 // Workgroups per row of the 2D dispatch (maxComputeWorkGroupCount[0] is at least 65535).
 CRISP_CONSTANT(uint, kRasterDispatchWidth, 65535u);
 

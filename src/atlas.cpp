@@ -220,6 +220,12 @@ void GlyphAtlas::evict(uint32_t id) {
     ++total_counters_.evictions;
 }
 
+void GlyphAtlas::evict_font(FontId font) {
+    for (uint32_t id = 0; id < slots_.size(); ++id) {
+        if (slots_[id].resident && slots_[id].entry.key.font == font && !pinned(slots_[id])) evict(id);
+    }
+}
+
 // Called when no free block of bit_count cells exists. Returns the block freed by evicting
 // unpinned entries least recently used first, or kNotFound having evicted nothing.
 uint32_t GlyphAtlas::make_room(uint32_t bit_count) {

@@ -22,18 +22,59 @@ namespace {
 
 constexpr VkFormat kAtlasFormat = VK_FORMAT_R16G16B16A16_UINT;
 static_assert(kCoverageOne == gpu::kRasterCoverageOne);
-static_assert(kMaxRendererFonts == gpu::kRasterMaxFonts);
+static_assert(kRendererFontPages == gpu::kRasterFontPages);
 // vkCmdUpdateBuffer takes at most this many bytes a call.
 constexpr VkDeviceSize kUpdateChunk = 65536;
 
 using GpuBuffer = vk::DeviceBuffer;
 
+// A byte range of a font page's buffer.
+struct Range {
+    VkDeviceSize offset = 0;
+    VkDeviceSize size = 0;
+};
+
+// Two device-local buffers (curve points, band words) that hold the ranges of several fonts:
+// fonts are suballocated from at most kRendererFontPages pages, so their number is not bound to
+// the shader's descriptor arrays, and removing a font frees its ranges for the next.
+struct FontPage {
+    GpuBuffer points;
+    GpuBuffer bands;
+    std::vector<Range> used_points;  // sorted by offset
+    std::vector<Range> used_bands;
+};
+
+// The offset of the first gap of `size` bytes (aligned to `alignment`) in a buffer of `capacity`
+// bytes whose taken ranges are `used` (sorted), inserted into `used`; nullopt when none fits.
+std::optional<VkDeviceSize> take_range(std::vector<Range>& used, VkDeviceSize capacity, VkDeviceSize size,
+                                       VkDeviceSize alignment) {
+    if (size == 0) return VkDeviceSize{0};
+    VkDeviceSize at = 0;
+    auto next = used.begin();
+    for (;; ++next) {
+        at = (at + alignment - 1) / alignment * alignment;
+        const VkDeviceSize end = next == used.end() ? capacity : next->offset;
+        if (at <= end && end - at >= size) break;
+        if (next == used.end()) return std::nullopt;
+        at = next->offset + next->size;
+    }
+    used.insert(next, {at, size});
+    return at;
+}
+
+void give_range(std::vector<Range>& used, VkDeviceSize offset, VkDeviceSize size) {
+    if (size == 0) return;
+    std::erase_if(used, [&](const Range& r) { return r.offset == offset; });
+}
+
 struct GpuFont {
-    const Font* font = nullptr;
-    GpuBuffer points;   // device-local
-    GpuBuffer bands;    // device-local
-    GpuBuffer staging;  // host-visible, points then bands; freed once copied and done
+    const Font* font = nullptr;  // null: a removed font's place, free for the next
+    uint32_t page = 0;
+    VkDeviceSize points_at = 0;  // byte offsets of its ranges in the page's buffers
+    VkDeviceSize bands_at = 0;
     VkDeviceSize points_bytes = 0;
+    VkDeviceSize bands_bytes = 0;
+    GpuBuffer staging;  // host-visible, points then bands; freed once copied and done
     bool uploaded = false;
     VkBuffer retired_staging = VK_NULL_HANDLE;  // the staging buffer the last upload retired
 };
@@ -42,6 +83,17 @@ struct Retired {
     GpuBuffer buffer;
     uint64_t frame = 0;  // free once frames_in_flight frames have been recorded after this one
 };
+
+// A removed font's page ranges, free once the frames that may read them are done.
+struct RetiredRanges {
+    uint32_t page = 0;
+    Range points, bands;
+    uint64_t frame = 0;
+};
+
+// Smallest capacities of a new font page; a page holds at least twice the font that makes it.
+constexpr VkDeviceSize kMinPagePoints = VkDeviceSize{4} << 20;
+constexpr VkDeviceSize kMinPageBands = VkDeviceSize{1} << 20;
 
 }  // namespace
 
@@ -64,8 +116,11 @@ struct Renderer::State {
     uint32_t item_capacity = 0;
     GpuBuffer dummy;  // bound to the font slots no font uses
 
-    std::vector<GpuFont> fonts;                      // slot order
+    std::vector<GpuFont> fonts;                      // index order; removed ones have no font
     std::unordered_map<FontId, uint32_t> font_slot;  // FontId -> index in fonts
+    std::vector<FontPage> pages;                     // at most kRendererFontPages
+    std::vector<FontId> removals;                    // remove_font()s, applied at begin_frame()
+    std::vector<RetiredRanges> retired_ranges;
     std::vector<Retired> retired;
 
     VkShaderModule shader = VK_NULL_HANDLE;
@@ -354,15 +409,17 @@ struct Renderer::State {
     void free_buffer(GpuBuffer& buffer);
     Status create_objects();
     void write_descriptors(VkDescriptorSet set);
+    Status place_font(GpuFont& font);
+    void apply_removals();
 };
 
 Renderer::State::~State() {
     if (!device) return;
     for (Retired& r : retired) free_buffer(r.buffer);
-    for (GpuFont& font : fonts) {
-        free_buffer(font.points);
-        free_buffer(font.bands);
-        free_buffer(font.staging);
+    for (GpuFont& font : fonts) free_buffer(font.staging);
+    for (FontPage& page : pages) {
+        free_buffer(page.points);
+        free_buffer(page.bands);
     }
     free_buffer(items);
     free_buffer(dummy);
@@ -409,11 +466,10 @@ Status Renderer::State::create_objects() {
     const VkDescriptorSetLayoutBinding bindings[] = {
         {0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
         {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-        {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kMaxRendererFonts, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-        {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kMaxRendererFonts, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
     };
     // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
-    const vk::DeviceRef refref;
     if (Status s =
             vk::create_descriptor_sets(ref, bindings, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(gpu::RasterPushConstants),
                                        frames_in_flight, "renderer", descriptors);
@@ -430,11 +486,11 @@ Status Renderer::State::create_objects() {
 void Renderer::State::write_descriptors(VkDescriptorSet set) {
     VkDescriptorImageInfo image{VK_NULL_HANDLE, atlas_image.view, VK_IMAGE_LAYOUT_GENERAL};
     VkDescriptorBufferInfo item_info{items.buffer, 0, VK_WHOLE_SIZE};
-    std::array<VkDescriptorBufferInfo, kMaxRendererFonts> point_infos{}, band_infos{};
-    for (uint32_t slot = 0; slot < kMaxRendererFonts; ++slot) {
-        const bool used = slot < fonts.size() && fonts[slot].uploaded;
-        point_infos[slot] = {used ? fonts[slot].points.buffer : dummy.buffer, 0, VK_WHOLE_SIZE};
-        band_infos[slot] = {used ? fonts[slot].bands.buffer : dummy.buffer, 0, VK_WHOLE_SIZE};
+    std::array<VkDescriptorBufferInfo, kRendererFontPages> point_infos{}, band_infos{};
+    for (uint32_t page = 0; page < kRendererFontPages; ++page) {
+        const bool used = page < pages.size();
+        point_infos[page] = {used ? pages[page].points.buffer : dummy.buffer, 0, VK_WHOLE_SIZE};
+        band_infos[page] = {used ? pages[page].bands.buffer : dummy.buffer, 0, VK_WHOLE_SIZE};
     }
     VkWriteDescriptorSet writes[4]{};
     for (VkWriteDescriptorSet& write : writes) {
@@ -449,10 +505,10 @@ void Renderer::State::write_descriptors(VkDescriptorSet set) {
     writes[1].dstBinding = 1;
     writes[1].pBufferInfo = &item_info;
     writes[2].dstBinding = 2;
-    writes[2].descriptorCount = kMaxRendererFonts;
+    writes[2].descriptorCount = kRendererFontPages;
     writes[2].pBufferInfo = point_infos.data();
     writes[3].dstBinding = 3;
-    writes[3].descriptorCount = kMaxRendererFonts;
+    writes[3].descriptorCount = kRendererFontPages;
     writes[3].pBufferInfo = band_infos.data();
     vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
 }
@@ -502,7 +558,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     if (!vk::has_compute_subgroup_arithmetic(info.physical_device)) {
         return Error{ErrorCode::vulkan, "renderer: the device lacks subgroup arithmetic in compute shaders"};
     }
-    const uint32_t buffers_needed = 1 + 2 * kMaxRendererFonts;
+    const uint32_t buffers_needed = 1 + 2 * kRendererFontPages;
     if (properties.limits.maxPerStageDescriptorStorageBuffers < buffers_needed) {
         return Error{ErrorCode::vulkan, "renderer: the device offers " +
                                             std::to_string(properties.limits.maxPerStageDescriptorStorageBuffers) +
@@ -534,48 +590,114 @@ Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 Renderer::~Renderer() = default;
 
+// Finds `font` its ranges in a page with room, or in a new page.
+Status Renderer::State::place_font(GpuFont& font) {
+    for (uint32_t i = 0; i < pages.size(); ++i) {
+        FontPage& page = pages[i];
+        const auto points_at = take_range(page.used_points, page.points.size, font.points_bytes, sizeof(Point));
+        if (!points_at) continue;
+        const auto bands_at = take_range(page.used_bands, page.bands.size, font.bands_bytes, sizeof(uint32_t));
+        if (!bands_at) {
+            give_range(page.used_points, *points_at, font.points_bytes);
+            continue;
+        }
+        font.page = i;
+        font.points_at = *points_at;
+        font.bands_at = *bands_at;
+        return {};
+    }
+    if (pages.size() >= kRendererFontPages) {
+        return Error{ErrorCode::invalid_argument,
+                     "renderer: the font does not fit the " + std::to_string(kRendererFontPages) +
+                         " font pages, which the fonts added before fill; remove one first"};
+    }
+    const auto capacity = [&](VkDeviceSize need, VkDeviceSize least) {
+        return std::max(need, std::min(std::max(2 * need, least), max_storage_buffer_range));
+    };
+    FontPage page;
+    const VkBufferUsageFlags usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    Status status = make_buffer(capacity(font.points_bytes, kMinPagePoints), usage, false, "font points", page.points);
+    if (status) status = make_buffer(capacity(font.bands_bytes, kMinPageBands), usage, false, "font bands", page.bands);
+    if (!status) {
+        free_buffer(page.points);
+        free_buffer(page.bands);
+        return status;
+    }
+    pages.push_back(std::move(page));
+    return place_font(font);
+}
+
 Status Renderer::add_font(const Font& font) {
     State& s = *state_;
-    if (s.font_slot.count(font.id())) {
+    if (s.font_slot.count(font.id()) && std::find(s.removals.begin(), s.removals.end(), font.id()) == s.removals.end()) {
         return Error{ErrorCode::invalid_argument,
                      "renderer: a font with id " + std::to_string(font.id()) + " was added already"};
     }
-    if (s.fonts.size() >= kMaxRendererFonts) {
-        return Error{ErrorCode::invalid_argument,
-                     "renderer: it holds " + std::to_string(kMaxRendererFonts) + " fonts already"};
+    if (s.font_slot.count(font.id())) {
+        return Error{ErrorCode::invalid_argument, "renderer: the font with id " + std::to_string(font.id()) +
+                                                      " is removed at the next begin_frame(); add it after that"};
     }
     const FontAsset& asset = font.asset();
-    const VkDeviceSize points_bytes = asset.points.size() * sizeof(Point);
-    const VkDeviceSize bands_bytes = asset.band_words.size() * sizeof(uint32_t);
-    if (std::max(points_bytes, bands_bytes) > s.max_storage_buffer_range) {
-        return Error{ErrorCode::vulkan, "renderer: the font's " +
-                                            std::string(points_bytes > bands_bytes ? "curve points" : "band bitsets") +
-                                            " (" + std::to_string(std::max(points_bytes, bands_bytes)) +
-                                            " bytes) pass the device's maxStorageBufferRange of " +
-                                            std::to_string(s.max_storage_buffer_range)};
-    }
     GpuFont gpu;
     gpu.font = &font;
-    gpu.points_bytes = points_bytes;
-    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    Status status = s.make_buffer(points_bytes, usage, false, "font curve points", gpu.points);
-    if (status) status = s.make_buffer(bands_bytes, usage, false, "font bands", gpu.bands);
-    if (status) {
-        status = s.make_buffer(points_bytes + bands_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "font staging",
-                               gpu.staging);
+    gpu.points_bytes = asset.points.size() * sizeof(Point);
+    gpu.bands_bytes = asset.band_words.size() * sizeof(uint32_t);
+    if (std::max(gpu.points_bytes, gpu.bands_bytes) > s.max_storage_buffer_range) {
+        return Error{ErrorCode::vulkan,
+                     "renderer: the font's " +
+                         std::string(gpu.points_bytes > gpu.bands_bytes ? "curve points" : "band bitsets") + " (" +
+                         std::to_string(std::max(gpu.points_bytes, gpu.bands_bytes)) +
+                         " bytes) pass the device's maxStorageBufferRange of " +
+                         std::to_string(s.max_storage_buffer_range)};
     }
-    if (!status) {
-        s.free_buffer(gpu.points);
-        s.free_buffer(gpu.bands);
-        s.free_buffer(gpu.staging);
-        return status;
+    if (Status placed = s.place_font(gpu); !placed) return placed;
+    if (Status made = s.make_buffer(gpu.points_bytes + gpu.bands_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
+                                    "font staging", gpu.staging);
+        !made) {
+        give_range(s.pages[gpu.page].used_points, gpu.points_at, gpu.points_bytes);
+        give_range(s.pages[gpu.page].used_bands, gpu.bands_at, gpu.bands_bytes);
+        return made;
     }
     auto* bytes = static_cast<std::byte*>(gpu.staging.mapped);
-    if (points_bytes) std::memcpy(bytes, asset.points.data(), points_bytes);
-    if (bands_bytes) std::memcpy(bytes + points_bytes, asset.band_words.data(), bands_bytes);
-    s.font_slot[font.id()] = static_cast<uint32_t>(s.fonts.size());
-    s.fonts.push_back(gpu);
+    if (gpu.points_bytes) std::memcpy(bytes, asset.points.data(), gpu.points_bytes);
+    if (gpu.bands_bytes) std::memcpy(bytes + gpu.points_bytes, asset.band_words.data(), gpu.bands_bytes);
+    // A removed font's place is taken again before the list grows.
+    const auto free_place = std::find_if(s.fonts.begin(), s.fonts.end(), [](const GpuFont& f) { return !f.font; });
+    const auto index = static_cast<uint32_t>(free_place - s.fonts.begin());
+    if (free_place == s.fonts.end()) {
+        s.fonts.push_back(gpu);
+    } else {
+        *free_place = gpu;
+    }
+    s.font_slot[font.id()] = index;
     return {};
+}
+
+Status Renderer::remove_font(FontId id) {
+    State& s = *state_;
+    if (!s.font_slot.count(id) || std::find(s.removals.begin(), s.removals.end(), id) != s.removals.end()) {
+        return Error{ErrorCode::invalid_argument, "renderer: no font with id " + std::to_string(id) + " to remove"};
+    }
+    s.removals.push_back(id);
+    return {};
+}
+
+// The fonts remove_font() named leave: their atlas entries go, their staging buffers and page
+// ranges are freed once the frames that may read them are done, and their ids are free.
+void Renderer::State::apply_removals() {
+    for (FontId id : removals) {
+        const auto slot = font_slot.find(id);
+        if (slot == font_slot.end()) continue;
+        GpuFont& font = fonts[slot->second];
+        atlas.evict_font(id);
+        if (font.staging.buffer) retired.push_back({font.staging, frame});
+        retired_ranges.push_back(
+            {font.page, {font.points_at, font.points_bytes}, {font.bands_at, font.bands_bytes}, frame});
+        font = GpuFont{};
+        font_slot.erase(slot);
+    }
+    removals.clear();
 }
 
 Status Renderer::set_subpixel_layout(const SubpixelLayout& layout) {
@@ -637,7 +759,8 @@ void Renderer::begin_frame() {
     s.undo.calm_frames = s.calm_frames;
     s.undo.calm_needed = s.calm_needed;
     s.undo.just_refined = s.just_refined;
-    s.atlas.begin_frame();
+    s.atlas.begin_frame();  // unpins last frame's glyphs, so that removed fonts' entries can go
+    s.apply_removals();
     s.pending.clear();
     s.clipped.clear();
     s.requests.clear();
@@ -734,20 +857,26 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         s.free_buffer(r.buffer);
         return true;
     });
+    std::erase_if(s.retired_ranges, [&](const RetiredRanges& r) {
+        if (r.frame + s.frames_in_flight > frame) return false;
+        give_range(s.pages[r.page].used_points, r.points.offset, r.points.size);
+        give_range(s.pages[r.page].used_bands, r.bands.offset, r.bands.size);
+        return true;
+    });
     bool uploaded = false;
     for (GpuFont& font : s.fonts) {
-        if (font.uploaded) continue;
+        if (font.uploaded || !font.font) continue;
         s.undo.uploaded_fonts.push_back(static_cast<uint32_t>(&font - s.fonts.data()));
+        const FontPage& page = s.pages[font.page];
         if (font.points_bytes) {
-            const VkBufferCopy copy{0, 0, font.points_bytes};
-            vkCmdCopyBuffer(command_buffer, font.staging.buffer, font.points.buffer, 1, &copy);
+            const VkBufferCopy copy{0, font.points_at, font.points_bytes};
+            vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.points.buffer, 1, &copy);
         }
-        const VkDeviceSize real_bands = font.font->asset().band_words.size() * sizeof(uint32_t);
-        if (real_bands) {
-            const VkBufferCopy copy{font.points_bytes, 0, real_bands};
-            vkCmdCopyBuffer(command_buffer, font.staging.buffer, font.bands.buffer, 1, &copy);
+        if (font.bands_bytes) {
+            const VkBufferCopy copy{font.points_bytes, font.bands_at, font.bands_bytes};
+            vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.bands.buffer, 1, &copy);
         }
-        s.stats.upload_bytes += font.points_bytes + real_bands;
+        s.stats.upload_bytes += font.points_bytes + font.bands_bytes;
         font.uploaded = true;
         font.retired_staging = font.staging.buffer;
         s.retired.push_back({font.staging, frame});
@@ -768,7 +897,8 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     for (const RasterWork& w : work) {
         const auto slot = s.font_slot.find(w.key.font);
         if (slot == s.font_slot.end() || w.sample_count == 0) continue;
-        const GlyphRecord& glyph = s.fonts[slot->second].font->asset().glyphs[w.key.glyph];
+        const GpuFont& font = s.fonts[slot->second];
+        const GlyphRecord& glyph = font.font->asset().glyphs[w.key.glyph];
         const GlyphRect rect = glyph_rect(glyph, w.key);
         const TexelToEm map = texel_to_em(rect, w.key);
         gpu::RasterItem item{};
@@ -782,11 +912,11 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         item.scale_y = map.scale_y;
         item.bbox_min_y = glyph.bbox_min_y;
         item.bbox_max_y = glyph.bbox_max_y;
-        item.point_offset = glyph.point_offset;
-        item.band_offset = glyph.band_offset;
+        item.point_offset = static_cast<uint32_t>(font.points_at / sizeof(Point)) + glyph.point_offset;
+        item.band_offset = static_cast<uint32_t>(font.bands_at / sizeof(uint32_t)) + glyph.band_offset;
         item.band_count = glyph.band_count;
         item.band_words = glyph.band_words;
-        item.font = slot->second;
+        item.font = font.page;
         item.first_sample = w.first_sample;
         item.sample_count = w.sample_count;
         item.part_x = w.part_x;

@@ -12,8 +12,6 @@
 
 namespace crisp {
 
-static_assert(kMaxSceneFonts == kMaxRendererFonts, "a scene holds what one renderer holds");
-
 namespace {
 
 using Type = json::Value::Type;
@@ -56,7 +54,7 @@ std::optional<Error> read_fonts(const json::Value& value, Scene& scene) {
         return fault("fonts", "expected a non-empty array of font asset paths");
     }
     if (value.array.size() > kMaxSceneFonts) {
-        return fault("fonts", "at most " + std::to_string(kMaxSceneFonts) + " fonts (what one renderer holds), got " +
+        return fault("fonts", "at most " + std::to_string(kMaxSceneFonts) + " fonts, got " +
                                   std::to_string(value.array.size()));
     }
     for (size_t i = 0; i < value.array.size(); ++i) {

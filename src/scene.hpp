@@ -19,7 +19,7 @@
 namespace crisp {
 
 // Limits a parsed scene keeps; docs/scene-format.md explains each.
-inline constexpr uint32_t kMaxSceneFonts = 8;        // the renderer's kMaxRendererFonts
+inline constexpr uint32_t kMaxSceneFonts = 8;        // a fallback chain of at most 8 faces
 inline constexpr uint32_t kMaxSceneCanvas = 16384;   // crisp-render's --canvas limit, per side
 inline constexpr float kMaxSceneTextSize = 4096.0f;  // pixels per em, crisp-render's --size limit
 // Runs one scene may hold (docs/limits.md): a screen of UI text is hundreds.

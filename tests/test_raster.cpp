@@ -759,5 +759,86 @@ TEST(Raster, DroppedFramesDoNotCountTowardsALabelsRest) {
     expect_no_validation_messages();
 }
 
+// Fonts share the font pages: more fonts than the shader has buffer slots draw, each texel
+// equal to the reference; a removed font's instances are unknown from the next frame on, and a
+// font added in its place (its ranges reused once the GPU is done with them) draws correctly.
+TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    constexpr uint32_t kSamples = 8;
+    auto renderer = make_renderer(*subpixel_preset("rgb"), kSamples);
+    ASSERT_TRUE(renderer);
+    constexpr FontId kFonts = 2 * kRendererFontPages + 3;
+    std::vector<std::unique_ptr<Font>> fonts;
+    for (FontId id = 1; id <= kFonts; ++id) {
+        fonts.push_back(test::bake_test_font("Hg@&1", id));  // the fixture's glyphs, under many ids
+        ASSERT_TRUE(fonts.back());
+        ASSERT_TRUE(renderer->add_font(*fonts.back()));
+    }
+    // One glyph of each font, side by side.
+    const auto glyphs_of = [&](const std::vector<std::unique_ptr<Font>>& held) {
+        std::vector<GlyphInstance> glyphs;
+        for (size_t i = 0; i < held.size(); ++i) {
+            const Font* one[] = {held[i].get()};
+            TextStyle style;
+            style.size = 11.0f + static_cast<float>(i % 5);
+            const char* text[] = {"H", "g", "@", "&", "1"};
+            auto laid = layout_text(one, text[i % 5], style,
+                                    LayoutOptions{.origin_x = 2.0f + 14.0f * static_cast<float>(i % 12),
+                                                  .origin_y = 20.0f + 24.0f * static_cast<float>(i / 12)});
+            EXPECT_TRUE(laid);
+            if (laid) glyphs.insert(glyphs.end(), laid->glyphs.begin(), laid->glyphs.end());
+        }
+        return glyphs;
+    };
+    const auto check = [&](const std::vector<GlyphInstance>& glyphs) {
+        uint32_t frames = 0;
+        const std::vector<Texel> texels =
+            render(*renderer, frames, 100, [&] { renderer->draw(glyphs); }, [] {});
+        ASSERT_EQ(renderer->drawn().size(), glyphs.size());
+        const Comparison result = compare(*renderer, texels, kSamples);
+        EXPECT_GT(result.covered, 0u);
+        EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
+    };
+    check(glyphs_of(fonts));
+
+    // Remove font 3: this frame still has it, the next one does not.
+    const std::vector<GlyphInstance> all = glyphs_of(fonts);
+    ASSERT_TRUE(renderer->remove_font(3));
+    EXPECT_FALSE(renderer->remove_font(3));  // already on its way out
+    EXPECT_FALSE(renderer->add_font(*fonts[2]));  // not gone yet
+    renderer->begin_frame();
+    renderer->draw(all);
+    EXPECT_EQ(renderer->stats().unknown_fonts, 1u);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    EXPECT_FALSE(renderer->remove_font(3));
+    // A different font under the same id takes its place: "g" is the only glyph it has.
+    fonts[2] = test::bake_test_font("g", 3);
+    ASSERT_TRUE(fonts[2]);
+    ASSERT_TRUE(renderer->add_font(*fonts[2]));
+    for (int cycle = 0; cycle < 3; ++cycle) {  // cycles of removal reuse the freed ranges
+        ASSERT_TRUE(renderer->remove_font(5));
+        renderer->begin_frame();
+        ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+        fonts[4] = test::bake_test_font("Hg@&1", 5);
+        ASSERT_TRUE(renderer->add_font(*fonts[4]));
+    }
+    std::vector<std::unique_ptr<Font>> without_third;
+    for (size_t i = 0; i < fonts.size(); ++i) {
+        if (i != 2) without_third.push_back(std::move(fonts[i]));
+    }
+    check(glyphs_of(without_third));
+    const Font* replaced[] = {fonts[2].get()};
+    auto g = layout_text(replaced, "g", TextStyle{}, LayoutOptions{.origin_x = 3.0f, .origin_y = 90.0f});
+    ASSERT_TRUE(g);
+    ASSERT_EQ(g->glyphs.size(), 1u);
+    uint32_t frames = 0;
+    const std::vector<Texel> texels = render(*renderer, frames, 100, [&] { renderer->draw(g->glyphs); }, [] {});
+    const Comparison result = compare(*renderer, texels, kSamples, fonts[2].get());
+    EXPECT_GT(result.covered, 0u);
+    EXPECT_EQ(result.unexplained, 0u);
+    expect_no_validation_messages();
+}
+
 }  // namespace
 }  // namespace crisp

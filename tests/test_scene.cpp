@@ -106,7 +106,7 @@ TEST(Scene, BadScenesNameTheirFault) {
         {R"({"canvas": [8, 8], "runs": []})", "scene: the \"fonts\" member is missing"},
         {R"({"fonts": "a.crisp", "canvas": [8, 8], "runs": []})", "scene: fonts: expected a non-empty array"},
         {R"({"fonts": [], "canvas": [8, 8], "runs": []})", "scene: fonts: expected a non-empty array"},
-        {nine_fonts, "scene: fonts: at most 8 fonts (what one renderer holds), got 9"},
+        {nine_fonts, "scene: fonts: at most 8 fonts, got 9"},
         {R"({"fonts": ["a", ""], "canvas": [8, 8], "runs": []})", "scene: fonts[1]: expected a non-empty path string"},
         {R"({"fonts": [1], "canvas": [8, 8], "runs": []})", "scene: fonts[0]: expected a non-empty path string"},
         {R"({"fonts": ["a\u0000b"], "canvas": [8, 8], "runs": []})", "scene: fonts[0]: expected a non-empty path"},

@@ -297,8 +297,8 @@ Arguments parse_arguments(int argc, char** argv) {
         }
     } else {
         if (args.fonts.empty()) usage_error("no --font given (or --scene)");
-        if (args.fonts.size() > crisp::kMaxRendererFonts) {
-            usage_error("at most " + std::to_string(crisp::kMaxRendererFonts) + " fonts, not " +
+        if (args.fonts.size() > crisp::kMaxSceneFonts) {
+            usage_error("at most " + std::to_string(crisp::kMaxSceneFonts) + " fonts, not " +
                         std::to_string(args.fonts.size()));
         }
         if (!args.text) usage_error("no --text given");

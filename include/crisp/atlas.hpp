@@ -242,6 +242,10 @@ public:
     // schedule() this frame it does nothing.
     void abandon_frame();
 
+    // Evicts every resident entry of `font` (a font the caller no longer draws); call after
+    // begin_frame() and before this frame's acquire()s. A font without entries changes nothing.
+    void evict_font(FontId font);
+
     // Forgets every resident entry's samples (after a subpixel layout change, for example): each
     // restarts its ramp at sample 0, and its next work item clears the rect. Entries stay resident.
     // Work already returned by schedule() this frame stays valid to execute.

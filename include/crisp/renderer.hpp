@@ -39,8 +39,10 @@ namespace crisp {
 inline constexpr uint32_t kCoverageOne = 64;
 // The most samples a texel can hold: 65535 / kCoverageOne.
 inline constexpr uint32_t kMaxRendererSamples = 1023;
-// Fonts one renderer can hold at once.
-inline constexpr uint32_t kMaxRendererFonts = 8;
+// Font pages: fonts' curves and bands are suballocated from at most this many pairs of buffers,
+// each at most maxStorageBufferRange bytes (a new page holds at least 4 MiB of points, 1 MiB of
+// bands, and twice the font that makes it). A renderer holds any number of fonts that fit them.
+inline constexpr uint32_t kRendererFontPages = 8;
 
 struct RendererCreateInfo {
     VkInstance instance = VK_NULL_HANDLE;
@@ -153,7 +155,7 @@ public:
     // Creates the atlas image, buffers and the compute pipeline. Fails with ErrorCode::vulkan when
     // the device is below Vulkan 1.2 or lacks what the rasterizer needs (named in the message:
     // shaderStorageBufferArrayDynamicIndexing, storage images of R16G16B16A16_UINT, subgroup
-    // arithmetic in compute shaders, 1 + 2 * kMaxRendererFonts storage buffers per stage), and with ErrorCode::invalid_argument for a bad atlas config
+    // arithmetic in compute shaders, 1 + 2 * kRendererFontPages storage buffers per stage), and with ErrorCode::invalid_argument for a bad atlas config
     // (see GlyphAtlas::create), max_samples above kMaxRendererSamples, frames_in_flight outside
     // 1..8, or an invalid layout.
     static Result<Renderer> create(const RendererCreateInfo& info);
@@ -166,11 +168,20 @@ public:
     // (e.g. vkDeviceWaitIdle) first.
     ~Renderer();
 
-    // Makes a font drawable. The renderer keeps a pointer: the Font must outlive it. Its curves and
-    // bands are copied to the GPU by the next record(). Errors: invalid_argument when a font with
-    // the same id was added, or kMaxRendererFonts are already held; vulkan when its buffers cannot
-    // be made or exceed maxStorageBufferRange (the message says which).
+    // Makes a font drawable. The renderer keeps a pointer: the Font must outlive it (or its
+    // removal). Its curves and bands get ranges of a font page and are copied to the GPU by the
+    // next record(). Errors: invalid_argument when a font with the same id is held (or removed
+    // but not yet gone: add it after the next begin_frame()), or the font pages have no room for
+    // it; vulkan when its buffers cannot be made or it exceeds maxStorageBufferRange (the message
+    // says which). A failed add_font() changes nothing.
     Status add_font(const Font& font);
+
+    // Removes a font at the next begin_frame(): its atlas entries are evicted, its page ranges
+    // are freed once the frames that may read them are done (frames_in_flight), and its id may be
+    // added again. The frame already drawn or recorded still shows it; from the next one on its
+    // instances count as unknown_fonts. After that begin_frame() the Font may be destroyed.
+    // Errors: invalid_argument for an id not held (or already being removed); nothing changes.
+    Status remove_font(FontId id);
 
     // Replaces the subpixel layout. Every accumulated sample is invalidated: glyphs restart their
     // sample schedule. An invalid layout is refused (invalid_argument) and the old one stays.
