@@ -45,8 +45,8 @@ bool reaches(const GlyphInstance& g, uint32_t width, uint32_t height) {
 }
 
 // Everything a quad's fragments depend on, most significant first: the sort key.
-auto content(const gpu::CompositeQuad& q, uint32_t paint_order) {
-    return std::make_tuple(q.key_depth, ~paint_order, q.y, q.x, q.height, q.width, q.atlas_y, q.atlas_x,
+auto content(const gpu::CompositeQuad& q) {
+    return std::make_tuple(q.key_depth, ~q.rank, q.y, q.x, q.height, q.width, q.atlas_y, q.atlas_x,
                            q.color.w, q.color.x, q.color.y, q.color.z);
 }
 
@@ -54,30 +54,22 @@ auto content(const gpu::CompositeQuad& q, uint32_t paint_order) {
 
 void sort_front_to_back(std::span<const DrawnGlyph> glyphs, uint32_t width, uint32_t height,
                         std::vector<gpu::CompositeQuad>& out) {
+    // Built in `out` itself (the rank holds the paint order), so that a frame allocates nothing
+    // once `out` has grown to the frame's glyphs.
     out.clear();
-    struct Entry {
-        gpu::CompositeQuad quad;
-        uint32_t paint_order;
-    };
-    std::vector<Entry> entries;
-    entries.reserve(glyphs.size());
     for (const DrawnGlyph& glyph : glyphs) {
         if (!reaches(glyph.instance, width, height)) continue;
-        Entry e{make_quad(glyph), glyph.instance.paint_order};
-        e.quad.key_depth = depth_bits(glyph.instance.depth, 32);
-        e.quad.rank = e.paint_order;
-        entries.push_back(e);
+        gpu::CompositeQuad quad = make_quad(glyph);
+        quad.key_depth = depth_bits(glyph.instance.depth, 32);
+        quad.rank = glyph.instance.paint_order;
+        out.push_back(quad);
     }
-    auto front_first = [](const Entry& a, const Entry& b) {
-        return content(a.quad, a.paint_order) < content(b.quad, b.paint_order);
+    auto front_first = [](const gpu::CompositeQuad& a, const gpu::CompositeQuad& b) {
+        return content(a) < content(b);
     };
     // A UI submits runs in paint order at few depths: often already sorted back to front.
-    std::reverse(entries.begin(), entries.end());
-    if (!std::is_sorted(entries.begin(), entries.end(), front_first)) {
-        std::sort(entries.begin(), entries.end(), front_first);
-    }
-    out.reserve(entries.size());
-    for (const Entry& e : entries) out.push_back(e.quad);
+    std::reverse(out.begin(), out.end());
+    if (!std::is_sorted(out.begin(), out.end(), front_first)) std::sort(out.begin(), out.end(), front_first);
 }
 
 uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height) {
