@@ -22,6 +22,8 @@ void main() {
     const CompositeQuad q = quads[index];
     const vec2 corner = vec2(float(gl_VertexIndex & 1), float(gl_VertexIndex >> 1));
     const vec2 p = vec2(q.x, q.y) + corner * vec2(q.width, q.height);
-    gl_Position = vec4(p / vec2(pc.width, pc.height) * 2.0 - 1.0, 0.0, 1.0);
+    // z: the glyph's depth (key_depth is depth * 2^32), which the draw path may test against the
+    // caller's depth attachment; passes without one ignore it.
+    gl_Position = vec4(p / vec2(pc.width, pc.height) * 2.0 - 1.0, float(q.key_depth) * exp2(-32.0), 1.0);
     v_quad = index;
 }

@@ -26,13 +26,21 @@ DrawCompositor::~DrawCompositor() {
 }
 
 Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice physical_device, VkFormat format,
-                              uint32_t frames_in_flight) {
+                              VkFormat depth_format, uint32_t frames_in_flight) {
     ref_ = device;
     VkFormatProperties properties{};
     vkGetPhysicalDeviceFormatProperties(physical_device, format, &properties);
     if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT) == 0) {
         return Error{ErrorCode::vulkan, "compositor: draw_format (VkFormat " + std::to_string(format) +
                                             ") cannot be a blended colour attachment on this device"};
+    }
+    if (depth_format != VK_FORMAT_UNDEFINED) {
+        VkFormatProperties depth{};
+        vkGetPhysicalDeviceFormatProperties(physical_device, depth_format, &depth);
+        if ((depth.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT) == 0) {
+            return Error{ErrorCode::vulkan, "compositor: draw_depth_format (VkFormat " + std::to_string(depth_format) +
+                                                ") cannot be a depth attachment on this device"};
+        }
     }
     // The bindings composite_fragment.glsl declares for a rasterized quad: the atlas and the quads.
     const VkDescriptorSetLayoutBinding bindings[] = {
@@ -59,6 +67,7 @@ Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice phys
     desc.layout = descriptors_.pipeline_layout;
     desc.blend_over = true;
     desc.color_format = format;
+    desc.depth_format = depth_format;
     desc.what = "compositor draw path";
     Result<VkPipeline> pipeline = create_quad_pipeline(ref_, desc);
     if (!pipeline) return pipeline.error();

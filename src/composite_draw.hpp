@@ -22,10 +22,11 @@ public:
     DrawCompositor& operator=(const DrawCompositor&) = delete;
     ~DrawCompositor();
 
-    // The pipeline for colour attachments of `format`. Errors: vulkan when the format cannot be
-    // a blended colour attachment or a call fails.
+    // The pipeline for colour attachments of `format`, depth-tested against a depth attachment
+    // of `depth_format` unless it is VK_FORMAT_UNDEFINED. Errors: vulkan when the format cannot
+    // be a blended colour attachment, the depth format a depth attachment, or a call fails.
     Status create(const vk::DeviceRef& device, VkPhysicalDevice physical_device, VkFormat format,
-                  uint32_t frames_in_flight);
+                  VkFormat depth_format, uint32_t frames_in_flight);
 
     // Records the draws into the active render pass; `quads` sorted front to back for rect's size.
     // Returns the bytes of quads uploaded.

@@ -5,6 +5,11 @@
 
 namespace crisp::composite {
 
+bool has_stencil(VkFormat format) {
+    return format == VK_FORMAT_D16_UNORM_S8_UINT || format == VK_FORMAT_D24_UNORM_S8_UINT ||
+           format == VK_FORMAT_D32_SFLOAT_S8_UINT || format == VK_FORMAT_S8_UINT;
+}
+
 Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadPipeline& desc) {
     VkPipelineShaderStageCreateInfo stages[2]{};
     for (VkPipelineShaderStageCreateInfo& stage : stages) {
@@ -53,10 +58,17 @@ Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadP
     dynamic.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
     dynamic.dynamicStateCount = 2;
     dynamic.pDynamicStates = dynamic_states;
+    VkPipelineDepthStencilStateCreateInfo depth{};
+    depth.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
+    depth.depthTestEnable = desc.depth_format != VK_FORMAT_UNDEFINED;
+    depth.depthWriteEnable = VK_FALSE;  // text covers nothing: the scene's depth stays the scene's
+    depth.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
     VkPipelineRenderingCreateInfo rendering{};
     rendering.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO;
     rendering.colorAttachmentCount = desc.blend_over ? 1 : 0;
     rendering.pColorAttachmentFormats = &desc.color_format;
+    rendering.depthAttachmentFormat = desc.depth_format;
+    if (has_stencil(desc.depth_format)) rendering.stencilAttachmentFormat = desc.depth_format;
 
     VkGraphicsPipelineCreateInfo info{};
     info.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
@@ -69,6 +81,7 @@ Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadP
     info.pRasterizationState = &raster;
     info.pMultisampleState = &multisample;
     info.pColorBlendState = &blend;
+    info.pDepthStencilState = desc.depth_format != VK_FORMAT_UNDEFINED ? &depth : nullptr;
     info.pDynamicState = &dynamic;
     info.layout = desc.layout;
     info.renderPass = desc.render_pass;

@@ -20,10 +20,16 @@ struct QuadPipeline {
     bool blend_over = false;
     VkRenderPass render_pass = VK_NULL_HANDLE;      // or, when null, dynamic rendering into:
     VkFormat color_format = VK_FORMAT_UNDEFINED;  // (with blend_over)
+    // Dynamic rendering only: the pass's depth attachment, which quads are tested against at
+    // their depth (LESS_OR_EQUAL, never written); VK_FORMAT_UNDEFINED: none.
+    VkFormat depth_format = VK_FORMAT_UNDEFINED;
     const char* what = "";                        // for the error message
 };
 
 Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadPipeline& desc);
+
+// True for depth formats with a stencil aspect (a pass with one has a stencil attachment too).
+bool has_stencil(VkFormat format);
 
 // Sets the dynamic viewport and scissor to `rect`.
 void set_viewport(VkCommandBuffer command_buffer, const VkRect2D& rect);

@@ -205,7 +205,8 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     }
     if (info.draw_format != VK_FORMAT_UNDEFINED) {
         state->draw = std::make_unique<composite::DrawCompositor>();
-        if (Status s = state->draw->create(state->ref, info.physical_device, info.draw_format, info.frames_in_flight);
+        if (Status s = state->draw->create(state->ref, info.physical_device, info.draw_format, info.draw_depth_format,
+                                           info.frames_in_flight);
             !s) {
             return s.error();
         }

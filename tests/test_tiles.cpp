@@ -340,6 +340,140 @@ TEST(TileCompositor, DrawPathMatchesTheCpuComputationPerChannel) {
     expect_no_validation_messages();
 }
 
+// A depth attachment of the test's own (D32_SFLOAT), in DEPTH_ATTACHMENT_OPTIMAL after create().
+struct DepthImage {
+    VkDevice device = VK_NULL_HANDLE;
+    VkImage image = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+    ~DepthImage() {
+        if (view) vkDestroyImageView(device, view, nullptr);
+        if (image) vkDestroyImage(device, image, nullptr);
+        if (memory) vkFreeMemory(device, memory, nullptr);
+    }
+    bool create(HeadlessContext& context, uint32_t width, uint32_t height) {
+        device = context.device();
+        VkImageCreateInfo info{};
+        info.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+        info.imageType = VK_IMAGE_TYPE_2D;
+        info.format = VK_FORMAT_D32_SFLOAT;
+        info.extent = {width, height, 1};
+        info.mipLevels = info.arrayLayers = 1;
+        info.samples = VK_SAMPLE_COUNT_1_BIT;
+        info.tiling = VK_IMAGE_TILING_OPTIMAL;
+        info.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+        if (vkCreateImage(device, &info, nullptr, &image) != VK_SUCCESS) return false;
+        VkMemoryRequirements needs{};
+        vkGetImageMemoryRequirements(device, image, &needs);
+        VkPhysicalDeviceMemoryProperties memory_properties{};
+        vkGetPhysicalDeviceMemoryProperties(context.physical_device(), &memory_properties);
+        VkMemoryAllocateInfo allocate{};
+        allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+        allocate.allocationSize = needs.size;
+        allocate.memoryTypeIndex = static_cast<uint32_t>(std::countr_zero(needs.memoryTypeBits));
+        if (vkAllocateMemory(device, &allocate, nullptr, &memory) != VK_SUCCESS) return false;
+        if (vkBindImageMemory(device, image, memory, 0) != VK_SUCCESS) return false;
+        VkImageViewCreateInfo view_info{};
+        view_info.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+        view_info.image = image;
+        view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
+        view_info.format = info.format;
+        view_info.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+        if (vkCreateImageView(device, &view_info, nullptr, &view) != VK_SUCCESS) return false;
+        return static_cast<bool>(context.submit_and_wait([&](VkCommandBuffer cb) {
+            VkImageMemoryBarrier barrier{};
+            barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+            barrier.dstAccessMask =
+                VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+            barrier.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+            barrier.newLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+            barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            barrier.image = image;
+            barrier.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+            vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT, 0,
+                                 0, nullptr, 0, nullptr, 1, &barrier);
+        }));
+    }
+};
+
+// World-space text among the caller's geometry: with draw_depth_format, glyphs behind the
+// depth attachment's surface are hidden and the others drawn as without it, bit for bit.
+TEST(TileCompositor, DrawPathTestsGlyphsAgainstTheCallersDepth) {
+    const Scene scene = render_scene(overlapping_runs(0.7f));
+    constexpr VkFormat kFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+    constexpr float kWall = 0.45f;  // the surface's depth over the left half
+    std::vector<DrawnGlyph> nearer;
+    for (const DrawnGlyph& g : scene.drawn) {
+        if (g.instance.depth <= kWall) nearer.push_back(g);
+    }
+    ASSERT_FALSE(nearer.empty());
+    ASSERT_LT(nearer.size(), scene.drawn.size());
+    CompositorCreateInfo plain_info = tile_info();
+    plain_info.draw_format = kFormat;
+    auto plain = Compositor::create(plain_info);
+    ASSERT_TRUE(plain) << plain.error().message;
+    CompositorCreateInfo depth_info = plain_info;
+    depth_info.draw_depth_format = VK_FORMAT_D32_SFLOAT;
+    auto tested = Compositor::create(depth_info);
+    ASSERT_TRUE(tested) << tested.error().message;
+
+    Target all = make_target(kFormat, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
+    composite_draw(*plain, scene, scene.drawn, all);
+    Target near_only = make_target(kFormat, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
+    composite_draw(*plain, scene, nearer, near_only);
+    Target walled = make_target(kFormat, kWidth, kHeight, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
+    DepthImage depth;
+    ASSERT_TRUE(depth.create(*fixture().context, kWidth, kHeight));
+    const uint32_t half = kWidth / 2;
+    EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
+        VkRenderingAttachmentInfo color{};
+        color.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+        color.imageView = walled.image.view();
+        color.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+        color.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+        color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        VkRenderingAttachmentInfo depth_attachment{};
+        depth_attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+        depth_attachment.imageView = depth.view;
+        depth_attachment.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        depth_attachment.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        depth_attachment.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+        depth_attachment.clearValue.depthStencil = {1.0f, 0};
+        VkRenderingInfo rendering{};
+        rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+        rendering.renderArea = {{0, 0}, {kWidth, kHeight}};
+        rendering.layerCount = 1;
+        rendering.colorAttachmentCount = 1;
+        rendering.pColorAttachments = &color;
+        rendering.pDepthAttachment = &depth_attachment;
+        vkCmdBeginRendering(cb, &rendering);
+        // The wall: the left half's depth.
+        VkClearAttachment clear{};
+        clear.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
+        clear.clearValue.depthStencil = {kWall, 0};
+        const VkClearRect rect{{{0, 0}, {half, kHeight}}, 0, 1};
+        vkCmdClearAttachments(cb, 1, &clear, 1, &rect);
+        const Status s = tested->record_draw(cb, scene.drawn, scene.renderer->atlas_view(), {{0, 0}, {kWidth, kHeight}});
+        EXPECT_TRUE(s) << (s ? "" : s.error().message);
+        vkCmdEndRendering(cb);
+    }));
+    const std::vector<std::byte> got = read_target(walled), want_left = read_target(near_only),
+                                 want_right = read_target(all);
+    const size_t row = size_t{kWidth} * format_texel_size(kFormat), split = size_t{half} * format_texel_size(kFormat);
+    size_t hidden = 0;  // left-half texels where the wall hid something
+    for (uint32_t y = 0; y < kHeight; ++y) {
+        const size_t at = y * row;
+        EXPECT_EQ(std::memcmp(&got[at], &want_left[at], split), 0) << "row " << y << ", left of the wall's edge";
+        EXPECT_EQ(std::memcmp(&got[at + split], &want_right[at + split], row - split), 0) << "row " << y;
+        hidden += std::memcmp(&want_left[at], &want_right[at], split) != 0;
+    }
+    EXPECT_GT(hidden, 0u);  // the wall did hide glyphs
+    // A format that cannot be a depth attachment is refused.
+    depth_info.draw_depth_format = VK_FORMAT_R8G8B8A8_UNORM;
+    EXPECT_FALSE(Compositor::create(depth_info));
+    expect_no_validation_messages();
+}
+
 // Every target format of both paths: the image does not depend on the submission order.
 TEST(TileCompositor, ShuffledSubmissionGivesBitIdenticalImages) {
     const Scene scene = render_scene(overlapping_runs(0.6f));

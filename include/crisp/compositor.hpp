@@ -101,6 +101,13 @@ struct CompositorCreateInfo {
     // dynamicRendering and dualSrcBlend, and the format must blend. Blending is linear only where the format
     // is _SRGB or floating point.
     VkFormat draw_format = VK_FORMAT_UNDEFINED;
+    // The depth attachment format of that render pass, for world-space text among the caller's
+    // geometry: each glyph is depth-tested at its depth (GlyphInstance::depth, e.g. from
+    // depth_from_view_projection()) against the pass's depth attachment, LESS_OR_EQUAL, and never
+    // writes it, so a label behind a wall is hidden by the wall. VK_FORMAT_UNDEFINED (the
+    // default): the pass has no depth attachment and text is drawn over everything. A format
+    // that cannot be a depth attachment is refused (vulkan).
+    VkFormat draw_depth_format = VK_FORMAT_UNDEFINED;
 
     // ---- The reference modes (record_reference()): off unless asked for, since they hold
     // per-pixel buffers over the whole target (36 bytes a pixel, and the exact node pool).
