@@ -146,6 +146,40 @@ Result<GlyphAtlas> GlyphAtlas::create(const AtlasConfig& config) {
     return atlas;
 }
 
+bool GlyphAtlas::grow() {
+    if (config_.width * 2 > kAtlasMaxSize || config_.height * 2 > kAtlasMaxSize) return false;
+    const std::vector<uint64_t> old_permanent = permanent_words_;
+    std::vector<uint64_t> old_used = used_words_, old_pinned = pinned_words_;
+    config_.width *= 2;
+    config_.height *= 2;
+    cells_x_ *= 2;
+    cells_y_ *= 2;
+    usable_cells_ = cells_x_ * cells_y_;
+    // The new index space's cells outside the atlas (non-square or tiny atlases), as create() finds them.
+    const uint32_t side = std::max(cells_x_, cells_y_);
+    const uint32_t index_count = side * side;
+    const uint32_t word_count = (index_count + 63) / 64;
+    permanent_words_.assign(word_count, 0);
+    if (cells_x_ != cells_y_) {
+        for (uint32_t i = 0; i < index_count; ++i) {
+            const CellCoord cell = n_order_decode(i);
+            if (cell.x >= cells_x_ || cell.y >= cells_y_) permanent_words_[i / 64] |= uint64_t{1} << (i % 64);
+        }
+    }
+    if (index_count % 64 != 0) permanent_words_.back() |= kFullWord << (index_count % 64);
+    // The old cells keep their state: what entries own or pin, without the old outside bits.
+    used_words_ = permanent_words_;
+    pinned_words_ = permanent_words_;
+    for (size_t w = 0; w < old_permanent.size(); ++w) {
+        used_words_[w] |= old_used[w] & ~old_permanent[w];
+        pinned_words_[w] |= old_pinned[w] & ~old_permanent[w];
+    }
+    first_free_word_ = 0;
+    while (first_free_word_ < word_count && used_words_[first_free_word_] == kFullWord) ++first_free_word_;
+    block_used_.clear();
+    return true;
+}
+
 void GlyphAtlas::begin_frame() {
     ++frame_;
     pinned_words_ = permanent_words_;

@@ -110,7 +110,15 @@ struct Renderer::State {
     SubpixelLayout layout;
 
     vk::DeviceImage atlas_image;
+    uint32_t image_width = 0, image_height = 0;  // atlas_image's size (the atlas's, once grown)
     bool atlas_initialized = false;
+    uint64_t atlas_budget = 0;  // bytes the atlas image may grow to
+    uint32_t max_image_side = 0;
+    struct RetiredImage {
+        vk::DeviceImage image;
+        uint64_t frame = 0;
+    };
+    std::vector<RetiredImage> retired_images;  // smaller atlas images, until the GPU is done
 
     GpuBuffer items;  // device-local, RasterItem[usable cells]
     uint32_t item_capacity = 0;
@@ -150,6 +158,10 @@ struct Renderer::State {
     struct Undo {
         bool recorded = false;
         bool atlas_was_initialized = false;
+        // The atlas image this frame replaced by a larger one (its copy is in the dropped commands).
+        bool grew_image = false;
+        vk::DeviceImage old_image;
+        uint32_t old_width = 0, old_height = 0;
         std::vector<uint32_t> uploaded_fonts;  // slots whose staging went to `retired` this frame
         // The named draws this frame changed, as they were before it (nullopt: new this frame).
         std::vector<std::pair<uint64_t, std::optional<Motion>>> motions;
@@ -303,24 +315,34 @@ struct Renderer::State {
     // for a while. A visible glyph is dropped only when even whole-pixel positions do not fit.
     void settle_requests() {
         acquire_clipped();
-        while (atlas_full > 0 && level + 1 < kLevelSteps.size()) {
-            if (just_refined) calm_needed = std::min(calm_needed * 2, kMaxCalmFrames);  // it did not fit
-            just_refined = false;
-            ++level;
-            calm_frames = 0;
+        while (atlas_full > 0) {
+            if (can_grow()) {
+                atlas.grow();  // record() makes the larger image and copies the old one into it
+                ++stats.atlas_grown;
+            } else if (level + 1 < kLevelSteps.size()) {
+                if (just_refined) calm_needed = std::min(calm_needed * 2, kMaxCalmFrames);  // it did not fit
+                just_refined = false;
+                ++level;
+                calm_frames = 0;
+            } else {
+                break;
+            }
             atlas.begin_frame();
             pending.clear();
             clipped.clear();
             // The requests count again; what draw() counted before them stays.
-            const uint32_t moving = stats.moving_glyphs;
+            const uint32_t moving = stats.moving_glyphs, grown = stats.atlas_grown;
             stats = {};
             stats.moving_glyphs = moving;
+            stats.atlas_grown = grown;
             stats.skipped_glyphs = unplaceable;
             atlas_full = 0;
             for (const Request& r : requests) request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps);
             acquire_clipped();
         }
         stats.subpixel_steps = kLevelSteps[level];
+        stats.atlas_width = atlas.config().width;
+        stats.atlas_height = atlas.config().height;
         just_refined = false;
         const AtlasStats now = atlas.stats();
         if (level > 0 && atlas_full == 0 && now.pinned_cells < now.usable_cells / 4 && ++calm_frames >= calm_needed) {
@@ -385,6 +407,14 @@ struct Renderer::State {
         return m.moved != 0 && frames_begun - m.moved < kMotionSettleFrames;
     }
 
+    // Whether the atlas may double within the budget and the device's image size.
+    bool can_grow() const {
+        const uint64_t width = uint64_t{atlas.config().width} * 2, height = uint64_t{atlas.config().height} * 2;
+        return width <= std::min<uint64_t>(max_image_side, kAtlasMaxSize) &&
+               height <= std::min<uint64_t>(max_image_side, kAtlasMaxSize) &&
+               width * height * sizeof(uint16_t) * 4 <= atlas_budget;
+    }
+
     // Acquires the glyphs drawn in part, each glyph once for the bounding box of its parts.
     void acquire_clipped() {
         if (clipped.empty()) return;
@@ -411,11 +441,19 @@ struct Renderer::State {
     void write_descriptors(VkDescriptorSet set);
     Status place_font(GpuFont& font);
     void apply_removals();
+    Status grow_image(VkCommandBuffer command_buffer, uint64_t this_frame);
+    Status make_atlas_image(const AtlasConfig& config, vk::DeviceImage& out) {
+        return vk::create_image(ref, kAtlasFormat, config.width, config.height,
+                                VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                    VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                "atlas", out);
+    }
 };
 
 Renderer::State::~State() {
     if (!device) return;
     for (Retired& r : retired) free_buffer(r.buffer);
+    for (RetiredImage& r : retired_images) vk::destroy_image(ref, r.image);
     for (GpuFont& font : fonts) free_buffer(font.staging);
     for (FontPage& page : pages) {
         free_buffer(page.points);
@@ -441,13 +479,9 @@ void Renderer::State::free_buffer(GpuBuffer& buffer) {
 Status Renderer::State::create_objects() {
     // The atlas image.
     const AtlasConfig& config = atlas.config();
-    if (Status s = vk::create_image(ref, kAtlasFormat, config.width, config.height,
-                                    VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                    "atlas", atlas_image);
-        !s) {
-        return s;
-    }
+    if (Status s = make_atlas_image(config, atlas_image); !s) return s;
+    image_width = config.width;
+    image_height = config.height;
 
     // Work items: an entry takes at least one cell, so a frame never has more items than cells.
     item_capacity = atlas.stats().usable_cells;
@@ -579,6 +613,8 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     state->frames_in_flight = info.frames_in_flight;
     state->shared_row_roots = info.shared_row_roots;
     state->max_storage_buffer_range = properties.limits.maxStorageBufferRange;
+    state->max_image_side = properties.limits.maxImageDimension2D;
+    state->atlas_budget = info.atlas_memory_budget;
     state->ref = vk::make_device_ref(info.physical_device, info.device, info.allocator, info.pipeline_cache);
     state->layout = std::move(layout);
     if (Status s = state->create_objects(); !s) return s.error();
@@ -589,6 +625,57 @@ Renderer::Renderer(std::unique_ptr<State> state) : state_(std::move(state)) {}
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 Renderer::~Renderer() = default;
+
+// The atlas grew (GlyphAtlas::grow): a larger image takes the old one's texels at its top-left,
+// and the old one is freed once the frames that read it are done. The work items grow with it.
+Status Renderer::State::grow_image(VkCommandBuffer command_buffer, uint64_t this_frame) {
+    const AtlasConfig& config = atlas.config();
+    vk::DeviceImage grown;
+    if (Status s = make_atlas_image(config, grown); !s) return s;
+    const uint32_t cells = atlas.stats().usable_cells;
+    if (cells > item_capacity) {
+        GpuBuffer more;
+        if (Status s = make_buffer(VkDeviceSize{cells} * sizeof(gpu::RasterItem),
+                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false,
+                                   "work items", more);
+            !s) {
+            vk::destroy_image(ref, grown);
+            return s;
+        }
+        retired.push_back({items, this_frame});
+        items = more;
+        item_capacity = cells;
+    }
+    if (atlas_initialized) {
+        // Earlier frames' writes (and the compositor's reads) before the copy; the copy before
+        // this frame's dispatch and every later read.
+        vk::image_barrier(command_buffer, atlas_image.image, VK_IMAGE_LAYOUT_GENERAL,
+                          VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                          VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+        vk::image_barrier(command_buffer, grown.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                          VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                          VK_ACCESS_TRANSFER_WRITE_BIT);
+        VkImageCopy region{};
+        region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.dstSubresource = region.srcSubresource;
+        region.extent = {image_width, image_height, 1};
+        vkCmdCopyImage(command_buffer, atlas_image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, grown.image,
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        vk::image_barrier(command_buffer, grown.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+                          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);
+    }
+    undo.grew_image = true;
+    undo.old_image = atlas_image;
+    undo.old_width = image_width;
+    undo.old_height = image_height;
+    retired_images.push_back({atlas_image, this_frame});
+    atlas_image = grown;
+    image_width = config.width;
+    image_height = config.height;
+    return {};
+}
 
 // Finds `font` its ranges in a page with room, or in a new page.
 Status Renderer::State::place_font(GpuFont& font) {
@@ -716,6 +803,17 @@ void Renderer::abandon_frame() {
     if (!s.undo.recorded) return;
     s.undo.recorded = false;
     s.atlas.abandon_frame();
+    if (s.undo.grew_image) {
+        // The copy into the larger image never ran: the old image comes back, and the next
+        // record() grows it again. (The larger image was only in the dropped commands.)
+        vk::destroy_image(s.ref, s.atlas_image);
+        s.atlas_image = s.undo.old_image;
+        s.image_width = s.undo.old_width;
+        s.image_height = s.undo.old_height;
+        std::erase_if(s.retired_images,
+                      [&](const State::RetiredImage& r) { return r.image.image == s.undo.old_image.image; });
+        s.undo.grew_image = false;
+    }
     s.atlas_initialized = s.undo.atlas_was_initialized;
     // Motion and the subpixel-step level go back to what they were, as if the frame never began.
     for (auto it = s.undo.motions.rbegin(); it != s.undo.motions.rend(); ++it) {
@@ -857,6 +955,11 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         s.free_buffer(r.buffer);
         return true;
     });
+    std::erase_if(s.retired_images, [&](State::RetiredImage& r) {
+        if (r.frame + s.frames_in_flight > frame) return false;
+        vk::destroy_image(s.ref, r.image);
+        return true;
+    });
     std::erase_if(s.retired_ranges, [&](const RetiredRanges& r) {
         if (r.frame + s.frames_in_flight > frame) return false;
         give_range(s.pages[r.page].used_points, r.points.offset, r.points.size);
@@ -884,6 +987,10 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         uploaded = true;
     }
 
+    s.undo.grew_image = false;
+    if (s.atlas.config().width != s.image_width || s.atlas.config().height != s.image_height) {
+        if (Status grown = s.grow_image(command_buffer, frame); !grown) return grown;
+    }
     if (!s.atlas_initialized) {
         vk::image_barrier(command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
                           VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);

@@ -10,6 +10,7 @@
 #include <map>
 #include <numeric>
 #include <random>
+#include <set>
 #include <span>
 #include <utility>
 #include <vector>
@@ -913,6 +914,53 @@ TEST(Atlas, StatusNames) {
     EXPECT_STREQ(atlas_status_name(AtlasStatus::empty), "empty");
     EXPECT_STREQ(atlas_status_name(AtlasStatus::atlas_full), "atlas_full");
     EXPECT_STREQ(atlas_status_name(AtlasStatus::too_large), "too_large");
+}
+
+// grow() doubles the atlas and keeps every entry where it was; the new three quarters are free
+// (square, wide and tiny atlases, whose index spaces have cells outside the atlas).
+TEST(Atlas, GrowingKeepsEveryEntryInPlace) {
+    for (auto [width, height] : {std::pair{64u, 64u}, {128u, 32u}, {16u, 16u}}) {
+        SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height));
+        GlyphAtlas atlas = make_atlas(width, height);
+        std::vector<AtlasLookup> placed;
+        uint32_t glyph = 0;
+        for (;; ++glyph) {
+            const AtlasLookup lookup = atlas.acquire(key_of(glyph), 14, 14, 100);  // one cell each
+            if (lookup.status != AtlasStatus::placed) {
+                EXPECT_EQ(lookup.status, AtlasStatus::atlas_full);
+                break;
+            }
+            placed.push_back(lookup);
+        }
+        const uint32_t cells = atlas.stats().usable_cells;
+        EXPECT_EQ(placed.size(), cells);
+        ASSERT_TRUE(atlas.grow());
+        EXPECT_EQ(atlas.config().width, 2 * width);
+        EXPECT_EQ(atlas.config().height, 2 * height);
+        EXPECT_EQ(atlas.stats().usable_cells, 4 * cells);
+        EXPECT_EQ(atlas.stats().used_cells, cells);
+        EXPECT_EQ(atlas.stats().pinned_cells, cells);  // still pinned this frame
+        for (const AtlasLookup& before : placed) {
+            const AtlasEntry* entry = atlas.entry(before.entry);
+            ASSERT_NE(entry, nullptr);
+            EXPECT_EQ(entry->x, before.x);
+            EXPECT_EQ(entry->y, before.y);
+        }
+        // Three times as many again fit, in the new cells only, never overlapping.
+        std::set<std::pair<uint32_t, uint32_t>> taken;
+        for (const AtlasLookup& p : placed) taken.insert({p.x, p.y});
+        for (uint32_t more = 0; more < 3 * cells; ++more) {
+            const AtlasLookup lookup = atlas.acquire(key_of(glyph + more), 14, 14, 100);
+            ASSERT_EQ(lookup.status, AtlasStatus::placed) << more;
+            EXPECT_LT(lookup.x, 2 * width);
+            EXPECT_LT(lookup.y, 2 * height);
+            EXPECT_TRUE(taken.insert({lookup.x, lookup.y}).second) << "overlap at " << lookup.x << "," << lookup.y;
+        }
+        EXPECT_EQ(atlas.acquire(key_of(glyph + 3 * cells), 14, 14, 100).status, AtlasStatus::atlas_full);
+    }
+    GlyphAtlas largest = make_atlas(kAtlasMaxSize, kAtlasMaxSize / 2);
+    EXPECT_FALSE(largest.grow());
+    EXPECT_EQ(largest.config().width, kAtlasMaxSize);
 }
 
 }  // namespace

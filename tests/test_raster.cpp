@@ -155,6 +155,24 @@ Result<Renderer> make_renderer(const SubpixelLayout& layout, uint32_t samples) {
     return Renderer::create(info);
 }
 
+// Six lines of 11 px "Hg@&1Hg", each at its own subpixel offset: more keys than a 64 x 64
+// atlas's 16 cells hold.
+std::vector<GlyphInstance> six_lines_of_small_text() {
+    const Font* fonts[] = {fixture().font.get()};
+    std::vector<GlyphInstance> glyphs;
+    for (int line = 0; line < 6; ++line) {
+        TextStyle style;
+        style.size = 11.0f;
+        LayoutOptions options;
+        options.origin_x = 1.0f + 0.137f * static_cast<float>(line);
+        options.origin_y = 12.0f + 13.29f * static_cast<float>(line);
+        auto layout = layout_text(fonts, "Hg@&1Hg", style, options);
+        EXPECT_TRUE(layout);
+        if (layout) glyphs.insert(glyphs.end(), layout->glyphs.begin(), layout->glyphs.end());
+    }
+    return glyphs;
+}
+
 void expect_no_validation_messages() {
     const ValidationMessages messages = fixture().context->validation_messages();
     EXPECT_EQ(messages.errors + messages.warnings, 0u);
@@ -485,18 +503,8 @@ TEST(Raster, AFullAtlasDrawsGlyphsCoarserRatherThanDroppingThem) {
     auto renderer = Renderer::create(info);
     ASSERT_TRUE(renderer);
     ASSERT_TRUE(renderer->add_font(*f.font));
-    const Font* fonts[] = {f.font.get()};
-    std::vector<GlyphInstance> glyphs;
-    for (int line = 0; line < 6; ++line) {
-        TextStyle style;
-        style.size = 11.0f;
-        LayoutOptions options;
-        options.origin_x = 1.0f + 0.137f * static_cast<float>(line);
-        options.origin_y = 12.0f + 13.29f * static_cast<float>(line);
-        auto layout = layout_text(fonts, "Hg@&1Hg", style, options);
-        ASSERT_TRUE(layout);
-        glyphs.insert(glyphs.end(), layout->glyphs.begin(), layout->glyphs.end());
-    }
+    const std::vector<GlyphInstance> glyphs = six_lines_of_small_text();
+    ASSERT_EQ(glyphs.size(), 42u);
     std::set<GlyphKey, bool (*)(const GlyphKey&, const GlyphKey&)> keys([](const GlyphKey& a, const GlyphKey& b) {
         return std::tie(a.glyph, a.subpixel_x, a.subpixel_y) < std::tie(b.glyph, b.subpixel_x, b.subpixel_y);
     });
@@ -837,6 +845,58 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
     const Comparison result = compare(*renderer, texels, kSamples, fonts[2].get());
     EXPECT_GT(result.covered, 0u);
     EXPECT_EQ(result.unexplained, 0u);
+    expect_no_validation_messages();
+}
+
+// With a memory budget, an atlas too small for the frame's glyphs grows (its image copied into a
+// larger one) rather than coarsening them; glyphs that had converged before keep their samples
+// through the copy, and a dropped growth frame is grown again by the next one.
+TEST(Raster, AnAtlasWithABudgetGrowsInsteadOfCoarsening) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    HeadlessContext& context = *f.context;
+    constexpr uint32_t kSamples = 8;
+    RendererCreateInfo info = renderer_create_info(context);
+    info.atlas.width = info.atlas.height = 64;  // 16 cells
+    info.atlas.max_samples = kSamples;
+    info.atlas_memory_budget = 128 * 128 * 8;  // one doubling
+    auto renderer = Renderer::create(info);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*f.font));
+    const std::vector<GlyphInstance> glyphs = six_lines_of_small_text();
+    ASSERT_EQ(glyphs.size(), 42u);
+    // The first line fits the small atlas and converges there.
+    const std::span<const GlyphInstance> first_line(glyphs.data(), 7);
+    uint32_t frames = 0;
+    render(*renderer, frames, 100, [&] { renderer->draw(first_line); }, [] {});
+    ASSERT_TRUE(renderer->converged());
+    EXPECT_EQ(renderer->stats().atlas_width, 64u);
+
+    // All six lines: the frame that grows the atlas is dropped once, then submitted.
+    test::UnsubmittedCommandBuffer dropped(context);
+    ASSERT_TRUE(dropped.ok());
+    renderer->begin_frame();
+    renderer->draw(glyphs);
+    EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
+    EXPECT_EQ(renderer->stats().atlas_grown, 1u);
+    renderer->abandon_frame();
+    renderer->begin_frame();
+    renderer->draw(glyphs);
+    ASSERT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    const RendererStats& grown = renderer->stats();
+    EXPECT_EQ(grown.atlas_grown, 0u);  // the atlas grew in the dropped frame; this one made the image
+    EXPECT_EQ(grown.atlas_width, 128u);
+    EXPECT_EQ(grown.atlas_height, 128u);
+    EXPECT_EQ(grown.subpixel_steps, kSubpixelSteps);
+    EXPECT_EQ(grown.coarsened_glyphs, 0u);
+    EXPECT_EQ(grown.failed_glyphs, 0u);
+    EXPECT_EQ(renderer->drawn().size(), glyphs.size());
+    const std::vector<Texel> texels = render(*renderer, frames, 100, [&] { renderer->draw(glyphs); }, [] {});
+    ASSERT_TRUE(renderer->converged());
+    EXPECT_EQ(renderer->atlas().config().width, 128u);
+    const Comparison result = compare(*renderer, texels, kSamples);
+    EXPECT_GT(result.covered, 0u);
+    EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
     expect_no_validation_messages();
 }
 

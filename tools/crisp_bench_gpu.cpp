@@ -27,6 +27,7 @@ struct Args {
     uint32_t width = 1920, height = 1080;
     uint32_t samples = 512;
     uint32_t max_frames = 1000;
+    uint32_t atlas_budget_mib = 0;  // 0: the atlas keeps its 2048x2048
     bool no_shared_rows = false;
     bool validate = false;
 };
@@ -42,6 +43,7 @@ struct Args {
                  "  --layout NAME      subpixel layout preset or file (default rgb)\n"
                  "  --samples N        samples per glyph to converge to (default 512)\n"
                  "  --frames N         stop after N frames even if not converged (default 1000)\n"
+                 "  --atlas-budget MIB let the 2048x2048 atlas grow to MIB mebibytes (default 0: it does not)\n"
                  "  --no-shared-rows   solve roots per channel even where channels share rows\n"
                  "  --device TEXT      pick a device whose name contains TEXT\n"
                  "  --validate         turn the validation layer on\n"
@@ -79,6 +81,8 @@ Args parse(int argc, char** argv) {
             args.samples = number<uint32_t>(value());
         else if (arg == "--frames")
             args.max_frames = number<uint32_t>(value());
+        else if (arg == "--atlas-budget")
+            args.atlas_budget_mib = number<uint32_t>(value());
         else if (arg == "--device")
             args.device = value();
         else if (arg == "--no-shared-rows")
@@ -131,6 +135,7 @@ int main(int argc, char** argv) {
     info.atlas.max_samples = args.samples;
     info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: the benchmark measures raw throughput
     info.layout = *layout;
+    info.atlas_memory_budget = uint64_t{args.atlas_budget_mib} << 20;
     info.shared_row_roots = !args.no_shared_rows;
     auto renderer = crisp::Renderer::create(info);
     if (!renderer) fail(renderer.error().message);

@@ -242,6 +242,13 @@ public:
     // schedule() this frame it does nothing.
     void abandon_frame();
 
+    // Doubles the atlas on both axes, keeping every entry where it is: entries are placed in
+    // N-order over the cell grid, so the old grid is the first quarter of the new one's index
+    // space and the new cells are free. The caller copies the old image into the top-left of an
+    // image of the new config().width x height. False (nothing changes) when a side would pass
+    // kAtlasMaxSize. May be called at any time; entries pinned and work scheduled stay valid.
+    bool grow();
+
     // Evicts every resident entry of `font` (a font the caller no longer draws); call after
     // begin_frame() and before this frame's acquire()s. A font without entries changes nothing.
     void evict_font(FontId font);

@@ -62,6 +62,12 @@ struct RendererCreateInfo {
     VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
     uint32_t frames_in_flight = 2;  // 1 to 8
     AtlasConfig atlas;              // max_samples at most kMaxRendererSamples
+    // Bytes the atlas image may grow to (8 a texel). When a frame's glyphs do not fit, the atlas
+    // doubles on both axes (entries keep their places; the image is copied into a larger one),
+    // while the larger image fits this budget and the device's maxImageDimension2D; past it,
+    // glyphs take coarser subpixel steps (RendererStats::subpixel_steps). 0, or less than twice
+    // the initial size: the atlas never grows. The atlas never shrinks.
+    uint64_t atlas_memory_budget = 0;
     SubpixelLayout layout;          // default: rgb
     // Where the three channels sample the same rows (stripe layouts), solve each curve's roots
     // once for all three. Off only to measure what it saves.
@@ -138,6 +144,11 @@ struct RendererStats {
     // the atlas for 120 frames (twice as long each time the finer steps then did not fit, up to
     // 7680 frames).
     uint32_t subpixel_steps = kSubpixelSteps;
+    // The atlas's size after this frame, and how many times it doubled this frame to hold the
+    // frame's glyphs (RendererCreateInfo::atlas_memory_budget).
+    uint32_t atlas_width = 0;
+    uint32_t atlas_height = 0;
+    uint32_t atlas_grown = 0;
     uint32_t moving_glyphs = 0;   // instances of moving named draws (DrawOptions::id), at kMovingSubpixelSteps
     uint32_t unknown_fonts = 0;   // instances whose FontId was never added
     uint32_t culled_glyphs = 0;   // instances wholly outside draw()'s visible rect
