@@ -173,6 +173,27 @@ std::vector<GlyphInstance> six_lines_of_small_text() {
     return glyphs;
 }
 
+// `text` in the fixture's font at `size` px, its first pen at (x, y); empty where layout fails
+// (the caller's checks then fail).
+TextLayout fixture_layout(std::string_view text, float size, float x, float y) {
+    const Font* fonts[] = {fixture().font.get()};
+    TextStyle style;
+    style.size = size;
+    auto layout = layout_text(fonts, text, style, LayoutOptions{.origin_x = x, .origin_y = y});
+    EXPECT_TRUE(layout);
+    return layout ? std::move(*layout) : TextLayout{};
+}
+
+// Every drawn glyph's texels equal the reference (but where a sample lies on the outline), and
+// some texel holds ink. Returns the comparison for further checks.
+Comparison expect_matches_reference(const Renderer& renderer, const std::vector<Texel>& texels, uint32_t samples,
+                                    const Font* font = nullptr) {
+    const Comparison result = compare(renderer, texels, samples, font);
+    EXPECT_GT(result.covered, 0u);
+    EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
+    return result;
+}
+
 void expect_no_validation_messages() {
     const ValidationMessages messages = fixture().context->validation_messages();
     EXPECT_EQ(messages.errors + messages.warnings, 0u);
@@ -202,9 +223,7 @@ TEST_P(RasterMatchesReference, TexelByTexel) {
     const std::vector<Texel> texels = render(*renderer, *layout, frames);
     EXPECT_TRUE(renderer->converged());
     EXPECT_GE(frames, 4u);  // 8 + 4 + 2 + 1 + ... to 24
-    const Comparison result = compare(*renderer, texels, kSamples);
-    EXPECT_GT(result.covered, 0u);
-    EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
+    const Comparison result = expect_matches_reference(*renderer, texels, kSamples);
     EXPECT_LT(static_cast<double>(result.mismatched), 0.02 * static_cast<double>(result.texels));
     expect_no_validation_messages();
 }
@@ -354,9 +373,7 @@ TEST(Raster, AGlyphDearerThanTheBudgetIsSplitAcrossFrames) {
     EXPECT_GE(frames, 4u * 6u);
     EXPECT_LE(frames, 4u * 7u);
     EXPECT_GE(pieces, frames);  // a piece or two every frame
-    const Comparison result = compare(*renderer, texels, kSamples, &*font);
-    EXPECT_GT(result.covered, 0u);
-    EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
+    expect_matches_reference(*renderer, texels, kSamples, &*font);
     expect_no_validation_messages();
 }
 
@@ -562,20 +579,10 @@ TEST(Raster, DrawOptionsMoveRecolourAndSetDepthWithoutALayout) {
     auto renderer = make_renderer(*subpixel_preset("rgb"), 8);
     ASSERT_TRUE(renderer);
     ASSERT_TRUE(renderer->add_font(*f.font));
-    const Font* fonts[] = {f.font.get()};
-    TextStyle style;
-    style.size = 13.0f;
-    LayoutOptions at_origin;
-    at_origin.origin_x = 5.0f;
-    at_origin.origin_y = 20.0f;
-    auto layout = layout_text(fonts, "Hg@&1", style, at_origin);
-    ASSERT_TRUE(layout);
+    const TextLayout layout = fixture_layout("Hg@&1", 13.0f, 5.0f, 20.0f);
     // The same text laid out where the offset puts it (offsets exact in binary).
-    LayoutOptions moved_origin = at_origin;
-    moved_origin.origin_x += 3.25f;
-    moved_origin.origin_y += 0.5f;
-    auto moved = layout_text(fonts, "Hg@&1", style, moved_origin);
-    ASSERT_TRUE(moved);
+    const TextLayout moved = fixture_layout("Hg@&1", 13.0f, 5.0f + 3.25f, 20.0f + 0.5f);
+    ASSERT_FALSE(moved.glyphs.empty());
 
     DrawOptions options;
     options.offset_x = 3.25f;
@@ -583,11 +590,11 @@ TEST(Raster, DrawOptionsMoveRecolourAndSetDepthWithoutALayout) {
     options.color = std::array<float, 4>{1.0f, 0.5f, std::nanf(""), 2.0f};
     options.depth = 0.25f;
     renderer->begin_frame();
-    renderer->draw(layout->glyphs, options);
+    renderer->draw(layout.glyphs, options);
     ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
-    ASSERT_EQ(renderer->drawn().size(), moved->glyphs.size());
-    for (size_t i = 0; i < moved->glyphs.size(); ++i) {
-        const GlyphInstance& want = moved->glyphs[i];
+    ASSERT_EQ(renderer->drawn().size(), moved.glyphs.size());
+    for (size_t i = 0; i < moved.glyphs.size(); ++i) {
+        const GlyphInstance& want = moved.glyphs[i];
         const GlyphInstance& got = renderer->drawn()[i].instance;
         EXPECT_EQ(got.key, want.key) << i;
         EXPECT_EQ(got.x, want.x) << i;
@@ -603,18 +610,18 @@ TEST(Raster, DrawOptionsMoveRecolourAndSetDepthWithoutALayout) {
     }
     // A zero offset keeps the layout's glyphs as they are; a non-finite one draws nothing.
     renderer->begin_frame();
-    renderer->draw(layout->glyphs, DrawOptions{});
+    renderer->draw(layout.glyphs, DrawOptions{});
     DrawOptions broken;
     broken.offset_x = std::numeric_limits<float>::infinity();
-    renderer->draw(layout->glyphs, broken);
+    renderer->draw(layout.glyphs, broken);
     ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
-    ASSERT_EQ(renderer->drawn().size(), layout->glyphs.size());
-    for (size_t i = 0; i < layout->glyphs.size(); ++i) {
-        EXPECT_EQ(renderer->drawn()[i].instance.key, layout->glyphs[i].key);
-        EXPECT_EQ(renderer->drawn()[i].instance.x, layout->glyphs[i].x);
-        EXPECT_EQ(renderer->drawn()[i].instance.depth, layout->glyphs[i].depth);
+    ASSERT_EQ(renderer->drawn().size(), layout.glyphs.size());
+    for (size_t i = 0; i < layout.glyphs.size(); ++i) {
+        EXPECT_EQ(renderer->drawn()[i].instance.key, layout.glyphs[i].key);
+        EXPECT_EQ(renderer->drawn()[i].instance.x, layout.glyphs[i].x);
+        EXPECT_EQ(renderer->drawn()[i].instance.depth, layout.glyphs[i].depth);
     }
-    EXPECT_EQ(renderer->stats().skipped_glyphs, layout->glyphs.size());
+    EXPECT_EQ(renderer->stats().skipped_glyphs, layout.glyphs.size());
     expect_no_validation_messages();
 }
 
@@ -624,15 +631,8 @@ TEST(Raster, DrawOptionsMoveRecolourAndSetDepthWithoutALayout) {
 TEST(Raster, MovingTextTakesCoarserStepsAndKeepsConverging) {
     Fixture& f = fixture();
     ASSERT_TRUE(f.context);
-    const Font* fonts[] = {f.font.get()};
-    TextStyle style;
-    style.size = 13.0f;
-    LayoutOptions origin;
-    origin.origin_x = 4.0f;
-    origin.origin_y = 16.0f;
-    auto label = layout_text(fonts, "Hg", style, origin);
-    ASSERT_TRUE(label);
-    ASSERT_EQ(label->glyphs.size(), 2u);
+    const TextLayout label = fixture_layout("Hg", 13.0f, 4.0f, 16.0f);
+    ASSERT_EQ(label.glyphs.size(), 2u);
     constexpr int kFrames = 40;
     struct Run {
         std::set<GlyphKey, bool (*)(const GlyphKey&, const GlyphKey&)> keys{
@@ -649,7 +649,7 @@ TEST(Raster, MovingTextTakesCoarserStepsAndKeepsConverging) {
             options.offset_x = start + speed * static_cast<float>(frame);
             options.id = id;
             renderer.begin_frame();
-            renderer.draw(label->glyphs, options);
+            renderer.draw(label.glyphs, options);
             EXPECT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer.record(cb)); }));
             for (const DrawnGlyph& d : renderer.drawn()) result.keys.insert(d.instance.key);
             result.last_samples = renderer.drawn().empty() ? 0 : renderer.drawn()[0].samples;
@@ -690,17 +690,14 @@ TEST(Raster, DrawnGlyphsStayInsideTheVisibleRect) {
     auto renderer = make_renderer(*subpixel_preset("rgb"), 8);
     ASSERT_TRUE(renderer);
     ASSERT_TRUE(renderer->add_font(*f.font));
-    const Font* fonts[] = {f.font.get()};
-    TextStyle style;
-    style.size = 24.0f;
-    auto layout = layout_text(fonts, "Hg@&1", style, LayoutOptions{.origin_x = 3.0f, .origin_y = 30.0f});
-    ASSERT_TRUE(layout);
+    const TextLayout layout = fixture_layout("Hg@&1", 24.0f, 3.0f, 30.0f);
+    ASSERT_FALSE(layout.glyphs.empty());
     // A box through the middle of the line: every glyph is cut above and below.
     const VkRect2D box{{10, 18}, {60, 7}};
     DrawOptions options;
     options.visible = box;
     renderer->begin_frame();
-    renderer->draw(layout->glyphs, options);
+    renderer->draw(layout.glyphs, options);
     ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
     ASSERT_FALSE(renderer->drawn().empty());
     uint64_t shown = 0;
@@ -714,7 +711,7 @@ TEST(Raster, DrawnGlyphsStayInsideTheVisibleRect) {
     }
     // ... and nothing inside it is lost: the shown texels are the glyphs' rects within the box.
     uint64_t expected = 0;
-    for (const GlyphInstance& g : layout->glyphs) {
+    for (const GlyphInstance& g : layout.glyphs) {
         const int64_t w = std::min<int64_t>(int64_t{g.x} + g.width, 70) - std::max<int64_t>(g.x, 10);
         const int64_t h = std::min<int64_t>(int64_t{g.y} + g.height, 25) - std::max<int64_t>(g.y, 18);
         if (w > 0 && h > 0) expected += static_cast<uint64_t>(w * h);
@@ -729,11 +726,8 @@ TEST(Raster, DroppedFramesDoNotCountTowardsALabelsRest) {
     Fixture& f = fixture();
     ASSERT_TRUE(f.context);
     HeadlessContext& context = *f.context;
-    const Font* fonts[] = {f.font.get()};
-    TextStyle style;
-    style.size = 13.0f;
-    auto label = layout_text(fonts, "Hg", style, LayoutOptions{.origin_x = 4.0f, .origin_y = 16.0f});
-    ASSERT_TRUE(label);
+    const TextLayout label = fixture_layout("Hg", 13.0f, 4.0f, 16.0f);
+    ASSERT_FALSE(label.glyphs.empty());
     test::UnsubmittedCommandBuffer dropped(context);
     ASSERT_TRUE(dropped.ok());
 
@@ -748,12 +742,12 @@ TEST(Raster, DroppedFramesDoNotCountTowardsALabelsRest) {
             options.id = 3;
             if (drop) {  // each frame is first recorded once and dropped
                 renderer->begin_frame();
-                renderer->draw(label->glyphs, options);
+                renderer->draw(label.glyphs, options);
                 EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
                 renderer->abandon_frame();
             }
             renderer->begin_frame();
-            renderer->draw(label->glyphs, options);
+            renderer->draw(label.glyphs, options);
             EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
             moving.push_back(renderer->stats().moving_glyphs);
         }
@@ -804,9 +798,7 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
         const std::vector<Texel> texels =
             render(*renderer, frames, 100, [&] { renderer->draw(glyphs); }, [] {});
         ASSERT_EQ(renderer->drawn().size(), glyphs.size());
-        const Comparison result = compare(*renderer, texels, kSamples);
-        EXPECT_GT(result.covered, 0u);
-        EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
+        expect_matches_reference(*renderer, texels, kSamples);
     };
     check(glyphs_of(fonts));
 
@@ -842,9 +834,7 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
     ASSERT_EQ(g->glyphs.size(), 1u);
     uint32_t frames = 0;
     const std::vector<Texel> texels = render(*renderer, frames, 100, [&] { renderer->draw(g->glyphs); }, [] {});
-    const Comparison result = compare(*renderer, texels, kSamples, fonts[2].get());
-    EXPECT_GT(result.covered, 0u);
-    EXPECT_EQ(result.unexplained, 0u);
+    expect_matches_reference(*renderer, texels, kSamples, fonts[2].get());
     expect_no_validation_messages();
 }
 
@@ -894,9 +884,7 @@ TEST(Raster, AnAtlasWithABudgetGrowsInsteadOfCoarsening) {
     const std::vector<Texel> texels = render(*renderer, frames, 100, [&] { renderer->draw(glyphs); }, [] {});
     ASSERT_TRUE(renderer->converged());
     EXPECT_EQ(renderer->atlas().config().width, 128u);
-    const Comparison result = compare(*renderer, texels, kSamples);
-    EXPECT_GT(result.covered, 0u);
-    EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
+    expect_matches_reference(*renderer, texels, kSamples);
     expect_no_validation_messages();
 }
 
