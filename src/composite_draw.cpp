@@ -17,9 +17,9 @@ constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_ST
 
 DrawCompositor::~DrawCompositor() {
     if (!ref_.device) return;
-    if (pipeline_) vkDestroyPipeline(ref_.device, pipeline_, ref_.allocator);
+    if (pipeline_) ref_.fn->vkDestroyPipeline(ref_.device, pipeline_, ref_.allocator);
     for (VkShaderModule module : {vertex_, fragment_}) {
-        if (module) vkDestroyShaderModule(ref_.device, module, ref_.allocator);
+        if (module) ref_.fn->vkDestroyShaderModule(ref_.device, module, ref_.allocator);
     }
     for (Slot& slot : slots_) vk::destroy_buffer(ref_, slot.quads);
     vk::destroy_descriptor_sets(ref_, descriptors_);
@@ -29,14 +29,14 @@ Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice phys
                               VkFormat depth_format, uint32_t frames_in_flight) {
     ref_ = device;
     VkFormatProperties properties{};
-    vkGetPhysicalDeviceFormatProperties(physical_device, format, &properties);
+    ref_.fn->vkGetPhysicalDeviceFormatProperties(physical_device, format, &properties);
     if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT) == 0) {
         return Error{ErrorCode::vulkan, "compositor: draw_format (VkFormat " + std::to_string(format) +
                                             ") cannot be a blended colour attachment on this device"};
     }
     if (depth_format != VK_FORMAT_UNDEFINED) {
         VkFormatProperties depth{};
-        vkGetPhysicalDeviceFormatProperties(physical_device, depth_format, &depth);
+        ref_.fn->vkGetPhysicalDeviceFormatProperties(physical_device, depth_format, &depth);
         if ((depth.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT) == 0) {
             return Error{ErrorCode::vulkan, "compositor: draw_depth_format (VkFormat " + std::to_string(depth_format) +
                                                 ") cannot be a depth attachment on this device"};
@@ -102,7 +102,7 @@ Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::spa
     writes[0].pImageInfo = &atlas;
     writes[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[1].pBufferInfo = &quad_info;
-    vkUpdateDescriptorSets(ref_.device, 2, writes, 0, nullptr);
+    ref_.fn->vkUpdateDescriptorSets(ref_.device, 2, writes, 0, nullptr);
     ++frame_;
     recorded_ = true;
     if (quads.empty()) return uint64_t{0};
@@ -114,12 +114,12 @@ Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::spa
     push.back_to_front = 1;
     push.origin_x = rect.offset.x;
     push.origin_y = rect.offset.y;
-    vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
-    vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, descriptors_.pipeline_layout, 0, 1,
-                            &slot.set, 0, nullptr);
-    vkCmdPushConstants(command_buffer, descriptors_.pipeline_layout, kStages, 0, sizeof(push), &push);
-    set_viewport(command_buffer, rect);
-    vkCmdDraw(command_buffer, 4, push.quad_count, 0, 0);
+    ref_.fn->vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
+    ref_.fn->vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, descriptors_.pipeline_layout, 0,
+                                     1, &slot.set, 0, nullptr);
+    ref_.fn->vkCmdPushConstants(command_buffer, descriptors_.pipeline_layout, kStages, 0, sizeof(push), &push);
+    set_viewport(*ref_.fn, command_buffer, rect);
+    ref_.fn->vkCmdDraw(command_buffer, 4, push.quad_count, 0, 0);
     return uint64_t{bytes};
 }
 

@@ -86,8 +86,8 @@ Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadP
     info.layout = desc.layout;
     info.renderPass = desc.render_pass;
     VkPipeline pipeline = VK_NULL_HANDLE;
-    if (VkResult r =
-            vkCreateGraphicsPipelines(device.device, device.pipeline_cache, 1, &info, device.allocator, &pipeline);
+    if (VkResult r = device.fn->vkCreateGraphicsPipelines(device.device, device.pipeline_cache, 1, &info,
+                                                          device.allocator, &pipeline);
         r != VK_SUCCESS) {
         return vk::vulkan_error(std::string("vkCreateGraphicsPipelines (") + desc.what + ")", r);
     }
@@ -95,12 +95,15 @@ Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadP
     return pipeline;
 }
 
-void set_viewport(VkCommandBuffer command_buffer, const VkRect2D& rect) {
-    const VkViewport viewport{static_cast<float>(rect.offset.x), static_cast<float>(rect.offset.y),
-                              static_cast<float>(rect.extent.width), static_cast<float>(rect.extent.height), 0.0f,
+void set_viewport(const vk::Functions& fn, VkCommandBuffer command_buffer, const VkRect2D& rect) {
+    const VkViewport viewport{static_cast<float>(rect.offset.x),
+                              static_cast<float>(rect.offset.y),
+                              static_cast<float>(rect.extent.width),
+                              static_cast<float>(rect.extent.height),
+                              0.0f,
                               1.0f};
-    vkCmdSetViewport(command_buffer, 0, 1, &viewport);
-    vkCmdSetScissor(command_buffer, 0, 1, &rect);
+    fn.vkCmdSetViewport(command_buffer, 0, 1, &viewport);
+    fn.vkCmdSetScissor(command_buffer, 0, 1, &rect);
 }
 
 }  // namespace crisp::composite

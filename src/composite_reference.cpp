@@ -39,12 +39,11 @@ enum Binding : uint32_t {
     kBindTarget = 6,
     kBindTiles = 7,
 };
-constexpr uint32_t kBindings[] = {kBindAtlas, kBindQuads, kBindAccumulators, kBindNodes,
+constexpr uint32_t kBindings[] = {kBindAtlas, kBindQuads,  kBindAccumulators, kBindNodes,
                                   kBindStats, kBindTarget, kBindTiles};
 constexpr uint32_t kBindingCount = std::size(kBindings);
 constexpr VkShaderStageFlags kPushStages =
     VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT | VK_SHADER_STAGE_COMPUTE_BIT;
-
 
 }  // namespace
 
@@ -53,13 +52,13 @@ ReferenceCompositor::~ReferenceCompositor() {
     VkDevice device = ref.device;
     const VkAllocationCallbacks* allocator = ref.allocator;
     for (VkPipeline pipeline : {unsorted, wboit, exact, wboit_resolve, exact_resolve, wboit_compute, exact_compute}) {
-        if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
+        if (pipeline) ref.fn->vkDestroyPipeline(device, pipeline, allocator);
     }
-    for (auto& [name, shader] : modules) vkDestroyShaderModule(device, shader, allocator);
-    if (empty_framebuffer) vkDestroyFramebuffer(device, empty_framebuffer, allocator);
-    if (color_framebuffer) vkDestroyFramebuffer(device, color_framebuffer, allocator);
-    if (empty_pass) vkDestroyRenderPass(device, empty_pass, allocator);
-    if (color_pass) vkDestroyRenderPass(device, color_pass, allocator);
+    for (auto& [name, shader] : modules) ref.fn->vkDestroyShaderModule(device, shader, allocator);
+    if (empty_framebuffer) ref.fn->vkDestroyFramebuffer(device, empty_framebuffer, allocator);
+    if (color_framebuffer) ref.fn->vkDestroyFramebuffer(device, color_framebuffer, allocator);
+    if (empty_pass) ref.fn->vkDestroyRenderPass(device, empty_pass, allocator);
+    if (color_pass) ref.fn->vkDestroyRenderPass(device, color_pass, allocator);
     vk::destroy_descriptor_sets(ref, descriptors);
     for (FrameSlot& slot : slots) {
         vk::destroy_buffer(ref, slot.quads);
@@ -80,7 +79,7 @@ Result<VkShaderModule> ReferenceCompositor::module(const char* name) {
 }
 
 Result<VkPipeline> ReferenceCompositor::graphics_pipeline(const char* fragment,
-                                                        const VkSpecializationInfo* specialization, bool blend) {
+                                                          const VkSpecializationInfo* specialization, bool blend) {
     Result<VkShaderModule> vertex_module = module("composite.vert");
     if (!vertex_module) return vertex_module.error();
     Result<VkShaderModule> fragment_module = module(fragment);
@@ -96,7 +95,8 @@ Result<VkPipeline> ReferenceCompositor::graphics_pipeline(const char* fragment,
     return create_quad_pipeline(ref, desc);
 }
 
-Result<VkPipeline> ReferenceCompositor::compute_pipeline(const char* shader, const VkSpecializationInfo* specialization) {
+Result<VkPipeline> ReferenceCompositor::compute_pipeline(const char* shader,
+                                                         const VkSpecializationInfo* specialization) {
     Result<VkShaderModule> compute_module = module(shader);
     if (!compute_module) return compute_module.error();
     return vk::create_compute_pipeline(ref, *compute_module, descriptors.pipeline_layout, specialization, shader);
@@ -105,7 +105,7 @@ Result<VkPipeline> ReferenceCompositor::compute_pipeline(const char* shader, con
 // Per-pixel buffers: the accumulators (plane-major), the exact mode's node pool and the stats.
 Status ReferenceCompositor::create_buffers(const CompositorCreateInfo& info, std::vector<std::string>& warnings) {
     VkPhysicalDeviceProperties properties{};
-    vkGetPhysicalDeviceProperties(info.physical_device, &properties);
+    ref.fn->vkGetPhysicalDeviceProperties(info.physical_device, &properties);
     const VkDeviceSize range = properties.limits.maxStorageBufferRange;
     const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     static_assert(gpu::kWboitWords >= gpu::kExactWords);
@@ -116,7 +116,9 @@ Status ReferenceCompositor::create_buffers(const CompositorCreateInfo& info, std
                                             std::to_string(accumulator_bytes) +
                                             " bytes, above maxStorageBufferRange (" + std::to_string(range) + ")"};
     }
-    if (Status s = vk::create_buffer(ref, accumulator_bytes, storage, false, "reference accumulators", accumulators); !s) return s;
+    if (Status s = vk::create_buffer(ref, accumulator_bytes, storage, false, "reference accumulators", accumulators);
+        !s)
+        return s;
     const VkDeviceSize node_bytes = gpu::kCompositeNodeWords * kWord;
     VkDeviceSize wanted_nodes = VkDeviceSize{pixels} * info.exact_nodes_per_pixel;
     if (wanted_nodes * node_bytes > range) {
@@ -151,7 +153,7 @@ Status ReferenceCompositor::create_passes() {
     pass_info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO;
     pass_info.subpassCount = 1;
     pass_info.pSubpasses = &subpass;
-    if (VkResult r = vkCreateRenderPass(device, &pass_info, allocator, &empty_pass); r != VK_SUCCESS) {
+    if (VkResult r = ref.fn->vkCreateRenderPass(device, &pass_info, allocator, &empty_pass); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateRenderPass (compositor)", r);
     }
     VkAttachmentDescription attachment{};
@@ -168,7 +170,7 @@ Status ReferenceCompositor::create_passes() {
     subpass.pColorAttachments = &reference;
     pass_info.attachmentCount = 1;
     pass_info.pAttachments = &attachment;
-    if (VkResult r = vkCreateRenderPass(device, &pass_info, allocator, &color_pass); r != VK_SUCCESS) {
+    if (VkResult r = ref.fn->vkCreateRenderPass(device, &pass_info, allocator, &color_pass); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateRenderPass (compositor)", r);
     }
     VkFramebufferCreateInfo framebuffer{};
@@ -177,13 +179,15 @@ Status ReferenceCompositor::create_passes() {
     framebuffer.width = width;
     framebuffer.height = height;
     framebuffer.layers = 1;
-    if (VkResult r = vkCreateFramebuffer(device, &framebuffer, allocator, &empty_framebuffer); r != VK_SUCCESS) {
+    if (VkResult r = ref.fn->vkCreateFramebuffer(device, &framebuffer, allocator, &empty_framebuffer);
+        r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateFramebuffer (compositor)", r);
     }
     framebuffer.renderPass = color_pass;
     framebuffer.attachmentCount = 1;
     framebuffer.pAttachments = &target_.view;
-    if (VkResult r = vkCreateFramebuffer(device, &framebuffer, allocator, &color_framebuffer); r != VK_SUCCESS) {
+    if (VkResult r = ref.fn->vkCreateFramebuffer(device, &framebuffer, allocator, &color_framebuffer);
+        r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateFramebuffer (compositor)", r);
     }
 
@@ -198,9 +202,9 @@ Status ReferenceCompositor::create(const vk::DeviceRef& device, const Compositor
     pixels = info.width * info.height;
     frames_in_flight = info.frames_in_flight;
     VkPhysicalDeviceProperties properties{};
-    vkGetPhysicalDeviceProperties(info.physical_device, &properties);
+    ref.fn->vkGetPhysicalDeviceProperties(info.physical_device, &properties);
     VkFormatProperties format{};
-    vkGetPhysicalDeviceFormatProperties(info.physical_device, kTargetFormat, &format);
+    ref.fn->vkGetPhysicalDeviceFormatProperties(info.physical_device, kTargetFormat, &format);
     const VkFormatFeatureFlags needed = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
                                         VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT |
                                         VK_FORMAT_FEATURE_TRANSFER_DST_BIT;
@@ -248,9 +252,8 @@ Status ReferenceCompositor::create_descriptors() {
     for (uint32_t i = 0; i < frames_in_flight; ++i) {
         FrameSlot& slot = slots[i];
         slot.set = descriptors.sets[i];
-        if (Status s =
-                vk::create_buffer(ref, gpu::kStatWords * kWord, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true,
-                                  "reference statistics readback", slot.stats);
+        if (Status s = vk::create_buffer(ref, gpu::kStatWords * kWord, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true,
+                                         "reference statistics readback", slot.stats);
             !s) {
             return s;
         }
@@ -324,15 +327,14 @@ void ReferenceCompositor::build_tiles() {
 }
 
 Status ReferenceCompositor::upload(vk::DeviceBuffer& buffer, uint32_t& capacity, const void* data, uint32_t count,
-                                 size_t size) {
+                                   size_t size) {
     if (count > capacity || !buffer.buffer) {
         // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
         vk::destroy_buffer(ref, buffer);
         capacity = 0;
         const uint32_t grown = std::max<uint32_t>(64, std::bit_ceil(std::max(count, 1u)));
-        if (Status s =
-                vk::create_buffer(ref, VkDeviceSize{grown} * size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
-                                  "reference quads", buffer);
+        if (Status s = vk::create_buffer(ref, VkDeviceSize{grown} * size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
+                                         "reference quads", buffer);
             !s) {
             return s;
         }
@@ -383,7 +385,7 @@ void ReferenceCompositor::write_descriptors(const FrameSlot& slot, VkImageView a
                 break;
         }
     }
-    vkUpdateDescriptorSets(ref.device, kBindingCount, writes, 0, nullptr);
+    ref.fn->vkUpdateDescriptorSets(ref.device, kBindingCount, writes, 0, nullptr);
 }
 
 Status ReferenceCompositor::check(const CompositeParams& params) const {
@@ -439,10 +441,10 @@ void ReferenceCompositor::record_target_init(VkCommandBuffer command_buffer) {
     barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     barrier.image = target_.image;
     barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-                         VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
-                             VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                         0, 0, nullptr, 0, nullptr, 1, &barrier);
+    ref.fn->vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                                 VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+                                     VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                 0, 0, nullptr, 0, nullptr, 1, &barrier);
     target_initialized = true;
 }
 
@@ -452,23 +454,23 @@ void ReferenceCompositor::record_target_init(VkCommandBuffer command_buffer) {
 uint64_t ReferenceCompositor::record_clears(VkCommandBuffer command_buffer, CompositeMode mode) {
     constexpr VkPipelineStageFlags stages =
         kShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
-    memory_barrier(command_buffer, stages,
+    memory_barrier(*ref.fn, command_buffer, stages,
                    kShaderAccess | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
                        VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
                    stages,
                    kShaderAccess | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
                        VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
     const VkDeviceSize pixel_words = VkDeviceSize{pixels} * kWord;
-    vkCmdFillBuffer(command_buffer, stats_words.buffer, 0, VK_WHOLE_SIZE, 0);
+    ref.fn->vkCmdFillBuffer(command_buffer, stats_words.buffer, 0, VK_WHOLE_SIZE, 0);
     uint64_t buffer_bytes = 0;
     switch (mode) {
         case CompositeMode::wboit:
-            vkCmdFillBuffer(command_buffer, accumulators.buffer, 0, pixel_words * gpu::kWboitWords, 0);
+            ref.fn->vkCmdFillBuffer(command_buffer, accumulators.buffer, 0, pixel_words * gpu::kWboitWords, 0);
             buffer_bytes = pixel_words * gpu::kWboitWords;
             break;
         case CompositeMode::exact:
-            vkCmdFillBuffer(command_buffer, accumulators.buffer, 0, pixel_words * gpu::kExactWords,
-                            gpu::kCompositeNoNode);
+            ref.fn->vkCmdFillBuffer(command_buffer, accumulators.buffer, 0, pixel_words * gpu::kExactWords,
+                                    gpu::kCompositeNoNode);
             buffer_bytes =
                 pixel_words * gpu::kExactWords + VkDeviceSize{node_capacity} * gpu::kCompositeNodeWords * kWord;
             break;
@@ -477,7 +479,7 @@ uint64_t ReferenceCompositor::record_clears(VkCommandBuffer command_buffer, Comp
         case CompositeMode::draw:
             break;
     }
-    memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+    memory_barrier(*ref.fn, command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                    kShaderStages | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
                    kShaderAccess | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
     return buffer_bytes;
@@ -494,26 +496,26 @@ void ReferenceCompositor::record_draw(VkCommandBuffer command_buffer, const Fram
     const VkClearValue clear{{{push.background.x, push.background.y, push.background.z, push.background.w}}};
     begin.clearValueCount = color ? 1 : 0;
     begin.pClearValues = &clear;
-    vkCmdBeginRenderPass(command_buffer, &begin, VK_SUBPASS_CONTENTS_INLINE);
+    ref.fn->vkCmdBeginRenderPass(command_buffer, &begin, VK_SUBPASS_CONTENTS_INLINE);
     if (push.quad_count > 0) {
-        vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-        set_viewport(command_buffer, begin.renderArea);
-        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, descriptors.pipeline_layout, 0, 1,
-                                &slot.set, 0, nullptr);
-        vkCmdPushConstants(command_buffer, descriptors.pipeline_layout, kPushStages, 0, sizeof(push), &push);
-        vkCmdDraw(command_buffer, 4, push.quad_count, 0, 0);
+        ref.fn->vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+        set_viewport(*ref.fn, command_buffer, begin.renderArea);
+        ref.fn->vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_GRAPHICS, descriptors.pipeline_layout, 0,
+                                        1, &slot.set, 0, nullptr);
+        ref.fn->vkCmdPushConstants(command_buffer, descriptors.pipeline_layout, kPushStages, 0, sizeof(push), &push);
+        ref.fn->vkCmdDraw(command_buffer, 4, push.quad_count, 0, 0);
     }
-    vkCmdEndRenderPass(command_buffer);
+    ref.fn->vkCmdEndRenderPass(command_buffer);
 }
 
 void ReferenceCompositor::record_dispatch(VkCommandBuffer command_buffer, const FrameSlot& slot, VkPipeline pipeline,
                                           uint32_t x, uint32_t y, const gpu::CompositePushConstants& push) {
     if (x == 0 || y == 0) return;
-    vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors.pipeline_layout, 0, 1,
-                            &slot.set, 0, nullptr);
-    vkCmdPushConstants(command_buffer, descriptors.pipeline_layout, kPushStages, 0, sizeof(push), &push);
-    vkCmdDispatch(command_buffer, x, y, 1);
+    ref.fn->vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    ref.fn->vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors.pipeline_layout, 0, 1,
+                                    &slot.set, 0, nullptr);
+    ref.fn->vkCmdPushConstants(command_buffer, descriptors.pipeline_layout, kPushStages, 0, sizeof(push), &push);
+    ref.fn->vkCmdDispatch(command_buffer, x, y, 1);
 }
 
 // The mode's quad passes (rasterized, or compute over the frame's 8 x 8 tiles, one workgroup
@@ -532,7 +534,7 @@ void ReferenceCompositor::record_passes(VkCommandBuffer command_buffer, const Fr
     const VkPipelineStageFlags quad_stage =
         compute ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
     auto quads_to = [&](VkPipelineStageFlags stage) {
-        memory_barrier(command_buffer, quad_stage, VK_ACCESS_SHADER_WRITE_BIT, stage, kShaderAccess);
+        memory_barrier(*ref.fn, command_buffer, quad_stage, VK_ACCESS_SHADER_WRITE_BIT, stage, kShaderAccess);
     };
     auto resolve = [&](VkPipeline pipeline) {
         quads_to(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
@@ -560,11 +562,11 @@ void ReferenceCompositor::record_passes(VkCommandBuffer command_buffer, const Fr
             break;  // refused by check()
     }
     // The target for the caller; the stats words for the host.
-    memory_barrier(command_buffer, last_stage, last_access, kShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT,
+    memory_barrier(*ref.fn, command_buffer, last_stage, last_access, kShaderStages | VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
     const VkBufferCopy copy{0, 0, gpu::kStatWords * kWord};
-    vkCmdCopyBuffer(command_buffer, stats_words.buffer, slot.stats.buffer, 1, &copy);
-    memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+    ref.fn->vkCmdCopyBuffer(command_buffer, stats_words.buffer, slot.stats.buffer, 1, &copy);
+    memory_barrier(*ref.fn, command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                    VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
@@ -630,16 +632,17 @@ void ReferenceCompositor::record_target_readback(VkCommandBuffer command_buffer,
     barriers[1].dstAccessMask = kShaderAccess | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
     barriers[1].oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
     barriers[1].newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    vkCmdPipelineBarrier(command_buffer, kShaderStages | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                         VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &barriers[0]);
+    ref.fn->vkCmdPipelineBarrier(command_buffer, kShaderStages | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                 VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &barriers[0]);
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {width, height, 1};
-    vkCmdCopyImageToBuffer(command_buffer, target_.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &region);
-    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         kShaderStages | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, 0, 0, nullptr, 0, nullptr, 1,
-                         &barriers[1]);
-    memory_barrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+    ref.fn->vkCmdCopyImageToBuffer(command_buffer, target_.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1,
+                                   &region);
+    ref.fn->vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                 kShaderStages | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, 0, 0, nullptr, 0,
+                                 nullptr, 1, &barriers[1]);
+    memory_barrier(*ref.fn, command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                    VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 

@@ -16,9 +16,8 @@ namespace {
 
 constexpr VkDeviceSize kWord = 4;
 size_t variant_index(VkFormat format, VkFormat view_format) {
-    const auto found = std::find_if(kTileVariants.begin(), kTileVariants.end(), [&](const TileVariant& v) {
-        return v.image == format && v.view == view_format;
-    });
+    const auto found = std::find_if(kTileVariants.begin(), kTileVariants.end(),
+                                    [&](const TileVariant& v) { return v.image == format && v.view == view_format; });
     return static_cast<size_t>(found - kTileVariants.begin());
 }
 
@@ -50,13 +49,13 @@ TileCompositor::~TileCompositor() {
     if (!ref_.device) return;
     for (const auto& passes : tile_pipelines_) {
         for (VkPipeline pipeline : passes) {
-            if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
+            if (pipeline) ref_.fn->vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
         }
     }
     for (VkPipeline pipeline : {count_, scan_[0], scan_[1], scan_[2], scatter_}) {
-        if (pipeline) vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
+        if (pipeline) ref_.fn->vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
     }
-    for (VkShaderModule module : modules_) vkDestroyShaderModule(ref_.device, module, ref_.allocator);
+    for (VkShaderModule module : modules_) ref_.fn->vkDestroyShaderModule(ref_.device, module, ref_.allocator);
     for (Slot& slot : slots_) {
         for (vk::DeviceBuffer* buffer : {&slot.quads, &slot.tiles, &slot.bins, &slot.header}) {
             vk::destroy_buffer(ref_, *buffer);
@@ -69,7 +68,7 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     ref_ = device;
     config_ = config;
     // The tile pass reduces its statistics per subgroup.
-    if (!vk::has_compute_subgroup_arithmetic(config.physical_device)) {
+    if (!vk::has_compute_subgroup_arithmetic(*ref_.fn, config.physical_device)) {
         return Error{ErrorCode::vulkan, "compositor: the device has no subgroup arithmetic in compute shaders"};
     }
     constexpr VkShaderStageFlags stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -114,7 +113,7 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     for (size_t i = 0; i < kTileVariants.size(); ++i) {
         const TileVariant& variant = kTileVariants[i];
         VkFormatProperties properties{};
-        vkGetPhysicalDeviceFormatProperties(config.physical_device, variant.view, &properties);
+        ref_.fn->vkGetPhysicalDeviceFormatProperties(config.physical_device, variant.view, &properties);
         if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT) == 0) continue;
         if (std::string_view(variant.shader) == "tile_composite_any.comp" && !config.storage_without_format) continue;
         // constant_id 0: K; 1: the target's encoding; 2: the list capacity; 3: red and blue swap;
@@ -136,8 +135,8 @@ bool TileCompositor::supports(VkFormat format, VkFormat view_format) const {
     return i < kTileVariants.size() && tile_pipelines_[i][0] != VK_NULL_HANDLE;
 }
 
-Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage,
-                            bool host_visible, const char* what) {
+Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
+                            const char* what) {
     if (buffer.buffer && buffer.size >= bytes) return {};
     // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
     vk::destroy_buffer(ref_, buffer);
@@ -188,7 +187,7 @@ void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view,
     writes[gpu::kTileBindTiles].pBufferInfo = &buffers[1];
     writes[gpu::kTileBindBins].pBufferInfo = &buffers[2];
     writes[gpu::kTileBindHeader].pBufferInfo = &buffers[3];
-    vkUpdateDescriptorSets(ref_.device, gpu::kTileBindingCount, writes, 0, nullptr);
+    ref_.fn->vkUpdateDescriptorSets(ref_.device, gpu::kTileBindingCount, writes, 0, nullptr);
 }
 
 // Count, prefix sum, scatter: the frame's quads into the slot's bins. The descriptor set and push
@@ -200,24 +199,24 @@ void TileCompositor::record_binning(VkCommandBuffer cb, const gpu::TilePushConst
     const VkExtent2D quad_groups = grid(push.quad_count, gpu::kTileBinInvocations);
     auto bin = [&](VkPipeline pipeline) {
         if (quad_groups.width == 0) return;
-        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-        vkCmdDispatch(cb, quad_groups.width, quad_groups.height, 1);
+        ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+        ref_.fn->vkCmdDispatch(cb, quad_groups.width, quad_groups.height, 1);
     };
     bin(count_);
     // The prefix sum: block sums, their scan in one workgroup, the blocks' own scans.
     const VkExtent2D blocks = grid(tiles, gpu::kTileScanBlock);
     for (uint32_t phase = 0; phase < scan_.size(); ++phase) {
-        vk::memory_barrier(cb, compute, shader, compute, shader);
-        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, scan_[phase]);
+        vk::memory_barrier(*ref_.fn, cb, compute, shader, compute, shader);
+        ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, scan_[phase]);
         if (phase == 1) {
-            vkCmdDispatch(cb, 1, 1, 1);
+            ref_.fn->vkCmdDispatch(cb, 1, 1, 1);
         } else {
-            vkCmdDispatch(cb, blocks.width, blocks.height, 1);
+            ref_.fn->vkCmdDispatch(cb, blocks.width, blocks.height, 1);
         }
     }
-    vk::memory_barrier(cb, compute, shader, compute, shader);
+    vk::memory_barrier(*ref_.fn, cb, compute, shader, compute, shader);
     bin(scatter_);
-    vk::memory_barrier(cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+    vk::memory_barrier(*ref_.fn, cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
                        shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
 }
 
@@ -229,7 +228,7 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const s
     const uint32_t tiles = push.tiles_x * push.tiles_y;
     // This slot's buffers were last used by a frame the caller has waited for; the barrier orders
     // them for the validation layer and for callers who recycle command buffers early.
-    vk::memory_barrier(cb, compute | transfer | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+    vk::memory_barrier(*ref_.fn, cb, compute | transfer | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
                        shader | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT, transfer,
                        VK_ACCESS_TRANSFER_WRITE_BIT);
     if (reuse_bins) {
@@ -238,27 +237,29 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const s
         constexpr uint32_t reset[] = {0, 0, 0, 0, 0, 1, 1};  // layered tiles .. layered dispatch z
         static_assert(offsetof(gpu::TileHeader, layered_dispatch_z) - offsetof(gpu::TileHeader, layered_tiles) ==
                       sizeof(reset) - kWord);
-        vkCmdUpdateBuffer(cb, slot.header.buffer, offsetof(gpu::TileHeader, layered_tiles), sizeof(reset), reset);
+        ref_.fn->vkCmdUpdateBuffer(cb, slot.header.buffer, offsetof(gpu::TileHeader, layered_tiles), sizeof(reset),
+                                   reset);
     } else {
-        vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
-        vkCmdFillBuffer(cb, slot.header.buffer, 0, sizeof(gpu::TileHeader), 0);
+        ref_.fn->vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
+        ref_.fn->vkCmdFillBuffer(cb, slot.header.buffer, 0, sizeof(gpu::TileHeader), 0);
     }
-    vk::memory_barrier(cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
-                       shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+    vk::memory_barrier(*ref_.fn, cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT,
+                       compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
 
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set, 0,
-                            nullptr);
-    vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    ref_.fn->vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set,
+                                     0, nullptr);
+    ref_.fn->vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
     if (!reuse_bins) record_binning(cb, push);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[0]);
-    vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
+    ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[0]);
+    ref_.fn->vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
     // The tiles the exact pass handed on; usually none, and then an empty dispatch.
-    vk::memory_barrier(cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+    vk::memory_barrier(*ref_.fn, cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
                        shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[1]);
-    vkCmdDispatchIndirect(cb, slot.header.buffer, gpu::kTileLayeredDispatchOffset);
+    ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[1]);
+    ref_.fn->vkCmdDispatchIndirect(cb, slot.header.buffer, gpu::kTileLayeredDispatchOffset);
     // The frame's counts for the host.
-    vk::memory_barrier(cb, compute, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    vk::memory_barrier(*ref_.fn, cb, compute, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                       VK_ACCESS_HOST_READ_BIT);
 }
 
 void TileCompositor::abandon_frame() {
@@ -277,8 +278,10 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     if (slot.pending) {
         gpu::TileHeader header{};
         std::memcpy(&header, slot.header.mapped, sizeof(header));
-        measured = {header.busy_tiles, header.busy_tiles - header.layered_tiles, header.layered_tiles,
-                    header.max_overlap, header.tail_pixels, header.pairs, header.lost_pairs};
+        measured = {header.busy_tiles,    header.busy_tiles - header.layered_tiles,
+                    header.layered_tiles, header.max_overlap,
+                    header.tail_pixels,   header.pairs,
+                    header.lost_pairs};
         measured_frame = slot.frame;
         slot.pending = false;
     }
@@ -317,8 +320,7 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     slot.frame = frame_;
     recorded_ = true;
     last_binned_ = !reused;
-    return quads.size_bytes() + tile_words(tiles) * kWord + pairs * kWord +
-           header_words(tiles) * kWord;
+    return quads.size_bytes() + tile_words(tiles) * kWord + pairs * kWord + header_words(tiles) * kWord;
 }
 
 }  // namespace crisp::composite

@@ -40,10 +40,9 @@ Result<VkRect2D> checked_rect(VkRect2D rect, VkExtent2D extent) {
     if (rect.extent.width == 0 || rect.extent.height == 0 || rect.extent.width > kMaxTargetSide ||
         rect.extent.height > kMaxTargetSide || rect.offset.x < 0 || rect.offset.y < 0 || right > extent.width ||
         bottom > extent.height) {
-        return Error{ErrorCode::invalid_argument, "compositor: the rect " + rect_string(rect) +
-                                                      " is empty, above 16384 a side, or outside the " +
-                                                      std::to_string(extent.width) + "x" +
-                                                      std::to_string(extent.height) + " image"};
+        return Error{ErrorCode::invalid_argument,
+                     "compositor: the rect " + rect_string(rect) + " is empty, above 16384 a side, or outside the " +
+                         std::to_string(extent.width) + "x" + std::to_string(extent.height) + " image"};
     }
     return rect;
 }
@@ -52,7 +51,9 @@ Status check_create_info(const CompositorCreateInfo& info) {
     auto invalid = [](const std::string& message) {
         return Status(Error{ErrorCode::invalid_argument, "compositor: " + message});
     };
-    if (!info.device || !info.physical_device) return invalid("a physical device and a device are required");
+    if (!info.instance || !info.device || !info.physical_device) {
+        return invalid("an instance, a physical device and a device are required");
+    }
     if (info.frames_in_flight < 1 || info.frames_in_flight > 8) return invalid("frames_in_flight must be 1 to 8");
     if (info.tile_capacity < 4 || info.tile_capacity > kMaxTileCapacity || !std::has_single_bit(info.tile_capacity)) {
         return invalid("tile_capacity must be a power of two from 4 to " + std::to_string(kMaxTileCapacity));
@@ -101,8 +102,8 @@ std::optional<QuadPath> parse_quad_path(std::string_view name) {
 }
 
 std::optional<CompositeMode> parse_composite_mode(std::string_view name) {
-    for (CompositeMode mode :
-         {CompositeMode::tiled, CompositeMode::draw, CompositeMode::unsorted, CompositeMode::wboit, CompositeMode::exact}) {
+    for (CompositeMode mode : {CompositeMode::tiled, CompositeMode::draw, CompositeMode::unsorted, CompositeMode::wboit,
+                               CompositeMode::exact}) {
         if (name == composite_mode_name(mode)) return mode;
     }
     return std::nullopt;
@@ -126,6 +127,7 @@ std::optional<float> depth_from_view_projection(const float view_projection[16],
 }
 
 struct Compositor::State {
+    vk::Functions fn;  // the caller's Vulkan entry points (CompositorCreateInfo::get_instance_proc_addr)
     vk::DeviceRef ref;
     bool storage_without_format = false;
     composite::TileCompositor tiles;
@@ -159,6 +161,8 @@ Compositor::~Compositor() = default;
 
 CompositorCreateInfo compositor_create_info(const HeadlessContext& context) {
     CompositorCreateInfo info;
+    info.instance = context.instance();
+    info.get_instance_proc_addr = context.get_instance_proc_addr();
     info.physical_device = context.physical_device();
     info.device = context.device();
     info.allocator = context.allocation_callbacks();
@@ -173,8 +177,9 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     const VkPhysicalDeviceFeatures& core = enabled->features2.features;
     // What each asked-for path needs, against what the device was created with.
     const auto lacks = [](const char* path, const char* feature) {
-        return Error{ErrorCode::vulkan, std::string("compositor: ") + path + " needs " + feature +
-                                            ", and the device was created without it (add_crisp_features() enables it)"};
+        return Error{ErrorCode::vulkan,
+                     std::string("compositor: ") + path + " needs " + feature +
+                         ", and the device was created without it (add_crisp_features() enables it)"};
     };
     if (info.draw_format != VK_FORMAT_UNDEFINED && !enabled->vulkan13.dynamicRendering) {
         return lacks("the draw path (draw_format)", "dynamicRendering");
@@ -189,7 +194,10 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     const bool storage_without_format =
         core.shaderStorageImageReadWithoutFormat && core.shaderStorageImageWriteWithoutFormat;
     auto state = std::make_unique<State>();
-    state->ref = vk::make_device_ref(info.physical_device, info.device, info.allocator, info.pipeline_cache);
+    if (Status s = vk::load_functions(info.get_instance_proc_addr, info.instance, info.device, state->fn); !s) {
+        return Error{s.error().code, "compositor: " + s.error().message};
+    }
+    state->ref = vk::make_device_ref(state->fn, info.physical_device, info.device, info.allocator, info.pipeline_cache);
     state->storage_without_format = storage_without_format;
     composite::TileConfig tiles;
     tiles.physical_device = info.physical_device;

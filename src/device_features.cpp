@@ -1,5 +1,7 @@
 #include <crisp/device_features.hpp>
 
+#include "vk_functions.hpp"
+
 #include <string>
 
 namespace crisp {
@@ -19,16 +21,25 @@ VkBool32* find_dynamic_rendering(VkPhysicalDeviceFeatures2& features) {
 
 }  // namespace
 
-Status add_crisp_features(VkPhysicalDevice physical_device, VkPhysicalDeviceFeatures2& features,
-                          const CrispFeatureNeeds& needs) {
+Status add_crisp_features(VkInstance instance, VkPhysicalDevice physical_device, VkPhysicalDeviceFeatures2& features,
+                          const CrispFeatureNeeds& needs, PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+    if (instance == VK_NULL_HANDLE || physical_device == VK_NULL_HANDLE) {
+        return Error{ErrorCode::invalid_argument, "add_crisp_features: an instance and a physical device are required"};
+    }
     if (features.sType != VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2) {
         return Error{ErrorCode::invalid_argument, "add_crisp_features: `features` is not a VkPhysicalDeviceFeatures2"};
     }
     VkBool32* dynamic_rendering = find_dynamic_rendering(features);
     if (needs.draw_path && dynamic_rendering == nullptr) {
-        return Error{ErrorCode::invalid_argument,
-                     "add_crisp_features: the draw path needs dynamicRendering; link a VkPhysicalDeviceVulkan13Features "
-                     "(or VkPhysicalDeviceDynamicRenderingFeatures) into the chain"};
+        return Error{
+            ErrorCode::invalid_argument,
+            "add_crisp_features: the draw path needs dynamicRendering; link a VkPhysicalDeviceVulkan13Features "
+            "(or VkPhysicalDeviceDynamicRenderingFeatures) into the chain"};
+    }
+
+    vk::Functions fn;
+    if (Status s = vk::load_functions(get_instance_proc_addr, instance, VK_NULL_HANDLE, fn); !s) {
+        return Error{s.error().code, "add_crisp_features: " + s.error().message};
     }
 
     // What the GPU offers, to refuse before changing anything.
@@ -37,12 +48,13 @@ Status add_crisp_features(VkPhysicalDevice physical_device, VkPhysicalDeviceFeat
     VkPhysicalDeviceFeatures2 offered{};
     offered.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
     VkPhysicalDeviceProperties properties{};
-    vkGetPhysicalDeviceProperties(physical_device, &properties);
+    fn.vkGetPhysicalDeviceProperties(physical_device, &properties);
     if (needs.draw_path && properties.apiVersion >= VK_API_VERSION_1_3) offered.pNext = &offered13;
-    vkGetPhysicalDeviceFeatures2(physical_device, &offered);
+    fn.vkGetPhysicalDeviceFeatures2(physical_device, &offered);
     const VkPhysicalDeviceFeatures& has = offered.features;
     const auto lacks = [&](const char* feature) {
-        return Error{ErrorCode::vulkan, std::string("add_crisp_features: ") + properties.deviceName + " lacks " + feature};
+        return Error{ErrorCode::vulkan,
+                     std::string("add_crisp_features: ") + properties.deviceName + " lacks " + feature};
     };
     if (!has.shaderStorageBufferArrayDynamicIndexing) return lacks("shaderStorageBufferArrayDynamicIndexing");
     if ((needs.draw_path || needs.reference_modes) && !has.dualSrcBlend) return lacks("dualSrcBlend");

@@ -101,6 +101,7 @@ struct Renderer::State {
     VkDevice device = VK_NULL_HANDLE;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
+    vk::Functions fn;   // the caller's Vulkan entry points (RendererCreateInfo::get_instance_proc_addr)
     vk::DeviceRef ref;  // device, allocator, memory properties, pipeline cache, debug names
     VkDeviceSize max_storage_buffer_range = 0;
     uint32_t frames_in_flight = 2;
@@ -190,8 +191,8 @@ struct Renderer::State {
     uint32_t calm_frames = 0;
     uint32_t calm_needed = kCalmFrames;
     bool just_refined = false;  // the level went down at the end of the last frame
-    uint32_t atlas_full = 0;  // instances refused as atlas_full this frame
-    uint32_t unplaceable = 0;  // instances draw() could not move (a pen out of range)
+    uint32_t atlas_full = 0;    // instances refused as atlas_full this frame
+    uint32_t unplaceable = 0;   // instances draw() could not move (a pen out of range)
 
     // Where each named draw (DrawOptions::id) was, to tell moving text from static text.
     std::unordered_map<uint64_t, Motion> motions;
@@ -461,9 +462,9 @@ Renderer::State::~State() {
     }
     free_buffer(items);
     free_buffer(dummy);
-    if (pipeline) vkDestroyPipeline(device, pipeline, allocator);
+    if (pipeline) fn.vkDestroyPipeline(device, pipeline, allocator);
     vk::destroy_descriptor_sets(ref, descriptors);
-    if (shader) vkDestroyShaderModule(device, shader, allocator);
+    if (shader) fn.vkDestroyShaderModule(device, shader, allocator);
     vk::destroy_image(ref, atlas_image);
 }
 
@@ -486,8 +487,8 @@ Status Renderer::State::create_objects() {
     // Work items: an entry takes at least one cell, so a frame never has more items than cells.
     item_capacity = atlas.stats().usable_cells;
     if (Status s = make_buffer(VkDeviceSize{item_capacity} * sizeof(gpu::RasterItem),
-                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, "work items",
-                               items);
+                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false,
+                               "work items", items);
         !s) {
         return s;
     }
@@ -544,12 +545,13 @@ void Renderer::State::write_descriptors(VkDescriptorSet set) {
     writes[3].dstBinding = 3;
     writes[3].descriptorCount = kRendererFontPages;
     writes[3].pBufferInfo = band_infos.data();
-    vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
+    fn.vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
 }
 
 RendererCreateInfo renderer_create_info(const HeadlessContext& context) {
     RendererCreateInfo info;
     info.instance = context.instance();
+    info.get_instance_proc_addr = context.get_instance_proc_addr();
     info.physical_device = context.physical_device();
     info.device = context.device();
     info.queue_family = context.queue_family();
@@ -559,8 +561,8 @@ RendererCreateInfo renderer_create_info(const HeadlessContext& context) {
 }
 
 Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
-    if (!info.device || !info.physical_device) {
-        return Error{ErrorCode::invalid_argument, "renderer: a physical device and a device are required"};
+    if (!info.instance || !info.device || !info.physical_device) {
+        return Error{ErrorCode::invalid_argument, "renderer: an instance, a physical device and a device are required"};
     }
     if (info.frames_in_flight < 1 || info.frames_in_flight > 8) {
         return Error{ErrorCode::invalid_argument, "renderer: frames_in_flight must be 1 to 8"};
@@ -576,8 +578,12 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     auto atlas = GlyphAtlas::create(info.atlas);
     if (!atlas) return atlas.error();
 
+    vk::Functions fn;
+    if (Status s = vk::load_functions(info.get_instance_proc_addr, info.instance, info.device, fn); !s) {
+        return Error{s.error().code, "renderer: " + s.error().message};
+    }
     VkPhysicalDeviceProperties properties{};
-    vkGetPhysicalDeviceProperties(info.physical_device, &properties);
+    fn.vkGetPhysicalDeviceProperties(info.physical_device, &properties);
     if (properties.apiVersion < VK_API_VERSION_1_2) {
         return Error{ErrorCode::vulkan, std::string("renderer: ") + properties.deviceName + " offers Vulkan " +
                                             vk::version_string(properties.apiVersion) + "; crisp needs 1.2"};
@@ -589,7 +595,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
                      "renderer: the device was created without shaderStorageBufferArrayDynamicIndexing (enable it; "
                      "add_crisp_features() does)"};
     }
-    if (!vk::has_compute_subgroup_arithmetic(info.physical_device)) {
+    if (!vk::has_compute_subgroup_arithmetic(fn, info.physical_device)) {
         return Error{ErrorCode::vulkan, "renderer: the device lacks subgroup arithmetic in compute shaders"};
     }
     const uint32_t buffers_needed = 1 + 2 * kRendererFontPages;
@@ -601,7 +607,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
                                             std::to_string(buffers_needed)};
     }
     VkFormatProperties format{};
-    vkGetPhysicalDeviceFormatProperties(info.physical_device, kAtlasFormat, &format);
+    fn.vkGetPhysicalDeviceFormatProperties(info.physical_device, kAtlasFormat, &format);
     if (!(format.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT)) {
         return Error{ErrorCode::vulkan, "renderer: the device lacks storage images of R16G16B16A16_UINT"};
     }
@@ -615,7 +621,8 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     state->max_storage_buffer_range = properties.limits.maxStorageBufferRange;
     state->max_image_side = properties.limits.maxImageDimension2D;
     state->atlas_budget = info.atlas_memory_budget;
-    state->ref = vk::make_device_ref(info.physical_device, info.device, info.allocator, info.pipeline_cache);
+    state->fn = fn;
+    state->ref = vk::make_device_ref(state->fn, info.physical_device, info.device, info.allocator, info.pipeline_cache);
     state->layout = std::move(layout);
     if (Status s = state->create_objects(); !s) return s.error();
     return Renderer(std::move(state));
@@ -649,21 +656,21 @@ Status Renderer::State::grow_image(VkCommandBuffer command_buffer, uint64_t this
     if (atlas_initialized) {
         // Earlier frames' writes (and the compositor's reads) before the copy; the copy before
         // this frame's dispatch and every later read.
-        vk::image_barrier(command_buffer, atlas_image.image, VK_IMAGE_LAYOUT_GENERAL,
+        vk::image_barrier(fn, command_buffer, atlas_image.image, VK_IMAGE_LAYOUT_GENERAL,
                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
                           VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-        vk::image_barrier(command_buffer, grown.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                          VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                          VK_ACCESS_TRANSFER_WRITE_BIT);
+        vk::image_barrier(fn, command_buffer, grown.image, VK_IMAGE_LAYOUT_UNDEFINED,
+                          VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0,
+                          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
         VkImageCopy region{};
         region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         region.dstSubresource = region.srcSubresource;
         region.extent = {image_width, image_height, 1};
-        vkCmdCopyImage(command_buffer, atlas_image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, grown.image,
-                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-        vk::image_barrier(command_buffer, grown.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
-                          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+        fn.vkCmdCopyImage(command_buffer, atlas_image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, grown.image,
+                          VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        vk::image_barrier(fn, command_buffer, grown.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                          VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);
     }
     undo.grew_image = true;
@@ -702,8 +709,7 @@ Status Renderer::State::place_font(GpuFont& font) {
         return std::max(need, std::min(std::max(2 * need, least), max_storage_buffer_range));
     };
     FontPage page;
-    const VkBufferUsageFlags usage =
-        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     Status status = make_buffer(capacity(font.points_bytes, kMinPagePoints), usage, false, "font points", page.points);
     if (status) status = make_buffer(capacity(font.bands_bytes, kMinPageBands), usage, false, "font bands", page.bands);
     if (!status) {
@@ -717,7 +723,8 @@ Status Renderer::State::place_font(GpuFont& font) {
 
 Status Renderer::add_font(const Font& font) {
     State& s = *state_;
-    if (s.font_slot.count(font.id()) && std::find(s.removals.begin(), s.removals.end(), font.id()) == s.removals.end()) {
+    if (s.font_slot.count(font.id()) &&
+        std::find(s.removals.begin(), s.removals.end(), font.id()) == s.removals.end()) {
         return Error{ErrorCode::invalid_argument,
                      "renderer: a font with id " + std::to_string(font.id()) + " was added already"};
     }
@@ -849,7 +856,8 @@ void Renderer::begin_frame() {
     State& s = *state_;
     ++s.frames_begun;
     if (s.frames_begun % State::kForgetMotionFrames == 0) {
-        std::erase_if(s.motions, [&](const auto& m) { return s.frames_begun - m.second.seen > State::kForgetMotionFrames; });
+        std::erase_if(s.motions,
+                      [&](const auto& m) { return s.frames_begun - m.second.seen > State::kForgetMotionFrames; });
     }
     s.undo.recorded = false;
     s.undo.motions.clear();
@@ -928,6 +936,7 @@ void Renderer::draw(std::span<const GlyphInstance> glyphs, const DrawOptions& op
 
 Status Renderer::record(VkCommandBuffer command_buffer) {
     State& s = *state_;
+    const vk::Functions& fn = s.fn;
     s.settle_requests();
     const std::span<const RasterWork> work = s.atlas.schedule();
 
@@ -973,11 +982,11 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         const FontPage& page = s.pages[font.page];
         if (font.points_bytes) {
             const VkBufferCopy copy{0, font.points_at, font.points_bytes};
-            vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.points.buffer, 1, &copy);
+            fn.vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.points.buffer, 1, &copy);
         }
         if (font.bands_bytes) {
             const VkBufferCopy copy{font.points_bytes, font.bands_at, font.bands_bytes};
-            vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.bands.buffer, 1, &copy);
+            fn.vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.bands.buffer, 1, &copy);
         }
         s.stats.upload_bytes += font.points_bytes + font.bands_bytes;
         font.uploaded = true;
@@ -992,8 +1001,9 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         if (Status grown = s.grow_image(command_buffer, frame); !grown) return grown;
     }
     if (!s.atlas_initialized) {
-        vk::image_barrier(command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
-                          VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);
+        vk::image_barrier(fn, command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                          VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                          vk::kShaderAccess);
         s.atlas_initialized = true;
     }
 
@@ -1044,13 +1054,13 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     before.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
     before.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     if (!s.item_data.empty()) {
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, nullptr, 0, nullptr);
+        fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, nullptr, 0, nullptr);
         const auto* bytes = reinterpret_cast<const std::byte*>(s.item_data.data());
         const VkDeviceSize total = s.item_data.size() * sizeof(gpu::RasterItem);
         for (VkDeviceSize offset = 0; offset < total; offset += kUpdateChunk) {
             const VkDeviceSize size = std::min(kUpdateChunk, total - offset);
-            vkCmdUpdateBuffer(command_buffer, s.items.buffer, offset, size, bytes + offset);
+            fn.vkCmdUpdateBuffer(command_buffer, s.items.buffer, offset, size, bytes + offset);
         }
         s.stats.upload_bytes += total;
     }
@@ -1059,8 +1069,8 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         after.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
         after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
         after.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                             &after, 0, nullptr, 0, nullptr);
+        fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
+                                1, &after, 0, nullptr, 0, nullptr);
     }
 
     if (!s.item_data.empty()) {
@@ -1069,16 +1079,16 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         readers.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
         readers.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
         readers.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-        vkCmdPipelineBarrier(command_buffer,
-                             VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
-                                 VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &readers, 0, nullptr, 0, nullptr);
+        fn.vkCmdPipelineBarrier(command_buffer,
+                                VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+                                    VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &readers, 0, nullptr, 0, nullptr);
 
         const VkDescriptorSet set = s.descriptors.sets[frame % s.frames_in_flight];
         s.write_descriptors(set);
-        vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline);
-        vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.descriptors.pipeline_layout, 0, 1,
-                                &set, 0, nullptr);
+        fn.vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline);
+        fn.vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.descriptors.pipeline_layout, 0, 1,
+                                   &set, 0, nullptr);
         gpu::RasterPushConstants push{};
         for (size_t c = 0; c < 3; ++c) {
             const SampleRect& r = s.layout.channels[c];
@@ -1087,26 +1097,27 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         push.item_count = static_cast<uint32_t>(s.item_data.size());
         push.workgroup_count = workgroups;
         push.shared_rows = s.shared_row_roots && shares_sample_rows(s.layout) ? 1u : 0u;
-        vkCmdPushConstants(command_buffer, s.descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
-                           &push);
+        fn.vkCmdPushConstants(command_buffer, s.descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                              sizeof push, &push);
         const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);
         const uint32_t height = (workgroups + gpu::kRasterDispatchWidth - 1) / gpu::kRasterDispatchWidth;
-        vkCmdDispatch(command_buffer, width, height, 1);
+        fn.vkCmdDispatch(command_buffer, width, height, 1);
 
         VkMemoryBarrier done{};
         done.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
         done.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
         done.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                             VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
-                                 VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             0, 1, &done, 0, nullptr, 0, nullptr);
+        fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+                                    VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                0, 1, &done, 0, nullptr, 0, nullptr);
     }
     return {};
 }
 
 void Renderer::record_atlas_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const {
     const State& s = *state_;
+    const vk::Functions& fn = s.fn;
     VkImageMemoryBarrier barrier{};
     barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
     barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
@@ -1117,24 +1128,25 @@ void Renderer::record_atlas_readback(VkCommandBuffer command_buffer, VkBuffer bu
     barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     barrier.image = s.atlas_image.image;
     barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                         nullptr, 0, nullptr, 1, &barrier);
+    fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                            nullptr, 0, nullptr, 1, &barrier);
     VkBufferImageCopy copy{};
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.imageExtent = {s.atlas.config().width, s.atlas.config().height, 1};
-    vkCmdCopyImageToBuffer(command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &copy);
+    fn.vkCmdCopyImageToBuffer(command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1,
+                              &copy);
     barrier.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
     barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
     barrier.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
     barrier.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                         nullptr, 0, nullptr, 1, &barrier);
+    fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
+                            nullptr, 0, nullptr, 1, &barrier);
     VkMemoryBarrier to_host{};
     to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
     to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
-                         nullptr, 0, nullptr);
+    fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host,
+                            0, nullptr, 0, nullptr);
 }
 
 std::span<const DrawnGlyph> Renderer::drawn() const {

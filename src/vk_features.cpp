@@ -204,9 +204,10 @@ Result<DeviceFeatures> copy_required_features(const VkPhysicalDeviceFeatures2* c
 Result<DeviceFeatures> read_enabled_features(const VkPhysicalDeviceFeatures2* chain, const char* who) {
     if (chain == nullptr || chain->sType != VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2) {
         return Error{ErrorCode::invalid_argument,
-                     std::string(who) + ": enabled_features must point at the VkPhysicalDeviceFeatures2 chain the "
-                                        "device was created with (crisp checks what the device enabled, not what "
-                                        "the GPU offers)"};
+                     std::string(who) +
+                         ": enabled_features must point at the VkPhysicalDeviceFeatures2 chain the "
+                         "device was created with (crisp checks what the device enabled, not what "
+                         "the GPU offers)"};
     }
     DeviceFeatures enabled;
     enabled.features2.features = chain->features;
@@ -234,9 +235,9 @@ Result<DeviceFeatures> read_enabled_features(const VkPhysicalDeviceFeatures2* ch
     return enabled;
 }
 
-DeviceFeatures query_features(VkPhysicalDevice device, bool with_vulkan13) {
+DeviceFeatures query_features(const Functions& fn, VkPhysicalDevice device, bool with_vulkan13) {
     DeviceFeatures offered;
-    vkGetPhysicalDeviceFeatures2(device, offered.link(with_vulkan13));
+    fn.vkGetPhysicalDeviceFeatures2(device, offered.link(with_vulkan13));
     // The result is copied out; pointers into this local would dangle.
     offered.features2.pNext = nullptr;
     offered.vulkan11.pNext = nullptr;

@@ -2,6 +2,8 @@
 // comparing it with what a device offers and naming what is missing.
 #pragma once
 
+#include "vk_functions.hpp"
+
 #include <crisp/result.hpp>
 
 #include <vulkan/vulkan.h>
@@ -43,7 +45,7 @@ Result<DeviceFeatures> read_enabled_features(const VkPhysicalDeviceFeatures2* ch
 
 // The features `device` offers. Vulkan 1.3 features are queried only when with_vulkan13 (the
 // instance and the device are both 1.3 or newer); otherwise they read as absent.
-DeviceFeatures query_features(VkPhysicalDevice device, bool with_vulkan13);
+DeviceFeatures query_features(const Functions& fn, VkPhysicalDevice device, bool with_vulkan13);
 
 // The names of the features `required` asks for and `offered` lacks ("shaderBufferInt64Atomics"),
 // in declaration order.

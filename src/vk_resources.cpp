@@ -36,13 +36,13 @@ std::optional<uint32_t> find_memory_type(const VkPhysicalDeviceMemoryProperties&
     return fallback;
 }
 
-bool has_compute_subgroup_arithmetic(VkPhysicalDevice physical_device) {
+bool has_compute_subgroup_arithmetic(const Functions& fn, VkPhysicalDevice physical_device) {
     VkPhysicalDeviceSubgroupProperties subgroup{};
     subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
     VkPhysicalDeviceProperties2 properties{};
     properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
     properties.pNext = &subgroup;
-    vkGetPhysicalDeviceProperties2(physical_device, &properties);
+    fn.vkGetPhysicalDeviceProperties2(physical_device, &properties);
     return (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
            (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) != 0;
 }
@@ -52,27 +52,27 @@ std::string version_string(uint32_t version) {
            std::to_string(VK_API_VERSION_PATCH(version));
 }
 
-DeviceRef make_device_ref(VkPhysicalDevice physical_device, VkDevice device, const VkAllocationCallbacks* allocator,
-                          VkPipelineCache pipeline_cache) {
+DeviceRef make_device_ref(const Functions& fn, VkPhysicalDevice physical_device, VkDevice device,
+                          const VkAllocationCallbacks* allocator, VkPipelineCache pipeline_cache) {
     DeviceRef ref;
+    ref.fn = &fn;
+    ref.physical_device = physical_device;
     ref.device = device;
     ref.allocator = allocator;
     ref.pipeline_cache = pipeline_cache;
-    vkGetPhysicalDeviceMemoryProperties(physical_device, &ref.memory_properties);
-    ref.set_object_name = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
-        vkGetDeviceProcAddr(device, "vkSetDebugUtilsObjectNameEXT"));
+    fn.vkGetPhysicalDeviceMemoryProperties(physical_device, &ref.memory_properties);
     return ref;
 }
 
 void name_object(const DeviceRef& device, VkObjectType type, uint64_t handle, std::string_view what) {
-    if (!device.set_object_name || handle == 0) return;
+    if (!device.fn->vkSetDebugUtilsObjectNameEXT || handle == 0) return;
     const std::string name = "crisp " + std::string(what);
     VkDebugUtilsObjectNameInfoEXT info{};
     info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT;
     info.objectType = type;
     info.objectHandle = handle;
     info.pObjectName = name.c_str();
-    device.set_object_name(device.device, &info);  // a failed name changes nothing crisp does
+    device.fn->vkSetDebugUtilsObjectNameEXT(device.device, &info);  // a failed name changes nothing crisp does
 }
 
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
@@ -84,12 +84,12 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
     info.size = std::max<VkDeviceSize>(size, 16);
     info.usage = usage;
     info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    if (VkResult r = vkCreateBuffer(device.device, &info, device.allocator, &out.buffer); r != VK_SUCCESS) {
+    if (VkResult r = device.fn->vkCreateBuffer(device.device, &info, device.allocator, &out.buffer); r != VK_SUCCESS) {
         return vulkan_error("vkCreateBuffer" + suffix, r);
     }
     out.size = info.size;
     VkMemoryRequirements requirements{};
-    vkGetBufferMemoryRequirements(device.device, out.buffer, &requirements);
+    device.fn->vkGetBufferMemoryRequirements(device.device, out.buffer, &requirements);
     const VkMemoryPropertyFlags required =
         host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
                      : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
@@ -105,13 +105,15 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
     allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     allocate.allocationSize = requirements.size;
     allocate.memoryTypeIndex = *type;
-    if (VkResult r = vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory); r != VK_SUCCESS) {
+    if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory);
+        r != VK_SUCCESS) {
         destroy_buffer(device, out);
         return vulkan_error("vkAllocateMemory" + suffix, r);
     }
-    vkBindBufferMemory(device.device, out.buffer, out.memory, 0);
+    device.fn->vkBindBufferMemory(device.device, out.buffer, out.memory, 0);
     if (host_visible) {
-        if (VkResult r = vkMapMemory(device.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped); r != VK_SUCCESS) {
+        if (VkResult r = device.fn->vkMapMemory(device.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
+            r != VK_SUCCESS) {
             destroy_buffer(device, out);
             return vulkan_error("vkMapMemory" + suffix, r);
         }
@@ -122,8 +124,8 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
 }
 
 void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer) {
-    if (buffer.buffer) vkDestroyBuffer(device.device, buffer.buffer, device.allocator);
-    if (buffer.memory) vkFreeMemory(device.device, buffer.memory, device.allocator);
+    if (buffer.buffer) device.fn->vkDestroyBuffer(device.device, buffer.buffer, device.allocator);
+    if (buffer.memory) device.fn->vkFreeMemory(device.device, buffer.memory, device.allocator);
     buffer = {};
 }
 
@@ -143,11 +145,11 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     image.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     image.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     const std::string suffix = std::string(" (") + what + ")";
-    if (VkResult r = vkCreateImage(device.device, &image, device.allocator, &out.image); r != VK_SUCCESS) {
+    if (VkResult r = device.fn->vkCreateImage(device.device, &image, device.allocator, &out.image); r != VK_SUCCESS) {
         return vulkan_error("vkCreateImage" + suffix, r);
     }
     VkMemoryRequirements requirements{};
-    vkGetImageMemoryRequirements(device.device, out.image, &requirements);
+    device.fn->vkGetImageMemoryRequirements(device.device, out.image, &requirements);
     const auto type =
         find_memory_type(device.memory_properties, requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
     if (!type) {
@@ -158,18 +160,19 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     allocate.allocationSize = requirements.size;
     allocate.memoryTypeIndex = *type;
-    if (VkResult r = vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory); r != VK_SUCCESS) {
+    if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory);
+        r != VK_SUCCESS) {
         destroy_image(device, out);
         return vulkan_error("vkAllocateMemory" + suffix, r);
     }
-    vkBindImageMemory(device.device, out.image, out.memory, 0);
+    device.fn->vkBindImageMemory(device.device, out.image, out.memory, 0);
     VkImageViewCreateInfo view{};
     view.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
     view.image = out.image;
     view.viewType = VK_IMAGE_VIEW_TYPE_2D;
     view.format = format;
     view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    if (VkResult r = vkCreateImageView(device.device, &view, device.allocator, &out.view); r != VK_SUCCESS) {
+    if (VkResult r = device.fn->vkCreateImageView(device.device, &view, device.allocator, &out.view); r != VK_SUCCESS) {
         destroy_image(device, out);
         return vulkan_error("vkCreateImageView" + suffix, r);
     }
@@ -180,9 +183,9 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
 }
 
 void destroy_image(const DeviceRef& device, DeviceImage& image) {
-    if (image.view) vkDestroyImageView(device.device, image.view, device.allocator);
-    if (image.image) vkDestroyImage(device.device, image.image, device.allocator);
-    if (image.memory) vkFreeMemory(device.device, image.memory, device.allocator);
+    if (image.view) device.fn->vkDestroyImageView(device.device, image.view, device.allocator);
+    if (image.image) device.fn->vkDestroyImage(device.device, image.image, device.allocator);
+    if (image.memory) device.fn->vkFreeMemory(device.device, image.memory, device.allocator);
     image = {};
 }
 
@@ -199,7 +202,8 @@ Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescrip
     set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
     set_info.bindingCount = static_cast<uint32_t>(bindings.size());
     set_info.pBindings = bindings.data();
-    if (VkResult r = vkCreateDescriptorSetLayout(device.device, &set_info, device.allocator, &out.set_layout);
+    if (VkResult r =
+            device.fn->vkCreateDescriptorSetLayout(device.device, &set_info, device.allocator, &out.set_layout);
         r != VK_SUCCESS) {
         return failed("vkCreateDescriptorSetLayout", r);
     }
@@ -210,7 +214,8 @@ Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescrip
     layout_info.pSetLayouts = &out.set_layout;
     layout_info.pushConstantRangeCount = push_bytes > 0 ? 1 : 0;
     layout_info.pPushConstantRanges = &push;
-    if (VkResult r = vkCreatePipelineLayout(device.device, &layout_info, device.allocator, &out.pipeline_layout);
+    if (VkResult r =
+            device.fn->vkCreatePipelineLayout(device.device, &layout_info, device.allocator, &out.pipeline_layout);
         r != VK_SUCCESS) {
         return failed("vkCreatePipelineLayout", r);
     }
@@ -227,7 +232,8 @@ Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescrip
     pool_info.maxSets = set_count;
     pool_info.poolSizeCount = static_cast<uint32_t>(sizes.size());
     pool_info.pPoolSizes = sizes.data();
-    if (VkResult r = vkCreateDescriptorPool(device.device, &pool_info, device.allocator, &out.pool); r != VK_SUCCESS) {
+    if (VkResult r = device.fn->vkCreateDescriptorPool(device.device, &pool_info, device.allocator, &out.pool);
+        r != VK_SUCCESS) {
         return failed("vkCreateDescriptorPool", r);
     }
     const std::vector<VkDescriptorSetLayout> layouts(set_count, out.set_layout);
@@ -237,7 +243,7 @@ Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescrip
     allocate.descriptorPool = out.pool;
     allocate.descriptorSetCount = set_count;
     allocate.pSetLayouts = layouts.data();
-    if (VkResult r = vkAllocateDescriptorSets(device.device, &allocate, out.sets.data()); r != VK_SUCCESS) {
+    if (VkResult r = device.fn->vkAllocateDescriptorSets(device.device, &allocate, out.sets.data()); r != VK_SUCCESS) {
         return failed("vkAllocateDescriptorSets", r);
     }
     name_object(device, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, out.set_layout, what);
@@ -248,9 +254,9 @@ Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescrip
 }
 
 void destroy_descriptor_sets(const DeviceRef& device, DescriptorSets& sets) {
-    if (sets.pool) vkDestroyDescriptorPool(device.device, sets.pool, device.allocator);  // frees the sets
-    if (sets.pipeline_layout) vkDestroyPipelineLayout(device.device, sets.pipeline_layout, device.allocator);
-    if (sets.set_layout) vkDestroyDescriptorSetLayout(device.device, sets.set_layout, device.allocator);
+    if (sets.pool) device.fn->vkDestroyDescriptorPool(device.device, sets.pool, device.allocator);  // frees the sets
+    if (sets.pipeline_layout) device.fn->vkDestroyPipelineLayout(device.device, sets.pipeline_layout, device.allocator);
+    if (sets.set_layout) device.fn->vkDestroyDescriptorSetLayout(device.device, sets.set_layout, device.allocator);
     sets = {};
 }
 
@@ -265,8 +271,8 @@ Result<VkPipeline> create_compute_pipeline(const DeviceRef& device, VkShaderModu
     info.stage.pSpecializationInfo = specialization;
     info.layout = layout;
     VkPipeline pipeline = VK_NULL_HANDLE;
-    if (VkResult r =
-            vkCreateComputePipelines(device.device, device.pipeline_cache, 1, &info, device.allocator, &pipeline);
+    if (VkResult r = device.fn->vkCreateComputePipelines(device.device, device.pipeline_cache, 1, &info,
+                                                         device.allocator, &pipeline);
         r != VK_SUCCESS) {
         return vulkan_error(std::string("vkCreateComputePipelines (") + what + ")", r);
     }
@@ -282,7 +288,8 @@ Result<VkShaderModule> create_embedded_shader(const DeviceRef& device, std::stri
     info.codeSize = code->size;
     info.pCode = code->code;
     VkShaderModule module = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateShaderModule(device.device, &info, device.allocator, &module); r != VK_SUCCESS) {
+    if (VkResult r = device.fn->vkCreateShaderModule(device.device, &info, device.allocator, &module);
+        r != VK_SUCCESS) {
         return vulkan_error("vkCreateShaderModule (" + std::string(name) + ")", r);
     }
     name_object(device, VK_OBJECT_TYPE_SHADER_MODULE, module, name);
@@ -345,7 +352,8 @@ bool is_real_layout(VkImageLayout layout) {
 // --- Buffer ---------------------------------------------------------------------------------------
 
 Buffer::Buffer(Buffer&& other) noexcept
-    : device_(std::exchange(other.device_, VK_NULL_HANDLE)),
+    : fn_(std::exchange(other.fn_, nullptr)),
+      device_(std::exchange(other.device_, VK_NULL_HANDLE)),
       buffer_(std::exchange(other.buffer_, VK_NULL_HANDLE)),
       memory_(std::exchange(other.memory_, VK_NULL_HANDLE)),
       size_(std::exchange(other.size_, 0)),
@@ -355,6 +363,7 @@ Buffer::Buffer(Buffer&& other) noexcept
 Buffer& Buffer::operator=(Buffer&& other) noexcept {
     if (this != &other) {
         destroy();
+        fn_ = std::exchange(other.fn_, nullptr);
         device_ = std::exchange(other.device_, VK_NULL_HANDLE);
         buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
         memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
@@ -372,8 +381,8 @@ Buffer::~Buffer() {
 void Buffer::destroy() {
     if (device_ == VK_NULL_HANDLE) return;
     // The buffer goes before the memory bound to it.
-    if (buffer_ != VK_NULL_HANDLE) vkDestroyBuffer(device_, buffer_, nullptr);
-    if (memory_ != VK_NULL_HANDLE) vkFreeMemory(device_, memory_, nullptr);  // also unmaps
+    if (buffer_ != VK_NULL_HANDLE) fn_->vkDestroyBuffer(device_, buffer_, nullptr);
+    if (memory_ != VK_NULL_HANDLE) fn_->vkFreeMemory(device_, memory_, nullptr);  // also unmaps
     device_ = VK_NULL_HANDLE;
     buffer_ = VK_NULL_HANDLE;
     memory_ = VK_NULL_HANDLE;
@@ -385,7 +394,8 @@ void Buffer::destroy() {
 // --- Image ----------------------------------------------------------------------------------------
 
 Image::Image(Image&& other) noexcept
-    : device_(std::exchange(other.device_, VK_NULL_HANDLE)),
+    : fn_(std::exchange(other.fn_, nullptr)),
+      device_(std::exchange(other.device_, VK_NULL_HANDLE)),
       image_(std::exchange(other.image_, VK_NULL_HANDLE)),
       view_(std::exchange(other.view_, VK_NULL_HANDLE)),
       memory_(std::exchange(other.memory_, VK_NULL_HANDLE)),
@@ -396,6 +406,7 @@ Image::Image(Image&& other) noexcept
 Image& Image::operator=(Image&& other) noexcept {
     if (this != &other) {
         destroy();
+        fn_ = std::exchange(other.fn_, nullptr);
         device_ = std::exchange(other.device_, VK_NULL_HANDLE);
         image_ = std::exchange(other.image_, VK_NULL_HANDLE);
         view_ = std::exchange(other.view_, VK_NULL_HANDLE);
@@ -414,9 +425,9 @@ Image::~Image() {
 void Image::destroy() {
     if (device_ == VK_NULL_HANDLE) return;
     // View, then image, then the memory bound to it.
-    if (view_ != VK_NULL_HANDLE) vkDestroyImageView(device_, view_, nullptr);
-    if (image_ != VK_NULL_HANDLE) vkDestroyImage(device_, image_, nullptr);
-    if (memory_ != VK_NULL_HANDLE) vkFreeMemory(device_, memory_, nullptr);
+    if (view_ != VK_NULL_HANDLE) fn_->vkDestroyImageView(device_, view_, nullptr);
+    if (image_ != VK_NULL_HANDLE) fn_->vkDestroyImage(device_, image_, nullptr);
+    if (memory_ != VK_NULL_HANDLE) fn_->vkFreeMemory(device_, memory_, nullptr);
     device_ = VK_NULL_HANDLE;
     image_ = VK_NULL_HANDLE;
     view_ = VK_NULL_HANDLE;
@@ -449,6 +460,7 @@ Result<Buffer> HeadlessContext::create_buffer(VkDeviceSize size, VkBufferUsageFl
 
     const VkDevice vk_device = device();
     Buffer buffer;  // owns whatever exists so far, so every early return cleans up
+    buffer.fn_ = &functions();
     buffer.device_ = vk_device;
     buffer.size_ = size;
     buffer.usage_ = usage;
@@ -457,11 +469,12 @@ Result<Buffer> HeadlessContext::create_buffer(VkDeviceSize size, VkBufferUsageFl
     info.size = size;
     info.usage = usage;
     info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    if (VkResult result = vkCreateBuffer(vk_device, &info, nullptr, &buffer.buffer_); result != VK_SUCCESS) {
+    if (VkResult result = functions().vkCreateBuffer(vk_device, &info, nullptr, &buffer.buffer_);
+        result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateBuffer", result);
     }
     VkMemoryRequirements requirements{};
-    vkGetBufferMemoryRequirements(vk_device, buffer.buffer_, &requirements);
+    functions().vkGetBufferMemoryRequirements(vk_device, buffer.buffer_, &requirements);
     const std::optional<uint32_t> type =
         vk::find_memory_type(memory_properties(), requirements.memoryTypeBits, required, preferred);
     if (!type) {
@@ -472,15 +485,17 @@ Result<Buffer> HeadlessContext::create_buffer(VkDeviceSize size, VkBufferUsageFl
     allocation.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     allocation.allocationSize = requirements.size;
     allocation.memoryTypeIndex = *type;
-    if (VkResult result = vkAllocateMemory(vk_device, &allocation, nullptr, &buffer.memory_); result != VK_SUCCESS) {
+    if (VkResult result = functions().vkAllocateMemory(vk_device, &allocation, nullptr, &buffer.memory_);
+        result != VK_SUCCESS) {
         return vk::vulkan_error("vkAllocateMemory", result);
     }
-    if (VkResult result = vkBindBufferMemory(vk_device, buffer.buffer_, buffer.memory_, 0); result != VK_SUCCESS) {
+    if (VkResult result = functions().vkBindBufferMemory(vk_device, buffer.buffer_, buffer.memory_, 0);
+        result != VK_SUCCESS) {
         return vk::vulkan_error("vkBindBufferMemory", result);
     }
     if (memory != MemoryUsage::device_local) {
         void* mapped = nullptr;
-        if (VkResult result = vkMapMemory(vk_device, buffer.memory_, 0, VK_WHOLE_SIZE, 0, &mapped);
+        if (VkResult result = functions().vkMapMemory(vk_device, buffer.memory_, 0, VK_WHOLE_SIZE, 0, &mapped);
             result != VK_SUCCESS) {
             return vk::vulkan_error("vkMapMemory", result);
         }
@@ -518,14 +533,14 @@ Status HeadlessContext::upload(const Buffer& destination, std::span<const std::b
     std::memcpy(staging->mapped().data(), bytes.data(), bytes.size());
     return submit_and_wait([&](VkCommandBuffer commands) {
         // Earlier GPU work may still read or write the range being overwritten.
-        memory_barrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
+        memory_barrier(functions(), commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
                        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
         VkBufferCopy region{};
         region.dstOffset = offset;
         region.size = bytes.size();
-        vkCmdCopyBuffer(commands, staging->handle(), destination.handle(), 1, &region);
+        functions().vkCmdCopyBuffer(commands, staging->handle(), destination.handle(), 1, &region);
         // So that later submissions may use the data without a barrier of their own.
-        memory_barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+        memory_barrier(functions(), commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                        VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
     });
 }
@@ -542,7 +557,7 @@ Result<std::vector<std::byte>> HeadlessContext::read_buffer(const Buffer& source
     if (!source.mapped().empty()) {
         // GPU writes reach the host only through a barrier to the host stage.
         Status made_visible = submit_and_wait([&](VkCommandBuffer commands) {
-            memory_barrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
+            memory_barrier(functions(), commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
                            VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
         });
         if (!made_visible) return made_visible.error();
@@ -555,13 +570,13 @@ Result<std::vector<std::byte>> HeadlessContext::read_buffer(const Buffer& source
     Result<Buffer> staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
     if (!staging) return staging.error();
     Status copied = submit_and_wait([&](VkCommandBuffer commands) {
-        memory_barrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
+        memory_barrier(functions(), commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
                        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
         VkBufferCopy region{};
         region.srcOffset = offset;
         region.size = size;
-        vkCmdCopyBuffer(commands, source.handle(), staging->handle(), 1, &region);
-        memory_barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+        functions().vkCmdCopyBuffer(commands, source.handle(), staging->handle(), 1, &region);
+        memory_barrier(functions(), commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     });
     if (!copied) return copied.error();
@@ -583,8 +598,8 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
     const VkImageCreateFlags flags =
         view_format != desc.format ? VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT | VK_IMAGE_CREATE_EXTENDED_USAGE_BIT : 0;
     VkImageFormatProperties limits{};
-    VkResult supported = vkGetPhysicalDeviceImageFormatProperties(physical_device(), desc.format, VK_IMAGE_TYPE_2D,
-                                                                  VK_IMAGE_TILING_OPTIMAL, desc.usage, flags, &limits);
+    VkResult supported = functions().vkGetPhysicalDeviceImageFormatProperties(
+        physical_device(), desc.format, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_OPTIMAL, desc.usage, flags, &limits);
     if (supported == VK_ERROR_FORMAT_NOT_SUPPORTED ||
         (supported == VK_SUCCESS && (desc.width > limits.maxExtent.width || desc.height > limits.maxExtent.height))) {
         return Error{ErrorCode::vulkan, "create_image: the device does not support a " + std::to_string(desc.width) +
@@ -596,6 +611,7 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
 
     const VkDevice vk_device = device();
     Image image;  // owns whatever exists so far, so every early return cleans up
+    image.fn_ = &functions();
     image.device_ = vk_device;
     image.format_ = desc.format;
     image.extent_ = {desc.width, desc.height};
@@ -613,11 +629,11 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
     info.usage = desc.usage;
     info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    if (VkResult result = vkCreateImage(vk_device, &info, nullptr, &image.image_); result != VK_SUCCESS) {
+    if (VkResult result = functions().vkCreateImage(vk_device, &info, nullptr, &image.image_); result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateImage", result);
     }
     VkMemoryRequirements requirements{};
-    vkGetImageMemoryRequirements(vk_device, image.image_, &requirements);
+    functions().vkGetImageMemoryRequirements(vk_device, image.image_, &requirements);
     const std::optional<uint32_t> type =
         vk::find_memory_type(memory_properties(), requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
     if (!type) return Error{ErrorCode::vulkan, "create_image: no device-local memory type suits this image"};
@@ -625,10 +641,12 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
     allocation.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     allocation.allocationSize = requirements.size;
     allocation.memoryTypeIndex = *type;
-    if (VkResult result = vkAllocateMemory(vk_device, &allocation, nullptr, &image.memory_); result != VK_SUCCESS) {
+    if (VkResult result = functions().vkAllocateMemory(vk_device, &allocation, nullptr, &image.memory_);
+        result != VK_SUCCESS) {
         return vk::vulkan_error("vkAllocateMemory", result);
     }
-    if (VkResult result = vkBindImageMemory(vk_device, image.image_, image.memory_, 0); result != VK_SUCCESS) {
+    if (VkResult result = functions().vkBindImageMemory(vk_device, image.image_, image.memory_, 0);
+        result != VK_SUCCESS) {
         return vk::vulkan_error("vkBindImageMemory", result);
     }
     if ((desc.usage & kViewUsages) != 0) {
@@ -638,7 +656,8 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
         view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
         view_info.format = view_format;
         view_info.subresourceRange = color_range();
-        if (VkResult result = vkCreateImageView(vk_device, &view_info, nullptr, &image.view_); result != VK_SUCCESS) {
+        if (VkResult result = functions().vkCreateImageView(vk_device, &view_info, nullptr, &image.view_);
+            result != VK_SUCCESS) {
             return vk::vulkan_error("vkCreateImageView", result);
         }
     }
@@ -670,13 +689,13 @@ Status HeadlessContext::upload(const Image& destination, std::span<const std::by
     std::memcpy(staging->mapped().data(), bytes.data(), bytes.size());
     return submit_and_wait([&](VkCommandBuffer commands) {
         // From UNDEFINED: the old contents are discarded, but earlier work on the image must finish.
-        image_barrier(commands, destination.handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                      VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                      VK_ACCESS_TRANSFER_WRITE_BIT);
+        image_barrier(functions(), commands, destination.handle(), VK_IMAGE_LAYOUT_UNDEFINED,
+                      VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                      VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
         const VkBufferImageCopy region = whole_image_copy(destination.extent());
-        vkCmdCopyBufferToImage(commands, staging->handle(), destination.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                               1, &region);
-        image_barrier(commands, destination.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
+        functions().vkCmdCopyBufferToImage(commands, staging->handle(), destination.handle(),
+                                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        image_barrier(functions(), commands, destination.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
                       VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
                       VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
     });
@@ -701,17 +720,17 @@ Result<std::vector<std::byte>> HeadlessContext::read_image(const Image& source, 
     Result<Buffer> staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
     if (!staging) return staging.error();
     Status copied = submit_and_wait([&](VkCommandBuffer commands) {
-        image_barrier(commands, source.handle(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+        image_barrier(functions(), commands, source.handle(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                       VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_TRANSFER_READ_BIT);
         const VkBufferImageCopy region = whole_image_copy(source.extent());
-        vkCmdCopyImageToBuffer(commands, source.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging->handle(), 1,
-                               &region);
+        functions().vkCmdCopyImageToBuffer(commands, source.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                           staging->handle(), 1, &region);
         // Back to the caller's layout; later work must wait for the copy's reads.
-        image_barrier(commands, source.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout,
+        image_barrier(functions(), commands, source.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout,
                       VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
                       VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
-        memory_barrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+        memory_barrier(functions(), commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     });
     if (!copied) return copied.error();

@@ -1,6 +1,8 @@
 // Private helpers shared by the Vulkan sources: error values and memory-type choice.
 #pragma once
 
+#include "vk_functions.hpp"
+
 #include <crisp/result.hpp>
 
 #include <vulkan/vulkan.h>
@@ -25,7 +27,7 @@ std::optional<uint32_t> find_memory_type(const VkPhysicalDeviceMemoryProperties&
 
 // True when compute shaders on the device may use subgroup arithmetic (subgroupAdd, subgroupMax,
 // ...): the rasterizer and the tile compositor both do.
-bool has_compute_subgroup_arithmetic(VkPhysicalDevice physical_device);
+bool has_compute_subgroup_arithmetic(const Functions& fn, VkPhysicalDevice physical_device);
 
 // "1.3.230".
 std::string version_string(uint32_t version);
@@ -38,20 +40,20 @@ struct DeviceBuffer {
     VkDeviceSize size = 0;
 };
 
-// The device objects buffers and pipelines are made with.
+// The device objects buffers and pipelines are made with, and the functions they are made through.
 struct DeviceRef {
+    const Functions* fn = nullptr;  // owned by whoever made the DeviceRef; outlives it
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkDevice device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
     VkPhysicalDeviceMemoryProperties memory_properties{};
     VkPipelineCache pipeline_cache = VK_NULL_HANDLE;  // the caller's, or none
-    // vkSetDebugUtilsObjectNameEXT where the instance has VK_EXT_debug_utils, else null.
-    PFN_vkSetDebugUtilsObjectNameEXT set_object_name = nullptr;
 };
 
-// A DeviceRef for `device`: its memory properties, the debug-utils naming function when the
-// instance enabled VK_EXT_debug_utils, and the caller's pipeline cache.
-DeviceRef make_device_ref(VkPhysicalDevice physical_device, VkDevice device, const VkAllocationCallbacks* allocator,
-                          VkPipelineCache pipeline_cache);
+// A DeviceRef for `device`, calling through `fn` (which must outlive it): its memory properties
+// and the caller's pipeline cache.
+DeviceRef make_device_ref(const Functions& fn, VkPhysicalDevice physical_device, VkDevice device,
+                          const VkAllocationCallbacks* allocator, VkPipelineCache pipeline_cache);
 
 // Names `handle` "crisp <what>" for debuggers and the validation layer; nothing without
 // VK_EXT_debug_utils.

@@ -77,20 +77,20 @@ bool has_extension(const std::vector<VkExtensionProperties>& extensions, const c
                        [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
-std::vector<VkExtensionProperties> instance_extensions(const char* layer) {
+std::vector<VkExtensionProperties> instance_extensions(const vk::Functions& fn, const char* layer) {
     uint32_t count = 0;
-    if (vkEnumerateInstanceExtensionProperties(layer, &count, nullptr) != VK_SUCCESS) return {};
+    if (fn.vkEnumerateInstanceExtensionProperties(layer, &count, nullptr) != VK_SUCCESS) return {};
     std::vector<VkExtensionProperties> extensions(count);
-    if (vkEnumerateInstanceExtensionProperties(layer, &count, extensions.data()) != VK_SUCCESS) return {};
+    if (fn.vkEnumerateInstanceExtensionProperties(layer, &count, extensions.data()) != VK_SUCCESS) return {};
     extensions.resize(count);
     return extensions;
 }
 
-bool has_layer(const char* name) {
+bool has_layer(const vk::Functions& fn, const char* name) {
     uint32_t count = 0;
-    if (vkEnumerateInstanceLayerProperties(&count, nullptr) != VK_SUCCESS) return false;
+    if (fn.vkEnumerateInstanceLayerProperties(&count, nullptr) != VK_SUCCESS) return false;
     std::vector<VkLayerProperties> layers(count);
-    if (vkEnumerateInstanceLayerProperties(&count, layers.data()) != VK_SUCCESS) return false;
+    if (fn.vkEnumerateInstanceLayerProperties(&count, layers.data()) != VK_SUCCESS) return false;
     layers.resize(count);
     return std::any_of(layers.begin(), layers.end(),
                        [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
@@ -157,8 +157,8 @@ struct DeviceCandidate {
 
 // Empty when `candidate` meets every requirement; otherwise what it lacks. Fills the candidate's
 // properties and queue family.
-std::vector<std::string> check_device(DeviceCandidate& candidate, const HeadlessContextOptions& options,
-                                      const vk::DeviceFeatures& required) {
+std::vector<std::string> check_device(const vk::Functions& fn, DeviceCandidate& candidate,
+                                      const HeadlessContextOptions& options, const vk::DeviceFeatures& required) {
     std::vector<std::string> lacks;
     const uint32_t device_version = candidate.properties.apiVersion;
     if (!meets_version(device_version, options.api_version)) {
@@ -173,13 +173,13 @@ std::vector<std::string> check_device(DeviceCandidate& candidate, const Headless
     candidate.vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES;
     properties2.pNext = &candidate.vulkan11;
     candidate.vulkan11.pNext = &candidate.vulkan12;
-    vkGetPhysicalDeviceProperties2(candidate.handle, &properties2);
+    fn.vkGetPhysicalDeviceProperties2(candidate.handle, &properties2);
     candidate.vulkan11.pNext = nullptr;
 
     uint32_t family_count = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(candidate.handle, &family_count, nullptr);
+    fn.vkGetPhysicalDeviceQueueFamilyProperties(candidate.handle, &family_count, nullptr);
     std::vector<VkQueueFamilyProperties> families(family_count);
-    vkGetPhysicalDeviceQueueFamilyProperties(candidate.handle, &family_count, families.data());
+    fn.vkGetPhysicalDeviceQueueFamilyProperties(candidate.handle, &family_count, families.data());
     // Graphics and compute together imply transfer; one queue keeps ownership transfers away.
     const VkQueueFlags wanted = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
     auto family = std::find_if(families.begin(), families.end(), [&](const VkQueueFamilyProperties& f) {
@@ -192,9 +192,9 @@ std::vector<std::string> check_device(DeviceCandidate& candidate, const Headless
     }
 
     uint32_t extension_count = 0;
-    vkEnumerateDeviceExtensionProperties(candidate.handle, nullptr, &extension_count, nullptr);
+    fn.vkEnumerateDeviceExtensionProperties(candidate.handle, nullptr, &extension_count, nullptr);
     std::vector<VkExtensionProperties> extensions(extension_count);
-    vkEnumerateDeviceExtensionProperties(candidate.handle, nullptr, &extension_count, extensions.data());
+    fn.vkEnumerateDeviceExtensionProperties(candidate.handle, nullptr, &extension_count, extensions.data());
     extensions.resize(extension_count);
     for (const std::string& name : options.required_extensions) {
         if (!has_extension(extensions, name.c_str())) lacks.push_back("the device lacks extension " + name);
@@ -203,7 +203,7 @@ std::vector<std::string> check_device(DeviceCandidate& candidate, const Headless
     const bool vulkan13 =
         meets_version(device_version, VK_API_VERSION_1_3) && meets_version(options.api_version, VK_API_VERSION_1_3);
     const std::vector<std::string> missing =
-        vk::missing_features(required, vk::query_features(candidate.handle, vulkan13));
+        vk::missing_features(required, vk::query_features(fn, candidate.handle, vulkan13));
     if (!missing.empty()) lacks.push_back("the device lacks " + join(missing, ", "));
 
     const VkSubgroupFeatureFlags wanted_operations = options.required_compute_subgroup_operations;
@@ -222,6 +222,7 @@ std::vector<std::string> check_device(DeviceCandidate& candidate, const Headless
 }  // namespace
 
 struct HeadlessContext::State {
+    vk::Functions fn;  // from the system loader
     VkInstance instance = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
     PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger = nullptr;
@@ -258,15 +259,16 @@ struct HeadlessContext::State {
     // part-way through.
     ~State() {
         const ValidationMessages before = validation_log.snapshot();
-        if (device != VK_NULL_HANDLE) {
+        // A device or instance whose functions failed to load cannot be destroyed; it is leaked.
+        if (device != VK_NULL_HANDLE && fn.vkDestroyDevice != nullptr) {
             // Nothing may be destroyed while the GPU still uses it.
-            vkDeviceWaitIdle(device);
-            if (fence != VK_NULL_HANDLE) vkDestroyFence(device, fence, nullptr);
-            if (command_pool != VK_NULL_HANDLE) vkDestroyCommandPool(device, command_pool, nullptr);
-            vkDestroyDevice(device, nullptr);
+            fn.vkDeviceWaitIdle(device);
+            if (fence != VK_NULL_HANDLE) fn.vkDestroyFence(device, fence, nullptr);
+            if (command_pool != VK_NULL_HANDLE) fn.vkDestroyCommandPool(device, command_pool, nullptr);
+            fn.vkDestroyDevice(device, nullptr);
         }
         if (messenger != VK_NULL_HANDLE) destroy_messenger(instance, messenger, nullptr);
-        if (instance != VK_NULL_HANDLE) vkDestroyInstance(instance, nullptr);
+        if (instance != VK_NULL_HANDLE && fn.vkDestroyInstance != nullptr) fn.vkDestroyInstance(instance, nullptr);
         // What the layer says during teardown (typically: a Buffer or Image outlived its context)
         // has no one left to read it, so it goes to stderr.
         const ValidationMessages after = validation_log.snapshot();
@@ -287,14 +289,15 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     if (!copied) return copied.error();
     vk::DeviceFeatures& required = copied.value();
 
+    auto state = std::make_unique<State>();
+    vk::Functions& fn = state->fn;
+    if (Status s = vk::load_functions(nullptr, VK_NULL_HANDLE, VK_NULL_HANDLE, fn); !s) return s.error();
     uint32_t loader_version = VK_API_VERSION_1_0;
-    if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS ||
+    if (fn.vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS ||
         !meets_version(loader_version, options.api_version)) {
         return Error{ErrorCode::vulkan, "the Vulkan loader supports Vulkan " + vk::version_string(loader_version) +
                                             ", below the " + vk::version_string(options.api_version) + " crisp needs"};
     }
-
-    auto state = std::make_unique<State>();
 
     std::vector<const char*> layers;
     std::vector<const char*> extensions;
@@ -302,13 +305,13 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     VkValidationFeaturesEXT validation_features{};
     const VkValidationFeatureEnableEXT sync_validation = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
     if (options.validation) {
-        if (!has_layer(kValidationLayer)) {
+        if (!has_layer(fn, kValidationLayer)) {
             return Error{ErrorCode::vulkan, std::string("validation was requested but ") + kValidationLayer +
                                                 " is not available (Debian: apt install vulkan-validationlayers)"};
         }
         layers.push_back(kValidationLayer);
-        std::vector<VkExtensionProperties> available = instance_extensions(nullptr);
-        const std::vector<VkExtensionProperties> from_layer = instance_extensions(kValidationLayer);
+        std::vector<VkExtensionProperties> available = instance_extensions(fn, nullptr);
+        const std::vector<VkExtensionProperties> from_layer = instance_extensions(fn, kValidationLayer);
         available.insert(available.end(), from_layer.begin(), from_layer.end());
         if (!has_extension(available, VK_EXT_DEBUG_UTILS_EXTENSION_NAME)) {
             return Error{ErrorCode::vulkan, "validation was requested but VK_EXT_debug_utils is not available"};
@@ -342,7 +345,7 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     instance_info.ppEnabledLayerNames = layers.data();
     instance_info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
     instance_info.ppEnabledExtensionNames = extensions.data();
-    if (VkResult result = vkCreateInstance(&instance_info, nullptr, &state->instance); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkCreateInstance(&instance_info, nullptr, &state->instance); result != VK_SUCCESS) {
         if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
             return Error{ErrorCode::vulkan, "no Vulkan driver supports Vulkan " +
                                                 vk::version_string(options.api_version) +
@@ -350,11 +353,14 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
         }
         return vk::vulkan_error("vkCreateInstance", result);
     }
+    if (Status s = vk::load_functions(fn.vkGetInstanceProcAddr, state->instance, VK_NULL_HANDLE, fn); !s) {
+        return s.error();
+    }
     if (options.validation) {
         auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(state->instance, "vkCreateDebugUtilsMessengerEXT"));
+            fn.vkGetInstanceProcAddr(state->instance, "vkCreateDebugUtilsMessengerEXT"));
         state->destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(state->instance, "vkDestroyDebugUtilsMessengerEXT"));
+            fn.vkGetInstanceProcAddr(state->instance, "vkDestroyDebugUtilsMessengerEXT"));
         if (create_messenger == nullptr || state->destroy_messenger == nullptr) {
             return Error{ErrorCode::vulkan, "VK_EXT_debug_utils is enabled but its functions are missing"};
         }
@@ -366,11 +372,12 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     }
 
     uint32_t device_count = 0;
-    if (VkResult result = vkEnumeratePhysicalDevices(state->instance, &device_count, nullptr); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkEnumeratePhysicalDevices(state->instance, &device_count, nullptr);
+        result != VK_SUCCESS) {
         return vk::vulkan_error("vkEnumeratePhysicalDevices", result);
     }
     std::vector<VkPhysicalDevice> devices(device_count);
-    if (VkResult result = vkEnumeratePhysicalDevices(state->instance, &device_count, devices.data());
+    if (VkResult result = fn.vkEnumeratePhysicalDevices(state->instance, &device_count, devices.data());
         result != VK_SUCCESS && result != VK_INCOMPLETE) {
         return vk::vulkan_error("vkEnumeratePhysicalDevices", result);
     }
@@ -383,11 +390,11 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     for (VkPhysicalDevice handle : devices) {
         DeviceCandidate candidate;
         candidate.handle = handle;
-        vkGetPhysicalDeviceProperties(handle, &candidate.properties);
+        fn.vkGetPhysicalDeviceProperties(handle, &candidate.properties);
         const std::string name = candidate.properties.deviceName;
         names.push_back(name);
         if (name.find(options.device_name_contains) == std::string::npos) continue;
-        const std::vector<std::string> lacks = check_device(candidate, options, required);
+        const std::vector<std::string> lacks = check_device(fn, candidate, options, required);
         if (!lacks.empty()) {
             rejections.push_back(name + ": " + join(lacks, "; "));
             continue;
@@ -419,7 +426,7 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     state->subgroup.supportedStages = chosen->vulkan11.subgroupSupportedStages;
     state->subgroup.supportedOperations = chosen->vulkan11.subgroupSupportedOperations;
     state->subgroup.quadOperationsInAllStages = chosen->vulkan11.subgroupQuadOperationsInAllStages;
-    vkGetPhysicalDeviceMemoryProperties(state->physical_device, &state->memory_properties);
+    fn.vkGetPhysicalDeviceMemoryProperties(state->physical_device, &state->memory_properties);
     for (const std::string& name : options.required_extensions) {
         // Listing an extension twice is harmless to the caller but invalid for vkCreateDevice.
         if (std::find(state->enabled_extensions.begin(), state->enabled_extensions.end(), name) ==
@@ -445,20 +452,23 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     device_info.pQueueCreateInfos = &queue_info;
     device_info.enabledExtensionCount = static_cast<uint32_t>(device_extensions.size());
     device_info.ppEnabledExtensionNames = device_extensions.data();
-    if (VkResult result = vkCreateDevice(state->physical_device, &device_info, nullptr, &state->device);
+    if (VkResult result = fn.vkCreateDevice(state->physical_device, &device_info, nullptr, &state->device);
         result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateDevice", result);
     }
+    if (Status s = vk::load_functions(fn.vkGetInstanceProcAddr, state->instance, state->device, fn); !s) {
+        return s.error();
+    }
     state->enabled = required;
     state->enabled_chain = state->enabled.link(true);
-    vkGetDeviceQueue(state->device, state->queue_family, 0, &state->queue);
+    fn.vkGetDeviceQueue(state->device, state->queue_family, 0, &state->queue);
 
     VkCommandPoolCreateInfo pool_info{};
     pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
     // One command buffer, re-recorded for every submission.
     pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT | VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     pool_info.queueFamilyIndex = state->queue_family;
-    if (VkResult result = vkCreateCommandPool(state->device, &pool_info, nullptr, &state->command_pool);
+    if (VkResult result = fn.vkCreateCommandPool(state->device, &pool_info, nullptr, &state->command_pool);
         result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateCommandPool", result);
     }
@@ -467,13 +477,13 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     buffer_info.commandPool = state->command_pool;
     buffer_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     buffer_info.commandBufferCount = 1;
-    if (VkResult result = vkAllocateCommandBuffers(state->device, &buffer_info, &state->command_buffer);
+    if (VkResult result = fn.vkAllocateCommandBuffers(state->device, &buffer_info, &state->command_buffer);
         result != VK_SUCCESS) {
         return vk::vulkan_error("vkAllocateCommandBuffers", result);
     }
     VkFenceCreateInfo fence_info{};
     fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-    if (VkResult result = vkCreateFence(state->device, &fence_info, nullptr, &state->fence); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkCreateFence(state->device, &fence_info, nullptr, &state->fence); result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateFence", result);
     }
     return HeadlessContext(std::move(state));
@@ -484,6 +494,12 @@ HeadlessContext::HeadlessContext(HeadlessContext&& other) noexcept = default;
 HeadlessContext& HeadlessContext::operator=(HeadlessContext&& other) noexcept = default;
 HeadlessContext::~HeadlessContext() = default;
 
+const vk::Functions& HeadlessContext::functions() const {
+    return state_->fn;
+}
+PFN_vkGetInstanceProcAddr HeadlessContext::get_instance_proc_addr() const {
+    return state_->fn.vkGetInstanceProcAddr;
+}
 VkInstance HeadlessContext::instance() const {
     return state_->instance;
 }
@@ -545,6 +561,7 @@ ValidationMessages HeadlessContext::validation_messages() const {
 
 Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) {
     State& s = *state_;
+    const vk::Functions& fn = s.fn;
     assert(!s.recording && "submit_and_wait called from inside its own record callback");
     if (s.lost) return Error{ErrorCode::device_lost, "the device was lost earlier: make a new context"};
     // Leaves the command buffer reusable even if `record` throws.
@@ -553,7 +570,7 @@ Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer
         bool ended = false;
         explicit RecordingGuard(State& state) : s(state) { s.recording = true; }
         ~RecordingGuard() {
-            if (!ended) vkResetCommandBuffer(s.command_buffer, 0);
+            if (!ended) s.fn.vkResetCommandBuffer(s.command_buffer, 0);
             s.recording = false;
         }
     } guard(s);
@@ -561,11 +578,11 @@ Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer
     VkCommandBufferBeginInfo begin{};
     begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    if (VkResult result = vkBeginCommandBuffer(s.command_buffer, &begin); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkBeginCommandBuffer(s.command_buffer, &begin); result != VK_SUCCESS) {
         return vk::vulkan_error("vkBeginCommandBuffer", result);
     }
     record(s.command_buffer);
-    VkResult ended = vkEndCommandBuffer(s.command_buffer);
+    VkResult ended = fn.vkEndCommandBuffer(s.command_buffer);
     guard.ended = ended == VK_SUCCESS;
     if (ended != VK_SUCCESS) return vk::vulkan_error("vkEndCommandBuffer", ended);
 
@@ -573,15 +590,15 @@ Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer
     submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &s.command_buffer;
-    if (VkResult result = vkQueueSubmit(s.queue, 1, &submit, s.fence); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkQueueSubmit(s.queue, 1, &submit, s.fence); result != VK_SUCCESS) {
         s.lost = result == VK_ERROR_DEVICE_LOST;
         return vk::vulkan_error("vkQueueSubmit", result);
     }
-    if (VkResult result = vkWaitForFences(s.device, 1, &s.fence, VK_TRUE, UINT64_MAX); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkWaitForFences(s.device, 1, &s.fence, VK_TRUE, UINT64_MAX); result != VK_SUCCESS) {
         s.lost = result == VK_ERROR_DEVICE_LOST;
         return vk::vulkan_error("vkWaitForFences", result);
     }
-    if (VkResult result = vkResetFences(s.device, 1, &s.fence); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkResetFences(s.device, 1, &s.fence); result != VK_SUCCESS) {
         return vk::vulkan_error("vkResetFences", result);
     }
     return {};

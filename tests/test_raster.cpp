@@ -19,6 +19,8 @@
 #include <memory>
 #include <tuple>
 #include <set>
+#include <string>
+#include <string_view>
 
 namespace crisp {
 namespace {
@@ -75,7 +77,8 @@ std::vector<Texel> render(Renderer& renderer, uint32_t& frames, uint32_t max_fra
 
 // Renders `layout` until it converges and returns the atlas texels.
 std::vector<Texel> render(Renderer& renderer, const TextLayout& layout, uint32_t& frames) {
-    return render(renderer, frames, 1000, [&] { renderer.draw(layout.glyphs); }, [] {});
+    return render(
+        renderer, frames, 1000, [&] { renderer.draw(layout.glyphs); }, [] {});
 }
 
 // The float positions the shader computes for sample n of texel (tx, ty), channel c.
@@ -121,8 +124,8 @@ Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, u
                     uint32_t hits = 0;
                     for (uint32_t n = 0; n < samples; ++n) {
                         float x = 0, y = 0;
-                        gpu_sample(map, renderer.subpixel_layout().channels[static_cast<size_t>(c)],
-                                   tx + d.part_x, ty + d.part_y, n, x, y);
+                        gpu_sample(map, renderer.subpixel_layout().channels[static_cast<size_t>(c)], tx + d.part_x,
+                                   ty + d.part_y, n, x, y);
                         const double xd = x, yd = y;
                         const bool hit = winding_number_banded<double>(asset, glyph, xd, yd) != 0;
                         hits += hit;
@@ -345,8 +348,7 @@ TEST(Raster, AGlyphDearerThanTheBudgetIsSplitAcrossFrames) {
     ASSERT_TRUE(layout);
     ASSERT_EQ(layout->glyphs.size(), 1u);
     const GlyphInstance& glyph = layout->glyphs[0];
-    const uint64_t cost =
-        curve_tests_per_sample(font->asset(), font->asset().glyphs[glyph.key.glyph], glyph.key);
+    const uint64_t cost = curve_tests_per_sample(font->asset(), font->asset().glyphs[glyph.key.glyph], glyph.key);
 
     constexpr uint32_t kSamples = 4;
     const HeadlessContext& context = *f.context;
@@ -428,8 +430,8 @@ TEST(Raster, OnlyTheVisiblePartOfAHugeGlyphIsRasterized) {
     EXPECT_LE(drawn.instance.width, 200 + 2 * kAtlasPartMargin);
     EXPECT_EQ(drawn.instance.x, layout->glyphs[0].x + static_cast<int32_t>(drawn.part_x));
     const Comparison result = compare(*renderer, texels, kSamples);
-    EXPECT_GT(result.covered, 1000u);                         // ink is visible...
-    EXPECT_LT(result.covered, 3 * result.texels - 1000u);     // ...and so is paper
+    EXPECT_GT(result.covered, 1000u);                      // ink is visible...
+    EXPECT_LT(result.covered, 3 * result.texels - 1000u);  // ...and so is paper
     EXPECT_EQ(result.unexplained, 0u) << result.mismatched << " of " << result.texels << " texels differ";
 
     // Wholly off the target: culled, no work.
@@ -480,12 +482,12 @@ TEST(Raster, FeaturesAreCheckedAgainstTheDeviceAsCreated) {
     vulkan13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
     VkPhysicalDeviceFeatures2 features{};
     features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    const Status no_room = add_crisp_features(bare->physical_device(), features, {.draw_path = true});
+    const Status no_room = add_crisp_features(bare->instance(), bare->physical_device(), features, {.draw_path = true});
     ASSERT_FALSE(no_room);  // no structure to hold dynamicRendering
     EXPECT_EQ(no_room.error().code, ErrorCode::invalid_argument);
     EXPECT_FALSE(features.features.shaderStorageBufferArrayDynamicIndexing);  // unchanged
     features.pNext = &vulkan13;
-    ASSERT_TRUE(add_crisp_features(bare->physical_device(), features,
+    ASSERT_TRUE(add_crisp_features(bare->instance(), bare->physical_device(), features,
                                    {.draw_path = true, .reference_modes = true, .storage_without_format = false}));
     EXPECT_TRUE(features.features.shaderStorageBufferArrayDynamicIndexing);
     EXPECT_TRUE(features.features.dualSrcBlend);
@@ -635,10 +637,9 @@ TEST(Raster, MovingTextTakesCoarserStepsAndKeepsConverging) {
     ASSERT_EQ(label.glyphs.size(), 2u);
     constexpr int kFrames = 40;
     struct Run {
-        std::set<GlyphKey, bool (*)(const GlyphKey&, const GlyphKey&)> keys{
-            [](const GlyphKey& a, const GlyphKey& b) {
-                return std::tie(a.glyph, a.subpixel_x, a.subpixel_y) < std::tie(b.glyph, b.subpixel_x, b.subpixel_y);
-            }};
+        std::set<GlyphKey, bool (*)(const GlyphKey&, const GlyphKey&)> keys{[](const GlyphKey& a, const GlyphKey& b) {
+            return std::tie(a.glyph, a.subpixel_x, a.subpixel_y) < std::tie(b.glyph, b.subpixel_x, b.subpixel_y);
+        }};
         uint32_t last_samples = 0;
         uint32_t moving = 0;
     };
@@ -756,8 +757,8 @@ TEST(Raster, DroppedFramesDoNotCountTowardsALabelsRest) {
     const std::vector<uint32_t> kept = run(false);
     const std::vector<uint32_t> with_drops = run(true);
     EXPECT_EQ(kept, with_drops);
-    EXPECT_GT(kept[4], 0u);       // still moving just after it stopped
-    EXPECT_EQ(kept.back(), 0u);   // at rest in the end
+    EXPECT_GT(kept[4], 0u);      // still moving just after it stopped
+    EXPECT_EQ(kept.back(), 0u);  // at rest in the end
     expect_no_validation_messages();
 }
 
@@ -795,8 +796,8 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
     };
     const auto check = [&](const std::vector<GlyphInstance>& glyphs) {
         uint32_t frames = 0;
-        const std::vector<Texel> texels =
-            render(*renderer, frames, 100, [&] { renderer->draw(glyphs); }, [] {});
+        const std::vector<Texel> texels = render(
+            *renderer, frames, 100, [&] { renderer->draw(glyphs); }, [] {});
         ASSERT_EQ(renderer->drawn().size(), glyphs.size());
         expect_matches_reference(*renderer, texels, kSamples);
     };
@@ -805,7 +806,7 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
     // Remove font 3: this frame still has it, the next one does not.
     const std::vector<GlyphInstance> all = glyphs_of(fonts);
     ASSERT_TRUE(renderer->remove_font(3));
-    EXPECT_FALSE(renderer->remove_font(3));  // already on its way out
+    EXPECT_FALSE(renderer->remove_font(3));       // already on its way out
     EXPECT_FALSE(renderer->add_font(*fonts[2]));  // not gone yet
     renderer->begin_frame();
     renderer->draw(all);
@@ -833,7 +834,8 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
     ASSERT_TRUE(g);
     ASSERT_EQ(g->glyphs.size(), 1u);
     uint32_t frames = 0;
-    const std::vector<Texel> texels = render(*renderer, frames, 100, [&] { renderer->draw(g->glyphs); }, [] {});
+    const std::vector<Texel> texels = render(
+        *renderer, frames, 100, [&] { renderer->draw(g->glyphs); }, [] {});
     expect_matches_reference(*renderer, texels, kSamples, fonts[2].get());
     expect_no_validation_messages();
 }
@@ -841,6 +843,95 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
 // With a memory budget, an atlas too small for the frame's glyphs grows (its image copied into a
 // larger one) rather than coarsening them; glyphs that had converged before keep their samples
 // through the copy, and a dropped growth frame is grown again by the next one.
+// An engine's own entry point (as volk's would be): it counts what crisp asks for and the
+// dispatches crisp records through it, and withholds one function on request.
+namespace engine_loader {
+PFN_vkGetInstanceProcAddr loader = nullptr;  // the real one behind it
+PFN_vkGetDeviceProcAddr device_loader = nullptr;
+PFN_vkCmdDispatch dispatch = nullptr;
+std::set<std::string> asked;
+uint32_t dispatches = 0;
+std::string withheld;
+
+VKAPI_ATTR void VKAPI_CALL counting_dispatch(VkCommandBuffer cb, uint32_t x, uint32_t y, uint32_t z) {
+    ++dispatches;
+    dispatch(cb, x, y, z);
+}
+
+VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL device_proc_addr(VkDevice device, const char* name) {
+    asked.insert(name);
+    if (name == withheld) return nullptr;
+    const PFN_vkVoidFunction real = device_loader(device, name);
+    if (std::string_view(name) != "vkCmdDispatch") return real;
+    dispatch = reinterpret_cast<PFN_vkCmdDispatch>(real);
+    return reinterpret_cast<PFN_vkVoidFunction>(counting_dispatch);
+}
+
+VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL instance_proc_addr(VkInstance instance, const char* name) {
+    asked.insert(name);
+    if (name == withheld) return nullptr;
+    const PFN_vkVoidFunction real = loader(instance, name);
+    if (std::string_view(name) != "vkGetDeviceProcAddr") return real;
+    device_loader = reinterpret_cast<PFN_vkGetDeviceProcAddr>(real);
+    return reinterpret_cast<PFN_vkVoidFunction>(device_proc_addr);
+}
+}  // namespace engine_loader
+
+// crisp calls Vulkan only through the entry point the caller hands it (and references no Vulkan
+// symbol of its own: the crisp_references_no_vulkan_symbol test), so that an engine that loads
+// Vulkan itself gets crisp's calls through its own dispatch, and the text comes out right.
+TEST(Raster, VulkanIsCalledThroughTheCallersEntryPoint) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    HeadlessContext& context = *f.context;
+    engine_loader::loader = context.get_instance_proc_addr();
+    engine_loader::asked.clear();
+    engine_loader::dispatches = 0;
+    engine_loader::withheld.clear();
+    const TextLayout layout = fixture_layout("Hg@", 14.0f, 2.0f, 16.0f);
+    RendererCreateInfo info = renderer_create_info(context);
+    info.atlas.width = info.atlas.height = 128;
+    info.atlas.max_samples = 16;
+    {
+        auto renderer = Renderer::create(info);
+        ASSERT_TRUE(renderer);
+        ASSERT_TRUE(renderer->add_font(*f.font));
+        uint32_t frames = 0;
+        render(*renderer, layout, frames);
+    }
+    EXPECT_TRUE(engine_loader::asked.empty());
+    EXPECT_EQ(engine_loader::dispatches, 0u);
+
+    info.get_instance_proc_addr = engine_loader::instance_proc_addr;
+    {
+        auto renderer = Renderer::create(info);
+        ASSERT_TRUE(renderer) << renderer.error().message;
+        ASSERT_TRUE(renderer->add_font(*f.font));
+        uint32_t frames = 0;
+        const std::vector<Texel> through_engine = render(*renderer, layout, frames);
+        EXPECT_EQ(engine_loader::dispatches, frames);  // one rasterizer dispatch a frame with work
+        expect_matches_reference(*renderer, through_engine, 16);
+    }
+    for (const char* name : {"vkGetPhysicalDeviceProperties", "vkCreateComputePipelines", "vkCmdPipelineBarrier"}) {
+        EXPECT_EQ(engine_loader::asked.count(name), 1u) << name;
+    }
+
+    // A function the engine's loader does not give is named, and nothing is made.
+    engine_loader::withheld = "vkCmdDispatchIndirect";
+    auto refused = Renderer::create(info);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::vulkan);
+    EXPECT_NE(refused.error().message.find("vkCmdDispatchIndirect"), std::string::npos) << refused.error().message;
+    CompositorCreateInfo compositor_info = compositor_create_info(context);
+    compositor_info.get_instance_proc_addr = engine_loader::instance_proc_addr;
+    auto no_compositor = Compositor::create(compositor_info);
+    ASSERT_FALSE(no_compositor);
+    EXPECT_NE(no_compositor.error().message.find("vkCmdDispatchIndirect"), std::string::npos);
+    engine_loader::withheld.clear();
+    EXPECT_TRUE(Compositor::create(compositor_info));
+    expect_no_validation_messages();
+}
+
 TEST(Raster, AnAtlasWithABudgetGrowsInsteadOfCoarsening) {
     Fixture& f = fixture();
     ASSERT_TRUE(f.context);
@@ -858,7 +949,8 @@ TEST(Raster, AnAtlasWithABudgetGrowsInsteadOfCoarsening) {
     // The first line fits the small atlas and converges there.
     const std::span<const GlyphInstance> first_line(glyphs.data(), 7);
     uint32_t frames = 0;
-    render(*renderer, frames, 100, [&] { renderer->draw(first_line); }, [] {});
+    render(
+        *renderer, frames, 100, [&] { renderer->draw(first_line); }, [] {});
     ASSERT_TRUE(renderer->converged());
     EXPECT_EQ(renderer->stats().atlas_width, 64u);
 
@@ -881,7 +973,8 @@ TEST(Raster, AnAtlasWithABudgetGrowsInsteadOfCoarsening) {
     EXPECT_EQ(grown.coarsened_glyphs, 0u);
     EXPECT_EQ(grown.failed_glyphs, 0u);
     EXPECT_EQ(renderer->drawn().size(), glyphs.size());
-    const std::vector<Texel> texels = render(*renderer, frames, 100, [&] { renderer->draw(glyphs); }, [] {});
+    const std::vector<Texel> texels = render(
+        *renderer, frames, 100, [&] { renderer->draw(glyphs); }, [] {});
     ASSERT_TRUE(renderer->converged());
     EXPECT_EQ(renderer->atlas().config().width, 128u);
     expect_matches_reference(*renderer, texels, kSamples);

@@ -127,11 +127,13 @@ struct ComputeKernel {
 };
 
 // Builds `kernel` for the test shader `name`, bound to `storage`.
-Status create_kernel(ComputeKernel& kernel, VkDevice device, const char* name, uint32_t push_constant_size,
-                     const Buffer& storage) {
+Status create_kernel(ComputeKernel& kernel, const HeadlessContext& context, const char* name,
+                     uint32_t push_constant_size, const Buffer& storage) {
     const test_shaders::EmbeddedShader* shader = test_shaders::find_embedded_shader(name);
     if (shader == nullptr) return Error{ErrorCode::vulkan, std::string(name) + " is not embedded"};
-    kernel.device.device = device;
+    kernel.device =
+        vk::make_device_ref(context.functions(), context.physical_device(), context.device(), nullptr, VK_NULL_HANDLE);
+    const VkDevice device = context.device();
 
     VkShaderModuleCreateInfo module_info{};
     module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
@@ -177,8 +179,7 @@ std::vector<SelftestResult> run_selftest(HeadlessContext& context, uint32_t coun
         return {};
     }
     ComputeKernel kernel;
-    if (Status s = create_kernel(kernel, context.device(), "selftest.comp", sizeof(SelftestPushConstants), *results);
-        !s) {
+    if (Status s = create_kernel(kernel, context, "selftest.comp", sizeof(SelftestPushConstants), *results); !s) {
         ADD_FAILURE() << "creating the selftest pipeline: " << s.error().message;
         return {};
     }
@@ -186,8 +187,7 @@ std::vector<SelftestResult> run_selftest(HeadlessContext& context, uint32_t coun
     Status ran = context.submit_and_wait([&](VkCommandBuffer commands) {
         vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.pipeline);
         vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, kernel.descriptors.pipeline_layout, 0, 1,
-                                &kernel.descriptors.sets[0], 0,
-                                nullptr);
+                                &kernel.descriptors.sets[0], 0, nullptr);
         vkCmdPushConstants(commands, kernel.descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
                            &push);
         vkCmdDispatch(commands, (count + gpu::kSelftestWorkgroupSize - 1) / gpu::kSelftestWorkgroupSize, 1, 1);
@@ -707,8 +707,9 @@ TEST_F(VulkanTest, ResourcesMove) {
 // so that the validation layer and debuggers say whose object a message is about.
 TEST_F(VulkanTest, ObjectsAreNamedForTheValidationLayer) {
     CRISP_CREATE_CONTEXT(context, validated_options());
-    const vk::DeviceRef ref = vk::make_device_ref(context.physical_device(), context.device(), nullptr, VK_NULL_HANDLE);
-    ASSERT_NE(ref.set_object_name, nullptr);
+    const vk::DeviceRef ref =
+        vk::make_device_ref(context.functions(), context.physical_device(), context.device(), nullptr, VK_NULL_HANDLE);
+    ASSERT_NE(ref.fn->vkSetDebugUtilsObjectNameEXT, nullptr);
     vk::DeviceBuffer buffer;
     ASSERT_TRUE(vk::create_buffer(ref, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "probe", buffer));
     // A fill into a buffer made without TRANSFER_DST: the layer reports it, naming the buffer.

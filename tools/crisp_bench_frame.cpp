@@ -127,8 +127,7 @@ const Option kOptions[] = {
      "again every frame) and moving (as changed, and every label moves every frame)\n"
      "(default static,changed,moving)",
      [](Args& a, const std::string& v) { a.variants = split(v, ','); }},
-    {"--device", "TEXT", "pick a device whose name contains TEXT",
-     [](Args& a, const std::string& v) { a.device = v; }},
+    {"--device", "TEXT", "pick a device whose name contains TEXT", [](Args& a, const std::string& v) { a.device = v; }},
     {"--json-out", "FILE", "also write the results as JSON to FILE",
      [](Args& a, const std::string& v) { a.json_out = v; }},
     {"--validate", nullptr, "turn the validation layer on (to check the tool; the times then mean little)",
@@ -211,9 +210,9 @@ std::string_view write_counter(Counter counter, uint64_t frame, std::array<char,
             break;
         case Counter::clock: {
             const uint64_t ms = frame * 1000 / 60;
-            n = std::snprintf(out.data(), out.size(), "Time %02llu:%02llu.%03llu",
-                              static_cast<unsigned long long>(ms / 60000 % 100),
-                              static_cast<unsigned long long>(ms / 1000 % 60), static_cast<unsigned long long>(ms % 1000));
+            n = std::snprintf(
+                out.data(), out.size(), "Time %02llu:%02llu.%03llu", static_cast<unsigned long long>(ms / 60000 % 100),
+                static_cast<unsigned long long>(ms / 1000 % 60), static_cast<unsigned long long>(ms % 1000));
             break;
         }
         case Counter::none:
@@ -260,7 +259,8 @@ struct Labels {
     }
     void lay_out(crisp::Layouter& layouter, std::span<const crisp::Font* const> fonts, const crisp::TextStyle& style,
                  size_t i) {
-        if (crisp::Status s = layouter.layout(fonts, text[i], style, placement[i], laid[i]); !s) fail(s.error().message);
+        if (crisp::Status s = layouter.layout(fonts, text[i], style, placement[i], laid[i]); !s)
+            fail(s.error().message);
     }
 };
 
@@ -393,10 +393,9 @@ private:
 
 // The timed phases of a frame, in order.
 enum Phase : size_t { kLayout, kDraws, kRendererRecord, kCompositorRecord, kPhaseCount };
-constexpr std::array<const char*, kPhaseCount> kPhaseNames = {
-    "begin_frame + 3 layouts", "8 draws", "renderer.record", "compositor.record"};
-constexpr std::array<const char*, kPhaseCount> kPhaseKeys = {"layout", "draws", "renderer_record",
-                                                             "compositor_record"};
+constexpr std::array<const char*, kPhaseCount> kPhaseNames = {"begin_frame + 3 layouts", "8 draws", "renderer.record",
+                                                              "compositor.record"};
+constexpr std::array<const char*, kPhaseCount> kPhaseKeys = {"layout", "draws", "renderer_record", "compositor_record"};
 
 struct Summary {
     double median = 0.0, p90 = 0.0, p99 = 0.0, max = 0.0, mean = 0.0;
@@ -423,7 +422,7 @@ struct VariantResult {
     const Variant* variant = nullptr;
     std::array<std::vector<double>, kPhaseCount> phase_us;  // per timed frame
     std::vector<double> total_us;
-    std::vector<double> thread_cpu_us;  // the same region's thread CPU time
+    std::vector<double> thread_cpu_us;                              // the same region's thread CPU time
     std::vector<double> total_us_with_work, total_us_without_work;  // by whether the frame had raster work
     // Per timed frame, summed: what the renderer and the compositor did.
     uint64_t drawn_glyphs = 0;
@@ -460,8 +459,8 @@ struct Bench {
         style.size = args.size;
         style.color[0] = style.color[1] = style.color[2] = 0.95f;
         const VkRect2D visible{{0, 0}, {args.width, args.height}};
-        const crisp::CompositeTarget composite_target{target.view(), kTargetFormat, VK_FORMAT_UNDEFINED,
-                                                      visible.extent, visible};
+        const crisp::CompositeTarget composite_target{target.view(), kTargetFormat, VK_FORMAT_UNDEFINED, visible.extent,
+                                                      visible};
         crisp::Layouter layouter;
         Labels labels(args.width, args.height);
         for (size_t i = 0; i < kLabels.size(); ++i) labels.lay_out(layouter, fonts, style, i);
@@ -479,8 +478,9 @@ struct Bench {
             if (!cb) fail(cb.error().message);
             // The caller's side, untimed: last frame's compositing into the target before this
             // frame's, the new strings and the labels' draw options.
-            crisp::vk::memory_barrier(*cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, crisp::vk::kShaderAccess,
-                                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, crisp::vk::kShaderAccess);
+            crisp::vk::memory_barrier(context.functions(), *cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                      crisp::vk::kShaderAccess, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                      crisp::vk::kShaderAccess);
             if (variant.change_strings) labels.write_counters(frame);
             for (size_t i = 0; i < kLabels.size(); ++i) options[i] = draw_options(i, frame, variant.move, visible);
 
@@ -623,8 +623,9 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Va
         std::printf(" %.1f | %.1f | %.1f |\n", cpu.median, cpu.p99, cpu.max);
     }
 
-    std::printf("\nWhere the time goes:\n\n| variant | phase | median µs | p90 µs | p99 µs | max µs | mean µs |\n"
-                "|---|---|---:|---:|---:|---:|---:|\n");
+    std::printf(
+        "\nWhere the time goes:\n\n| variant | phase | median µs | p90 µs | p99 µs | max µs | mean µs |\n"
+        "|---|---|---:|---:|---:|---:|---:|\n");
     for (const VariantResult& r : results) {
         for (size_t p = 0; p < kPhaseCount; ++p) {
             std::printf("| %s | %s | ", r.variant->name, kPhaseNames[p]);
@@ -727,8 +728,8 @@ int main(int argc, char** argv) {
     const Args args = parse(argc, argv);
     std::vector<const Variant*> variants;
     for (const std::string& name : args.variants) {
-        const auto* found = std::find_if(std::begin(kVariants), std::end(kVariants),
-                                         [&](const Variant& v) { return name == v.name; });
+        const auto* found =
+            std::find_if(std::begin(kVariants), std::end(kVariants), [&](const Variant& v) { return name == v.name; });
         if (found == std::end(kVariants)) refuse("--variants: unknown variant '" + crisp::cli::printable(name) + "'");
         variants.push_back(found);
     }
@@ -759,9 +760,9 @@ int main(int argc, char** argv) {
     auto target = context->create_image(target_desc);
     if (!target) fail(target.error().message);
     const crisp::Status to_general = context->submit_and_wait([&](VkCommandBuffer cb) {
-        crisp::vk::image_barrier(cb, target->handle(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
-                                 VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                                 crisp::vk::kShaderAccess);
+        crisp::vk::image_barrier(context->functions(), cb, target->handle(), VK_IMAGE_LAYOUT_UNDEFINED,
+                                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0,
+                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, crisp::vk::kShaderAccess);
     });
     if (!to_general) fail(to_general.error().message);
     auto slots = FrameSlots::create(*context);

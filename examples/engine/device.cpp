@@ -65,7 +65,7 @@ std::optional<uint32_t> find_queue_family(VkPhysicalDevice device, VkSurfaceKHR 
 }
 
 // Why `device` cannot run the example; empty when it can.
-std::string unsuitability(VkPhysicalDevice device, VkSurfaceKHR surface) {
+std::string unsuitability(VkInstance instance, VkPhysicalDevice device, VkSurfaceKHR surface) {
     VkPhysicalDeviceProperties properties{};
     vkGetPhysicalDeviceProperties(device, &properties);
     if (properties.apiVersion < VK_API_VERSION_1_3) return "below Vulkan 1.3";
@@ -81,7 +81,8 @@ std::string unsuitability(VkPhysicalDevice device, VkSurfaceKHR surface) {
     // crisp's own check, on a scratch chain: it names the feature the GPU lacks.
     VkPhysicalDeviceFeatures2 scratch{};
     scratch.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    if (crisp::Status s = crisp::add_crisp_features(device, scratch); !s) return s.error().message;
+    if (crisp::Status s = crisp::add_crisp_features(instance, device, scratch, {}, vkGetInstanceProcAddr); !s)
+        return s.error().message;
     return {};
 }
 
@@ -93,6 +94,10 @@ crisp::Result<std::unique_ptr<Device>> Device::create(const DeviceOptions& optio
         return crisp::Error{crisp::ErrorCode::vulkan, "GLFW could not start (no display? set DISPLAY or use xvfb-run)"};
     }
     self->glfw_started_ = true;
+    // The engine loads Vulkan itself; crisp is handed the same entry point (vkGetInstanceProcAddr).
+    if (VkResult r = volkInitialize(); r != VK_SUCCESS) {
+        return crisp::Error{crisp::ErrorCode::vulkan, "volk finds no Vulkan loader (Debian: libvulkan1)"};
+    }
     if (!glfwVulkanSupported()) {
         return crisp::Error{crisp::ErrorCode::vulkan, "GLFW finds no Vulkan loader with surface support"};
     }
@@ -151,6 +156,7 @@ crisp::Status Device::create_instance(bool validation, std::atomic<uint32_t>* me
     info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
     info.ppEnabledExtensionNames = extensions.data();
     if (crisp::Status s = check("vkCreateInstance", vkCreateInstance(&info, nullptr, &instance_)); !s) return s;
+    volkLoadInstance(instance_);
     if (!validation) return {};
     auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
@@ -189,7 +195,7 @@ crisp::Status Device::pick_physical_device() {
     std::stable_sort(devices.begin(), devices.end(), [&](auto a, auto b) { return rank(a) < rank(b); });
     std::string rejected;
     for (VkPhysicalDevice candidate : devices) {
-        const std::string why = unsuitability(candidate, surface_);
+        const std::string why = unsuitability(instance_, candidate, surface_);
         if (why.empty()) {
             physical_device_ = candidate;
             queue_family_ = *find_queue_family(candidate, surface_);
@@ -210,7 +216,9 @@ crisp::Status Device::create_device() {
     vulkan13_.dynamicRendering = VK_TRUE;
     features_.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
     features_.pNext = &vulkan13_;
-    if (crisp::Status s = crisp::add_crisp_features(physical_device_, features_); !s) return s;
+    if (crisp::Status s = crisp::add_crisp_features(instance_, physical_device_, features_, {}, vkGetInstanceProcAddr);
+        !s)
+        return s;
 
     const float priority = 1.0f;
     VkDeviceQueueCreateInfo queue{};
@@ -228,6 +236,7 @@ crisp::Status Device::create_device() {
     info.ppEnabledExtensionNames = extensions;
     if (crisp::Status s = check("vkCreateDevice", vkCreateDevice(physical_device_, &info, nullptr, &device_)); !s)
         return s;
+    volkLoadDevice(device_);  // the device's functions, without the loader's dispatch
     vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
     return {};
 }

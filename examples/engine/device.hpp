@@ -8,7 +8,7 @@
 
 #include <crisp/result.hpp>
 
-#include <vulkan/vulkan.h>
+#include <volk.h>
 
 #include <atomic>
 #include <cstdint>

@@ -7,7 +7,7 @@
 
 #include <crisp/result.hpp>
 
-#include <vulkan/vulkan.h>
+#include <volk.h>
 
 namespace engine {
 

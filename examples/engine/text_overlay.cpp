@@ -75,6 +75,7 @@ crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& de
     std::unique_ptr<TextOverlay> self(new TextOverlay(std::move(font)));
     crisp::RendererCreateInfo renderer_info;
     renderer_info.instance = device.instance();
+    renderer_info.get_instance_proc_addr = vkGetInstanceProcAddr;  // volk's: crisp calls what the engine calls
     renderer_info.physical_device = device.physical_device();
     renderer_info.device = device.device();
     renderer_info.queue_family = device.queue_family();
@@ -88,6 +89,8 @@ crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& de
     if (crisp::Status s = self->renderer_->add_font(self->font_); !s) return s.error();
 
     crisp::CompositorCreateInfo compositor_info;
+    compositor_info.instance = device.instance();
+    compositor_info.get_instance_proc_addr = vkGetInstanceProcAddr;
     compositor_info.physical_device = device.physical_device();
     compositor_info.device = device.device();
     compositor_info.enabled_features = device.enabled_features();

@@ -4,7 +4,7 @@
 
 #include <crisp/result.hpp>
 
-#include <vulkan/vulkan.h>
+#include <volk.h>
 
 #include <string>
 #include <utility>
@@ -17,9 +17,10 @@ crisp::Error vulkan_error(const char* call, VkResult result);
 // Success, or vulkan_error(call, result).
 crisp::Status check(const char* call, VkResult result);
 
-// One object of a device, destroyed with it by `Destroy` unless moved from. Members of this type
-// are destroyed in reverse order of declaration, so declaration order is destruction order.
-template <class Handle, void (*Destroy)(VkDevice, Handle, const VkAllocationCallbacks*)>
+// One object of a device, destroyed with it by `*Destroy` unless moved from (a pointer to volk's
+// function pointer, which is loaded at run time). Members of this type are destroyed in reverse
+// order of declaration, so declaration order is destruction order.
+template <class Handle, void (**Destroy)(VkDevice, Handle, const VkAllocationCallbacks*)>
 class Owned {
 public:
     Owned() = default;
@@ -40,7 +41,7 @@ public:
     ~Owned() { reset(); }
 
     void reset() {
-        if (handle_ != VK_NULL_HANDLE) Destroy(device_, handle_, nullptr);
+        if (handle_ != VK_NULL_HANDLE) (*Destroy)(device_, handle_, nullptr);
         handle_ = VK_NULL_HANDLE;
     }
     Handle get() const { return handle_; }
@@ -51,17 +52,17 @@ private:
     Handle handle_ = VK_NULL_HANDLE;
 };
 
-using OwnedMemory = Owned<VkDeviceMemory, vkFreeMemory>;
-using OwnedBuffer = Owned<VkBuffer, vkDestroyBuffer>;
-using OwnedImage = Owned<VkImage, vkDestroyImage>;
-using OwnedImageView = Owned<VkImageView, vkDestroyImageView>;
-using OwnedSemaphore = Owned<VkSemaphore, vkDestroySemaphore>;
-using OwnedFence = Owned<VkFence, vkDestroyFence>;
-using OwnedCommandPool = Owned<VkCommandPool, vkDestroyCommandPool>;
-using OwnedShaderModule = Owned<VkShaderModule, vkDestroyShaderModule>;
-using OwnedPipelineLayout = Owned<VkPipelineLayout, vkDestroyPipelineLayout>;
-using OwnedPipeline = Owned<VkPipeline, vkDestroyPipeline>;
-using OwnedSwapchain = Owned<VkSwapchainKHR, vkDestroySwapchainKHR>;
+using OwnedMemory = Owned<VkDeviceMemory, &vkFreeMemory>;
+using OwnedBuffer = Owned<VkBuffer, &vkDestroyBuffer>;
+using OwnedImage = Owned<VkImage, &vkDestroyImage>;
+using OwnedImageView = Owned<VkImageView, &vkDestroyImageView>;
+using OwnedSemaphore = Owned<VkSemaphore, &vkDestroySemaphore>;
+using OwnedFence = Owned<VkFence, &vkDestroyFence>;
+using OwnedCommandPool = Owned<VkCommandPool, &vkDestroyCommandPool>;
+using OwnedShaderModule = Owned<VkShaderModule, &vkDestroyShaderModule>;
+using OwnedPipelineLayout = Owned<VkPipelineLayout, &vkDestroyPipelineLayout>;
+using OwnedPipeline = Owned<VkPipeline, &vkDestroyPipeline>;
+using OwnedSwapchain = Owned<VkSwapchainKHR, &vkDestroySwapchainKHR>;
 
 // A buffer and its memory; `mapped` is its host address when made host-visible.
 struct Buffer {

@@ -73,6 +73,11 @@ inline constexpr VkFormat kTileTargetFormats[] = {
 inline constexpr uint32_t kMaxTileCapacity = 1024;
 
 struct CompositorCreateInfo {
+    // Required: the instance `device` belongs to, and the entry point crisp loads its Vulkan
+    // functions through, as RendererCreateInfo::instance and get_instance_proc_addr (null: the
+    // system loader's).
+    VkInstance instance = VK_NULL_HANDLE;
+    PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkDevice device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
@@ -151,7 +156,7 @@ struct CompositeTarget {
     // The view's format where it differs from the image's (R8G8B8A8_UNORM over B8G8R8A8_UNORM);
     // VK_FORMAT_UNDEFINED: the same.
     VkFormat view_format = VK_FORMAT_UNDEFINED;
-    VkExtent2D extent{};                    // the image's size
+    VkExtent2D extent{};  // the image's size
     // Where text lands: glyph pixel (0, 0) is rect.offset, and nothing outside the rect is read
     // or written. An extent of 0 x 0 means the whole image.
     VkRect2D rect{};
@@ -170,16 +175,16 @@ struct CompositorStats {
     QuadPath path = QuadPath::raster;  // the path this frame's quad passes took
     uint32_t tiles = 0;                // compute path: 8 x 8 tiles dispatched
     bool bins_reused = false;          // tiled: the glyphs were unchanged, binning was skipped
-    uint32_t quads = 0;            // glyph quads drawn
-    uint64_t buffer_bytes = 0;     // buffers this frame used: tiled and draw: quads and bins;
-                                   // reference modes: their per-pixel buffers over the whole target
+    uint32_t quads = 0;                // glyph quads drawn
+    uint64_t buffer_bytes = 0;         // buffers this frame used: tiled and draw: quads and bins;
+                                       // reference modes: their per-pixel buffers over the whole target
     // From the last frame whose GPU work has completed (frames_in_flight frames ago), if any:
     bool measured = false;
-    uint64_t measured_frame = 0;      // which frame (1 = the first record())
-    uint32_t max_overlap = 0;         // tiled and exact: most fragments one pixel had
-    uint32_t tail_pixels = 0;         // tiled: pixels with fragments past K (the layered way)
-    uint64_t exact_lost_nodes = 0;    // exact: fragments the node pool could not hold
-    uint64_t exact_dropped = 0;       // exact: fragments past kMaxExactFragmentsPerPixel
+    uint64_t measured_frame = 0;    // which frame (1 = the first record())
+    uint32_t max_overlap = 0;       // tiled and exact: most fragments one pixel had
+    uint32_t tail_pixels = 0;       // tiled: pixels with fragments past K (the layered way)
+    uint64_t exact_lost_nodes = 0;  // exact: fragments the node pool could not hold
+    uint64_t exact_dropped = 0;     // exact: fragments past kMaxExactFragmentsPerPixel
     // tiled: the last completed tiled frame's tiles with quads, how many took the exact way (their
     // list fit) and the layered way, the (quad, tile) pairs binned; max_overlap and tail_pixels
     // above count for it too.
@@ -250,8 +255,8 @@ public:
     // with no node pool; vulkan for a failed Vulkan call; either
     // leaves no commands recorded. On the compute path a rect over 65535 texels a side draws
     // nothing.
-    Status record_reference(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
-                            VkImageView atlas_view, const CompositeParams& params);
+    Status record_reference(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
+                            const CompositeParams& params);
 
     // Takes back the most recent record(), record_draw() or record_reference() when its command
     // buffer will not be submitted (a dropped frame): the bins it made do not count as made, its

@@ -7,7 +7,7 @@
 //     VkPhysicalDeviceVulkan13Features vulkan13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
 //     VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &vulkan13};
 //     ... the engine's own features ...
-//     crisp::add_crisp_features(physical_device, features, {.draw_path = true});
+//     crisp::add_crisp_features(instance, physical_device, features, {.draw_path = true});
 //     device_info.pNext = &features;                    // then vkCreateDevice
 //     renderer_info.enabled_features = &features;       // and the same chain for crisp
 #pragma once
@@ -33,9 +33,12 @@ struct CrispFeatureNeeds {
 // leaving whatever else the chain enables as it is; it never allocates into the chain. Errors:
 // invalid_argument when `features` is not a VkPhysicalDeviceFeatures2, or the draw path is asked
 // for and the chain holds no structure with dynamicRendering (link a
-// VkPhysicalDeviceVulkan13Features); vulkan when the GPU lacks a required feature (named), in
-// which case `features` is unchanged.
-Status add_crisp_features(VkPhysicalDevice physical_device, VkPhysicalDeviceFeatures2& features,
-                          const CrispFeatureNeeds& needs = {});
+// VkPhysicalDeviceVulkan13Features), or `instance` or `physical_device` is null; vulkan when the
+// GPU lacks a required feature (named), or the loader gives no function crisp queries with, in
+// which case `features` is unchanged. The GPU is queried through `get_instance_proc_addr` (null:
+// the system loader's), as RendererCreateInfo::get_instance_proc_addr.
+Status add_crisp_features(VkInstance instance, VkPhysicalDevice physical_device, VkPhysicalDeviceFeatures2& features,
+                          const CrispFeatureNeeds& needs = {},
+                          PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
 
 }  // namespace crisp

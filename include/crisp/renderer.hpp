@@ -45,7 +45,14 @@ inline constexpr uint32_t kMaxRendererSamples = 1023;
 inline constexpr uint32_t kRendererFontPages = 8;
 
 struct RendererCreateInfo {
+    // Required: the instance `device` belongs to. crisp loads every Vulkan function it calls
+    // through it, with this entry point; null: the system loader's (libvulkan.so.1, opened on
+    // first use). An engine that loads Vulkan itself (volk, a dispatch table of its own) passes
+    // its vkGetInstanceProcAddr, and crisp then calls exactly the functions the engine does; crisp
+    // itself references no Vulkan symbol. A required function the loader does not give fails
+    // create() (vulkan), naming it.
     VkInstance instance = VK_NULL_HANDLE;
+    PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkDevice device = VK_NULL_HANDLE;
     uint32_t queue_family = 0;  // the family of the queue the caller submits crisp's work on
@@ -68,7 +75,7 @@ struct RendererCreateInfo {
     // glyphs take coarser subpixel steps (RendererStats::subpixel_steps). 0, or less than twice
     // the initial size: the atlas never grows. The atlas never shrinks.
     uint64_t atlas_memory_budget = 0;
-    SubpixelLayout layout;          // default: rgb
+    SubpixelLayout layout;  // default: rgb
     // Where the three channels sample the same rows (stripe layouts), solve each curve's roots
     // once for all three. Off only to measure what it saves.
     bool shared_row_roots = true;
@@ -166,9 +173,9 @@ public:
     // Creates the atlas image, buffers and the compute pipeline. Fails with ErrorCode::vulkan when
     // the device is below Vulkan 1.2 or lacks what the rasterizer needs (named in the message:
     // shaderStorageBufferArrayDynamicIndexing, storage images of R16G16B16A16_UINT, subgroup
-    // arithmetic in compute shaders, 1 + 2 * kRendererFontPages storage buffers per stage), and with ErrorCode::invalid_argument for a bad atlas config
-    // (see GlyphAtlas::create), max_samples above kMaxRendererSamples, frames_in_flight outside
-    // 1..8, or an invalid layout.
+    // arithmetic in compute shaders, 1 + 2 * kRendererFontPages storage buffers per stage), and with
+    // ErrorCode::invalid_argument for a bad atlas config (see GlyphAtlas::create), max_samples above
+    // kMaxRendererSamples, frames_in_flight outside 1..8, or an invalid layout.
     static Result<Renderer> create(const RendererCreateInfo& info);
 
     Renderer(Renderer&&) noexcept;

@@ -25,6 +25,10 @@
 
 namespace crisp {
 
+namespace vk {
+struct Functions;  // the Vulkan functions crisp calls through (private)
+}
+
 // How a buffer's memory is used; picks the memory type (one VkDeviceMemory per resource).
 enum class MemoryUsage {
     device_local,  // GPU only; filled by transfers (upload) or shaders
@@ -56,6 +60,7 @@ private:
     friend class HeadlessContext;
     void destroy();
 
+    const vk::Functions* fn_ = nullptr;
     VkDevice device_ = VK_NULL_HANDLE;
     VkBuffer buffer_ = VK_NULL_HANDLE;
     VkDeviceMemory memory_ = VK_NULL_HANDLE;
@@ -100,6 +105,7 @@ private:
     friend class HeadlessContext;
     void destroy();
 
+    const vk::Functions* fn_ = nullptr;
     VkDevice device_ = VK_NULL_HANDLE;
     VkImage image_ = VK_NULL_HANDLE;
     VkImageView view_ = VK_NULL_HANDLE;
@@ -171,6 +177,12 @@ public:
     // while the context lives.
     const VkPhysicalDeviceFeatures2* enabled_features() const;
     VkQueue queue() const;
+    // The loader entry point the context was made through, for
+    // RendererCreateInfo::get_instance_proc_addr and CompositorCreateInfo::get_instance_proc_addr.
+    PFN_vkGetInstanceProcAddr get_instance_proc_addr() const;
+    // The functions the context calls through, for crisp's own tools and tests (the type is in
+    // the private src/vk_functions.hpp).
+    const vk::Functions& functions() const;
     // crisp uses the driver's allocator: always nullptr, passed wherever Vulkan takes one.
     const VkAllocationCallbacks* allocation_callbacks() const { return nullptr; }
 

@@ -28,13 +28,10 @@ AtlasConfig atlas_config(uint32_t size) {
 
 }  // namespace
 
-GpuFrame::GpuFrame(VulkanWindow& window) : window_(window) {
-    device_.device = window.device();
-    device_.memory_properties = window.memory_properties();
-}
+GpuFrame::GpuFrame(VulkanWindow& window) : window_(window) {}
 
 GpuFrame::~GpuFrame() {
-    vkDeviceWaitIdle(device_.device);
+    vkDeviceWaitIdle(window_.device());
     preview_compositor_.reset();
     interface_compositor_.reset();
     preview_renderer_.reset();
@@ -50,16 +47,23 @@ GpuFrame::~GpuFrame() {
 Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const Font& font,
                                                    const SubpixelLayout& preview_layout) {
     std::unique_ptr<GpuFrame> self(new GpuFrame(window));
-    const uint32_t width = window.width(), height = window.height();
-    const VkDeviceSize bytes = VkDeviceSize{width} * height * 4;
-    if (Status s = create_image(self->device_, VK_FORMAT_R8G8B8A8_UNORM, width, height,
-                                VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                "canvas", self->canvas_);
+    if (Status s = vk::load_functions(vkGetInstanceProcAddr, window.instance(), window.device(), self->functions_);
         !s) {
         return s.error();
     }
-    if (Status s = create_buffer(self->device_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "editor upload",
-                                 self->upload_);
+    self->device_ =
+        vk::make_device_ref(self->functions_, window.physical_device(), window.device(), nullptr, VK_NULL_HANDLE);
+    const uint32_t width = window.width(), height = window.height();
+    const VkDeviceSize bytes = VkDeviceSize{width} * height * 4;
+    if (Status s =
+            create_image(self->device_, VK_FORMAT_R8G8B8A8_UNORM, width, height,
+                         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                         "canvas", self->canvas_);
+        !s) {
+        return s.error();
+    }
+    if (Status s =
+            create_buffer(self->device_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "editor upload", self->upload_);
         !s) {
         return s.error();
     }
@@ -93,7 +97,8 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
         query_info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
         query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
         query_info.queryCount = 2;
-        if (VkResult r = vkCreateQueryPool(window.device(), &query_info, nullptr, &self->timestamps_); r != VK_SUCCESS) {
+        if (VkResult r = vkCreateQueryPool(window.device(), &query_info, nullptr, &self->timestamps_);
+            r != VK_SUCCESS) {
             return vk::vulkan_error("vkCreateQueryPool", r);
         }
     }
@@ -123,6 +128,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
     }
 
     CompositorCreateInfo compositor_info;
+    compositor_info.instance = window.instance();
     compositor_info.physical_device = window.physical_device();
     compositor_info.device = window.device();
     compositor_info.frames_in_flight = 1;
@@ -169,7 +175,9 @@ std::span<const uint8_t> GpuFrame::previous_frame() const {
     return {static_cast<const uint8_t*>(readback_.mapped), static_cast<size_t>(readback_.size)};
 }
 
-Status GpuFrame::set_preview_layout(const SubpixelLayout& layout) { return preview_renderer_->set_subpixel_layout(layout); }
+Status GpuFrame::set_preview_layout(const SubpixelLayout& layout) {
+    return preview_renderer_->set_subpixel_layout(layout);
+}
 
 Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const GlyphInstance> interface_glyphs,
                         std::span<const GlyphInstance> preview_glyphs) {
@@ -192,13 +200,13 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
     }
 
     // The CPU-drawn canvas into the image (its old contents, last read by transfers, are dropped).
-    image_barrier(cb, canvas_.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+    image_barrier(functions_, cb, canvas_.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                   VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
     VkBufferImageCopy copy{};
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.imageExtent = {width, height, 1};
     vkCmdCopyBufferToImage(cb, upload_.buffer, canvas_.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
-    image_barrier(cb, canvas_.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+    image_barrier(functions_, cb, canvas_.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
                   VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 
@@ -222,15 +230,15 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
         !s) {
         return fail(s.error());
     }
-    image_barrier(cb, canvas_.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
-                  VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                  VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    image_barrier(functions_, cb, canvas_.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
+                  VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                  VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     if (Status s = preview_compositor_->record(cb, preview_renderer_->drawn(), preview_renderer_->atlas_view(),
                                                composite_target);
         !s) {
         return fail(s.error());
     }
-    image_barrier(cb, canvas_.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+    image_barrier(functions_, cb, canvas_.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                   VK_ACCESS_TRANSFER_READ_BIT);
 
@@ -246,17 +254,18 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
     to_host.size = VK_WHOLE_SIZE;
     vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr, 1, &to_host, 0,
                          nullptr);
-    image_barrier(cb, target.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+    image_barrier(functions_, cb, target.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                   VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
     VkImageBlit blit{};
     blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     blit.srcOffsets[1] = {static_cast<int32_t>(width), static_cast<int32_t>(height), 1};
     blit.dstSubresource = blit.srcSubresource;
     blit.dstOffsets[1] = blit.srcOffsets[1];
-    vkCmdBlitImage(cb, canvas_.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
-                   &blit, VK_FILTER_NEAREST);
-    image_barrier(cb, target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0);
+    vkCmdBlitImage(cb, canvas_.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target.image,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_NEAREST);
+    image_barrier(functions_, cb, target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT,
+                  0);
     if (timestamps_) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, 1);
     if (VkResult r = vkEndCommandBuffer(cb); r != VK_SUCCESS) return vk::vulkan_error("vkEndCommandBuffer", r);
 

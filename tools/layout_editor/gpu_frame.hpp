@@ -54,6 +54,7 @@ private:
     explicit GpuFrame(VulkanWindow& window);
 
     VulkanWindow& window_;
+    vk::Functions functions_;  // for crisp's private helpers (the editor itself calls the loader)
     vk::DeviceRef device_;
     vk::DeviceImage canvas_;
     vk::DeviceBuffer upload_;

@@ -86,7 +86,8 @@ struct WindowCallbacks {
 };
 
 Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& options) {
-    if (!glfwInit()) return Error{ErrorCode::vulkan, "GLFW could not start (no display? set DISPLAY or run under xvfb-run)"};
+    if (!glfwInit())
+        return Error{ErrorCode::vulkan, "GLFW could not start (no display? set DISPLAY or run under xvfb-run)"};
     if (!glfwVulkanSupported()) {
         glfwTerminate();
         return Error{ErrorCode::vulkan, "GLFW finds no Vulkan loader with surface support"};
@@ -101,8 +102,9 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
     std::vector<const char*> layers;
     if (options.validation) {
         if (!has_layer("VK_LAYER_KHRONOS_validation")) {
-            return Error{ErrorCode::vulkan,
-                         "--validation: VK_LAYER_KHRONOS_validation is not installed (Debian: vulkan-validationlayers)"};
+            return Error{
+                ErrorCode::vulkan,
+                "--validation: VK_LAYER_KHRONOS_validation is not installed (Debian: vulkan-validationlayers)"};
         }
         layers.push_back("VK_LAYER_KHRONOS_validation");
         extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
@@ -152,7 +154,8 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
     glfwSetMouseButtonCallback(self->window_, WindowCallbacks::button);
     glfwSetKeyCallback(self->window_, WindowCallbacks::key);
     glfwSetCharCallback(self->window_, WindowCallbacks::character);
-    if (VkResult r = glfwCreateWindowSurface(self->instance_, self->window_, nullptr, &self->surface_); r != VK_SUCCESS) {
+    if (VkResult r = glfwCreateWindowSurface(self->instance_, self->window_, nullptr, &self->surface_);
+        r != VK_SUCCESS) {
         return vk::vulkan_error("glfwCreateWindowSurface", r);
     }
 
@@ -205,7 +208,9 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
     // crisp is then told what the device was created with.
     self->features_ = VkPhysicalDeviceFeatures2{};
     self->features_.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    if (Status s = add_crisp_features(self->physical_device_, self->features_, {.storage_without_format = true}); !s) {
+    if (Status s = add_crisp_features(self->instance_, self->physical_device_, self->features_,
+                                      {.storage_without_format = true});
+        !s) {
         return s.error();
     }
     self->storage_without_format_ = self->features_.features.shaderStorageImageWriteWithoutFormat == VK_TRUE;
@@ -251,7 +256,8 @@ Status VulkanWindow::create_swapchain() {
             break;
         }
     }
-    if (chosen.format == VK_FORMAT_UNDEFINED) return Error{ErrorCode::vulkan, "the surface offers no 8-bit UNORM format"};
+    if (chosen.format == VK_FORMAT_UNDEFINED)
+        return Error{ErrorCode::vulkan, "the surface offers no 8-bit UNORM format"};
     VkFormatProperties format_properties{};
     vkGetPhysicalDeviceFormatProperties(physical_device_, chosen.format, &format_properties);
     if (!(format_properties.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_DST_BIT)) {
@@ -261,7 +267,8 @@ Status VulkanWindow::create_swapchain() {
     VkExtent2D extent = capabilities.currentExtent;
     if (extent.width == UINT32_MAX) extent = {options_.width, options_.height};
     uint32_t image_count = capabilities.minImageCount + 1;
-    if (capabilities.maxImageCount != 0 && image_count > capabilities.maxImageCount) image_count = capabilities.maxImageCount;
+    if (capabilities.maxImageCount != 0 && image_count > capabilities.maxImageCount)
+        image_count = capabilities.maxImageCount;
 
     VkSwapchainCreateInfoKHR info{};
     info.sType = VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR;
@@ -328,7 +335,9 @@ VulkanWindow::~VulkanWindow() {
     glfwTerminate();
 }
 
-bool VulkanWindow::should_close() const { return glfwWindowShouldClose(window_) != 0; }
+bool VulkanWindow::should_close() const {
+    return glfwWindowShouldClose(window_) != 0;
+}
 
 std::vector<InputEvent> VulkanWindow::poll_events() {
     glfwPollEvents();
@@ -337,8 +346,8 @@ std::vector<InputEvent> VulkanWindow::poll_events() {
 
 Result<VulkanWindow::Acquired> VulkanWindow::acquire() {
     Acquired acquired;
-    const VkResult r = vkAcquireNextImageKHR(device_, swapchain_, UINT64_MAX, image_ready_, VK_NULL_HANDLE,
-                                             &acquired.index);
+    const VkResult r =
+        vkAcquireNextImageKHR(device_, swapchain_, UINT64_MAX, image_ready_, VK_NULL_HANDLE, &acquired.index);
     if (r == VK_ERROR_OUT_OF_DATE_KHR) {
         if (Status status = create_swapchain(); !status) return status.error();
         return acquired;
