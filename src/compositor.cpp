@@ -6,6 +6,7 @@
 #include "composite_reference.hpp"
 #include "composite_tiles.hpp"
 #include "vk_features.hpp"
+#include "vk_memory.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/vulkan_context.hpp>
@@ -128,6 +129,7 @@ std::optional<float> depth_from_view_projection(const float view_projection[16],
 
 struct Compositor::State {
     vk::Functions fn;  // the caller's Vulkan entry points (CompositorCreateInfo::get_instance_proc_addr)
+    std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory; outlives the paths below
     vk::DeviceRef ref;
     bool storage_without_format = false;
     composite::TileCompositor tiles;
@@ -198,6 +200,9 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
         return Error{s.error().code, "compositor: " + s.error().message};
     }
     state->ref = vk::make_device_ref(state->fn, info.physical_device, info.device, info.allocator, info.pipeline_cache);
+    state->arena =
+        std::make_unique<vk::MemoryArena>(state->fn, info.device, info.allocator, state->ref.memory_properties);
+    state->ref.arena = state->arena.get();
     state->storage_without_format = storage_without_format;
     composite::TileConfig tiles;
     tiles.physical_device = info.physical_device;
@@ -335,6 +340,16 @@ uint32_t Compositor::height() const {
 }
 const CompositorStats& Compositor::stats() const {
     return state_->stats;
+}
+DeviceMemoryUse Compositor::device_memory() const {
+    const State& s = *state_;
+    DeviceMemoryUse use{s.arena->block_count(), s.arena->block_bytes()};
+    if (s.reference) {
+        const vk::DeviceImage& target = s.reference->target();
+        use.allocations += target.memory != VK_NULL_HANDLE ? 1 : 0;
+        use.bytes += target.memory_size;
+    }
+    return use;
 }
 const std::vector<std::string>& Compositor::warnings() const {
     return state_->warnings;

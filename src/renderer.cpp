@@ -1,6 +1,7 @@
 #include "shared.h"
 #include "vk_barriers.hpp"
 #include "vk_features.hpp"
+#include "vk_memory.hpp"
 #include "vk_resources.hpp"
 
 #include <crisp/renderer.hpp>
@@ -101,8 +102,9 @@ struct Renderer::State {
     VkDevice device = VK_NULL_HANDLE;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
-    vk::Functions fn;   // the caller's Vulkan entry points (RendererCreateInfo::get_instance_proc_addr)
-    vk::DeviceRef ref;  // device, allocator, memory properties, pipeline cache, debug names
+    vk::Functions fn;  // the caller's Vulkan entry points (RendererCreateInfo::get_instance_proc_addr)
+    std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory; freed after the body of ~State
+    vk::DeviceRef ref;  // device, allocator, memory properties, pipeline cache, debug names, arena
     VkDeviceSize max_storage_buffer_range = 0;
     uint32_t frames_in_flight = 2;
     bool shared_row_roots = true;
@@ -623,6 +625,9 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     state->atlas_budget = info.atlas_memory_budget;
     state->fn = fn;
     state->ref = vk::make_device_ref(state->fn, info.physical_device, info.device, info.allocator, info.pipeline_cache);
+    state->arena =
+        std::make_unique<vk::MemoryArena>(state->fn, info.device, info.allocator, state->ref.memory_properties);
+    state->ref.arena = state->arena.get();
     state->layout = std::move(layout);
     if (Status s = state->create_objects(); !s) return s.error();
     return Renderer(std::move(state));
@@ -1157,6 +1162,19 @@ bool Renderer::converged() const {
 }
 const RendererStats& Renderer::stats() const {
     return state_->stats;
+}
+DeviceMemoryUse Renderer::device_memory() const {
+    const State& s = *state_;
+    DeviceMemoryUse use{s.arena->block_count(), s.arena->block_bytes()};
+    for (const vk::DeviceImage* image : {&s.atlas_image}) {
+        use.allocations += image->memory != VK_NULL_HANDLE ? 1 : 0;
+        use.bytes += image->memory_size;
+    }
+    for (const State::RetiredImage& r : s.retired_images) {
+        ++use.allocations;
+        use.bytes += r.image.memory_size;
+    }
+    return use;
 }
 const GlyphAtlas& Renderer::atlas() const {
     return state_->atlas;

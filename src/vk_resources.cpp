@@ -3,6 +3,7 @@
 #include "vk_resources.hpp"
 
 #include "vk_barriers.hpp"
+#include "vk_memory.hpp"
 
 #include "embedded_shaders.hpp"
 
@@ -101,31 +102,53 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
         destroy_buffer(device, out);
         return Error{ErrorCode::vulkan, "no memory type for a buffer of " + std::to_string(size) + " bytes" + suffix};
     }
-    VkMemoryAllocateInfo allocate{};
-    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-    allocate.allocationSize = requirements.size;
-    allocate.memoryTypeIndex = *type;
-    if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory);
-        r != VK_SUCCESS) {
-        destroy_buffer(device, out);
-        return vulkan_error("vkAllocateMemory" + suffix, r);
-    }
-    device.fn->vkBindBufferMemory(device.device, out.buffer, out.memory, 0);
-    if (host_visible) {
-        if (VkResult r = device.fn->vkMapMemory(device.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
+    if (device.arena != nullptr) {
+        Result<MemoryArena::Range> range = device.arena->allocate(requirements, *type, what);
+        if (!range) {
+            destroy_buffer(device, out);
+            return range.error();
+        }
+        out.memory = range->memory;
+        out.memory_offset = range->offset;
+        out.memory_size = range->size;
+        out.mapped = range->mapped;
+        out.suballocated = true;
+    } else {
+        VkMemoryAllocateInfo allocate{};
+        allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+        allocate.allocationSize = requirements.size;
+        allocate.memoryTypeIndex = *type;
+        if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory);
             r != VK_SUCCESS) {
             destroy_buffer(device, out);
-            return vulkan_error("vkMapMemory" + suffix, r);
+            return vulkan_error("vkAllocateMemory" + suffix, r);
         }
+        out.memory_size = requirements.size;
+        if (host_visible) {
+            if (VkResult r = device.fn->vkMapMemory(device.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
+                r != VK_SUCCESS) {
+                destroy_buffer(device, out);
+                return vulkan_error("vkMapMemory" + suffix, r);
+            }
+        }
+        name_object(device, VK_OBJECT_TYPE_DEVICE_MEMORY, out.memory, what);
+    }
+    if (VkResult r = device.fn->vkBindBufferMemory(device.device, out.buffer, out.memory, out.memory_offset);
+        r != VK_SUCCESS) {
+        destroy_buffer(device, out);
+        return vulkan_error("vkBindBufferMemory" + suffix, r);
     }
     name_object(device, VK_OBJECT_TYPE_BUFFER, out.buffer, what);
-    name_object(device, VK_OBJECT_TYPE_DEVICE_MEMORY, out.memory, what);
     return {};
 }
 
 void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer) {
     if (buffer.buffer) device.fn->vkDestroyBuffer(device.device, buffer.buffer, device.allocator);
-    if (buffer.memory) device.fn->vkFreeMemory(device.device, buffer.memory, device.allocator);
+    if (buffer.suballocated) {
+        device.arena->free({buffer.memory, buffer.memory_offset, buffer.memory_size, nullptr});
+    } else if (buffer.memory) {
+        device.fn->vkFreeMemory(device.device, buffer.memory, device.allocator);
+    }
     buffer = {};
 }
 
@@ -165,6 +188,7 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
         destroy_image(device, out);
         return vulkan_error("vkAllocateMemory" + suffix, r);
     }
+    out.memory_size = requirements.size;
     device.fn->vkBindImageMemory(device.device, out.image, out.memory, 0);
     VkImageViewCreateInfo view{};
     view.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;

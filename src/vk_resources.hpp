@@ -32,12 +32,18 @@ bool has_compute_subgroup_arithmetic(const Functions& fn, VkPhysicalDevice physi
 // "1.3.230".
 std::string version_string(uint32_t version);
 
-// A buffer with its own memory; host-visible ones stay mapped (coherent).
+class MemoryArena;
+
+// A buffer and its memory: a range of an arena's block (DeviceRef::arena), or memory of its own.
+// Host-visible ones stay mapped (coherent).
 struct DeviceBuffer {
     VkBuffer buffer = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;  // the block's, when suballocated
     void* mapped = nullptr;
     VkDeviceSize size = 0;
+    VkDeviceSize memory_offset = 0;  // where in `memory` the buffer lies
+    VkDeviceSize memory_size = 0;    // bytes of `memory` it takes
+    bool suballocated = false;
 };
 
 // The device objects buffers and pipelines are made with, and the functions they are made through.
@@ -48,6 +54,8 @@ struct DeviceRef {
     const VkAllocationCallbacks* allocator = nullptr;
     VkPhysicalDeviceMemoryProperties memory_properties{};
     VkPipelineCache pipeline_cache = VK_NULL_HANDLE;  // the caller's, or none
+    // Where buffers take their memory (create_buffer); null: each buffer its own allocation.
+    MemoryArena* arena = nullptr;
 };
 
 // A DeviceRef for `device`, calling through `fn` (which must outlive it): its memory properties
@@ -64,7 +72,8 @@ void name_object(const DeviceRef& device, VkObjectType type, Handle handle, std:
 }
 
 // Makes `out` (at least 16 bytes): device-local, or host-visible and coherent and mapped, named
-// `what`. On failure `out` is left empty and the error names the call and `what`.
+// `what`; its memory comes from the device's arena where it has one. On failure `out` is left empty and the error names
+// the call and `what`.
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
                      const char* what, DeviceBuffer& out);
 // Frees both objects (either may be null) and empties `buffer`.
@@ -73,8 +82,9 @@ void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer);
 // A 2D colour image (one mip level, one layer, optimal tiling) in device-local memory, with a view.
 struct DeviceImage {
     VkImage image = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;  // its own
     VkImageView view = VK_NULL_HANDLE;
+    VkDeviceSize memory_size = 0;
 };
 
 // Makes `out` in VK_IMAGE_LAYOUT_UNDEFINED. On failure what was made is destroyed and the error

@@ -18,6 +18,7 @@
 #include <cstring>
 #include <memory>
 #include <tuple>
+#include <type_traits>
 #include <set>
 #include <string>
 #include <string_view>
@@ -843,35 +844,64 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
 // With a memory budget, an atlas too small for the frame's glyphs grows (its image copied into a
 // larger one) rather than coarsening them; glyphs that had converged before keep their samples
 // through the copy, and a dropped growth frame is grown again by the next one.
-// An engine's own entry point (as volk's would be): it counts what crisp asks for and the
-// dispatches crisp records through it, and withholds one function on request.
+// An engine's own entry point (as volk's would be): it counts what crisp asks for, the dispatches,
+// memory allocations and buffers crisp makes through it, and withholds one function on request.
 namespace engine_loader {
 PFN_vkGetInstanceProcAddr loader = nullptr;  // the real one behind it
 PFN_vkGetDeviceProcAddr device_loader = nullptr;
 PFN_vkCmdDispatch dispatch = nullptr;
+PFN_vkAllocateMemory allocate_memory = nullptr;
+PFN_vkCreateBuffer create_buffer = nullptr;
 std::set<std::string> asked;
 uint32_t dispatches = 0;
+uint32_t allocations = 0;
+uint32_t buffers = 0;
 std::string withheld;
+
+void reset(PFN_vkGetInstanceProcAddr real) {
+    loader = real;
+    asked.clear();
+    dispatches = allocations = buffers = 0;
+    withheld.clear();
+}
 
 VKAPI_ATTR void VKAPI_CALL counting_dispatch(VkCommandBuffer cb, uint32_t x, uint32_t y, uint32_t z) {
     ++dispatches;
     dispatch(cb, x, y, z);
 }
+VKAPI_ATTR VkResult VKAPI_CALL counting_allocate_memory(VkDevice device, const VkMemoryAllocateInfo* info,
+                                                        const VkAllocationCallbacks* allocator, VkDeviceMemory* out) {
+    ++allocations;
+    return allocate_memory(device, info, allocator, out);
+}
+VKAPI_ATTR VkResult VKAPI_CALL counting_create_buffer(VkDevice device, const VkBufferCreateInfo* info,
+                                                      const VkAllocationCallbacks* allocator, VkBuffer* out) {
+    ++buffers;
+    return create_buffer(device, info, allocator, out);
+}
+
+// The wrapper in place of `real` for the functions counted, else `real` itself.
+PFN_vkVoidFunction hooked(std::string_view name, PFN_vkVoidFunction real) {
+    const auto wrap = [&](auto& keep, auto wrapper) {
+        keep = reinterpret_cast<std::remove_reference_t<decltype(keep)>>(real);
+        return reinterpret_cast<PFN_vkVoidFunction>(wrapper);
+    };
+    if (name == "vkCmdDispatch") return wrap(dispatch, counting_dispatch);
+    if (name == "vkAllocateMemory") return wrap(allocate_memory, counting_allocate_memory);
+    if (name == "vkCreateBuffer") return wrap(create_buffer, counting_create_buffer);
+    return real;
+}
 
 VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL device_proc_addr(VkDevice device, const char* name) {
     asked.insert(name);
-    if (name == withheld) return nullptr;
-    const PFN_vkVoidFunction real = device_loader(device, name);
-    if (std::string_view(name) != "vkCmdDispatch") return real;
-    dispatch = reinterpret_cast<PFN_vkCmdDispatch>(real);
-    return reinterpret_cast<PFN_vkVoidFunction>(counting_dispatch);
+    return name == withheld ? nullptr : hooked(name, device_loader(device, name));
 }
 
 VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL instance_proc_addr(VkInstance instance, const char* name) {
     asked.insert(name);
     if (name == withheld) return nullptr;
     const PFN_vkVoidFunction real = loader(instance, name);
-    if (std::string_view(name) != "vkGetDeviceProcAddr") return real;
+    if (std::string_view(name) != "vkGetDeviceProcAddr") return hooked(name, real);
     device_loader = reinterpret_cast<PFN_vkGetDeviceProcAddr>(real);
     return reinterpret_cast<PFN_vkVoidFunction>(device_proc_addr);
 }
@@ -884,10 +914,7 @@ TEST(Raster, VulkanIsCalledThroughTheCallersEntryPoint) {
     Fixture& f = fixture();
     ASSERT_TRUE(f.context);
     HeadlessContext& context = *f.context;
-    engine_loader::loader = context.get_instance_proc_addr();
-    engine_loader::asked.clear();
-    engine_loader::dispatches = 0;
-    engine_loader::withheld.clear();
+    engine_loader::reset(context.get_instance_proc_addr());
     const TextLayout layout = fixture_layout("Hg@", 14.0f, 2.0f, 16.0f);
     RendererCreateInfo info = renderer_create_info(context);
     info.atlas.width = info.atlas.height = 128;
@@ -929,6 +956,79 @@ TEST(Raster, VulkanIsCalledThroughTheCallersEntryPoint) {
     EXPECT_NE(no_compositor.error().message.find("vkCmdDispatchIndirect"), std::string::npos);
     engine_loader::withheld.clear();
     EXPECT_TRUE(Compositor::create(compositor_info));
+    expect_no_validation_messages();
+}
+
+// Buffers take their memory from a few shared blocks, not one allocation each, and once a scene
+// has been drawn a few frames, recording it again makes no buffer and allocates nothing, in the
+// renderer or in the compositor.
+TEST(Raster, BuffersShareAFewBlocksAndWarmFramesAllocateNothing) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    HeadlessContext& context = *f.context;
+    engine_loader::reset(context.get_instance_proc_addr());
+    RendererCreateInfo info = renderer_create_info(context);
+    info.get_instance_proc_addr = engine_loader::instance_proc_addr;
+    info.atlas.width = info.atlas.height = 256;
+    info.atlas.max_samples = 64;
+    auto renderer = Renderer::create(info);
+    ASSERT_TRUE(renderer) << renderer.error().message;
+    ASSERT_TRUE(renderer->add_font(*f.font));
+    CompositorCreateInfo compositor_info = compositor_create_info(context);
+    compositor_info.get_instance_proc_addr = engine_loader::instance_proc_addr;
+    auto compositor = Compositor::create(compositor_info);
+    ASSERT_TRUE(compositor) << compositor.error().message;
+
+    constexpr uint32_t kWidth = 96, kHeight = 96;
+    auto target = context.create_image({VK_FORMAT_R8G8B8A8_UNORM, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT});
+    ASSERT_TRUE(target);
+    ASSERT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) {
+        VkImageMemoryBarrier barrier{};
+        barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+        barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+        barrier.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        barrier.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+        barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        barrier.image = target->handle();
+        barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr,
+                             0, nullptr, 1, &barrier);
+    }));
+    const CompositeTarget composite_target{
+        target->view(), VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_UNDEFINED, {kWidth, kHeight}, {}};
+    const std::vector<GlyphInstance> glyphs = six_lines_of_small_text();
+    const auto frame = [&](uint32_t i) {
+        renderer->begin_frame();
+        // Each frame moves the text by a pixel or two, so that the compositor bins anew.
+        DrawOptions options;
+        options.offset_x = static_cast<float>(i % 3);
+        renderer->draw(glyphs, options);
+        EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) {
+            VkMemoryBarrier barrier{};
+            barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+            barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+            barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+            vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                                 &barrier, 0, nullptr, 0, nullptr);
+            EXPECT_TRUE(renderer->record(cb));
+            EXPECT_TRUE(compositor->record(cb, renderer->drawn(), renderer->atlas_view(), composite_target));
+        }));
+    };
+    for (uint32_t i = 0; i < 3; ++i) frame(i);  // warm-up: fonts uploaded, slots sized
+    const uint32_t allocations = engine_loader::allocations, buffers = engine_loader::buffers;
+    for (uint32_t i = 3; i < 12; ++i) frame(i);
+    EXPECT_EQ(engine_loader::allocations, allocations);
+    EXPECT_EQ(engine_loader::buffers, buffers);
+
+    // The renderer's buffers (items, a font page's points and bands, the font's staging, the empty
+    // slot) in a device-local and a host-visible block, and the atlas image; the compositor's
+    // slots' quads, tiles, bins and headers in two blocks likewise.
+    const DeviceMemoryUse renderer_memory = renderer->device_memory();
+    const DeviceMemoryUse compositor_memory = compositor->device_memory();
+    EXPECT_LE(renderer_memory.allocations, 3u);
+    EXPECT_LE(compositor_memory.allocations, 2u);
+    EXPECT_EQ(renderer_memory.allocations + compositor_memory.allocations, allocations);
+    EXPECT_GE(renderer_memory.bytes, VkDeviceSize{256} * 256 * 8);
     expect_no_validation_messages();
 }
 

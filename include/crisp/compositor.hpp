@@ -282,6 +282,9 @@ public:
     uint32_t width() const;
     uint32_t height() const;
     const CompositorStats& stats() const;
+    // The VkDeviceMemory objects the compositor holds now and their bytes (its buffers' blocks, as
+    // the renderer's, and the reference modes' target image).
+    DeviceMemoryUse device_memory() const;
     // What the compositor chose that the caller may want to know ("exact mode:
     // maxStorageBufferRange holds N of the M list nodes asked for").
     const std::vector<std::string>& warnings() const;

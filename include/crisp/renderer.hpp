@@ -44,6 +44,13 @@ inline constexpr uint32_t kMaxRendererSamples = 1023;
 // bands, and twice the font that makes it). A renderer holds any number of fonts that fit them.
 inline constexpr uint32_t kRendererFontPages = 8;
 
+// Device memory a renderer or compositor holds: how many VkDeviceMemory objects (counting towards
+// maxMemoryAllocationCount) and their bytes.
+struct DeviceMemoryUse {
+    uint32_t allocations = 0;
+    uint64_t bytes = 0;
+};
+
 struct RendererCreateInfo {
     // Required: the instance `device` belongs to. crisp loads every Vulkan function it calls
     // through it, with this entry point; null: the system loader's (libvulkan.so.1, opened on
@@ -261,6 +268,9 @@ public:
     void record_atlas_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const;
 
     const RendererStats& stats() const;
+    // The VkDeviceMemory objects the renderer holds now and their bytes: its buffers share a few
+    // blocks (4 MiB, growing to 64 MiB as more are needed), and the atlas image has its own.
+    DeviceMemoryUse device_memory() const;
     const GlyphAtlas& atlas() const;
     VkImage atlas_image() const;
     VkImageView atlas_view() const;
