@@ -104,7 +104,7 @@ struct Renderer::State {
     const VkAllocationCallbacks* allocator = nullptr;
     vk::Functions fn;  // the caller's Vulkan entry points (RendererCreateInfo::get_instance_proc_addr)
     std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory; freed after the body of ~State
-    vk::DeviceRef ref;  // device, allocator, memory properties, pipeline cache, debug names, arena
+    vk::DeviceRef ref;                       // device, allocator, memory properties, pipeline cache, debug names, arena
     VkDeviceSize max_storage_buffer_range = 0;
     uint32_t frames_in_flight = 2;
     bool shared_row_roots = true;
@@ -445,6 +445,14 @@ struct Renderer::State {
     Status place_font(GpuFont& font);
     void apply_removals();
     Status grow_image(VkCommandBuffer command_buffer, uint64_t this_frame);
+    // record()'s phases, in order.
+    void collect_drawn();
+    void release_finished(uint64_t this_frame);
+    bool record_font_uploads(VkCommandBuffer command_buffer, uint64_t this_frame);
+    Status prepare_atlas_image(VkCommandBuffer command_buffer, uint64_t this_frame);
+    uint32_t build_work_items(std::span<const RasterWork> work);
+    void record_item_upload(VkCommandBuffer command_buffer, bool fonts_uploaded);
+    void record_raster_dispatch(VkCommandBuffer command_buffer, uint64_t this_frame, uint32_t workgroups);
     Status make_atlas_image(const AtlasConfig& config, vk::DeviceImage& out) {
         return vk::create_image(ref, kAtlasFormat, config.width, config.height,
                                 VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
@@ -939,52 +947,51 @@ void Renderer::draw(std::span<const GlyphInstance> glyphs, const DrawOptions& op
     }
 }
 
-Status Renderer::record(VkCommandBuffer command_buffer) {
-    State& s = *state_;
-    const vk::Functions& fn = s.fn;
-    s.settle_requests();
-    const std::span<const RasterWork> work = s.atlas.schedule();
-
-    // Drawn glyphs: those whose texels hold samples once this frame's work has run.
-    for (State::Pending& p : s.pending) {
+// The glyphs this frame draws: those whose texels hold samples once the frame's work has run.
+void Renderer::State::collect_drawn() {
+    for (Pending& p : pending) {
         DrawnGlyph& d = p.glyph;
-        const AtlasEntry* entry = s.atlas.entry(p.entry);
+        const AtlasEntry* entry = atlas.entry(p.entry);
         d.samples = entry ? entry->samples : 0;
-        if (entry && entry->samples < s.atlas.config().max_samples) s.converged = false;
+        if (entry && entry->samples < atlas.config().max_samples) converged = false;
         if (d.samples > 0) {
-            s.drawn.push_back(d);
-            ++s.stats.drawn_glyphs;
+            drawn.push_back(d);
+            ++stats.drawn_glyphs;
         } else {
-            ++s.stats.skipped_glyphs;
+            ++stats.skipped_glyphs;
         }
     }
+}
 
-    // Free what the GPU is done with, upload new fonts.
-    s.undo.recorded = true;
-    s.undo.atlas_was_initialized = s.atlas_initialized;
-    s.undo.uploaded_fonts.clear();
-    const uint64_t frame = s.frame++;
-    std::erase_if(s.retired, [&](Retired& r) {
-        if (r.frame + s.frames_in_flight > frame) return false;
-        s.free_buffer(r.buffer);
+// Frees the buffers, images and font ranges the GPU is done with (frames_in_flight frames old).
+void Renderer::State::release_finished(uint64_t this_frame) {
+    const auto done = [&](uint64_t retired_at) { return retired_at + frames_in_flight <= this_frame; };
+    std::erase_if(retired, [&](Retired& r) {
+        if (!done(r.frame)) return false;
+        free_buffer(r.buffer);
         return true;
     });
-    std::erase_if(s.retired_images, [&](State::RetiredImage& r) {
-        if (r.frame + s.frames_in_flight > frame) return false;
-        vk::destroy_image(s.ref, r.image);
+    std::erase_if(retired_images, [&](RetiredImage& r) {
+        if (!done(r.frame)) return false;
+        vk::destroy_image(ref, r.image);
         return true;
     });
-    std::erase_if(s.retired_ranges, [&](const RetiredRanges& r) {
-        if (r.frame + s.frames_in_flight > frame) return false;
-        give_range(s.pages[r.page].used_points, r.points.offset, r.points.size);
-        give_range(s.pages[r.page].used_bands, r.bands.offset, r.bands.size);
+    std::erase_if(retired_ranges, [&](const RetiredRanges& r) {
+        if (!done(r.frame)) return false;
+        give_range(pages[r.page].used_points, r.points.offset, r.points.size);
+        give_range(pages[r.page].used_bands, r.bands.offset, r.bands.size);
         return true;
     });
+}
+
+// Copies every font added since the last frame from its staging buffer into its page; the staging
+// buffer is retired. True when something was copied.
+bool Renderer::State::record_font_uploads(VkCommandBuffer command_buffer, uint64_t this_frame) {
     bool uploaded = false;
-    for (GpuFont& font : s.fonts) {
+    for (GpuFont& font : fonts) {
         if (font.uploaded || !font.font) continue;
-        s.undo.uploaded_fonts.push_back(static_cast<uint32_t>(&font - s.fonts.data()));
-        const FontPage& page = s.pages[font.page];
+        undo.uploaded_fonts.push_back(static_cast<uint32_t>(&font - fonts.data()));
+        const FontPage& page = pages[font.page];
         if (font.points_bytes) {
             const VkBufferCopy copy{0, font.points_at, font.points_bytes};
             fn.vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.points.buffer, 1, &copy);
@@ -993,33 +1000,39 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
             const VkBufferCopy copy{font.points_bytes, font.bands_at, font.bands_bytes};
             fn.vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.bands.buffer, 1, &copy);
         }
-        s.stats.upload_bytes += font.points_bytes + font.bands_bytes;
+        stats.upload_bytes += font.points_bytes + font.bands_bytes;
         font.uploaded = true;
         font.retired_staging = font.staging.buffer;
-        s.retired.push_back({font.staging, frame});
+        retired.push_back({font.staging, this_frame});
         font.staging = {};
         uploaded = true;
     }
+    return uploaded;
+}
 
-    s.undo.grew_image = false;
-    if (s.atlas.config().width != s.image_width || s.atlas.config().height != s.image_height) {
-        if (Status grown = s.grow_image(command_buffer, frame); !grown) return grown;
+// The atlas image at the atlas's size (grown where the atlas grew) and in GENERAL.
+Status Renderer::State::prepare_atlas_image(VkCommandBuffer command_buffer, uint64_t this_frame) {
+    undo.grew_image = false;
+    if (atlas.config().width != image_width || atlas.config().height != image_height) {
+        if (Status grown = grow_image(command_buffer, this_frame); !grown) return grown;
     }
-    if (!s.atlas_initialized) {
-        vk::image_barrier(fn, command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+    if (!atlas_initialized) {
+        vk::image_barrier(fn, command_buffer, atlas_image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
                           VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                           vk::kShaderAccess);
-        s.atlas_initialized = true;
+        atlas_initialized = true;
     }
+    return {};
+}
 
-    // The work list. Items are written with vkCmdUpdateBuffer, so they live in the command buffer
-    // and no host memory needs fencing; a barrier first keeps last frame's reads before the writes.
-    s.item_data.clear();
+// The rasterizer's work items for `work` into item_data; returns the workgroups they take.
+uint32_t Renderer::State::build_work_items(std::span<const RasterWork> work) {
+    item_data.clear();
     uint32_t workgroups = 0;
     for (const RasterWork& w : work) {
-        const auto slot = s.font_slot.find(w.key.font);
-        if (slot == s.font_slot.end() || w.sample_count == 0) continue;
-        const GpuFont& font = s.fonts[slot->second];
+        const auto slot = font_slot.find(w.key.font);
+        if (slot == font_slot.end() || w.sample_count == 0) continue;
+        const GpuFont& font = fonts[slot->second];
         const GlyphRecord& glyph = font.font->asset().glyphs[w.key.glyph];
         const GlyphRect rect = glyph_rect(glyph, w.key);
         const TexelToEm map = texel_to_em(rect, w.key);
@@ -1047,111 +1060,102 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
         item.texel_count = w.texel_count;
         item.first_workgroup = workgroups;
         workgroups += (w.texel_count + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
-        s.item_data.push_back(item);
+        item_data.push_back(item);
     }
-    s.stats.work_items = static_cast<uint32_t>(s.item_data.size());
-    s.stats.workgroups = workgroups;
-    s.stats.samples = s.atlas.stats().frame.samples;
-    s.stats.curve_tests = s.atlas.stats().frame.curve_tests;
+    stats.work_items = static_cast<uint32_t>(item_data.size());
+    stats.workgroups = workgroups;
+    stats.samples = atlas.stats().frame.samples;
+    stats.curve_tests = atlas.stats().frame.curve_tests;
+    return workgroups;
+}
 
-    VkMemoryBarrier before{};
-    before.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-    before.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    before.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    if (!s.item_data.empty()) {
-        fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, nullptr, 0, nullptr);
-        const auto* bytes = reinterpret_cast<const std::byte*>(s.item_data.data());
-        const VkDeviceSize total = s.item_data.size() * sizeof(gpu::RasterItem);
+// The work list into the items buffer. Items are written with vkCmdUpdateBuffer, so they live in
+// the command buffer and no host memory needs fencing; a barrier first keeps last frame's reads
+// before the writes, one after makes them (and the fonts' copies) visible to the rasterizer.
+void Renderer::State::record_item_upload(VkCommandBuffer command_buffer, bool fonts_uploaded) {
+    if (!item_data.empty()) {
+        vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_ACCESS_TRANSFER_WRITE_BIT);
+        const auto* bytes = reinterpret_cast<const std::byte*>(item_data.data());
+        const VkDeviceSize total = item_data.size() * sizeof(gpu::RasterItem);
         for (VkDeviceSize offset = 0; offset < total; offset += kUpdateChunk) {
             const VkDeviceSize size = std::min(kUpdateChunk, total - offset);
-            fn.vkCmdUpdateBuffer(command_buffer, s.items.buffer, offset, size, bytes + offset);
+            fn.vkCmdUpdateBuffer(command_buffer, items.buffer, offset, size, bytes + offset);
         }
-        s.stats.upload_bytes += total;
+        stats.upload_bytes += total;
     }
-    if (uploaded || !s.item_data.empty()) {
-        VkMemoryBarrier after{};
-        after.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-        after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        after.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-        fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
-                                1, &after, 0, nullptr, 0, nullptr);
+    if (fonts_uploaded || !item_data.empty()) {
+        vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
     }
+}
 
-    if (!s.item_data.empty()) {
-        // Last frame's readers (composite shaders, copies) finish before the atlas is written.
-        VkMemoryBarrier readers{};
-        readers.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-        readers.srcAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
-        readers.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-        fn.vkCmdPipelineBarrier(command_buffer,
-                                VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
-                                    VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &readers, 0, nullptr, 0, nullptr);
-
-        const VkDescriptorSet set = s.descriptors.sets[frame % s.frames_in_flight];
-        s.write_descriptors(set);
-        fn.vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline);
-        fn.vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, s.descriptors.pipeline_layout, 0, 1,
-                                   &set, 0, nullptr);
-        gpu::RasterPushConstants push{};
-        for (size_t c = 0; c < 3; ++c) {
-            const SampleRect& r = s.layout.channels[c];
-            push.channel_rects[c] = {r.x0, r.y0, r.x1, r.y1};
-        }
-        push.item_count = static_cast<uint32_t>(s.item_data.size());
-        push.workgroup_count = workgroups;
-        push.shared_rows = s.shared_row_roots && shares_sample_rows(s.layout) ? 1u : 0u;
-        fn.vkCmdPushConstants(command_buffer, s.descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
-                              sizeof push, &push);
-        const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);
-        const uint32_t height = (workgroups + gpu::kRasterDispatchWidth - 1) / gpu::kRasterDispatchWidth;
-        fn.vkCmdDispatch(command_buffer, width, height, 1);
-
-        VkMemoryBarrier done{};
-        done.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-        done.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-        done.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
-        fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                                VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
-                                    VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                0, 1, &done, 0, nullptr, 0, nullptr);
+// The rasterizer's dispatch over `workgroups`, between barriers against last frame's readers of
+// the atlas (composite shaders, copies) and for this frame's.
+void Renderer::State::record_raster_dispatch(VkCommandBuffer command_buffer, uint64_t this_frame, uint32_t workgroups) {
+    constexpr VkPipelineStageFlags kReaders =
+        VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+    vk::memory_barrier(fn, command_buffer, kReaders, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);
+    const VkDescriptorSet set = descriptors.sets[this_frame % frames_in_flight];
+    write_descriptors(set);
+    fn.vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    fn.vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors.pipeline_layout, 0, 1, &set,
+                               0, nullptr);
+    gpu::RasterPushConstants push{};
+    for (size_t c = 0; c < 3; ++c) {
+        const SampleRect& r = layout.channels[c];
+        push.channel_rects[c] = {r.x0, r.y0, r.x1, r.y1};
     }
+    push.item_count = static_cast<uint32_t>(item_data.size());
+    push.workgroup_count = workgroups;
+    push.shared_rows = shared_row_roots && shares_sample_rows(layout) ? 1u : 0u;
+    fn.vkCmdPushConstants(command_buffer, descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
+                          &push);
+    const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);
+    const uint32_t height = (workgroups + gpu::kRasterDispatchWidth - 1) / gpu::kRasterDispatchWidth;
+    fn.vkCmdDispatch(command_buffer, width, height, 1);
+    vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, kReaders,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+}
+
+Status Renderer::record(VkCommandBuffer command_buffer) {
+    State& s = *state_;
+    s.settle_requests();
+    const std::span<const RasterWork> work = s.atlas.schedule();
+    s.collect_drawn();
+
+    s.undo.recorded = true;
+    s.undo.atlas_was_initialized = s.atlas_initialized;
+    s.undo.uploaded_fonts.clear();
+    const uint64_t frame = s.frame++;
+    s.release_finished(frame);
+    const bool fonts_uploaded = s.record_font_uploads(command_buffer, frame);
+    if (Status prepared = s.prepare_atlas_image(command_buffer, frame); !prepared) return prepared;
+    const uint32_t workgroups = s.build_work_items(work);
+    s.record_item_upload(command_buffer, fonts_uploaded);
+    if (!s.item_data.empty()) s.record_raster_dispatch(command_buffer, frame, workgroups);
     return {};
 }
 
 void Renderer::record_atlas_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const {
     const State& s = *state_;
     const vk::Functions& fn = s.fn;
-    VkImageMemoryBarrier barrier{};
-    barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-    barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-    barrier.oldLayout = s.atlas_initialized ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_UNDEFINED;
-    barrier.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-    barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    barrier.image = s.atlas_image.image;
-    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                            nullptr, 0, nullptr, 1, &barrier);
+    const VkImage image = s.atlas_image.image;
+    vk::image_barrier(fn, command_buffer, image,
+                      s.atlas_initialized ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_UNDEFINED,
+                      VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     VkBufferImageCopy copy{};
     copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.imageExtent = {s.atlas.config().width, s.atlas.config().height, 1};
-    fn.vkCmdCopyImageToBuffer(command_buffer, s.atlas_image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1,
-                              &copy);
-    barrier.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-    barrier.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-    barrier.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                            nullptr, 0, nullptr, 1, &barrier);
-    VkMemoryBarrier to_host{};
-    to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-    to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    fn.vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host,
-                            0, nullptr, 0, nullptr);
+    fn.vkCmdCopyImageToBuffer(command_buffer, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &copy);
+    vk::image_barrier(fn, command_buffer, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+                      VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      vk::kShaderAccess);
+    vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
 std::span<const DrawnGlyph> Renderer::drawn() const {
