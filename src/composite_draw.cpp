@@ -15,15 +15,7 @@ constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_ST
 
 }  // namespace
 
-DrawCompositor::~DrawCompositor() {
-    if (!ref_.device) return;
-    if (pipeline_) ref_.fn->vkDestroyPipeline(ref_.device, pipeline_, ref_.allocator);
-    for (VkShaderModule module : {vertex_, fragment_}) {
-        if (module) ref_.fn->vkDestroyShaderModule(ref_.device, module, ref_.allocator);
-    }
-    for (Slot& slot : slots_) vk::destroy_buffer(ref_, slot.quads);
-    vk::destroy_descriptor_sets(ref_, descriptors_);
-}
+DrawCompositor::~DrawCompositor() = default;
 
 Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice physical_device, VkFormat format,
                               VkFormat depth_format, uint32_t frames_in_flight) {
@@ -56,10 +48,10 @@ Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice phys
     for (uint32_t i = 0; i < frames_in_flight; ++i) slots_[i].set = descriptors_.sets[i];
     Result<VkShaderModule> vertex = vk::create_embedded_shader(ref_, "composite.vert");
     if (!vertex) return vertex.error();
-    vertex_ = *vertex;
+    vertex_ = objects_.keep(ref_, *vertex);
     Result<VkShaderModule> fragment = vk::create_embedded_shader(ref_, "unsorted.frag");
     if (!fragment) return fragment.error();
-    fragment_ = *fragment;
+    fragment_ = objects_.keep(ref_, *fragment);
 
     QuadPipeline desc;
     desc.vertex = vertex_;
@@ -71,7 +63,7 @@ Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice phys
     desc.what = "compositor draw path";
     Result<VkPipeline> pipeline = create_quad_pipeline(ref_, desc);
     if (!pipeline) return pipeline.error();
-    pipeline_ = *pipeline;
+    pipeline_ = objects_.keep(ref_, *pipeline);
     return {};
 }
 
@@ -81,7 +73,7 @@ Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::spa
     const VkDeviceSize bytes = quads.size_bytes();
     if (!slot.quads.buffer || slot.quads.size < bytes) {
         // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
-        vk::destroy_buffer(ref_, slot.quads);
+        slot.quads.reset();
         if (Status s = vk::create_buffer(ref_, std::max<VkDeviceSize>(256, std::bit_ceil(bytes)),
                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "draw quads", slot.quads);
             !s) {

@@ -25,8 +25,8 @@ public:
     // The pipeline for colour attachments of `format`, depth-tested against a depth attachment
     // of `depth_format` unless it is VK_FORMAT_UNDEFINED. Errors: vulkan when the format cannot
     // be a blended colour attachment, the depth format a depth attachment, or a call fails.
-    Status create(const vk::DeviceRef& device, VkPhysicalDevice physical_device, VkFormat format,
-                  VkFormat depth_format, uint32_t frames_in_flight);
+    Status create(const vk::DeviceRef& device, VkPhysicalDevice physical_device, VkFormat format, VkFormat depth_format,
+                  uint32_t frames_in_flight);
 
     // Records the draws into the active render pass; `quads` sorted front to back for rect's size.
     // Returns the bytes of quads uploaded.
@@ -47,6 +47,7 @@ private:
 
     vk::DeviceRef ref_;
     vk::DescriptorSets descriptors_;
+    vk::DeviceObjects objects_;  // the shader modules and the pipeline
     VkShaderModule vertex_ = VK_NULL_HANDLE, fragment_ = VK_NULL_HANDLE;
     VkPipeline pipeline_ = VK_NULL_HANDLE;
     std::vector<Slot> slots_;

@@ -47,34 +47,12 @@ constexpr VkShaderStageFlags kPushStages =
 
 }  // namespace
 
-ReferenceCompositor::~ReferenceCompositor() {
-    if (!ref.device) return;
-    VkDevice device = ref.device;
-    const VkAllocationCallbacks* allocator = ref.allocator;
-    for (VkPipeline pipeline : {unsorted, wboit, exact, wboit_resolve, exact_resolve, wboit_compute, exact_compute}) {
-        if (pipeline) ref.fn->vkDestroyPipeline(device, pipeline, allocator);
-    }
-    for (auto& [name, shader] : modules) ref.fn->vkDestroyShaderModule(device, shader, allocator);
-    if (empty_framebuffer) ref.fn->vkDestroyFramebuffer(device, empty_framebuffer, allocator);
-    if (color_framebuffer) ref.fn->vkDestroyFramebuffer(device, color_framebuffer, allocator);
-    if (empty_pass) ref.fn->vkDestroyRenderPass(device, empty_pass, allocator);
-    if (color_pass) ref.fn->vkDestroyRenderPass(device, color_pass, allocator);
-    vk::destroy_descriptor_sets(ref, descriptors);
-    for (FrameSlot& slot : slots) {
-        vk::destroy_buffer(ref, slot.quads);
-        vk::destroy_buffer(ref, slot.tiles);
-        vk::destroy_buffer(ref, slot.stats);
-    }
-    vk::destroy_buffer(ref, accumulators);
-    vk::destroy_buffer(ref, nodes);
-    vk::destroy_buffer(ref, stats_words);
-    vk::destroy_image(ref, target_);
-}
+ReferenceCompositor::~ReferenceCompositor() = default;
 
 Result<VkShaderModule> ReferenceCompositor::module(const char* name) {
     if (auto it = modules.find(name); it != modules.end()) return it->second;
     Result<VkShaderModule> made = vk::create_embedded_shader(ref, name);
-    if (made) modules.emplace(name, *made);
+    if (made) modules.emplace(name, objects.keep(ref, *made));
     return made;
 }
 
@@ -92,14 +70,19 @@ Result<VkPipeline> ReferenceCompositor::graphics_pipeline(const char* fragment,
     desc.blend_over = blend;  // unsorted
     desc.render_pass = blend ? color_pass : empty_pass;
     desc.what = fragment;
-    return create_quad_pipeline(ref, desc);
+    Result<VkPipeline> made = create_quad_pipeline(ref, desc);
+    if (made) objects.keep(ref, *made);
+    return made;
 }
 
 Result<VkPipeline> ReferenceCompositor::compute_pipeline(const char* shader,
                                                          const VkSpecializationInfo* specialization) {
     Result<VkShaderModule> compute_module = module(shader);
     if (!compute_module) return compute_module.error();
-    return vk::create_compute_pipeline(ref, *compute_module, descriptors.pipeline_layout, specialization, shader);
+    Result<VkPipeline> made =
+        vk::create_compute_pipeline(ref, *compute_module, descriptors.pipeline_layout, specialization, shader);
+    if (made) objects.keep(ref, *made);
+    return made;
 }
 
 // Per-pixel buffers: the accumulators (plane-major), the exact mode's node pool and the stats.
@@ -156,6 +139,7 @@ Status ReferenceCompositor::create_passes() {
     if (VkResult r = ref.fn->vkCreateRenderPass(device, &pass_info, allocator, &empty_pass); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateRenderPass (compositor)", r);
     }
+    objects.keep(ref, empty_pass);
     VkAttachmentDescription attachment{};
     attachment.format = kTargetFormat;
     attachment.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -173,6 +157,7 @@ Status ReferenceCompositor::create_passes() {
     if (VkResult r = ref.fn->vkCreateRenderPass(device, &pass_info, allocator, &color_pass); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateRenderPass (compositor)", r);
     }
+    objects.keep(ref, color_pass);
     VkFramebufferCreateInfo framebuffer{};
     framebuffer.sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO;
     framebuffer.renderPass = empty_pass;
@@ -183,6 +168,7 @@ Status ReferenceCompositor::create_passes() {
         r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateFramebuffer (compositor)", r);
     }
+    objects.keep(ref, empty_framebuffer);
     framebuffer.renderPass = color_pass;
     framebuffer.attachmentCount = 1;
     framebuffer.pAttachments = &target_.view;
@@ -190,6 +176,7 @@ Status ReferenceCompositor::create_passes() {
         r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateFramebuffer (compositor)", r);
     }
+    objects.keep(ref, color_framebuffer);
 
     return {};
 }
@@ -330,7 +317,7 @@ Status ReferenceCompositor::upload(vk::DeviceBuffer& buffer, uint32_t& capacity,
                                    size_t size) {
     if (count > capacity || !buffer.buffer) {
         // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
-        vk::destroy_buffer(ref, buffer);
+        buffer.reset();
         capacity = 0;
         const uint32_t grown = std::max<uint32_t>(64, std::bit_ceil(std::max(count, 1u)));
         if (Status s = vk::create_buffer(ref, VkDeviceSize{grown} * size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,

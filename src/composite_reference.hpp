@@ -83,6 +83,7 @@ private:
     vk::DeviceBuffer nodes;         // exact mode's pool; a stand-in of 16 bytes when there is none
     vk::DeviceBuffer stats_words;   // device-local kStatWords
 
+    vk::DeviceObjects objects;  // shader modules, pipelines, render passes, framebuffers
     std::map<std::string, VkShaderModule> modules;
     vk::DescriptorSets descriptors;            // one set per frame in flight
     VkRenderPass empty_pass = VK_NULL_HANDLE;  // no attachments: the storage-only passes

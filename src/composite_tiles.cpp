@@ -45,24 +45,7 @@ VkExtent2D grid(uint32_t count, uint32_t size) {
 
 }  // namespace
 
-TileCompositor::~TileCompositor() {
-    if (!ref_.device) return;
-    for (const auto& passes : tile_pipelines_) {
-        for (VkPipeline pipeline : passes) {
-            if (pipeline) ref_.fn->vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
-        }
-    }
-    for (VkPipeline pipeline : {count_, scan_[0], scan_[1], scan_[2], scatter_}) {
-        if (pipeline) ref_.fn->vkDestroyPipeline(ref_.device, pipeline, ref_.allocator);
-    }
-    for (VkShaderModule module : modules_) ref_.fn->vkDestroyShaderModule(ref_.device, module, ref_.allocator);
-    for (Slot& slot : slots_) {
-        for (vk::DeviceBuffer* buffer : {&slot.quads, &slot.tiles, &slot.bins, &slot.header}) {
-            vk::destroy_buffer(ref_, *buffer);
-        }
-    }
-    vk::destroy_descriptor_sets(ref_, descriptors_);
-}
+TileCompositor::~TileCompositor() = default;
 
 Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& config) {
     ref_ = device;
@@ -92,11 +75,11 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     auto pipeline = [&](const char* shader, const VkSpecializationInfo* specialization, VkPipeline& out) -> Status {
         Result<VkShaderModule> module = vk::create_embedded_shader(ref_, shader);
         if (!module) return module.error();
-        modules_.push_back(*module);
+        objects_.keep(ref_, *module);
         Result<VkPipeline> made =
             vk::create_compute_pipeline(ref_, *module, descriptors_.pipeline_layout, specialization, shader);
         if (!made) return made.error();
-        out = *made;
+        out = objects_.keep(ref_, *made);
         return {};
     };
     const uint32_t scatter = 1;
@@ -139,7 +122,7 @@ Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBuff
                             const char* what) {
     if (buffer.buffer && buffer.size >= bytes) return {};
     // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
-    vk::destroy_buffer(ref_, buffer);
+    buffer.reset();
     return vk::create_buffer(ref_, std::max<VkDeviceSize>(256, std::bit_ceil(bytes)), usage, host_visible, what,
                              buffer);
 }

@@ -28,7 +28,7 @@ struct TileVariant {
 inline constexpr std::array<TileVariant, 5> kTileVariants = {{
     {VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM, "tile_composite_rgba8.comp"},
     {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM, "tile_composite_rgba8.comp"},  // red and blue swap
-    {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_B8G8R8A8_UNORM, "tile_composite_any.comp"},  // storage_without_format
+    {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_B8G8R8A8_UNORM, "tile_composite_any.comp"},    // storage_without_format
     {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R16G16B16A16_SFLOAT, "tile_composite_rgba16f.comp"},
     {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT, "tile_composite_rgba32f.comp"},
 }};
@@ -91,10 +91,10 @@ public:
 
 private:
     struct Slot {
-        vk::DeviceBuffer quads;     // host-visible CompositeQuad[]
-        vk::DeviceBuffer tiles;     // three planes of tile words
-        vk::DeviceBuffer bins;      // quad indices
-        vk::DeviceBuffer header;    // host-visible: TileHeader, then the busy tiles' indices
+        vk::DeviceBuffer quads;   // host-visible CompositeQuad[]
+        vk::DeviceBuffer tiles;   // three planes of tile words
+        vk::DeviceBuffer bins;    // quad indices
+        vk::DeviceBuffer header;  // host-visible: TileHeader, then the busy tiles' indices
         VkDescriptorSet set = VK_NULL_HANDLE;
         bool pending = false;
         uint64_t frame = 0;
@@ -115,14 +115,14 @@ private:
     vk::DeviceRef ref_;
     TileConfig config_;
     vk::DescriptorSets descriptors_;
-    std::vector<VkShaderModule> modules_;
+    vk::DeviceObjects objects_;  // shader modules and pipelines
     VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
-    std::array<VkPipeline, 3> scan_{};  // reduce, blocks, down
+    std::array<VkPipeline, 3> scan_{};                                              // reduce, blocks, down
     std::array<std::array<VkPipeline, 2>, kTileVariants.size()> tile_pipelines_{};  // exact, layered pass
     std::vector<Slot> slots_;
     uint64_t frame_ = 0;
-    bool recorded_ = false;       // record() since the last abandon_frame()
-    bool last_binned_ = false;    // the last record() binned anew
+    bool recorded_ = false;     // record() since the last abandon_frame()
+    bool last_binned_ = false;  // the last record() binned anew
 };
 
 }  // namespace crisp::composite

@@ -103,7 +103,7 @@ struct Renderer::State {
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
     vk::Functions fn;  // the caller's Vulkan entry points (RendererCreateInfo::get_instance_proc_addr)
-    std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory; freed after the body of ~State
+    std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory: declared first, destroyed last
     vk::DeviceRef ref;                       // device, allocator, memory properties, pipeline cache, debug names, arena
     VkDeviceSize max_storage_buffer_range = 0;
     uint32_t frames_in_flight = 2;
@@ -134,6 +134,7 @@ struct Renderer::State {
     std::vector<RetiredRanges> retired_ranges;
     std::vector<Retired> retired;
 
+    vk::DeviceObjects objects;  // the shader module and the pipeline
     VkShaderModule shader = VK_NULL_HANDLE;
     vk::DescriptorSets descriptors;  // one set per frame in flight
     VkPipeline pipeline = VK_NULL_HANDLE;
@@ -163,7 +164,7 @@ struct Renderer::State {
         bool atlas_was_initialized = false;
         // The atlas image this frame replaced by a larger one (its copy is in the dropped commands).
         bool grew_image = false;
-        vk::DeviceImage old_image;
+        VkImage old_image = VK_NULL_HANDLE;  // in retired_images until the frame is known submitted
         uint32_t old_width = 0, old_height = 0;
         std::vector<uint32_t> uploaded_fonts;  // slots whose staging went to `retired` this frame
         // The named draws this frame changed, as they were before it (nullopt: new this frame).
@@ -461,22 +462,7 @@ struct Renderer::State {
     }
 };
 
-Renderer::State::~State() {
-    if (!device) return;
-    for (Retired& r : retired) free_buffer(r.buffer);
-    for (RetiredImage& r : retired_images) vk::destroy_image(ref, r.image);
-    for (GpuFont& font : fonts) free_buffer(font.staging);
-    for (FontPage& page : pages) {
-        free_buffer(page.points);
-        free_buffer(page.bands);
-    }
-    free_buffer(items);
-    free_buffer(dummy);
-    if (pipeline) fn.vkDestroyPipeline(device, pipeline, allocator);
-    vk::destroy_descriptor_sets(ref, descriptors);
-    if (shader) fn.vkDestroyShaderModule(device, shader, allocator);
-    vk::destroy_image(ref, atlas_image);
-}
+Renderer::State::~State() = default;
 
 Status Renderer::State::make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, const char* what,
                                     GpuBuffer& out) {
@@ -484,7 +470,7 @@ Status Renderer::State::make_buffer(VkDeviceSize size, VkBufferUsageFlags usage,
 }
 
 void Renderer::State::free_buffer(GpuBuffer& buffer) {
-    vk::destroy_buffer(ref, buffer);
+    buffer.reset();
 }
 
 Status Renderer::State::create_objects() {
@@ -507,7 +493,7 @@ Status Renderer::State::create_objects() {
     // The pipeline.
     Result<VkShaderModule> module = vk::create_embedded_shader(ref, "raster.comp");
     if (!module) return module.error();
-    shader = *module;
+    shader = objects.keep(ref, *module);
     const VkDescriptorSetLayoutBinding bindings[] = {
         {0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
         {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
@@ -524,7 +510,7 @@ Status Renderer::State::create_objects() {
     Result<VkPipeline> made =
         vk::create_compute_pipeline(ref, shader, descriptors.pipeline_layout, nullptr, "raster.comp");
     if (!made) return made.error();
-    pipeline = *made;
+    pipeline = objects.keep(ref, *made);
     return {};
 }
 
@@ -659,11 +645,11 @@ Status Renderer::State::grow_image(VkCommandBuffer command_buffer, uint64_t this
                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false,
                                    "work items", more);
             !s) {
-            vk::destroy_image(ref, grown);
+            grown.reset();
             return s;
         }
-        retired.push_back({items, this_frame});
-        items = more;
+        retired.push_back({std::move(items), this_frame});
+        items = std::move(more);
         item_capacity = cells;
     }
     if (atlas_initialized) {
@@ -687,11 +673,11 @@ Status Renderer::State::grow_image(VkCommandBuffer command_buffer, uint64_t this
                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);
     }
     undo.grew_image = true;
-    undo.old_image = atlas_image;
+    undo.old_image = atlas_image.image;
     undo.old_width = image_width;
     undo.old_height = image_height;
-    retired_images.push_back({atlas_image, this_frame});
-    atlas_image = grown;
+    retired_images.push_back({std::move(atlas_image), this_frame});
+    atlas_image = std::move(grown);
     image_width = config.width;
     image_height = config.height;
     return {};
@@ -773,9 +759,9 @@ Status Renderer::add_font(const Font& font) {
     const auto free_place = std::find_if(s.fonts.begin(), s.fonts.end(), [](const GpuFont& f) { return !f.font; });
     const auto index = static_cast<uint32_t>(free_place - s.fonts.begin());
     if (free_place == s.fonts.end()) {
-        s.fonts.push_back(gpu);
+        s.fonts.push_back(std::move(gpu));
     } else {
-        *free_place = gpu;
+        *free_place = std::move(gpu);
     }
     s.font_slot[font.id()] = index;
     return {};
@@ -798,7 +784,7 @@ void Renderer::State::apply_removals() {
         if (slot == font_slot.end()) continue;
         GpuFont& font = fonts[slot->second];
         atlas.evict_font(id);
-        if (font.staging.buffer) retired.push_back({font.staging, frame});
+        if (font.staging.buffer) retired.push_back({std::move(font.staging), frame});
         retired_ranges.push_back(
             {font.page, {font.points_at, font.points_bytes}, {font.bands_at, font.bands_bytes}, frame});
         font = GpuFont{};
@@ -826,12 +812,14 @@ void Renderer::abandon_frame() {
     if (s.undo.grew_image) {
         // The copy into the larger image never ran: the old image comes back, and the next
         // record() grows it again. (The larger image was only in the dropped commands.)
-        vk::destroy_image(s.ref, s.atlas_image);
-        s.atlas_image = s.undo.old_image;
+        const auto old = std::find_if(s.retired_images.begin(), s.retired_images.end(),
+                                      [&](const State::RetiredImage& r) { return r.image.image == s.undo.old_image; });
+        if (old != s.retired_images.end()) {
+            s.atlas_image = std::move(old->image);  // frees the larger image
+            s.retired_images.erase(old);
+        }
         s.image_width = s.undo.old_width;
         s.image_height = s.undo.old_height;
-        std::erase_if(s.retired_images,
-                      [&](const State::RetiredImage& r) { return r.image.image == s.undo.old_image.image; });
         s.undo.grew_image = false;
     }
     s.atlas_initialized = s.undo.atlas_was_initialized;
@@ -856,7 +844,7 @@ void Renderer::abandon_frame() {
             return r.frame == s.frame - 1 && r.buffer.buffer == font.retired_staging;
         });
         if (retired == s.retired.end()) continue;
-        font.staging = retired->buffer;
+        font.staging = std::move(retired->buffer);
         font.uploaded = false;
         s.retired.erase(retired);
     }
@@ -973,7 +961,7 @@ void Renderer::State::release_finished(uint64_t this_frame) {
     });
     std::erase_if(retired_images, [&](RetiredImage& r) {
         if (!done(r.frame)) return false;
-        vk::destroy_image(ref, r.image);
+        r.image.reset();
         return true;
     });
     std::erase_if(retired_ranges, [&](const RetiredRanges& r) {
@@ -1003,8 +991,7 @@ bool Renderer::State::record_font_uploads(VkCommandBuffer command_buffer, uint64
         stats.upload_bytes += font.points_bytes + font.bands_bytes;
         font.uploaded = true;
         font.retired_staging = font.staging.buffer;
-        retired.push_back({font.staging, this_frame});
-        font.staging = {};
+        retired.push_back({std::move(font.staging), this_frame});
         uploaded = true;
     }
     return uploaded;

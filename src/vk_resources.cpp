@@ -78,7 +78,8 @@ void name_object(const DeviceRef& device, VkObjectType type, uint64_t handle, st
 
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
                      const char* what, DeviceBuffer& out) {
-    out = {};
+    out.reset();
+    out.adopt(device);  // what is made below is given back by out.reset() on failure
     const std::string suffix = std::string(" (") + what + ")";
     VkBufferCreateInfo info{};
     info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
@@ -99,13 +100,13 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
     const VkMemoryPropertyFlags preferred = host_visible ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT : 0;
     const auto type = find_memory_type(device.memory_properties, requirements.memoryTypeBits, required, preferred);
     if (!type) {
-        destroy_buffer(device, out);
+        out.reset();
         return Error{ErrorCode::vulkan, "no memory type for a buffer of " + std::to_string(size) + " bytes" + suffix};
     }
     if (device.arena != nullptr) {
         Result<MemoryArena::Range> range = device.arena->allocate(requirements, *type, what);
         if (!range) {
-            destroy_buffer(device, out);
+            out.reset();
             return range.error();
         }
         out.memory = range->memory;
@@ -120,14 +121,14 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
         allocate.memoryTypeIndex = *type;
         if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory);
             r != VK_SUCCESS) {
-            destroy_buffer(device, out);
+            out.reset();
             return vulkan_error("vkAllocateMemory" + suffix, r);
         }
         out.memory_size = requirements.size;
         if (host_visible) {
             if (VkResult r = device.fn->vkMapMemory(device.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
                 r != VK_SUCCESS) {
-                destroy_buffer(device, out);
+                out.reset();
                 return vulkan_error("vkMapMemory" + suffix, r);
             }
         }
@@ -135,26 +136,26 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
     }
     if (VkResult r = device.fn->vkBindBufferMemory(device.device, out.buffer, out.memory, out.memory_offset);
         r != VK_SUCCESS) {
-        destroy_buffer(device, out);
+        out.reset();
         return vulkan_error("vkBindBufferMemory" + suffix, r);
     }
     name_object(device, VK_OBJECT_TYPE_BUFFER, out.buffer, what);
     return {};
 }
 
-void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer) {
+void free_buffer(const DeviceRef& device, BufferFields& buffer) {
     if (buffer.buffer) device.fn->vkDestroyBuffer(device.device, buffer.buffer, device.allocator);
     if (buffer.suballocated) {
         device.arena->free({buffer.memory, buffer.memory_offset, buffer.memory_size, nullptr});
     } else if (buffer.memory) {
         device.fn->vkFreeMemory(device.device, buffer.memory, device.allocator);
     }
-    buffer = {};
 }
 
 Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height, VkImageUsageFlags usage,
                     const char* what, DeviceImage& out) {
-    out = {};
+    out.reset();
+    out.adopt(device);  // what is made below is given back by out.reset() on failure
     VkImageCreateInfo image{};
     image.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
     image.imageType = VK_IMAGE_TYPE_2D;
@@ -176,7 +177,7 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     const auto type =
         find_memory_type(device.memory_properties, requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
     if (!type) {
-        destroy_image(device, out);
+        out.reset();
         return Error{ErrorCode::vulkan, std::string("no device-local memory type for the ") + what + " image"};
     }
     VkMemoryAllocateInfo allocate{};
@@ -185,7 +186,7 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     allocate.memoryTypeIndex = *type;
     if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory);
         r != VK_SUCCESS) {
-        destroy_image(device, out);
+        out.reset();
         return vulkan_error("vkAllocateMemory" + suffix, r);
     }
     out.memory_size = requirements.size;
@@ -197,7 +198,7 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     view.format = format;
     view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     if (VkResult r = device.fn->vkCreateImageView(device.device, &view, device.allocator, &out.view); r != VK_SUCCESS) {
-        destroy_image(device, out);
+        out.reset();
         return vulkan_error("vkCreateImageView" + suffix, r);
     }
     name_object(device, VK_OBJECT_TYPE_IMAGE, out.image, what);
@@ -206,20 +207,20 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     return {};
 }
 
-void destroy_image(const DeviceRef& device, DeviceImage& image) {
+void free_image(const DeviceRef& device, ImageFields& image) {
     if (image.view) device.fn->vkDestroyImageView(device.device, image.view, device.allocator);
     if (image.image) device.fn->vkDestroyImage(device.device, image.image, device.allocator);
     if (image.memory) device.fn->vkFreeMemory(device.device, image.memory, device.allocator);
-    image = {};
 }
 
 Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescriptorSetLayoutBinding> bindings,
                               VkShaderStageFlags push_stages, uint32_t push_bytes, uint32_t set_count, const char* what,
                               DescriptorSets& out) {
-    out = {};
+    out.reset();
+    out.adopt(device);  // what is made below is given back by out.reset() on failure
     const std::string suffix = std::string(" (") + what + ")";
     auto failed = [&](const char* call, VkResult r) {
-        destroy_descriptor_sets(device, out);
+        out.reset();
         return vulkan_error(call + suffix, r);
     };
     VkDescriptorSetLayoutCreateInfo set_info{};
@@ -277,11 +278,67 @@ Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescrip
     return {};
 }
 
-void destroy_descriptor_sets(const DeviceRef& device, DescriptorSets& sets) {
+void free_descriptor_sets(const DeviceRef& device, DescriptorSetsFields& sets) {
     if (sets.pool) device.fn->vkDestroyDescriptorPool(device.device, sets.pool, device.allocator);  // frees the sets
     if (sets.pipeline_layout) device.fn->vkDestroyPipelineLayout(device.device, sets.pipeline_layout, device.allocator);
     if (sets.set_layout) device.fn->vkDestroyDescriptorSetLayout(device.device, sets.set_layout, device.allocator);
-    sets = {};
+}
+
+DeviceObjects::DeviceObjects(DeviceObjects&& other) noexcept
+    : device_(std::exchange(other.device_, nullptr)), objects_(std::exchange(other.objects_, {})) {}
+
+DeviceObjects& DeviceObjects::operator=(DeviceObjects&& other) noexcept {
+    if (this != &other) {
+        reset();
+        device_ = std::exchange(other.device_, nullptr);
+        objects_ = std::exchange(other.objects_, {});
+    }
+    return *this;
+}
+
+void DeviceObjects::keep(const DeviceRef& device, VkObjectType type, uint64_t handle) {
+    assert((device_ == nullptr || device_ == &device) && "one DeviceObjects per device reference");
+    device_ = &device;
+    if (handle != 0) objects_.emplace_back(type, handle);
+}
+VkPipeline DeviceObjects::keep(const DeviceRef& device, VkPipeline pipeline) {
+    keep(device, VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<uint64_t>(pipeline));
+    return pipeline;
+}
+VkShaderModule DeviceObjects::keep(const DeviceRef& device, VkShaderModule module) {
+    keep(device, VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<uint64_t>(module));
+    return module;
+}
+VkRenderPass DeviceObjects::keep(const DeviceRef& device, VkRenderPass pass) {
+    keep(device, VK_OBJECT_TYPE_RENDER_PASS, reinterpret_cast<uint64_t>(pass));
+    return pass;
+}
+VkFramebuffer DeviceObjects::keep(const DeviceRef& device, VkFramebuffer framebuffer) {
+    keep(device, VK_OBJECT_TYPE_FRAMEBUFFER, reinterpret_cast<uint64_t>(framebuffer));
+    return framebuffer;
+}
+
+void DeviceObjects::reset() {
+    for (auto it = objects_.rbegin(); it != objects_.rend(); ++it) {
+        const DeviceRef& d = *device_;
+        switch (it->first) {
+            case VK_OBJECT_TYPE_PIPELINE:
+                d.fn->vkDestroyPipeline(d.device, reinterpret_cast<VkPipeline>(it->second), d.allocator);
+                break;
+            case VK_OBJECT_TYPE_SHADER_MODULE:
+                d.fn->vkDestroyShaderModule(d.device, reinterpret_cast<VkShaderModule>(it->second), d.allocator);
+                break;
+            case VK_OBJECT_TYPE_RENDER_PASS:
+                d.fn->vkDestroyRenderPass(d.device, reinterpret_cast<VkRenderPass>(it->second), d.allocator);
+                break;
+            case VK_OBJECT_TYPE_FRAMEBUFFER:
+                d.fn->vkDestroyFramebuffer(d.device, reinterpret_cast<VkFramebuffer>(it->second), d.allocator);
+                break;
+            default:
+                assert(false && "DeviceObjects keeps no other type");
+        }
+    }
+    objects_.clear();
 }
 
 Result<VkPipeline> create_compute_pipeline(const DeviceRef& device, VkShaderModule module, VkPipelineLayout layout,

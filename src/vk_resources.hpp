@@ -13,6 +13,7 @@
 #include <vector>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace crisp::vk {
 
@@ -33,10 +34,46 @@ bool has_compute_subgroup_arithmetic(const Functions& fn, VkPhysicalDevice physi
 std::string version_string(uint32_t version);
 
 class MemoryArena;
+struct DeviceRef;
+
+// Move-only ownership of `Fields` (plain handles) made on a device: reset() and the destructor
+// give them back through Free with the DeviceRef they were made with, so that the objects that
+// hold them need no hand-written destructor. The DeviceRef must outlive the owner (it is the
+// member of the renderer's or compositor's state that every part is made from).
+template <class Fields, void (*Free)(const DeviceRef&, Fields&)>
+class Owner : public Fields {
+public:
+    Owner() = default;
+    Owner(Owner&& other) noexcept
+        : Fields(std::exchange(static_cast<Fields&>(other), Fields{})), owner_(std::exchange(other.owner_, nullptr)) {}
+    Owner& operator=(Owner&& other) noexcept {
+        if (this != &other) {
+            reset();
+            static_cast<Fields&>(*this) = std::exchange(static_cast<Fields&>(other), Fields{});
+            owner_ = std::exchange(other.owner_, nullptr);
+        }
+        return *this;
+    }
+    Owner(const Owner&) = delete;
+    Owner& operator=(const Owner&) = delete;
+    ~Owner() { reset(); }
+
+    // Gives everything back (nothing for an empty owner).
+    void reset() {
+        if (owner_ != nullptr) Free(*owner_, *this);
+        static_cast<Fields&>(*this) = Fields{};
+        owner_ = nullptr;
+    }
+    // Makes the owner responsible for what its fields now hold, made on `device`.
+    void adopt(const DeviceRef& device) { owner_ = &device; }
+
+private:
+    const DeviceRef* owner_ = nullptr;
+};
 
 // A buffer and its memory: a range of an arena's block (DeviceRef::arena), or memory of its own.
 // Host-visible ones stay mapped (coherent).
-struct DeviceBuffer {
+struct BufferFields {
     VkBuffer buffer = VK_NULL_HANDLE;
     VkDeviceMemory memory = VK_NULL_HANDLE;  // the block's, when suballocated
     void* mapped = nullptr;
@@ -45,6 +82,8 @@ struct DeviceBuffer {
     VkDeviceSize memory_size = 0;    // bytes of `memory` it takes
     bool suballocated = false;
 };
+void free_buffer(const DeviceRef& device, BufferFields& buffer);
+using DeviceBuffer = Owner<BufferFields, free_buffer>;
 
 // The device objects buffers and pipelines are made with, and the functions they are made through.
 struct DeviceRef {
@@ -77,36 +116,62 @@ void name_object(const DeviceRef& device, VkObjectType type, Handle handle, std:
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
                      const char* what, DeviceBuffer& out);
 // Frees both objects (either may be null) and empties `buffer`.
-void destroy_buffer(const DeviceRef& device, DeviceBuffer& buffer);
 
 // A 2D colour image (one mip level, one layer, optimal tiling) in device-local memory, with a view.
-struct DeviceImage {
+struct ImageFields {
     VkImage image = VK_NULL_HANDLE;
     VkDeviceMemory memory = VK_NULL_HANDLE;  // its own
     VkImageView view = VK_NULL_HANDLE;
     VkDeviceSize memory_size = 0;
 };
+void free_image(const DeviceRef& device, ImageFields& image);
+using DeviceImage = Owner<ImageFields, free_image>;
 
 // Makes `out` in VK_IMAGE_LAYOUT_UNDEFINED. On failure what was made is destroyed and the error
 // names the call and `what` ("atlas").
 Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height, VkImageUsageFlags usage,
                     const char* what, DeviceImage& out);
-void destroy_image(const DeviceRef& device, DeviceImage& image);
 
 // One descriptor set layout, a pipeline layout over it with one push-constant range at offset 0,
 // and a pool holding `sets.size()` sets of it (one per frame in flight, typically).
-struct DescriptorSets {
+struct DescriptorSetsFields {
     VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
     VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
     VkDescriptorPool pool = VK_NULL_HANDLE;
     std::vector<VkDescriptorSet> sets;
 };
+void free_descriptor_sets(const DeviceRef& device, DescriptorSetsFields& sets);
+using DescriptorSets = Owner<DescriptorSetsFields, free_descriptor_sets>;
 
 // Makes `out`; on failure what was made is destroyed and the error names the call and `what`.
 Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescriptorSetLayoutBinding> bindings,
                               VkShaderStageFlags push_stages, uint32_t push_bytes, uint32_t set_count, const char* what,
                               DescriptorSets& out);
-void destroy_descriptor_sets(const DeviceRef& device, DescriptorSets& sets);
+
+// The pipelines, shader modules, render passes and framebuffers an object made, destroyed with it
+// (newest first) through the DeviceRef they were made with, which must outlive it. keep() takes
+// ownership of a handle and returns it, so that a part keeps using plain handles.
+class DeviceObjects {
+public:
+    DeviceObjects() = default;
+    DeviceObjects(DeviceObjects&& other) noexcept;
+    DeviceObjects& operator=(DeviceObjects&& other) noexcept;
+    DeviceObjects(const DeviceObjects&) = delete;
+    DeviceObjects& operator=(const DeviceObjects&) = delete;
+    ~DeviceObjects() { reset(); }
+
+    VkPipeline keep(const DeviceRef& device, VkPipeline pipeline);
+    VkShaderModule keep(const DeviceRef& device, VkShaderModule module);
+    VkRenderPass keep(const DeviceRef& device, VkRenderPass pass);
+    VkFramebuffer keep(const DeviceRef& device, VkFramebuffer framebuffer);
+    void reset();  // destroys everything kept
+
+private:
+    void keep(const DeviceRef& device, VkObjectType type, uint64_t handle);
+
+    const DeviceRef* device_ = nullptr;
+    std::vector<std::pair<VkObjectType, uint64_t>> objects_;
+};
 
 // A compute pipeline of `module`'s "main" with `layout`.
 Result<VkPipeline> create_compute_pipeline(const DeviceRef& device, VkShaderModule module, VkPipelineLayout layout,

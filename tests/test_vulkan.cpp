@@ -121,7 +121,7 @@ struct ComputeKernel {
     ~ComputeKernel() {
         if (device.device == VK_NULL_HANDLE) return;
         vkDestroyPipeline(device.device, pipeline, nullptr);
-        vk::destroy_descriptor_sets(device, descriptors);
+        descriptors.reset();
         vkDestroyShaderModule(device.device, module, nullptr);
     }
 };
@@ -716,7 +716,7 @@ TEST_F(VulkanTest, ObjectsAreNamedForTheValidationLayer) {
     // (The submission may succeed or fail on the invalid command; only the message counts.)
     static_cast<void>(
         context.submit_and_wait([&](VkCommandBuffer cb) { vkCmdFillBuffer(cb, buffer.buffer, 0, 16, 0); }));
-    vk::destroy_buffer(ref, buffer);
+    buffer.reset();
     const ValidationMessages messages = context.validation_messages();
     EXPECT_GE(messages.errors, 1u);
     EXPECT_TRUE(std::any_of(messages.recent.begin(), messages.recent.end(), [](const std::string& message) {

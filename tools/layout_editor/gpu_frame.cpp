@@ -11,8 +11,6 @@ namespace {
 
 using vk::create_buffer;
 using vk::create_image;
-using vk::destroy_buffer;
-using vk::destroy_image;
 
 using vk::image_barrier;
 
@@ -39,9 +37,9 @@ GpuFrame::~GpuFrame() {
     if (timestamps_) vkDestroyQueryPool(device_.device, timestamps_, nullptr);
     if (fence_) vkDestroyFence(device_.device, fence_, nullptr);
     if (pool_) vkDestroyCommandPool(device_.device, pool_, nullptr);
-    destroy_buffer(device_, readback_);
-    destroy_buffer(device_, upload_);
-    destroy_image(device_, canvas_);
+    readback_.reset();
+    upload_.reset();
+    canvas_.reset();
 }
 
 Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const Font& font,
