@@ -301,23 +301,6 @@ void DeviceObjects::keep(const DeviceRef& device, VkObjectType type, uint64_t ha
     device_ = &device;
     if (handle != 0) objects_.emplace_back(type, handle);
 }
-VkPipeline DeviceObjects::keep(const DeviceRef& device, VkPipeline pipeline) {
-    keep(device, VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<uint64_t>(pipeline));
-    return pipeline;
-}
-VkShaderModule DeviceObjects::keep(const DeviceRef& device, VkShaderModule module) {
-    keep(device, VK_OBJECT_TYPE_SHADER_MODULE, reinterpret_cast<uint64_t>(module));
-    return module;
-}
-VkRenderPass DeviceObjects::keep(const DeviceRef& device, VkRenderPass pass) {
-    keep(device, VK_OBJECT_TYPE_RENDER_PASS, reinterpret_cast<uint64_t>(pass));
-    return pass;
-}
-VkFramebuffer DeviceObjects::keep(const DeviceRef& device, VkFramebuffer framebuffer) {
-    keep(device, VK_OBJECT_TYPE_FRAMEBUFFER, reinterpret_cast<uint64_t>(framebuffer));
-    return framebuffer;
-}
-
 void DeviceObjects::reset() {
     for (auto it = objects_.rbegin(); it != objects_.rend(); ++it) {
         const DeviceRef& d = *device_;

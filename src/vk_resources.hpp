@@ -13,6 +13,7 @@
 #include <vector>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 namespace crisp::vk {
@@ -160,13 +161,23 @@ public:
     DeviceObjects& operator=(const DeviceObjects&) = delete;
     ~DeviceObjects() { reset(); }
 
-    VkPipeline keep(const DeviceRef& device, VkPipeline pipeline);
-    VkShaderModule keep(const DeviceRef& device, VkShaderModule module);
-    VkRenderPass keep(const DeviceRef& device, VkRenderPass pass);
-    VkFramebuffer keep(const DeviceRef& device, VkFramebuffer framebuffer);
+    template <class Handle>
+    Handle keep(const DeviceRef& device, Handle handle) {
+        static_assert(type_of<Handle>() != VK_OBJECT_TYPE_UNKNOWN, "DeviceObjects keeps no such type");
+        keep(device, type_of<Handle>(), reinterpret_cast<uint64_t>(handle));
+        return handle;
+    }
     void reset();  // destroys everything kept
 
 private:
+    template <class Handle>
+    static constexpr VkObjectType type_of() {
+        if constexpr (std::is_same_v<Handle, VkPipeline>) return VK_OBJECT_TYPE_PIPELINE;
+        if constexpr (std::is_same_v<Handle, VkShaderModule>) return VK_OBJECT_TYPE_SHADER_MODULE;
+        if constexpr (std::is_same_v<Handle, VkRenderPass>) return VK_OBJECT_TYPE_RENDER_PASS;
+        if constexpr (std::is_same_v<Handle, VkFramebuffer>) return VK_OBJECT_TYPE_FRAMEBUFFER;
+        return VK_OBJECT_TYPE_UNKNOWN;
+    }
     void keep(const DeviceRef& device, VkObjectType type, uint64_t handle);
 
     const DeviceRef* device_ = nullptr;
