@@ -255,6 +255,14 @@ struct HeadlessContext::State {
     State(const State&) = delete;
     State& operator=(const State&) = delete;
 
+    // create()'s steps, in order; each leaves what it made for the destructor on failure.
+    Status create_instance(const HeadlessContextOptions& options);
+    Status create_messenger(const VkDebugUtilsMessengerCreateInfoEXT& info);
+    Result<DeviceCandidate> choose_device(const HeadlessContextOptions& options, const vk::DeviceFeatures& required);
+    Status create_device(const DeviceCandidate& chosen, const HeadlessContextOptions& options,
+                         vk::DeviceFeatures required);
+    Status create_submission_objects();
+
     // Destroys in reverse order of creation; create() relies on this to clean up after a failure
     // part-way through.
     ~State() {
@@ -280,18 +288,10 @@ struct HeadlessContext::State {
     }
 };
 
-Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& options) {
-    if (!meets_version(options.api_version, VK_API_VERSION_1_2)) {
-        return Error{ErrorCode::invalid_argument,
-                     "api_version " + vk::version_string(options.api_version) + " is below crisp's floor of 1.2"};
-    }
-    Result<vk::DeviceFeatures> copied = vk::copy_required_features(options.required_features, options.api_version);
-    if (!copied) return copied.error();
-    vk::DeviceFeatures& required = copied.value();
-
-    auto state = std::make_unique<State>();
-    vk::Functions& fn = state->fn;
-    if (Status s = vk::load_functions(nullptr, VK_NULL_HANDLE, VK_NULL_HANDLE, fn); !s) return s.error();
+// The instance (with the validation layer and its messenger where asked for), after checking the
+// loader's version.
+Status HeadlessContext::State::create_instance(const HeadlessContextOptions& options) {
+    if (Status s = vk::load_functions(nullptr, VK_NULL_HANDLE, VK_NULL_HANDLE, fn); !s) return s;
     uint32_t loader_version = VK_API_VERSION_1_0;
     if (fn.vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS ||
         !meets_version(loader_version, options.api_version)) {
@@ -301,7 +301,7 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
 
     std::vector<const char*> layers;
     std::vector<const char*> extensions;
-    VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info(&state->validation_log);
+    VkDebugUtilsMessengerCreateInfoEXT messenger_create = messenger_info(&validation_log);
     VkValidationFeaturesEXT validation_features{};
     const VkValidationFeatureEnableEXT sync_validation = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
     if (options.validation) {
@@ -327,7 +327,7 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
             validation_features.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
             validation_features.enabledValidationFeatureCount = 1;
             validation_features.pEnabledValidationFeatures = &sync_validation;
-            messenger.pNext = &validation_features;
+            messenger_create.pNext = &validation_features;
         }
     }
 
@@ -339,13 +339,13 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     VkInstanceCreateInfo instance_info{};
     instance_info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     // Chained here too so that messages from vkCreateInstance and vkDestroyInstance are counted.
-    instance_info.pNext = options.validation ? &messenger : nullptr;
+    instance_info.pNext = options.validation ? &messenger_create : nullptr;
     instance_info.pApplicationInfo = &application;
     instance_info.enabledLayerCount = static_cast<uint32_t>(layers.size());
     instance_info.ppEnabledLayerNames = layers.data();
     instance_info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
     instance_info.ppEnabledExtensionNames = extensions.data();
-    if (VkResult result = fn.vkCreateInstance(&instance_info, nullptr, &state->instance); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkCreateInstance(&instance_info, nullptr, &instance); result != VK_SUCCESS) {
         if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
             return Error{ErrorCode::vulkan, "no Vulkan driver supports Vulkan " +
                                                 vk::version_string(options.api_version) +
@@ -353,31 +353,39 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
         }
         return vk::vulkan_error("vkCreateInstance", result);
     }
-    if (Status s = vk::load_functions(fn.vkGetInstanceProcAddr, state->instance, VK_NULL_HANDLE, fn); !s) {
+    if (Status s = vk::load_functions(fn.vkGetInstanceProcAddr, instance, VK_NULL_HANDLE, fn); !s) {
         return s.error();
     }
-    if (options.validation) {
-        auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-            fn.vkGetInstanceProcAddr(state->instance, "vkCreateDebugUtilsMessengerEXT"));
-        state->destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-            fn.vkGetInstanceProcAddr(state->instance, "vkDestroyDebugUtilsMessengerEXT"));
-        if (create_messenger == nullptr || state->destroy_messenger == nullptr) {
-            return Error{ErrorCode::vulkan, "VK_EXT_debug_utils is enabled but its functions are missing"};
-        }
-        messenger.pNext = nullptr;  // the validation features belong to the instance only
-        if (VkResult result = create_messenger(state->instance, &messenger, nullptr, &state->messenger);
-            result != VK_SUCCESS) {
-            return vk::vulkan_error("vkCreateDebugUtilsMessengerEXT", result);
-        }
-    }
+    if (!options.validation) return {};
+    messenger_create.pNext = nullptr;  // the validation features belong to the instance only
+    return create_messenger(messenger_create);
+}
 
+// The messenger that counts the validation layer's messages after instance creation.
+Status HeadlessContext::State::create_messenger(const VkDebugUtilsMessengerCreateInfoEXT& info) {
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        fn.vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        fn.vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
+    if (create == nullptr || destroy_messenger == nullptr) {
+        return Error{ErrorCode::vulkan, "VK_EXT_debug_utils is enabled but its functions are missing"};
+    }
+    if (VkResult result = create(instance, &info, nullptr, &messenger); result != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateDebugUtilsMessengerEXT", result);
+    }
+    return {};
+}
+
+// The best device that meets every requirement (discrete > integrated > virtual > CPU), or an
+// error naming each device and what it lacks.
+Result<DeviceCandidate> HeadlessContext::State::choose_device(const HeadlessContextOptions& options,
+                                                              const vk::DeviceFeatures& required) {
     uint32_t device_count = 0;
-    if (VkResult result = fn.vkEnumeratePhysicalDevices(state->instance, &device_count, nullptr);
-        result != VK_SUCCESS) {
+    if (VkResult result = fn.vkEnumeratePhysicalDevices(instance, &device_count, nullptr); result != VK_SUCCESS) {
         return vk::vulkan_error("vkEnumeratePhysicalDevices", result);
     }
     std::vector<VkPhysicalDevice> devices(device_count);
-    if (VkResult result = fn.vkEnumeratePhysicalDevices(state->instance, &device_count, devices.data());
+    if (VkResult result = fn.vkEnumeratePhysicalDevices(instance, &device_count, devices.data());
         result != VK_SUCCESS && result != VK_INCOMPLETE) {
         return vk::vulkan_error("vkEnumeratePhysicalDevices", result);
     }
@@ -412,37 +420,42 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
         return Error{ErrorCode::vulkan, "no suitable Vulkan device: " + join(rejections, " | ")};
     }
 
-    state->physical_device = chosen->handle;
-    state->queue_family = chosen->queue_family;
-    state->properties = chosen->properties;
-    state->device_name = chosen->properties.deviceName;
-    state->driver_name = chosen->vulkan12.driverName;
-    state->driver_info = chosen->vulkan12.driverInfo;
-    state->driver_id = chosen->vulkan12.driverID;
-    state->driver_version = chosen->properties.driverVersion;
-    state->api_version = std::min(options.api_version, chosen->properties.apiVersion);
-    state->subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
-    state->subgroup.subgroupSize = chosen->vulkan11.subgroupSize;
-    state->subgroup.supportedStages = chosen->vulkan11.subgroupSupportedStages;
-    state->subgroup.supportedOperations = chosen->vulkan11.subgroupSupportedOperations;
-    state->subgroup.quadOperationsInAllStages = chosen->vulkan11.subgroupQuadOperationsInAllStages;
-    fn.vkGetPhysicalDeviceMemoryProperties(state->physical_device, &state->memory_properties);
+    return *chosen;
+}
+
+// The device from `chosen`, with exactly the required features and extensions, and its queue.
+Status HeadlessContext::State::create_device(const DeviceCandidate& chosen, const HeadlessContextOptions& options,
+                                             vk::DeviceFeatures required) {
+    physical_device = chosen.handle;
+    queue_family = chosen.queue_family;
+    properties = chosen.properties;
+    device_name = chosen.properties.deviceName;
+    driver_name = chosen.vulkan12.driverName;
+    driver_info = chosen.vulkan12.driverInfo;
+    driver_id = chosen.vulkan12.driverID;
+    driver_version = chosen.properties.driverVersion;
+    api_version = std::min(options.api_version, chosen.properties.apiVersion);
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    subgroup.subgroupSize = chosen.vulkan11.subgroupSize;
+    subgroup.supportedStages = chosen.vulkan11.subgroupSupportedStages;
+    subgroup.supportedOperations = chosen.vulkan11.subgroupSupportedOperations;
+    subgroup.quadOperationsInAllStages = chosen.vulkan11.subgroupQuadOperationsInAllStages;
+    fn.vkGetPhysicalDeviceMemoryProperties(physical_device, &memory_properties);
     for (const std::string& name : options.required_extensions) {
         // Listing an extension twice is harmless to the caller but invalid for vkCreateDevice.
-        if (std::find(state->enabled_extensions.begin(), state->enabled_extensions.end(), name) ==
-            state->enabled_extensions.end()) {
-            state->enabled_extensions.push_back(name);
+        if (std::find(enabled_extensions.begin(), enabled_extensions.end(), name) == enabled_extensions.end()) {
+            enabled_extensions.push_back(name);
         }
     }
 
     const float priority = 1.0f;
     VkDeviceQueueCreateInfo queue_info{};
     queue_info.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
-    queue_info.queueFamilyIndex = state->queue_family;
+    queue_info.queueFamilyIndex = queue_family;
     queue_info.queueCount = 1;
     queue_info.pQueuePriorities = &priority;
     std::vector<const char*> device_extensions;
-    for (const std::string& name : state->enabled_extensions) device_extensions.push_back(name.c_str());
+    for (const std::string& name : enabled_extensions) device_extensions.push_back(name.c_str());
     VkDeviceCreateInfo device_info{};
     device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
     // Exactly what the caller required; the 1.3 structure only when it asks for something, since
@@ -452,40 +465,58 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     device_info.pQueueCreateInfos = &queue_info;
     device_info.enabledExtensionCount = static_cast<uint32_t>(device_extensions.size());
     device_info.ppEnabledExtensionNames = device_extensions.data();
-    if (VkResult result = fn.vkCreateDevice(state->physical_device, &device_info, nullptr, &state->device);
-        result != VK_SUCCESS) {
+    if (VkResult result = fn.vkCreateDevice(physical_device, &device_info, nullptr, &device); result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateDevice", result);
     }
-    if (Status s = vk::load_functions(fn.vkGetInstanceProcAddr, state->instance, state->device, fn); !s) {
+    if (Status s = vk::load_functions(fn.vkGetInstanceProcAddr, instance, device, fn); !s) {
         return s.error();
     }
-    state->enabled = required;
-    state->enabled_chain = state->enabled.link(true);
-    fn.vkGetDeviceQueue(state->device, state->queue_family, 0, &state->queue);
+    enabled = required;
+    enabled_chain = enabled.link(true);
+    fn.vkGetDeviceQueue(device, queue_family, 0, &queue);
 
+    return {};
+}
+
+// The command pool, command buffer and fence submit_and_wait() uses.
+Status HeadlessContext::State::create_submission_objects() {
     VkCommandPoolCreateInfo pool_info{};
     pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
     // One command buffer, re-recorded for every submission.
     pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT | VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    pool_info.queueFamilyIndex = state->queue_family;
-    if (VkResult result = fn.vkCreateCommandPool(state->device, &pool_info, nullptr, &state->command_pool);
-        result != VK_SUCCESS) {
+    pool_info.queueFamilyIndex = queue_family;
+    if (VkResult result = fn.vkCreateCommandPool(device, &pool_info, nullptr, &command_pool); result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateCommandPool", result);
     }
     VkCommandBufferAllocateInfo buffer_info{};
     buffer_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-    buffer_info.commandPool = state->command_pool;
+    buffer_info.commandPool = command_pool;
     buffer_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     buffer_info.commandBufferCount = 1;
-    if (VkResult result = fn.vkAllocateCommandBuffers(state->device, &buffer_info, &state->command_buffer);
-        result != VK_SUCCESS) {
+    if (VkResult result = fn.vkAllocateCommandBuffers(device, &buffer_info, &command_buffer); result != VK_SUCCESS) {
         return vk::vulkan_error("vkAllocateCommandBuffers", result);
     }
     VkFenceCreateInfo fence_info{};
     fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-    if (VkResult result = fn.vkCreateFence(state->device, &fence_info, nullptr, &state->fence); result != VK_SUCCESS) {
+    if (VkResult result = fn.vkCreateFence(device, &fence_info, nullptr, &fence); result != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateFence", result);
     }
+    return {};
+}
+
+Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& options) {
+    if (!meets_version(options.api_version, VK_API_VERSION_1_2)) {
+        return Error{ErrorCode::invalid_argument,
+                     "api_version " + vk::version_string(options.api_version) + " is below crisp's floor of 1.2"};
+    }
+    Result<vk::DeviceFeatures> required = vk::copy_required_features(options.required_features, options.api_version);
+    if (!required) return required.error();
+    auto state = std::make_unique<State>();
+    if (Status s = state->create_instance(options); !s) return s.error();
+    Result<DeviceCandidate> chosen = state->choose_device(options, *required);
+    if (!chosen) return chosen.error();
+    if (Status s = state->create_device(*chosen, options, *required); !s) return s.error();
+    if (Status s = state->create_submission_objects(); !s) return s.error();
     return HeadlessContext(std::move(state));
 }
 
