@@ -23,7 +23,7 @@ namespace {
 constexpr double kFitTolerance = 1.0 / 1024.0;
 
 struct Run {
-    uint32_t begin = 0, end = 0;          // code points
+    uint32_t begin = 0, end = 0;            // code points
     size_t glyph_begin = 0, glyph_end = 0;  // in State::shaped
     hb_script_t script = HB_SCRIPT_INVALID;
     uint16_t font = 0;
@@ -74,7 +74,9 @@ struct LineRecord {
     bool rtl = false;
 };
 
-Error invalid(std::string message) { return Error{ErrorCode::invalid_argument, std::move(message)}; }
+Error invalid(std::string message) {
+    return Error{ErrorCode::invalid_argument, std::move(message)};
+}
 
 std::string show(double value) {
     if (std::isnan(value)) return "NaN";
@@ -121,8 +123,9 @@ Status validate(std::span<const Font* const> fonts, std::string_view utf8, const
         if (Status status = check_size("style.size_y", style.size_y); !status) return status;
     }
     const std::pair<const char*, float> finite[] = {
-        {"style.color[0]", style.color[0]}, {"style.color[1]", style.color[1]}, {"style.color[2]", style.color[2]},
-        {"style.color[3]", style.color[3]}, {"style.depth", style.depth},       {"options.origin_x", options.origin_x},
+        {"style.color[0]", style.color[0]},     {"style.color[1]", style.color[1]},
+        {"style.color[2]", style.color[2]},     {"style.color[3]", style.color[3]},
+        {"style.depth", style.depth},           {"options.origin_x", options.origin_x},
         {"options.origin_y", options.origin_y}, {"options.wrap_width", options.wrap_width},
     };
     for (const auto& [name, value] : finite) {
@@ -180,8 +183,8 @@ struct Layouter::State {
     double size_x = 0.0, size_y = 0.0;  // the key's quantized sizes, pixels per em
     double tab_width = 0.0;             // pixels; 0: tabs are spaces
     hb_language_t language = nullptr;
-    bool failed = false;                // HarfBuzz ran out of memory
-    uint32_t mark_splits = 0;           // clusters cut after kMaxMarksPerCluster attached characters
+    bool failed = false;       // HarfBuzz ran out of memory
+    uint32_t mark_splits = 0;  // clusters cut after kMaxMarksPerCluster attached characters
 
     // Whole text.
     std::vector<uint32_t> codepoints;
@@ -217,16 +220,22 @@ struct Layouter::State {
     bool shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level, hb_script_t script,
                uint16_t font);
     void break_lines(uint32_t p0, uint32_t p1);
+    size_t cut_pieces(uint32_t p0, uint32_t p1, uint32_t line_begin, uint32_t line_end, uint8_t base_level,
+                      size_t& run_cursor, size_t& glyph_cursor);
+    void order_pieces(size_t content_pieces);
+    double place_pieces(size_t content_pieces, uint8_t base_level);
     void place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, uint32_t line_end, uint8_t base_level,
                     size_t& run_cursor, size_t& glyph_cursor);
+    void align_lines(TextLayout& out);
+    void emit_glyphs(const TextStyle& style, TextLayout& out);
     bool safe_to_break(uint32_t at) const {
         return (flags[at] & kCharClusterStart) != 0 && (flags[at] & kCharUnsafe) == 0;
     }
     void finish(const TextStyle& style, TextLayout& out);
 };
 
-bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level,
-                            hb_script_t script, uint16_t font) {
+bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level, hb_script_t script,
+                            uint16_t font) {
     const bool rtl = (level & 1) != 0;
     hb_buffer_clear_contents(buffer);
     hb_buffer_set_direction(buffer, rtl ? HB_DIRECTION_RTL : HB_DIRECTION_LTR);
@@ -252,7 +261,8 @@ bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t e
     auto pixels = [snap](double value) { return static_cast<float>(snap ? std::round(value) : value); };
     // Grown geometrically: reserving exactly size + count here reallocated on every run (quadratic
     // in a paragraph of many runs).
-    if (shaped.capacity() < shaped.size() + count) shaped.reserve(std::max(shaped.size() + count, 2 * shaped.capacity()));
+    if (shaped.capacity() < shaped.size() + count)
+        shaped.reserve(std::max(shaped.size() + count, 2 * shaped.capacity()));
     for (unsigned k = 0; k < count; ++k) {
         // HarfBuzz returns right-to-left runs in visual order; keep everything logical.
         const unsigned i = rtl ? count - 1 - k : k;
@@ -398,10 +408,11 @@ void Layouter::State::break_lines(uint32_t p0, uint32_t p1) {
     line_ranges.emplace_back(line_begin, p1);
 }
 
-void Layouter::State::place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, uint32_t line_end,
-                                 uint8_t base_level, size_t& run_cursor, size_t& glyph_cursor) {
-    // Spaces at the end of the line hang: they take the paragraph's level (UAX #9 L1), are placed
-    // past the content in the paragraph's direction, and do not count toward the width.
+// The line's pieces: each run's part on the line, cut where trailing spaces begin (they hang: they
+// take the paragraph's level, UAX #9 L1, and are placed past the content). Returns how many pieces
+// are content, the rest are the hanging spaces; sets `failed` where re-shaping a cut run fails.
+size_t Layouter::State::cut_pieces(uint32_t p0, uint32_t p1, uint32_t line_begin, uint32_t line_end, uint8_t base_level,
+                                   size_t& run_cursor, size_t& glyph_cursor) {
     uint32_t content_end = line_end;
     while (content_end > line_begin && (flags[content_end - 1] & kCharSpace) != 0) --content_end;
 
@@ -436,11 +447,14 @@ void Layouter::State::place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, 
             ++content_pieces;
         }
         if (end > content_end) add_piece(run, std::max(begin, content_end), end, base_level);
-        if (failed) return;
+        if (failed) break;
     }
+    return content_pieces;
+}
 
-    // Visual order of the content (UAX #9 L2): from the highest level down to the lowest odd
-    // level, reverse every maximal sequence of pieces at that level or higher.
+// Visual order of the content pieces into `order` (UAX #9 L2): from the highest level down to the
+// lowest odd level, every maximal sequence of pieces at that level or higher is reversed.
+void Layouter::State::order_pieces(size_t content_pieces) {
     order.resize(content_pieces);
     uint8_t highest = 0, lowest_odd = 255;
     for (size_t i = 0; i < content_pieces; ++i) {
@@ -460,7 +474,11 @@ void Layouter::State::place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, 
             i = j;
         }
     }
+}
 
+// Every piece's glyphs' x into glyph_x: the content in visual order from 0 (tabs to the next
+// stop), then the hanging spaces past it in the paragraph's direction. Returns the content's width.
+double Layouter::State::place_pieces(size_t content_pieces, uint8_t base_level) {
     glyph_x.resize(shaped.size());
     double x = 0.0;
     auto place = [&](const Piece& piece, bool tabs) {
@@ -495,7 +513,15 @@ void Layouter::State::place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, 
             place(pieces[i], false);
         }
     }
+    return width;
+}
 
+void Layouter::State::place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, uint32_t line_end, uint8_t base_level,
+                                 size_t& run_cursor, size_t& glyph_cursor) {
+    const size_t content_pieces = cut_pieces(p0, p1, line_begin, line_end, base_level, run_cursor, glyph_cursor);
+    if (failed) return;
+    order_pieces(content_pieces);
+    const double width = place_pieces(content_pieces, base_level);
     const auto line = static_cast<uint32_t>(lines.size());
     for (const Piece& piece : pieces) {
         for (size_t g = piece.glyph_begin; g < piece.glyph_end; ++g) {
@@ -506,7 +532,9 @@ void Layouter::State::place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, 
     lines.push_back({line_begin, line_end, width, (base_level & 1) != 0});
 }
 
-void Layouter::State::finish(const TextStyle& style, TextLayout& out) {
+// Each line's x (aligned within the wrap width, or the widest line) and baseline into line_x and
+// line_baseline, the lines' records and the layout's box into `out`.
+void Layouter::State::align_lines(TextLayout& out) {
     const LayoutOptions& o = *options;
     const bool snap = o.snap_to_pixels;
     double line_height = static_cast<double>(fonts[0]->line_height()) * size_y;
@@ -550,7 +578,12 @@ void Layouter::State::finish(const TextStyle& style, TextLayout& out) {
         out.y = static_cast<float>(origin_y - static_cast<double>(fonts[0]->ascender()) * size_y);
         out.height = static_cast<float>(line_height * static_cast<double>(lines.size()));
     }
+}
 
+// The placed glyphs as instances into `out`, line by line: .notdef for glyphs the asset lacks,
+// blank glyphs kept only when asked, pens beyond kMaxCoordinate counted and dropped.
+void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
+    const LayoutOptions& o = *options;
     float color[4];
     for (int c = 0; c < 3; ++c) color[c] = srgb_to_linear(std::clamp(style.color[c], 0.0f, 1.0f));
     color[3] = std::clamp(style.color[3], 0.0f, 1.0f);
@@ -613,6 +646,11 @@ void Layouter::State::finish(const TextStyle& style, TextLayout& out) {
     out.next_paint_order = o.first_paint_order + static_cast<uint32_t>(out.glyphs.size());
 }
 
+void Layouter::State::finish(const TextStyle& style, TextLayout& out) {
+    align_lines(out);
+    emit_glyphs(style, out);
+}
+
 Status Layouter::State::layout(std::span<const Font* const> font_list, std::string_view utf8, const TextStyle& style,
                                const LayoutOptions& layout_options, TextLayout& out) {
     reset(out, layout_options.first_paint_order);
@@ -620,7 +658,8 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
 
     fonts = font_list;
     font_views.clear();
-    for (const Font* font : fonts) font_views.push_back({font->asset().glyphs.data(), font->asset().glyphs.size(), font->id()});
+    for (const Font* font : fonts)
+        font_views.push_back({font->asset().glyphs.data(), font->asset().glyphs.size(), font->id()});
     options = &layout_options;
     failed = false;
     mark_splits = 0;
