@@ -10,7 +10,7 @@ layout(push_constant) uniform PushConstants {
     CompositePushConstants pc;
 };
 
-layout(std430, set = 0, binding = 1) readonly buffer Quads {
+layout(std430, set = 0, binding = kCompositeBindQuads) readonly buffer Quads {
     CompositeQuad quads[];
 };
 

@@ -14,9 +14,9 @@ layout(push_constant) uniform PushConstants {
     CompositePushConstants pc;
 };
 
-layout(set = 0, binding = 0, rgba16ui) uniform readonly uimage2D atlas;
+layout(set = 0, binding = kCompositeBindAtlas, rgba16ui) uniform readonly uimage2D atlas;
 
-layout(std430, set = 0, binding = 1) readonly buffer Quads {
+layout(std430, set = 0, binding = kCompositeBindQuads) readonly buffer Quads {
     CompositeQuad quads[];
 };
 
@@ -24,7 +24,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Quads {
 
 #ifdef CRISP_COMPUTE
 // Per tile: the quad's index, and the tile's top-left texel in the quad's rect (x | y << 16).
-layout(std430, set = 0, binding = 7) readonly buffer Tiles {
+layout(std430, set = 0, binding = kCompositeBindTiles) readonly buffer Tiles {
     uvec2 tiles[];
 };
 #else

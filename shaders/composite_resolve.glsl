@@ -8,13 +8,13 @@ layout(push_constant) uniform PushConstants {
     CompositePushConstants pc;
 };
 
-layout(std430, set = 0, binding = 3) buffer Accumulators {
+layout(std430, set = 0, binding = kCompositeBindAccumulators) buffer Accumulators {
     uint words[];
 };
-layout(std430, set = 0, binding = 5) buffer Stats {
+layout(std430, set = 0, binding = kCompositeBindStats) buffer Stats {
     uint stats[];
 };
-layout(set = 0, binding = 6, rgba32f) uniform writeonly image2D target;
+layout(set = 0, binding = kCompositeBindTarget, rgba32f) uniform writeonly image2D target;
 
 // The background seen through `transmittance`, plus `light`; alpha is the most opaque channel's.
 void store_pixel(ivec2 pixel, vec3 light, vec3 transmittance) {

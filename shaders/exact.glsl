@@ -3,13 +3,13 @@
 // exact.frag and exact_quads.comp.
 #include "composite_fragment.glsl"
 
-layout(std430, set = 0, binding = 3) buffer Accumulators {
+layout(std430, set = 0, binding = kCompositeBindAccumulators) buffer Accumulators {
     uint words[];
 };
-layout(std430, set = 0, binding = 4) buffer Nodes {
+layout(std430, set = 0, binding = kCompositeBindNodes) buffer Nodes {
     uint nodes[];
 };
-layout(std430, set = 0, binding = 5) buffer Stats {
+layout(std430, set = 0, binding = kCompositeBindStats) buffer Stats {
     uint stats[];
 };
 

@@ -5,7 +5,7 @@
 
 #include "composite_resolve.glsl"
 
-layout(std430, set = 0, binding = 4) readonly buffer Nodes {
+layout(std430, set = 0, binding = kCompositeBindNodes) readonly buffer Nodes {
     uint nodes[];
 };
 

@@ -18,17 +18,17 @@ layout(push_constant) uniform PushConstants {
     RasterPushConstants pc;
 };
 
-layout(set = 0, binding = 0, rgba16ui) uniform uimage2D atlas;
+layout(set = 0, binding = kRasterBindAtlas, rgba16ui) uniform uimage2D atlas;
 
-layout(std430, set = 0, binding = 1) readonly buffer Items {
+layout(std430, set = 0, binding = kRasterBindItems) readonly buffer Items {
     RasterItem items[];
 };
 
-layout(std430, set = 0, binding = 2) readonly buffer Points {
+layout(std430, set = 0, binding = kRasterBindPoints) readonly buffer Points {
     vec2 points[];
 } fonts_points[kRasterFontPages];
 
-layout(std430, set = 0, binding = 3) readonly buffer Bands {
+layout(std430, set = 0, binding = kRasterBindBands) readonly buffer Bands {
     uint words[];
 } fonts_bands[kRasterFontPages];
 

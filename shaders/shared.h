@@ -56,6 +56,11 @@ CRISP_CONSTANT(uint, kRasterCoverageOne, 64u);
 CRISP_CONSTANT(uint, kRasterFontPages, 8u);  // font pages, each several fonts' points and bands
 // Workgroups per row of the 2D dispatch (maxComputeWorkGroupCount[0] is at least 65535).
 CRISP_CONSTANT(uint, kRasterDispatchWidth, 65535u);
+// The rasterizer's descriptor set.
+CRISP_CONSTANT(uint, kRasterBindAtlas, 0u);   // the atlas, storage image
+CRISP_CONSTANT(uint, kRasterBindItems, 1u);   // RasterItem[]
+CRISP_CONSTANT(uint, kRasterBindPoints, 2u);  // kRasterFontPages buffers of curve points
+CRISP_CONSTANT(uint, kRasterBindBands, 3u);   // kRasterFontPages buffers of band words
 
 // One glyph's work this frame, in a std430 storage buffer.
 struct RasterItem {
@@ -93,6 +98,15 @@ struct RasterPushConstants {
 
 
 // ---- The compositor (composite.vert and the *.frag / *_resolve.comp of each mode).
+
+// The descriptor set every quad pass shares (the draw path binds the first two).
+CRISP_CONSTANT(uint, kCompositeBindAtlas, 0u);         // the atlas, storage image
+CRISP_CONSTANT(uint, kCompositeBindQuads, 1u);         // CompositeQuad[]
+CRISP_CONSTANT(uint, kCompositeBindAccumulators, 3u);  // per-pixel sums (wboit, exact heads)
+CRISP_CONSTANT(uint, kCompositeBindNodes, 4u);         // exact: the node pool
+CRISP_CONSTANT(uint, kCompositeBindStats, 5u);         // counters read back after the frame
+CRISP_CONSTANT(uint, kCompositeBindTarget, 6u);        // the reference target, storage image
+CRISP_CONSTANT(uint, kCompositeBindTiles, 7u);         // the compute quad passes' tile list
 
 // The tile path's layered way keeps at most this many layers per pixel.
 CRISP_CONSTANT(uint, kCompositeMaxLayers, 8u);

@@ -6,7 +6,7 @@
 // wboit_quads.comp.
 #include "composite_fragment.glsl"
 
-layout(std430, set = 0, binding = 3) buffer Accumulators {
+layout(std430, set = 0, binding = kCompositeBindAccumulators) buffer Accumulators {
     uint words[];
 };
 

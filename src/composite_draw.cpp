@@ -36,8 +36,8 @@ Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice phys
     }
     // The bindings composite_fragment.glsl declares for a rasterized quad: the atlas and the quads.
     const VkDescriptorSetLayoutBinding bindings[] = {
-        {0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kStages, nullptr},
-        {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kStages, nullptr},
+        {gpu::kCompositeBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kStages, nullptr},
+        {gpu::kCompositeBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kStages, nullptr},
     };
     if (Status s = vk::create_descriptor_sets(ref_, bindings, kStages, sizeof(gpu::CompositePushConstants),
                                               frames_in_flight, "compositor draw path", descriptors_);
@@ -84,12 +84,13 @@ Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::spa
     const VkDescriptorImageInfo atlas{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
     const VkDescriptorBufferInfo quad_info{slot.quads.buffer, 0, VK_WHOLE_SIZE};
     VkWriteDescriptorSet writes[2]{};
-    for (uint32_t i = 0; i < 2; ++i) {
-        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        writes[i].dstSet = slot.set;
-        writes[i].dstBinding = i;
-        writes[i].descriptorCount = 1;
+    for (VkWriteDescriptorSet& write : writes) {
+        write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        write.dstSet = slot.set;
+        write.descriptorCount = 1;
     }
+    writes[0].dstBinding = gpu::kCompositeBindAtlas;
+    writes[1].dstBinding = gpu::kCompositeBindQuads;
     writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     writes[0].pImageInfo = &atlas;
     writes[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;

@@ -31,13 +31,13 @@ static_assert(kMaxExactFragmentsPerPixel == gpu::kCompositeExactMaxPerPixel);
 
 // Bindings of the one descriptor set layout every pipeline shares.
 enum Binding : uint32_t {
-    kBindAtlas = 0,
-    kBindQuads = 1,
-    kBindAccumulators = 3,
-    kBindNodes = 4,
-    kBindStats = 5,
-    kBindTarget = 6,
-    kBindTiles = 7,
+    kBindAtlas = gpu::kCompositeBindAtlas,
+    kBindQuads = gpu::kCompositeBindQuads,
+    kBindAccumulators = gpu::kCompositeBindAccumulators,
+    kBindNodes = gpu::kCompositeBindNodes,
+    kBindStats = gpu::kCompositeBindStats,
+    kBindTarget = gpu::kCompositeBindTarget,
+    kBindTiles = gpu::kCompositeBindTiles,
 };
 constexpr uint32_t kBindings[] = {kBindAtlas, kBindQuads,  kBindAccumulators, kBindNodes,
                                   kBindStats, kBindTarget, kBindTiles};

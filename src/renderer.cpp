@@ -495,10 +495,12 @@ Status Renderer::State::create_objects() {
     if (!module) return module.error();
     shader = objects.keep(ref, *module);
     const VkDescriptorSetLayoutBinding bindings[] = {
-        {0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-        {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-        {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-        {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {gpu::kRasterBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {gpu::kRasterBindItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {gpu::kRasterBindPoints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT,
+         nullptr},
+        {gpu::kRasterBindBands, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT,
+         nullptr},
     };
     // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
     if (Status s =
@@ -530,15 +532,15 @@ void Renderer::State::write_descriptors(VkDescriptorSet set) {
         write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         write.descriptorCount = 1;
     }
-    writes[0].dstBinding = 0;
+    writes[0].dstBinding = gpu::kRasterBindAtlas;
     writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     writes[0].pImageInfo = &image;
-    writes[1].dstBinding = 1;
+    writes[1].dstBinding = gpu::kRasterBindItems;
     writes[1].pBufferInfo = &item_info;
-    writes[2].dstBinding = 2;
+    writes[2].dstBinding = gpu::kRasterBindPoints;
     writes[2].descriptorCount = kRendererFontPages;
     writes[2].pBufferInfo = point_infos.data();
-    writes[3].dstBinding = 3;
+    writes[3].dstBinding = gpu::kRasterBindBands;
     writes[3].descriptorCount = kRendererFontPages;
     writes[3].pBufferInfo = band_infos.data();
     fn.vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
