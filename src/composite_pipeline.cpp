@@ -10,6 +10,9 @@ bool has_stencil(VkFormat format) {
            format == VK_FORMAT_D32_SFLOAT_S8_UINT || format == VK_FORMAT_S8_UINT;
 }
 
+// Longer than most functions here on purpose: one VkGraphicsPipelineCreateInfo and the state
+// structures it points to, filled in the order Vulkan lists them; split up, the pieces would only
+// be passed back and forth.
 Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadPipeline& desc) {
     VkPipelineShaderStageCreateInfo stages[2]{};
     for (VkPipelineShaderStageCreateInfo& stage : stages) {
