@@ -7,6 +7,7 @@
 // JSON with --json); docs/benchmarks-compositing.md.
 #include "cli.hpp"
 #include "gpu_tools.hpp"
+#include "vk_barriers.hpp"
 #include "vk_resources.hpp"
 #include "image_io.hpp"
 #include "json.hpp"
@@ -390,8 +391,8 @@ CpuExact cpu_exact(std::span<const crisp::DrawnGlyph> drawn, std::span<const uin
 
 struct ModeRun {
     crisp::CompositeMode mode;
-    VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;     // tiled and draw: the target image's
-    bool with_renderer = false;                          // tiled: the renderer's frame timed too
+    VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;  // tiled and draw: the target image's
+    bool with_renderer = false;                       // tiled: the renderer's frame timed too
     bool rebin = false;  // tiled: bin every frame (reuse_static_bins off), as for text that changes
 };
 
@@ -453,20 +454,9 @@ struct Targets {
     const crisp::Image& of(VkFormat format) const { return format == VK_FORMAT_R8G8B8A8_UNORM ? rgba8 : rgba32f; }
 };
 
-// Every use of a target image before, then `destination` after, from `old_layout` to `layout`.
-void image_barrier(VkCommandBuffer cb, VkImage image, VkPipelineStageFlags destination, VkAccessFlags access,
-                   VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL, VkImageLayout old_layout = VK_IMAGE_LAYOUT_GENERAL) {
-    VkImageMemoryBarrier barrier{};
-    barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-    barrier.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT | VK_ACCESS_MEMORY_READ_BIT;
-    barrier.dstAccessMask = access;
-    barrier.oldLayout = old_layout;
-    barrier.newLayout = layout;
-    barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    barrier.image = image;
-    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, destination, 0, 0, nullptr, 0, nullptr, 1, &barrier);
-}
+// Every earlier use of a target image, as the source of its barriers.
+constexpr VkPipelineStageFlags kAnyStage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+constexpr VkAccessFlags kAnyAccess = VK_ACCESS_MEMORY_WRITE_BIT | VK_ACCESS_MEMORY_READ_BIT;
 
 struct Bench {
     const Args& args;
@@ -507,7 +497,9 @@ struct Bench {
     // Clears the tile or draw path's image to the background before the timed commands.
     void clear_target(VkCommandBuffer cb, const ModeRun& run, const crisp::CompositeParams& params) {
         const VkImage image = targets.of(run.format).handle();
-        image_barrier(cb, image, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+        const crisp::vk::Functions& fn = context.functions();
+        crisp::vk::image_barrier(fn, cb, image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL, kAnyStage, kAnyAccess,
+                                 VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
         VkClearColorValue colour{};
         for (int c = 0; c < 4; ++c) colour.float32[c] = params.background[c];
         if (run.format == VK_FORMAT_R8G8B8A8_UNORM) {
@@ -515,10 +507,10 @@ struct Bench {
         }
         const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
         vkCmdClearColorImage(cb, image, VK_IMAGE_LAYOUT_GENERAL, &colour, 1, &range);
-        image_barrier(cb, image,
-                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
-                          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+        crisp::vk::image_barrier(fn, cb, image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL, kAnyStage, kAnyAccess,
+                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                 VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
+                                     VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
     }
 
     void read_back(VkCommandBuffer cb, crisp::Compositor& compositor, const ModeRun& run) {
@@ -527,20 +519,17 @@ struct Bench {
             return;
         }
         const VkImage image = targets.of(run.format).handle();
-        image_barrier(cb, image, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
-                      VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+        const crisp::vk::Functions& fn = context.functions();
+        crisp::vk::image_barrier(fn, cb, image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                 kAnyStage, kAnyAccess, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
         VkBufferImageCopy region{};
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         region.imageExtent = {args.width, args.height, 1};
         vkCmdCopyImageToBuffer(cb, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target_readback.handle(), 1, &region);
-        image_barrier(cb, image, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_IMAGE_LAYOUT_GENERAL,
-                      VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-        VkMemoryBarrier barrier{};
-        barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-        barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr,
-                             0, nullptr);
+        crisp::vk::image_barrier(fn, cb, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+                                 kAnyStage, kAnyAccess, VK_PIPELINE_STAGE_TRANSFER_BIT, 0);
+        crisp::vk::memory_barrier(fn, cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                  VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     }
 
     // 8-bit sRGB codes of the image read back (RGBA32F premultiplied over an opaque background, or
@@ -633,57 +622,61 @@ double buffer_bytes_per_pixel(const Measurement& m, const Args& args) {
 
 void print_json(std::FILE* out, const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
                 const std::vector<std::string>& warnings) {
-    std::fprintf(out, "{\n  \"device\": %s,\n  \"driver_name\": %s,\n  \"driver_info\": %s,\n  \"driver_version\": %u,\n",
-                json_string(header.device).c_str(), json_string(header.driver_name).c_str(),
-                json_string(header.driver_info).c_str(), header.driver_version);
+    std::fprintf(out,
+                 "{\n  \"device\": %s,\n  \"driver_name\": %s,\n  \"driver_info\": %s,\n  \"driver_version\": %u,\n",
+                 json_string(header.device).c_str(), json_string(header.driver_name).c_str(),
+                 json_string(header.driver_info).c_str(), header.driver_version);
     std::fprintf(out, "  \"api_version\": %s,\n  \"storage_without_format\": %s,\n  \"layout\": %s,\n",
                  json_string(header.api).c_str(), header.storage_without_format ? "true" : "false",
                  json_string(header.layout).c_str());
     std::fprintf(out, "  \"quad_path\": %s,\n", json_string(crisp::quad_path_name(args.path)).c_str());
     std::fprintf(out, "  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
-                args.height, json_string(args.font).c_str(), static_cast<double>(args.size), args.samples);
-    std::fprintf(out, "  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"timed_frames\": %u,\n",
-                args.subpixel_steps, args.warmup, args.warmup_ms, args.frames);
+                 args.height, json_string(args.font).c_str(), static_cast<double>(args.size), args.samples);
+    std::fprintf(out,
+                 "  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"timed_frames\": %u,\n",
+                 args.subpixel_steps, args.warmup, args.warmup_ms, args.frames);
     std::fprintf(out, "  \"background_srgb\": %g,\n  \"target_bytes_per_pixel\": %u,\n  \"scenes\": [\n",
-                static_cast<double>(kBackgroundSrgb), kTargetBytesPerPixel);
+                 static_cast<double>(kBackgroundSrgb), kTargetBytesPerPixel);
     for (size_t s = 0; s < scenes.size(); ++s) {
         const SceneResult& r = scenes[s];
-        std::fprintf(out, 
-            "    {\"layers\": %u, \"alpha\": %g, \"glyphs\": %zu, \"drawn_glyphs\": %zu, "
-            "\"converge_frames\": %u, \"exact_nodes_per_pixel\": %u,\n",
-            r.layers, static_cast<double>(r.alpha), r.glyphs, r.drawn, r.converge_frames, r.exact_nodes_per_pixel);
+        std::fprintf(out,
+                     "    {\"layers\": %u, \"alpha\": %g, \"glyphs\": %zu, \"drawn_glyphs\": %zu, "
+                     "\"converge_frames\": %u, \"exact_nodes_per_pixel\": %u,\n",
+                     r.layers, static_cast<double>(r.alpha), r.glyphs, r.drawn, r.converge_frames,
+                     r.exact_nodes_per_pixel);
         if (r.cpu) {
-            std::fprintf(out, 
-                "     \"cpu_fragments\": %llu, \"cpu_max_overlap\": %u, "
-                "\"exact_vs_cpu\": {\"rmse\": %.6g, \"max\": %d},\n",
-                static_cast<unsigned long long>(r.cpu->fragments), r.cpu->max_overlap, r.exact_vs_cpu.rmse,
-                r.exact_vs_cpu.max);
+            std::fprintf(out,
+                         "     \"cpu_fragments\": %llu, \"cpu_max_overlap\": %u, "
+                         "\"exact_vs_cpu\": {\"rmse\": %.6g, \"max\": %d},\n",
+                         static_cast<unsigned long long>(r.cpu->fragments), r.cpu->max_overlap, r.exact_vs_cpu.rmse,
+                         r.exact_vs_cpu.max);
         }
         std::fprintf(out, "     \"modes\": [\n");
         for (size_t i = 0; i < r.modes.size(); ++i) {
             const Measurement& m = r.modes[i];
-            std::fprintf(out, 
-                "       {\"mode\": %s, "
-                "\"warmup_frames\": %u, \"gpu_ms_median\": %.6g, \"gpu_ms\": [",
-                json_string(crisp::composite_mode_name(m.run.mode)).c_str(), m.warmup_frames, m.median_ms);
+            std::fprintf(out,
+                         "       {\"mode\": %s, "
+                         "\"warmup_frames\": %u, \"gpu_ms_median\": %.6g, \"gpu_ms\": [",
+                         json_string(crisp::composite_mode_name(m.run.mode)).c_str(), m.warmup_frames, m.median_ms);
             for (size_t f = 0; f < m.gpu_ms.size(); ++f) std::fprintf(out, "%s%.6g", f ? ", " : "", m.gpu_ms[f]);
-            std::fprintf(out, 
-                "], \"rmse\": %.6g, \"max\": %d, \"buffer_bytes\": %llu, \"buffer_bytes_per_pixel\": %.6g, "
-                "\"quads\": %u, \"bins_reused\": %s, \"measured\": %s, \"max_overlap\": %u, "
-                "\"tail_pixels\": %u, \"exact_lost_nodes\": %llu, \"exact_dropped\": %llu, \"label\": %s, "
-                "\"busy_tiles\": %u, \"exact_tiles\": %u, \"layered_tiles\": %u, \"tile_pairs\": %u}%s\n",
-                m.error.rmse, m.error.max, static_cast<unsigned long long>(m.stats.buffer_bytes),
-                buffer_bytes_per_pixel(m, args), m.stats.quads, m.stats.bins_reused ? "true" : "false",
-                m.stats.measured ? "true" : "false", m.stats.max_overlap, m.stats.tail_pixels,
-                static_cast<unsigned long long>(m.stats.exact_lost_nodes),
-                static_cast<unsigned long long>(m.stats.exact_dropped), json_string(mode_label(m.run)).c_str(),
-                m.stats.busy_tiles, m.stats.exact_tiles, m.stats.layered_tiles, m.stats.tile_pairs,
-                i + 1 < r.modes.size() ? "," : "");
+            std::fprintf(out,
+                         "], \"rmse\": %.6g, \"max\": %d, \"buffer_bytes\": %llu, \"buffer_bytes_per_pixel\": %.6g, "
+                         "\"quads\": %u, \"bins_reused\": %s, \"measured\": %s, \"max_overlap\": %u, "
+                         "\"tail_pixels\": %u, \"exact_lost_nodes\": %llu, \"exact_dropped\": %llu, \"label\": %s, "
+                         "\"busy_tiles\": %u, \"exact_tiles\": %u, \"layered_tiles\": %u, \"tile_pairs\": %u}%s\n",
+                         m.error.rmse, m.error.max, static_cast<unsigned long long>(m.stats.buffer_bytes),
+                         buffer_bytes_per_pixel(m, args), m.stats.quads, m.stats.bins_reused ? "true" : "false",
+                         m.stats.measured ? "true" : "false", m.stats.max_overlap, m.stats.tail_pixels,
+                         static_cast<unsigned long long>(m.stats.exact_lost_nodes),
+                         static_cast<unsigned long long>(m.stats.exact_dropped), json_string(mode_label(m.run)).c_str(),
+                         m.stats.busy_tiles, m.stats.exact_tiles, m.stats.layered_tiles, m.stats.tile_pairs,
+                         i + 1 < r.modes.size() ? "," : "");
         }
         std::fprintf(out, "     ]}%s\n", s + 1 < scenes.size() ? "," : "");
     }
     std::fprintf(out, "  ],\n  \"warnings\": [");
-    for (size_t i = 0; i < warnings.size(); ++i) std::fprintf(out, "%s%s", i ? ", " : "", json_string(warnings[i]).c_str());
+    for (size_t i = 0; i < warnings.size(); ++i)
+        std::fprintf(out, "%s%s", i ? ", " : "", json_string(warnings[i]).c_str());
     std::fprintf(out, "]\n}\n");
 }
 
@@ -694,9 +687,8 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
     std::printf(
         "Reference quad passes: %s. Canvas %ux%u; %s at %g px, layout %s, %u "
         "subpixel steps, %u samples per glyph; background sRGB %g grey.\n",
-        crisp::quad_path_name(args.path),
-        args.width, args.height, args.font.c_str(), static_cast<double>(args.size), header.layout.c_str(),
-        args.subpixel_steps, args.samples, static_cast<double>(kBackgroundSrgb));
+        crisp::quad_path_name(args.path), args.width, args.height, args.font.c_str(), static_cast<double>(args.size),
+        header.layout.c_str(), args.subpixel_steps, args.samples, static_cast<double>(kBackgroundSrgb));
     for (const std::string& w : header.compositor_warnings) std::printf("Compositor: %s.\n", w.c_str());
     std::printf(
         "GPU ms: median of %u frames after at least %u warm-up frames and %g ms, timestamps around the "
@@ -718,7 +710,8 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
                 const bool exact = m.run.mode == crisp::CompositeMode::exact;
                 const bool tiled = m.run.mode == crisp::CompositeMode::tiled;
                 char error[64] = "reference";
-                if (!exact || args.cpu_check) std::snprintf(error, sizeof error, "%.3f | %d", m.error.rmse, m.error.max);
+                if (!exact || args.cpu_check)
+                    std::snprintf(error, sizeof error, "%.3f | %d", m.error.rmse, m.error.max);
                 char overlap[32] = "";
                 if ((exact || tiled) && m.stats.measured)
                     std::snprintf(overlap, sizeof overlap, "%u", m.stats.max_overlap);
@@ -729,8 +722,8 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
                     std::snprintf(tiles, sizeof tiles, "%u / %u", m.stats.exact_tiles, m.stats.layered_tiles);
                 }
                 std::printf("| %u | %s | %.4g | %s%s | %.2f | %s | %s | %s |\n", r.layers, mode_label(m.run).c_str(),
-                            m.median_ms, error, exact && !args.cpu_check ? " | " : "",
-                            buffer_bytes_per_pixel(m, args), overlap, tail, tiles);
+                            m.median_ms, error, exact && !args.cpu_check ? " | " : "", buffer_bytes_per_pixel(m, args),
+                            overlap, tail, tiles);
             }
         }
     }
@@ -825,8 +818,8 @@ int main(int argc, char** argv) {
         runs.push_back(*run);
     }
     const bool reference_modes = std::any_of(runs.begin(), runs.end(), is_reference);
-    const auto exact_run = std::find_if(runs.begin(), runs.end(),
-                                        [](const ModeRun& r) { return r.mode == crisp::CompositeMode::exact; });
+    const auto exact_run =
+        std::find_if(runs.begin(), runs.end(), [](const ModeRun& r) { return r.mode == crisp::CompositeMode::exact; });
     if (!args.cpu_check && exact_run == runs.end()) fail("--no-cpu-check needs the exact mode as the reference");
 
     Targets targets;
