@@ -604,10 +604,6 @@ struct Bench {
 
 // ---- Output
 
-std::string json_string(const std::string& text) {
-    return crisp::json::quote(text);
-}
-
 struct Header {
     std::string device, driver_name, driver_info, api;
     uint32_t driver_version = 0;
@@ -624,14 +620,14 @@ void print_json(std::FILE* out, const Args& args, const Header& header, const st
                 const std::vector<std::string>& warnings) {
     std::fprintf(out,
                  "{\n  \"device\": %s,\n  \"driver_name\": %s,\n  \"driver_info\": %s,\n  \"driver_version\": %u,\n",
-                 json_string(header.device).c_str(), json_string(header.driver_name).c_str(),
-                 json_string(header.driver_info).c_str(), header.driver_version);
+                 crisp::json::quote(header.device).c_str(), crisp::json::quote(header.driver_name).c_str(),
+                 crisp::json::quote(header.driver_info).c_str(), header.driver_version);
     std::fprintf(out, "  \"api_version\": %s,\n  \"storage_without_format\": %s,\n  \"layout\": %s,\n",
-                 json_string(header.api).c_str(), header.storage_without_format ? "true" : "false",
-                 json_string(header.layout).c_str());
-    std::fprintf(out, "  \"quad_path\": %s,\n", json_string(crisp::quad_path_name(args.path)).c_str());
+                 crisp::json::quote(header.api).c_str(), header.storage_without_format ? "true" : "false",
+                 crisp::json::quote(header.layout).c_str());
+    std::fprintf(out, "  \"quad_path\": %s,\n", crisp::json::quote(crisp::quad_path_name(args.path)).c_str());
     std::fprintf(out, "  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
-                 args.height, json_string(args.font).c_str(), static_cast<double>(args.size), args.samples);
+                 args.height, crisp::json::quote(args.font).c_str(), static_cast<double>(args.size), args.samples);
     std::fprintf(out,
                  "  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"timed_frames\": %u,\n",
                  args.subpixel_steps, args.warmup, args.warmup_ms, args.frames);
@@ -657,7 +653,8 @@ void print_json(std::FILE* out, const Args& args, const Header& header, const st
             std::fprintf(out,
                          "       {\"mode\": %s, "
                          "\"warmup_frames\": %u, \"gpu_ms_median\": %.6g, \"gpu_ms\": [",
-                         json_string(crisp::composite_mode_name(m.run.mode)).c_str(), m.warmup_frames, m.median_ms);
+                         crisp::json::quote(crisp::composite_mode_name(m.run.mode)).c_str(), m.warmup_frames,
+                         m.median_ms);
             for (size_t f = 0; f < m.gpu_ms.size(); ++f) std::fprintf(out, "%s%.6g", f ? ", " : "", m.gpu_ms[f]);
             std::fprintf(out,
                          "], \"rmse\": %.6g, \"max\": %d, \"buffer_bytes\": %llu, \"buffer_bytes_per_pixel\": %.6g, "
@@ -668,15 +665,15 @@ void print_json(std::FILE* out, const Args& args, const Header& header, const st
                          buffer_bytes_per_pixel(m, args), m.stats.quads, m.stats.bins_reused ? "true" : "false",
                          m.stats.measured ? "true" : "false", m.stats.max_overlap, m.stats.tail_pixels,
                          static_cast<unsigned long long>(m.stats.exact_lost_nodes),
-                         static_cast<unsigned long long>(m.stats.exact_dropped), json_string(mode_label(m.run)).c_str(),
-                         m.stats.busy_tiles, m.stats.exact_tiles, m.stats.layered_tiles, m.stats.tile_pairs,
-                         i + 1 < r.modes.size() ? "," : "");
+                         static_cast<unsigned long long>(m.stats.exact_dropped),
+                         crisp::json::quote(mode_label(m.run)).c_str(), m.stats.busy_tiles, m.stats.exact_tiles,
+                         m.stats.layered_tiles, m.stats.tile_pairs, i + 1 < r.modes.size() ? "," : "");
         }
         std::fprintf(out, "     ]}%s\n", s + 1 < scenes.size() ? "," : "");
     }
     std::fprintf(out, "  ],\n  \"warnings\": [");
     for (size_t i = 0; i < warnings.size(); ++i)
-        std::fprintf(out, "%s%s", i ? ", " : "", json_string(warnings[i]).c_str());
+        std::fprintf(out, "%s%s", i ? ", " : "", crisp::json::quote(warnings[i]).c_str());
     std::fprintf(out, "]\n}\n");
 }
 
