@@ -1,5 +1,7 @@
 // Fuzzes the baker's font path: FreeType's parsers, the outline walk, cubic lowering, bands and
 // the asset validation the baker applies to its own output.
+#include "utf8.hpp"
+
 #include <crisp/bake.hpp>
 
 #include <cstdint>

@@ -5,11 +5,11 @@
 // reads every field with memcpy so no access is unaligned or out of bounds. Decoding only checks
 // what the in-memory FontAsset cannot express (section sizes, counts, reserved fields); every rule
 // about the decoded values lives in validate_asset, which the baker also runs before it writes.
+#include "crc32c.hpp"
 #include "file_io.hpp"
 #include "limits.hpp"
 
 #include <crisp/asset.hpp>
-#include <crisp/bake.hpp>
 
 #include <hb.h>
 

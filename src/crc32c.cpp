@@ -4,7 +4,7 @@
 // independent lookups instead of eight dependent ones. The tables are built at compile time, so
 // the library holds no mutable state and needs no initialisation. Portable C++ is fast enough
 // here (a few GB/s); the checksum runs once per asset load.
-#include <crisp/asset.hpp>
+#include "crc32c.hpp"
 
 #include <array>
 #include <bit>

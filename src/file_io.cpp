@@ -1,7 +1,5 @@
 #include "file_io.hpp"
 
-#include <crisp/asset.hpp>
-
 #include <algorithm>
 #include <cerrno>
 #include <chrono>

@@ -16,6 +16,11 @@ namespace crisp {
 // is refused before any byte is read, and a larger file before it is read whole.
 Result<std::vector<std::byte>> read_file(const std::filesystem::path& path, uint64_t max_bytes);
 
+// Writes `bytes` to `path` atomically, as write_files_atomically() below writes several: flushed to
+// a temporary file and renamed over `path` only when complete. On failure (ErrorCode::io) an
+// existing file at `path` is untouched. The file gets the usual permissions (0666 less the umask).
+Status write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes);
+
 // One output of a run: where, and its bytes.
 struct OutputFile {
     std::filesystem::path path;

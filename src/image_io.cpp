@@ -3,8 +3,6 @@
 #include "file_io.hpp"
 #include "limits.hpp"
 
-#include <crisp/asset.hpp>
-
 #include <png.h>
 
 #include <bit>

@@ -1,6 +1,6 @@
 #include "json.hpp"
 
-#include <crisp/bake.hpp>
+#include "utf8.hpp"
 
 #include <charconv>
 #include <cmath>

@@ -2,7 +2,6 @@
 #include "limits.hpp"
 #include "json.hpp"
 
-#include <crisp/asset.hpp>
 #include <crisp/glyph.hpp>
 #include <crisp/subpixel.hpp>
 

@@ -4,6 +4,7 @@
 #include "bands.hpp"
 #include "coverage.hpp"
 #include "test_support.hpp"
+#include "utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>

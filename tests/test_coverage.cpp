@@ -5,6 +5,7 @@
 #include "coverage.hpp"
 #include "outline.hpp"
 #include "test_support.hpp"
+#include "utf8.hpp"
 
 #include <crisp/bake.hpp>
 

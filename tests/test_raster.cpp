@@ -1,6 +1,7 @@
 // The GPU rasterizer held to the CPU reference, texel by texel, on lavapipe with validation on.
 #include "coverage.hpp"
 #include "test_support.hpp"
+#include "utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>

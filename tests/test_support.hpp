@@ -1,6 +1,8 @@
 // Shared by the tests: where the fonts are, and reading files.
 #pragma once
 
+#include "utf8.hpp"
+
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
 #include <crisp/vulkan_context.hpp>

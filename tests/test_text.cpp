@@ -1,3 +1,5 @@
+#include "utf8.hpp"
+
 #include <crisp/bake.hpp>
 
 #include <gtest/gtest.h>

@@ -2,6 +2,7 @@
 #include "cli.hpp"
 #include "file_io.hpp"
 #include "json.hpp"
+#include "utf8.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>

@@ -25,6 +25,11 @@ namespace crisp {
 
 inline constexpr uint32_t kAssetVersion = 1;
 
+// The most curves one glyph may have, in the baker and (with the pads between its contours, twice
+// as many curve slots) in the loader: the most complex glyphs of common fonts have about 550 (a CJK
+// face's), and a glyph's cost in every sample grows with its curves (docs/limits.md).
+inline constexpr uint32_t kMaxCurvesPerGlyph = 4096;
+
 struct Point {
     float x = 0.0f;
     float y = 0.0f;
@@ -121,12 +126,5 @@ std::vector<std::byte> serialize_asset(const FontAsset& asset);
 // which is flushed and renamed over `path` only when complete. On failure (ErrorCode::io) an
 // existing file at `path` is untouched and no temporary file is left behind.
 Status save_asset_file(const FontAsset& asset, const std::filesystem::path& path);
-
-// Writes any bytes to `path` with the same atomic temporary-and-rename protocol. The file gets the
-// usual permissions (0666 less the umask).
-Status write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes);
-
-// CRC-32C (Castagnoli) of `bytes`, continuing from `crc` (0 to start). The asset checksum.
-uint32_t crc32c(std::span<const std::byte> bytes, uint32_t crc = 0);
 
 }  // namespace crisp

@@ -15,6 +15,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace crisp {
@@ -26,10 +27,6 @@ inline constexpr float kDefaultToleranceEm = 1.0f / 4096.0f;
 // Bands are added until the fullest band holds at most this many curves, or until kMaxBands.
 inline constexpr uint32_t kTargetCurvesPerBand = 8;
 inline constexpr uint32_t kMaxBands = 32;
-// The most curves one glyph may have, in the baker and (with the pads between its contours, twice
-// as many curve slots) in the loader: the most complex glyphs of common fonts have about 550 (a CJK
-// face's), and a glyph's cost in every sample grows with its curves (docs/limits.md).
-inline constexpr uint32_t kMaxCurvesPerGlyph = 4096;
 // Each band reaches this fraction of its height past both of its edges, so a curve whose y-extent
 // ends exactly on an edge (or within float rounding of it) is listed in both bands.
 inline constexpr float kBandOverlap = 1.0f / 256.0f;
@@ -48,7 +45,7 @@ struct BakeOptions {
     bool all_glyphs = true;                    // false: bake only `codepoints` (and their closure)
     float tolerance_em = kDefaultToleranceEm;  // largest cubic-to-quadratic deviation, in (0, 0.1]
     bool split_y_extrema = false;              // split quadratics at y-extrema (docs/cubic-lowering.md)
-    // A glyph with more curves fails; at most kMaxCurvesPerGlyph.
+    // A glyph with more curves fails; at most kMaxCurvesPerGlyph (asset.hpp).
     uint32_t max_curves_per_glyph = kMaxCurvesPerGlyph;
     bool allow_failed = false;                 // keep going past failed glyphs, baking them empty
     // Called now and then with (glyphs done, glyphs to do); may be empty.
@@ -114,9 +111,6 @@ Result<Variation> parse_variation(std::string_view text);
 
 // Parses code point ranges "U+0020-007E,0x4E00-0x4E10,65" into a sorted list without duplicates.
 Result<std::vector<uint32_t>> parse_codepoint_ranges(std::string_view text);
-
-// Decodes UTF-8 into code points (invalid sequences become U+FFFD).
-std::vector<uint32_t> decode_utf8(std::string_view text);
 
 // A four-character tag as its 32-bit value, and back.
 uint32_t make_tag(std::string_view four_chars);

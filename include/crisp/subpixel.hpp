@@ -52,7 +52,7 @@ Result<SubpixelLayout> load_subpixel_layout_file(const std::filesystem::path& pa
 // The JSON form of a layout (one line, numbers in their shortest exact form).
 std::string subpixel_layout_to_json(const SubpixelLayout& layout);
 
-// Writes the JSON form atomically (see write_file_atomically). The layout must be valid.
+// Writes the JSON form atomically, as save_asset_file writes an asset. The layout must be valid.
 Status save_subpixel_layout_file(const SubpixelLayout& layout, const std::filesystem::path& path);
 
 // A preset name, or else a layout file: what crisp-render's --layout takes.

@@ -12,7 +12,7 @@ int main(int argc, char** argv) {
     }
     crisp::BakeOptions options;
     options.all_glyphs = false;
-    options.codepoints = crisp::decode_utf8("crisp");
+    options.codepoints = {'c', 'r', 'i', 's', 'p'};
     auto baked = crisp::bake_font_file(argv[1], options);
     if (!baked) {
         std::fprintf(stderr, "bake failed: %s\n", baked.error().message.c_str());
