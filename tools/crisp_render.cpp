@@ -10,7 +10,6 @@
 
 #include <crisp/asset.hpp>
 #include <crisp/atlas.hpp>
-#include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>
 #include <crisp/font.hpp>
 #include <crisp/glyph.hpp>

@@ -3,6 +3,10 @@
 // The baker reads outlines with FreeType, unhinted and in font units, normalises them to em, turns
 // lines into quadratics, lowers cubics to quadratics within a tolerance, drops zero-length curves,
 // closes open contours, and cuts each glyph into bands. It needs no GPU.
+//
+// The baker is its own library, crisp::bake (CMake target crisp_bake), which links crisp::crisp
+// and FreeType: an engine that loads assets baked offline links crisp::crisp alone
+// (docs/architecture.md).
 #pragma once
 
 #include <crisp/asset.hpp>

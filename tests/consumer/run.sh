@@ -1,15 +1,48 @@
 #!/usr/bin/env bash
 # run.sh CMAKE BUILD_DIR WORK_DIR SOURCE_DIR: installs the build into WORK_DIR/prefix, then
-# configures, builds and runs tests/consumer against it with find_package(crisp CONFIG).
+# configures, builds and runs two projects against it with find_package(crisp CONFIG):
+#   engine/  links crisp::crisp alone, as an engine does: it loads an asset the installed
+#            crisp-bake made and lays out text. It is configured with FreeType and libpng hidden
+#            from find_package, and neither its build commands, nor the undefined symbols of the
+#            installed crisp library, nor (shared) the libraries they need, name either.
+#   bake/    links crisp::bake and bakes a font.
 set -euo pipefail
 cmake=$1 build=$2 work=$3 source=$4
+prefix=$work/prefix
 rm -rf "$work"
 mkdir -p "$work"
-"$cmake" --install "$build" --prefix "$work/prefix" >/dev/null
-test -f "$work/prefix/lib/cmake/crisp/crispConfig.cmake"
-test -f "$work/prefix/lib/cmake/crisp/crispConfigVersion.cmake"
-test -x "$work/prefix/bin/crisp-bake"
-test ! -e "$work/prefix/include/crisp/../bands.hpp"   # nothing private is installed
-"$cmake" -S "$source/tests/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
-"$cmake" --build "$work/build" >/dev/null
-"$work/build/consumer" "$source/fonts/DejaVuSans.ttf"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+for tool in nm readelf; do
+  command -v "$tool" >/dev/null || fail "$tool is missing (binutils)"
+done
+"$cmake" --install "$build" --prefix "$prefix" >/dev/null
+test -f "$prefix/lib/cmake/crisp/crispConfig.cmake"
+test -f "$prefix/lib/cmake/crisp/crispConfigVersion.cmake"
+test -x "$prefix/bin/crisp-bake"
+test ! -e "$prefix/include/crisp/../bands.hpp"   # nothing private is installed
+test ! -e "$prefix/lib/libcrisp_support.a"       # nor the tools' support library
+
+# ---- The run time: no FreeType, no libpng.
+if [ -e "$prefix/lib/libcrisp.so" ]; then library=$prefix/lib/libcrisp.so; else library=$prefix/lib/libcrisp.a; fi
+nm -u "$library" >"$work/crisp-undefined.txt"
+! grep -E ' (FT_|png_)' "$work/crisp-undefined.txt" || fail "$library references FreeType or libpng (above)"
+"$prefix/bin/crisp-bake" "$source/fonts/DejaVuSans.ttf" --text crisp -q -o "$work/DejaVuSans-crisp.crisp"
+# A shared crisp's config looks neither up: --no-warn-unused-cli keeps CMake from saying so.
+"$cmake" -S "$source/tests/consumer/engine" -B "$work/engine" -DCMAKE_PREFIX_PATH="$prefix" --no-warn-unused-cli \
+  -DCMAKE_DISABLE_FIND_PACKAGE_Freetype=ON -DCMAKE_DISABLE_FIND_PACKAGE_PNG=ON >"$work/engine-configure.log"
+"$cmake" --build "$work/engine" -v >"$work/engine-build.log"
+# Every compile and link command, with the two directories (whatever their names) taken out.
+sed -e "s|$work|WORK|g" -e "s|$source|SOURCE|g" "$work/engine-build.log" >"$work/engine-commands.log"
+grep -q -- "-o engine_consumer .*libcrisp" "$work/engine-commands.log" || fail "no link command in $work/engine-build.log"
+! grep -i -E 'freetype|png' "$work/engine-commands.log" || fail "the engine consumer's build names FreeType or libpng (above)"
+if [ -e "$prefix/lib/libcrisp.so" ]; then
+  for binary in "$library" "$work/engine/engine_consumer"; do
+    ! readelf -d "$binary" | grep NEEDED | grep -i -E 'freetype|png' || fail "$binary needs FreeType or libpng (above)"
+  done
+fi
+"$work/engine/engine_consumer" "$work/DejaVuSans-crisp.crisp"
+
+# ---- The baker.
+"$cmake" -S "$source/tests/consumer/bake" -B "$work/bake" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
+"$cmake" --build "$work/bake" >/dev/null
+"$work/bake/bake_consumer" "$source/fonts/DejaVuSans.ttf"

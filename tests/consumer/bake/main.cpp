@@ -1,5 +1,5 @@
 // Bakes a few glyphs of a font given on the command line and loads the asset back, through the
-// installed headers and library only.
+// installed headers and libraries only.
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>
 
@@ -7,7 +7,7 @@
 
 int main(int argc, char** argv) {
     if (argc != 2) {
-        std::fprintf(stderr, "usage: consumer FONT\n");
+        std::fprintf(stderr, "usage: bake_consumer FONT\n");
         return 2;
     }
     crisp::BakeOptions options;
@@ -23,6 +23,6 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "round trip failed\n");
         return 1;
     }
-    std::printf("consumer: baked %u glyphs of %s\n", baked->report.baked_glyphs, loaded->info.family.c_str());
+    std::printf("bake_consumer: baked %u glyphs of %s\n", baked->report.baked_glyphs, loaded->info.family.c_str());
     return 0;
 }
