@@ -57,7 +57,9 @@ Result<MemoryArena::Block*> MemoryArena::add_block(VkDeviceSize least, uint32_t 
     const VkDeviceSize growing = std::min(kLargestMemoryBlock, kFirstMemoryBlock << std::min<long>(same_type, 8));
     Block block;
     block.type = type;
-    block.size = std::max(growing, least);
+    // At least the request; one larger than half the largest block gets a block of its own, sized
+    // to it, rather than one that would mostly stay empty.
+    block.size = least > kLargestMemoryBlock / 2 ? least : std::max(growing, least);
     VkMemoryAllocateInfo info{};
     info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     info.allocationSize = block.size;
@@ -91,14 +93,12 @@ Result<MemoryArena::Range> MemoryArena::allocate(const VkMemoryRequirements& req
         }
     }
     if (chosen == nullptr) {
-        // A request larger than half the largest block gets a block of its own, sized to it.
-        const VkDeviceSize least = requirements.size > kLargestMemoryBlock / 2 ? requirements.size : 0;
-        Result<Block*> added = add_block(least, type, what);
+        Result<Block*> added = add_block(requirements.size, type, what);
         if (!added) return added.error();
         chosen = *added;
-        const bool fits = take(*chosen, requirements, offset);
-        assert(fits && "a new block holds the request");
-        static_cast<void>(fits);
+        if (!take(*chosen, requirements, offset)) {  // a new block starts at offset 0: it always fits
+            return Error{ErrorCode::vulkan, std::string("memory arena: a new block does not hold the ") + what};
+        }
     }
     Range range;
     range.memory = chosen->memory;

@@ -6,6 +6,7 @@
 #include "embedded_shaders.hpp"
 #include "shared.h"
 #include "test_support.hpp"
+#include "vk_memory.hpp"
 #include "vk_resources.hpp"
 
 #include <crisp/compositor.hpp>
@@ -705,6 +706,57 @@ TEST_F(VulkanTest, ResourcesMove) {
 
 // crisp's objects carry debug names ("crisp <what>") where the instance has VK_EXT_debug_utils,
 // so that the validation layer and debuggers say whose object a message is about.
+// Buffers suballocated from an arena: each lies inside its block (a request larger than the
+// block the arena would add next gets a block that holds it), no two live buffers share a byte,
+// and ranges given back are taken again without overlap; the validation layer checks every bind.
+TEST_F(VulkanTest, ArenaBuffersFitTheirBlocksAndNeverOverlap) {
+    CRISP_CREATE_CONTEXT(context, validated_options());
+    vk::DeviceRef ref =
+        vk::make_device_ref(context.functions(), context.physical_device(), context.device(), nullptr, VK_NULL_HANDLE);
+    vk::MemoryArena arena(context.functions(), context.device(), nullptr, ref.memory_properties);
+    ref.arena = &arena;
+    constexpr VkDeviceSize kKiB = 1024, kMiB = 1024 * kKiB;
+    const VkDeviceSize sizes[] = {kKiB, 10 * kMiB, 3 * kMiB, 100 * kKiB, 40 * kMiB, 7 * kKiB, 5 * kMiB, 16};
+    std::vector<vk::DeviceBuffer> buffers;
+    const auto expect_disjoint = [&] {
+        for (size_t i = 0; i < buffers.size(); ++i) {
+            for (size_t j = i + 1; j < buffers.size(); ++j) {
+                const vk::DeviceBuffer& a = buffers[i];
+                const vk::DeviceBuffer& b = buffers[j];
+                if (a.memory != b.memory) continue;
+                const bool apart = a.memory_offset + a.memory_size <= b.memory_offset ||
+                                   b.memory_offset + b.memory_size <= a.memory_offset;
+                EXPECT_TRUE(apart) << "buffers " << i << " and " << j << " overlap";
+            }
+        }
+    };
+    for (bool host_visible : {false, true}) {
+        for (VkDeviceSize size : sizes) {
+            buffers.emplace_back();
+            ASSERT_TRUE(vk::create_buffer(ref, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, host_visible, "probe",
+                                          buffers.back()));
+            EXPECT_TRUE(buffers.back().suballocated);
+            EXPECT_GE(buffers.back().memory_size, size);
+            if (host_visible) {
+                ASSERT_NE(buffers.back().mapped, nullptr);
+                std::memset(buffers.back().mapped, 0xAB, static_cast<size_t>(size));  // the whole range is mapped
+            }
+        }
+    }
+    expect_disjoint();
+    // Every other buffer back, then as many again: the freed ranges are reused, still disjoint.
+    for (size_t i = 0; i < buffers.size(); i += 2) buffers[i].reset();
+    std::erase_if(buffers, [](const vk::DeviceBuffer& b) { return b.buffer == VK_NULL_HANDLE; });
+    for (VkDeviceSize size : sizes) {
+        buffers.emplace_back();
+        ASSERT_TRUE(vk::create_buffer(ref, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "again", buffers.back()));
+    }
+    expect_disjoint();
+    EXPECT_LE(arena.block_count(), 12u);
+    buffers.clear();
+    expect_no_validation_messages(context);
+}
+
 TEST_F(VulkanTest, ObjectsAreNamedForTheValidationLayer) {
     CRISP_CREATE_CONTEXT(context, validated_options());
     const vk::DeviceRef ref =
