@@ -77,22 +77,18 @@ Scene render_scene(const std::vector<TextRun>& runs, const char* layout_name, fl
         paint_order = laid->next_paint_order;
     }
     Renderer& r = *scene.renderer;
-    for (int frame = 0; frame < 200; ++frame) {
-        r.begin_frame();
+    const Result<uint32_t> frames = test::render_until_converged(context, r, 200, [&] {
         r.draw(glyphs, VkRect2D{{0, 0}, {kWidth, kHeight}});
-        EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(r.record(cb)); }));
-        if (r.converged()) break;
-    }
+    });
+    EXPECT_TRUE(frames) << frames.error().message;
     EXPECT_TRUE(r.converged());
     scene.drawn.assign(r.drawn().begin(), r.drawn().end());
 
     const uint32_t atlas_width = r.atlas().config().width;
-    const VkDeviceSize bytes = VkDeviceSize{atlas_width} * r.atlas().config().height * sizeof(Texel);
-    auto readback = context.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
-    EXPECT_TRUE(readback);
-    EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { r.record_atlas_readback(cb, readback->handle()); }));
-    std::vector<Texel> texels(bytes / sizeof(Texel));
-    std::memcpy(texels.data(), readback->mapped().data(), bytes);
+    Result<std::vector<Texel>> read = test::read_atlas(context, r);
+    EXPECT_TRUE(read) << read.error().message;
+    std::vector<Texel> texels =
+        read ? std::move(*read) : std::vector<Texel>(size_t{atlas_width} * r.atlas().config().height);
 
     scene.pixels.resize(size_t{kWidth} * kHeight);
     for (const DrawnGlyph& d : scene.drawn) {
@@ -131,7 +127,6 @@ CompositorCreateInfo compositor_info() {
     info.reference_modes = true;
     return info;
 }
-
 
 // Composites the scene's glyphs (in the given order) and returns linear premultiplied RGBA.
 std::vector<float> composite(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs,

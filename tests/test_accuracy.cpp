@@ -64,20 +64,12 @@ Accuracy render_and_measure(const Font& font, std::span<const GlyphInstance> gly
     EXPECT_TRUE(renderer) << renderer.error().message;
     if (!renderer) return {};
     EXPECT_TRUE(renderer->add_font(font));
-    uint32_t frames = 0;
-    do {
-        renderer->begin_frame();
-        renderer->draw(glyphs);
-        EXPECT_TRUE(ctx.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
-    } while (!renderer->converged() && ++frames < 2000);
-    const VkDeviceSize bytes = VkDeviceSize{atlas_size} * atlas_size * sizeof(Texel);
-    auto readback = ctx.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
-    EXPECT_TRUE(readback);
-    EXPECT_TRUE(
-        ctx.submit_and_wait([&](VkCommandBuffer cb) { renderer->record_atlas_readback(cb, readback->handle()); }));
-    auto data = ctx.read_buffer(*readback, 0, bytes);
-    std::vector<Texel> texels(size_t{atlas_size} * atlas_size);
-    std::memcpy(texels.data(), data->data(), bytes);
+    const Result<uint32_t> frames = test::render_until_converged(ctx, *renderer, 2000, [&] { renderer->draw(glyphs); });
+    EXPECT_TRUE(frames) << frames.error().message;
+    Result<std::vector<Texel>> read = test::read_atlas(ctx, *renderer);
+    EXPECT_TRUE(read) << read.error().message;
+    if (!read) return {};
+    std::vector<Texel> texels = std::move(*read);
 
     std::vector<double> errors;
     Accuracy result;

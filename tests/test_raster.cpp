@@ -47,33 +47,18 @@ using test::Texel;
 
 // Reads the whole atlas back.
 std::vector<Texel> read_atlas(const Renderer& renderer) {
-    HeadlessContext& context = *fixture().context;
-    const AtlasConfig& config = renderer.atlas().config();
-    const VkDeviceSize bytes = VkDeviceSize{config.width} * config.height * sizeof(Texel);
-    auto readback = context.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
-    EXPECT_TRUE(readback);
-    EXPECT_TRUE(
-        context.submit_and_wait([&](VkCommandBuffer cb) { renderer.record_atlas_readback(cb, readback->handle()); }));
-    auto data = context.read_buffer(*readback, 0, bytes);
-    EXPECT_TRUE(data);
-    std::vector<Texel> texels(config.width * config.height);
-    std::memcpy(texels.data(), data->data(), bytes);
-    return texels;
+    Result<std::vector<Texel>> texels = test::read_atlas(*fixture().context, renderer);
+    EXPECT_TRUE(texels) << texels.error().message;
+    return texels ? std::move(*texels) : std::vector<Texel>{};
 }
 
 // Renders frames of `draw` (which calls the renderer's draw()) until the text converges, at
 // most `max_frames`, calling `check` after each frame; returns the atlas texels.
 template <typename Draw, typename Check>
 std::vector<Texel> render(Renderer& renderer, uint32_t& frames, uint32_t max_frames, Draw&& draw, Check&& check) {
-    HeadlessContext& context = *fixture().context;
-    frames = 0;
-    do {
-        renderer.begin_frame();
-        draw();
-        EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer.record(cb)); }));
-        check();
-        ++frames;
-    } while (!renderer.converged() && frames < max_frames);
+    Result<uint32_t> rendered = test::render_until_converged(*fixture().context, renderer, max_frames, draw, check);
+    EXPECT_TRUE(rendered) << rendered.error().message;
+    frames = rendered ? *rendered : 0;
     return read_atlas(renderer);
 }
 
