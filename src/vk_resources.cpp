@@ -76,6 +76,26 @@ void name_object(const DeviceRef& device, VkObjectType type, uint64_t handle, st
     device.fn->vkSetDebugUtilsObjectNameEXT(device.device, &info);  // a failed name changes nothing crisp does
 }
 
+namespace {
+
+// A VkDeviceMemory of its own for one resource, into `memory` and its size into `size`; `suffix`
+// (" (what)") ends the error message.
+Status allocate_own_memory(const DeviceRef& device, const VkMemoryRequirements& requirements, uint32_t type,
+                           const std::string& suffix, VkDeviceMemory& memory, VkDeviceSize& size) {
+    VkMemoryAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    allocate.allocationSize = requirements.size;
+    allocate.memoryTypeIndex = type;
+    if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &memory);
+        r != VK_SUCCESS) {
+        return vulkan_error("vkAllocateMemory" + suffix, r);
+    }
+    size = requirements.size;
+    return {};
+}
+
+}  // namespace
+
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
                      const char* what, DeviceBuffer& out) {
     out.reset();
@@ -115,16 +135,10 @@ Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFl
         out.mapped = range->mapped;
         out.suballocated = true;
     } else {
-        VkMemoryAllocateInfo allocate{};
-        allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-        allocate.allocationSize = requirements.size;
-        allocate.memoryTypeIndex = *type;
-        if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory);
-            r != VK_SUCCESS) {
+        if (Status s = allocate_own_memory(device, requirements, *type, suffix, out.memory, out.memory_size); !s) {
             out.reset();
-            return vulkan_error("vkAllocateMemory" + suffix, r);
+            return s;
         }
-        out.memory_size = requirements.size;
         if (host_visible) {
             if (VkResult r = device.fn->vkMapMemory(device.device, out.memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
                 r != VK_SUCCESS) {
@@ -180,16 +194,10 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
         out.reset();
         return Error{ErrorCode::vulkan, std::string("no device-local memory type for the ") + what + " image"};
     }
-    VkMemoryAllocateInfo allocate{};
-    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-    allocate.allocationSize = requirements.size;
-    allocate.memoryTypeIndex = *type;
-    if (VkResult r = device.fn->vkAllocateMemory(device.device, &allocate, device.allocator, &out.memory);
-        r != VK_SUCCESS) {
+    if (Status s = allocate_own_memory(device, requirements, *type, suffix, out.memory, out.memory_size); !s) {
         out.reset();
-        return vulkan_error("vkAllocateMemory" + suffix, r);
+        return s;
     }
-    out.memory_size = requirements.size;
     device.fn->vkBindImageMemory(device.device, out.image, out.memory, 0);
     VkImageViewCreateInfo view{};
     view.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
