@@ -9,7 +9,6 @@
 #include "vk_memory.hpp"
 
 #include <crisp/compositor.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -74,6 +73,11 @@ Status no_reference_modes() {
                  "compositor: the reference modes were not made (CompositorCreateInfo::reference_modes)"};
 }
 
+Status check_frame(const DrawnFrame& frame) {
+    if (!frame.atlas) return Error{ErrorCode::invalid_argument, "compositor: the frame has no atlas view"};
+    return {};
+}
+
 }  // namespace
 
 const char* composite_mode_name(CompositeMode mode) {
@@ -127,7 +131,7 @@ std::optional<float> depth_from_view_projection(const float view_projection[16],
     return depth;
 }
 
-struct Compositor::State {
+struct CRISP_HIDDEN Compositor::State {
     vk::Functions fn;  // the caller's Vulkan entry points (CompositorCreateInfo::get_instance_proc_addr)
     std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory; outlives the paths below
     vk::DeviceRef ref;
@@ -160,17 +164,6 @@ Compositor::Compositor(std::unique_ptr<State> state) : state_(std::move(state)) 
 Compositor::Compositor(Compositor&&) noexcept = default;
 Compositor& Compositor::operator=(Compositor&&) noexcept = default;
 Compositor::~Compositor() = default;
-
-CompositorCreateInfo compositor_create_info(const HeadlessContext& context) {
-    CompositorCreateInfo info;
-    info.instance = context.instance();
-    info.get_instance_proc_addr = context.get_instance_proc_addr();
-    info.physical_device = context.physical_device();
-    info.device = context.device();
-    info.allocator = context.allocation_callbacks();
-    info.enabled_features = context.enabled_features();
-    return info;
-}
 
 Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     if (Status s = check_create_info(info); !s) return s.error();
@@ -233,9 +226,9 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     return Compositor(std::move(state));
 }
 
-Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
-                          const CompositeTarget& target) {
+Status Compositor::record(VkCommandBuffer command_buffer, const DrawnFrame& frame, const CompositeTarget& target) {
     State& s = *state_;
+    if (Status checked = check_frame(frame); !checked) return checked;
     if (!target.view) return Error{ErrorCode::invalid_argument, "compositor: the target has no image view"};
     const VkFormat view_format = target.view_format != VK_FORMAT_UNDEFINED ? target.view_format : target.format;
     if (!s.tiles.supports(target.format, view_format)) {
@@ -251,13 +244,13 @@ Status Compositor::record(VkCommandBuffer command_buffer, std::span<const DrawnG
     }
     Result<VkRect2D> rect = checked_rect(target.rect, target.extent);
     if (!rect) return rect.error();
-    composite::sort_front_to_back(glyphs, rect->extent.width, rect->extent.height, s.quads);
+    composite::sort_front_to_back(frame.glyphs, rect->extent.width, rect->extent.height, s.quads);
     composite::TileCounts counts;
     uint64_t measured_frame = 0;
     bool reused = false;
     const composite::TileTarget tile_target{target.view, target.format, view_format, rect->offset, rect->extent};
     Result<uint64_t> bytes =
-        s.tiles.record(command_buffer, s.quads, atlas_view, tile_target, counts, measured_frame, reused);
+        s.tiles.record(command_buffer, s.quads, frame.atlas, tile_target, counts, measured_frame, reused);
     if (!bytes) return bytes.error();
     if (measured_frame != 0) s.take(counts, measured_frame);
     s.last = State::Last::tiles;
@@ -288,9 +281,9 @@ void Compositor::abandon_frame() {
     s.last = State::Last::none;
 }
 
-Status Compositor::record_draw(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
-                               VkImageView atlas_view, const VkRect2D& rect) {
+Status Compositor::record_draw(VkCommandBuffer command_buffer, const DrawnFrame& frame, const VkRect2D& rect) {
     State& s = *state_;
+    if (Status checked = check_frame(frame); !checked) return checked;
     if (!s.draw) {
         return Error{ErrorCode::invalid_argument, "compositor: no draw pipeline (CompositorCreateInfo::draw_format)"};
     }
@@ -299,8 +292,8 @@ Status Compositor::record_draw(VkCommandBuffer command_buffer, std::span<const D
         return Error{ErrorCode::invalid_argument, "compositor: the draw rect " + rect_string(rect) +
                                                       " is empty, above 16384 a side or at a negative offset"};
     }
-    composite::sort_front_to_back(glyphs, rect.extent.width, rect.extent.height, s.quads);
-    Result<uint64_t> bytes = s.draw->record(command_buffer, s.quads, atlas_view, rect);
+    composite::sort_front_to_back(frame.glyphs, rect.extent.width, rect.extent.height, s.quads);
+    Result<uint64_t> bytes = s.draw->record(command_buffer, s.quads, frame.atlas, rect);
     if (!bytes) return bytes.error();
     s.last = State::Last::draw;
     s.stats.mode = CompositeMode::draw;
@@ -310,10 +303,11 @@ Status Compositor::record_draw(VkCommandBuffer command_buffer, std::span<const D
     return {};
 }
 
-Status Compositor::record_reference(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
-                                    VkImageView atlas_view, const CompositeParams& params) {
+Status Compositor::record_reference(VkCommandBuffer command_buffer, const DrawnFrame& frame,
+                                    const CompositeParams& params) {
     if (!state_->reference) return no_reference_modes();
-    Status status = state_->reference->record(command_buffer, glyphs, atlas_view, params, state_->stats);
+    if (Status checked = check_frame(frame); !checked) return checked;
+    Status status = state_->reference->record(command_buffer, frame.glyphs, frame.atlas, params, state_->stats);
     if (status) state_->last = State::Last::reference;
     return status;
 }

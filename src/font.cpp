@@ -60,7 +60,7 @@ Error invalid(std::string message) { return Error{ErrorCode::asset_invalid, std:
 
 }  // namespace
 
-struct Font::State {
+struct CRISP_HIDDEN Font::State {
     // The asset lives here, behind a pointer, and never moves again: the blob reads its font bytes
     // in place and the font functions hold its address.
     FontAsset asset;

@@ -173,7 +173,7 @@ float srgb_to_linear(float encoded) {
     return static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
 }
 
-struct Layouter::State {
+struct CRISP_HIDDEN Layouter::State {
     hb_buffer_t* buffer = hb_buffer_create();
 
     // Per call.

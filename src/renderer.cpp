@@ -5,7 +5,6 @@
 #include "vk_resources.hpp"
 
 #include <crisp/renderer.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <array>
@@ -98,7 +97,7 @@ constexpr VkDeviceSize kMinPageBands = VkDeviceSize{1} << 20;
 
 }  // namespace
 
-struct Renderer::State {
+struct CRISP_HIDDEN Renderer::State {
     VkDevice device = VK_NULL_HANDLE;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;
@@ -544,18 +543,6 @@ void Renderer::State::write_descriptors(VkDescriptorSet set) {
     writes[3].descriptorCount = kRendererFontPages;
     writes[3].pBufferInfo = band_infos.data();
     fn.vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
-}
-
-RendererCreateInfo renderer_create_info(const HeadlessContext& context) {
-    RendererCreateInfo info;
-    info.instance = context.instance();
-    info.get_instance_proc_addr = context.get_instance_proc_addr();
-    info.physical_device = context.physical_device();
-    info.device = context.device();
-    info.queue_family = context.queue_family();
-    info.enabled_features = context.enabled_features();
-    info.allocator = context.allocation_callbacks();
-    return info;
 }
 
 Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
@@ -1149,6 +1136,9 @@ void Renderer::record_atlas_readback(VkCommandBuffer command_buffer, VkBuffer bu
 
 std::span<const DrawnGlyph> Renderer::drawn() const {
     return state_->drawn;
+}
+DrawnFrame Renderer::drawn_frame() const {
+    return DrawnFrame{drawn(), atlas_view()};
 }
 bool Renderer::converged() const {
     return state_->converged;

@@ -5,11 +5,11 @@
 
 #include "oit_reference.hpp"
 #include "test_support.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/font.hpp>
 #include <crisp/renderer.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <cstdint>
 #include <memory>

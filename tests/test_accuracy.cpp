@@ -5,12 +5,12 @@
 #include "coverage.hpp"
 #include "test_support.hpp"
 #include "utf8.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <gtest/gtest.h>
 

@@ -3,6 +3,7 @@
 // bound, coplanar paint order, per-channel subpixel compositing and opaque text.
 #include "composite_fixture.hpp"
 #include "oit_reference.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>
@@ -10,7 +11,6 @@
 #include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
 #include <crisp/subpixel.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <gtest/gtest.h>
 

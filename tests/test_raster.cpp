@@ -2,6 +2,7 @@
 #include "coverage.hpp"
 #include "test_support.hpp"
 #include "utf8.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>
@@ -9,7 +10,6 @@
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <gtest/gtest.h>
 
@@ -997,7 +997,7 @@ TEST(Raster, BuffersShareAFewBlocksAndWarmFramesAllocateNothing) {
             vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
                                  &barrier, 0, nullptr, 0, nullptr);
             EXPECT_TRUE(renderer->record(cb));
-            EXPECT_TRUE(compositor->record(cb, renderer->drawn(), renderer->atlas_view(), composite_target));
+            EXPECT_TRUE(compositor->record(cb, renderer->drawn_frame(), composite_target));
         }));
     };
     for (uint32_t i = 0; i < 3; ++i) frame(i);  // warm-up: fonts uploaded, slots sized

@@ -2,11 +2,11 @@
 #pragma once
 
 #include "utf8.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
 #include <crisp/renderer.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <cstddef>

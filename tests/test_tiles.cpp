@@ -4,10 +4,10 @@
 // coplanar ties by paint order; overflowing tiles taking the layered way; the caller's rect.
 #include "composite_fixture.hpp"
 #include "gpu_tools.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/layout.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <gtest/gtest.h>
 
@@ -177,7 +177,7 @@ void composite_tiles(Compositor& compositor, const Scene& scene, std::span<const
     target.extent = {t.width, t.height};
     target.rect = {origin, {kWidth, kHeight}};
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
-        const Status s = compositor.record(cb, glyphs, scene.renderer->atlas_view(), target);
+        const Status s = compositor.record(cb, crisp::DrawnFrame{glyphs, scene.renderer->atlas_view()}, target);
         EXPECT_TRUE(s) << (s ? "" : s.error().message);
     }));
 }
@@ -186,7 +186,8 @@ void composite_tiles(Compositor& compositor, const Scene& scene, std::span<const
 void composite_draw(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs, Target& t) {
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
         tools::begin_rendering_over(cb, t.image.view(), {{0, 0}, {t.width, t.height}});
-        const Status s = compositor.record_draw(cb, glyphs, scene.renderer->atlas_view(), {{0, 0}, {kWidth, kHeight}});
+        const Status s = compositor.record_draw(cb, crisp::DrawnFrame{glyphs, scene.renderer->atlas_view()},
+                                                {{0, 0}, {kWidth, kHeight}});
         EXPECT_TRUE(s) << (s ? "" : s.error().message);
         vkCmdEndRendering(cb);
     }));
@@ -453,7 +454,8 @@ TEST(TileCompositor, DrawPathTestsGlyphsAgainstTheCallersDepth) {
         clear.clearValue.depthStencil = {kWall, 0};
         const VkClearRect rect{{{0, 0}, {half, kHeight}}, 0, 1};
         vkCmdClearAttachments(cb, 1, &clear, 1, &rect);
-        const Status s = tested->record_draw(cb, scene.drawn, scene.renderer->atlas_view(), {{0, 0}, {kWidth, kHeight}});
+        const Status s = tested->record_draw(cb, crisp::DrawnFrame{scene.drawn, scene.renderer->atlas_view()},
+                                             {{0, 0}, {kWidth, kHeight}});
         EXPECT_TRUE(s) << (s ? "" : s.error().message);
         vkCmdEndRendering(cb);
     }));
@@ -729,7 +731,7 @@ TEST(TileCompositor, ScansTileCountsAcrossBlocks) {
     Target t = make_target(VK_FORMAT_R16G16B16A16_SFLOAT, width, height, VK_IMAGE_USAGE_STORAGE_BIT);
     CompositeTarget target{t.image.view(), t.format, VK_FORMAT_UNDEFINED, {width, height}, {}};
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
-        EXPECT_TRUE(compositor->record(cb, copies, scene.renderer->atlas_view(), target));
+        EXPECT_TRUE(compositor->record(cb, crisp::DrawnFrame{copies, scene.renderer->atlas_view()}, target));
     }));
     const std::vector<std::byte> bytes = read_target(t);
     // Each copy's kWidth x kHeight region is what scene.pixels describes (glyph rects reach a
@@ -780,18 +782,20 @@ TEST(TileCompositor, RefusesWhatItCannotDraw) {
     EXPECT_FALSE(compositor->supports_target_format(VK_FORMAT_R8G8B8A8_SRGB));
     Target t = make_target(VK_FORMAT_R8G8B8A8_UNORM, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
     CompositeTarget target{t.image.view(), VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_UNDEFINED, {kWidth, kHeight}, {}};
+    const crisp::DrawnFrame frame{scene.drawn, scene.renderer->atlas_view()};
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
-        const Status wrong_format = compositor->record(cb, scene.drawn, scene.renderer->atlas_view(), target);
+        const Status wrong_format = compositor->record(cb, frame, target);
         ASSERT_FALSE(wrong_format);
         EXPECT_NE(wrong_format.error().message.find("storage_without_format"), std::string::npos);
         target.format = VK_FORMAT_R8G8B8A8_UNORM;
+        const crisp::DrawnFrame no_atlas{scene.drawn, VK_NULL_HANDLE};
+        EXPECT_EQ(compositor->record(cb, no_atlas, target).error().code, ErrorCode::invalid_argument);
         target.rect = {{10, 0}, {kWidth, kHeight}};  // past the right edge
-        EXPECT_EQ(compositor->record(cb, scene.drawn, scene.renderer->atlas_view(), target).error().code,
-                  ErrorCode::invalid_argument);
-        EXPECT_EQ(compositor->record_draw(cb, scene.drawn, scene.renderer->atlas_view(), {{0, 0}, {8, 8}}).error().code,
+        EXPECT_EQ(compositor->record(cb, frame, target).error().code, ErrorCode::invalid_argument);
+        EXPECT_EQ(compositor->record_draw(cb, frame, {{0, 0}, {8, 8}}).error().code,
                   ErrorCode::invalid_argument);  // no draw_format
         CompositeParams params;
-        EXPECT_EQ(compositor->record_reference(cb, scene.drawn, scene.renderer->atlas_view(), params).error().code,
+        EXPECT_EQ(compositor->record_reference(cb, frame, params).error().code,
                   ErrorCode::invalid_argument);  // no reference_modes
     }));
     // Untouched: every refusal recorded nothing.
@@ -837,7 +841,7 @@ std::vector<std::byte> run_with_drops(const std::vector<bool>& drops, uint32_t& 
 
     const auto record = [&](VkCommandBuffer cb) {
         EXPECT_TRUE(renderer->record(cb));
-        EXPECT_TRUE(compositor->record(cb, renderer->drawn(), renderer->atlas_view(), target));
+        EXPECT_TRUE(compositor->record(cb, renderer->drawn_frame(), target));
     };
     frames = 0;
     for (size_t i = 0;; ++i) {

@@ -1,13 +1,13 @@
 // HeadlessContext on a real Vulkan driver (Mesa lavapipe in CI): device choice, feature and
 // extension checks, validation plumbing, transfers, and a compute shader using subgroup arithmetic.
 // Every test that creates a context with validation on also asserts that the layer stayed silent.
-#include <crisp/vulkan_context.hpp>
 
 #include "embedded_shaders.hpp"
 #include "shared.h"
 #include "test_support.hpp"
 #include "vk_memory.hpp"
 #include "vk_resources.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/renderer.hpp>

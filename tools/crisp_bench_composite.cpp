@@ -12,13 +12,13 @@
 #include "image_io.hpp"
 #include "json.hpp"
 #include "oit_reference.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -482,14 +482,14 @@ struct Bench {
             if (run.with_renderer) s = renderer.record(cb);
             if (s) {
                 const crisp::CompositeTarget target{image.view(), run.format, VK_FORMAT_UNDEFINED, rect.extent, rect};
-                s = compositor.record(cb, renderer.drawn(), renderer.atlas_view(), target);
+                s = compositor.record(cb, renderer.drawn_frame(), target);
             }
         } else if (run.mode == crisp::CompositeMode::draw) {
             crisp::tools::begin_rendering_over(cb, image.view(), rect);
-            s = compositor.record_draw(cb, renderer.drawn(), renderer.atlas_view(), rect);
+            s = compositor.record_draw(cb, renderer.drawn_frame(), rect);
             vkCmdEndRendering(cb);
         } else {
-            s = compositor.record_reference(cb, renderer.drawn(), renderer.atlas_view(), params);
+            s = compositor.record_reference(cb, renderer.drawn_frame(), params);
         }
         if (!s) fail(mode_label(run) + ": " + s.error().message);
     }

@@ -10,13 +10,13 @@
 #include "json.hpp"
 #include "vk_barriers.hpp"
 #include "vk_resources.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <array>
@@ -496,8 +496,7 @@ struct Bench {
             stamps[2] = Clock::now();
             if (crisp::Status s = renderer->record(*cb); !s) fail(s.error().message);
             stamps[3] = Clock::now();
-            if (crisp::Status s = compositor->record(*cb, renderer->drawn(), renderer->atlas_view(), composite_target);
-                !s) {
+            if (crisp::Status s = compositor->record(*cb, renderer->drawn_frame(), composite_target); !s) {
                 fail(s.error().message);
             }
             stamps[4] = Clock::now();

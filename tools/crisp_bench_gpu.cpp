@@ -3,12 +3,12 @@
 // Vulkan timestamp queries around the recorded work; prints Markdown (or JSON with --json).
 #include "cli.hpp"
 #include "gpu_tools.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <charconv>

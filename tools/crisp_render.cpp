@@ -7,6 +7,7 @@
 #include "image_io.hpp"
 #include "json.hpp"
 #include "scene.hpp"
+#include "headless_context.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/atlas.hpp>
@@ -16,7 +17,6 @@
 #include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
 #include <crisp/subpixel.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <algorithm>
 #include <array>
@@ -540,10 +540,10 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
         const int code = run_composite_frame(context, frame, out, [&](VkCommandBuffer command_buffer) {
             if (!draw) {
                 const crisp::CompositeTarget target{image->view(), kFormat, VK_FORMAT_UNDEFINED, {width, height}, rect};
-                return compositor.record(command_buffer, renderer.drawn(), renderer.atlas_view(), target);
+                return compositor.record(command_buffer, renderer.drawn_frame(), target);
             }
             crisp::tools::begin_rendering_over(command_buffer, image->view(), rect);
-            crisp::Status recorded = compositor.record_draw(command_buffer, renderer.drawn(), renderer.atlas_view(), rect);
+            crisp::Status recorded = compositor.record_draw(command_buffer, renderer.drawn_frame(), rect);
             vkCmdEndRendering(command_buffer);
             return recorded;
         });
@@ -600,9 +600,9 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
     constexpr int kCompositeFrames = 2;
     for (int frame = 1; frame <= kCompositeFrames; ++frame) {
         const int code = run_composite_frame(context, frame, out, [&](VkCommandBuffer command_buffer) {
-            crisp::Status recorded =
-                compositor.record_reference(command_buffer, renderer.drawn(), renderer.atlas_view(), params);
-            if (recorded && frame == kCompositeFrames) compositor.record_target_readback(command_buffer, buffer->handle());
+            crisp::Status recorded = compositor.record_reference(command_buffer, renderer.drawn_frame(), params);
+            if (recorded && frame == kCompositeFrames)
+                compositor.record_target_readback(command_buffer, buffer->handle());
             return recorded;
         });
         if (code != kExitOk) return code;

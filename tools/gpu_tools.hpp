@@ -2,8 +2,9 @@
 // (docs/vulkan.md), and a GPU timer from timestamp queries.
 #pragma once
 
+#include "headless_context.hpp"
+
 #include <crisp/result.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <vulkan/vulkan.h>
 

@@ -271,7 +271,7 @@ crisp::Status TextOverlay::record_composite(VkCommandBuffer command_buffer, cons
     target.format = kSceneColorFormat;
     target.extent = targets.color.extent;
     target.rect = {{0, 0}, targets.color.extent};
-    crisp::Status status = compositor_->record(command_buffer, renderer_->drawn(), renderer_->atlas_view(), target);
+    crisp::Status status = compositor_->record(command_buffer, renderer_->drawn_frame(), target);
     composited_ = status.ok();
     return status;
 }

@@ -1,6 +1,6 @@
 #include "vk_objects.hpp"
 
-#include <crisp/vulkan_context.hpp>
+#include <crisp/device_features.hpp>
 
 namespace engine {
 namespace {

@@ -12,6 +12,8 @@
 // no band references; readers only ever visit curves through the band bitsets.
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/result.hpp>
 
 #include <cstddef>
@@ -91,7 +93,7 @@ struct FontInfo {
 
 // A font asset in memory. `glyphs` is indexed by glyph index and holds one record for every glyph
 // of the face, baked or not.
-struct FontAsset {
+struct CRISP_API FontAsset {
     FontInfo info;
     std::vector<GlyphRecord> glyphs;
     std::vector<Point> points;
@@ -110,21 +112,21 @@ struct FontAsset {
 // the checksum is checked before anything is used, and a bad asset returns
 // ErrorCode::asset_invalid (or asset_version) with a message naming the fault; nothing crashes
 // and nothing is read out of bounds.
-Result<FontAsset> load_asset(std::span<const std::byte> bytes);
+CRISP_API Result<FontAsset> load_asset(std::span<const std::byte> bytes);
 
 // Reads a file and loads it as above. An unreadable file returns ErrorCode::io.
-Result<FontAsset> load_asset_file(const std::filesystem::path& path);
+CRISP_API Result<FontAsset> load_asset_file(const std::filesystem::path& path);
 
 // Checks an in-memory asset against the same rules the loader applies (so a baker can refuse to
 // write an asset the loader would reject). Returns ErrorCode::asset_invalid naming the fault.
-Status validate_asset(const FontAsset& asset);
+CRISP_API Status validate_asset(const FontAsset& asset);
 
 // Encodes an asset in the file format (little-endian, checksummed). The asset must be valid.
-std::vector<std::byte> serialize_asset(const FontAsset& asset);
+CRISP_API std::vector<std::byte> serialize_asset(const FontAsset& asset);
 
 // Writes serialize_asset(asset) to `path` atomically: the bytes go to a temporary file beside it,
 // which is flushed and renamed over `path` only when complete. On failure (ErrorCode::io) an
 // existing file at `path` is untouched and no temporary file is left behind.
-Status save_asset_file(const FontAsset& asset, const std::filesystem::path& path);
+CRISP_API Status save_asset_file(const FontAsset& asset, const std::filesystem::path& path);
 
 }  // namespace crisp

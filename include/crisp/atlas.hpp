@@ -32,6 +32,8 @@
 // it holds no global state, so a program may keep several.
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/glyph.hpp>
 #include <crisp/result.hpp>
 
@@ -83,7 +85,7 @@ enum class AtlasStatus : uint8_t {
 };
 
 // Short stable name of a status ("atlas_full"), for logs and JSON.
-const char* atlas_status_name(AtlasStatus status);
+CRISP_API const char* atlas_status_name(AtlasStatus status);
 
 // A rectangle of texels within a glyph's rect: (0, 0) is the rect's top-left texel.
 struct TexelRect {
@@ -174,7 +176,7 @@ struct AtlasStats {
     AtlasCounters total;           // since create()
 };
 
-class GlyphAtlas {
+class CRISP_API GlyphAtlas {
 public:
     // Makes an empty atlas in frame 0. A size that is not a power of two in [kAtlasMinSize,
     // kAtlasMaxSize], a ramp or steady value outside [1, max_samples], max_samples outside

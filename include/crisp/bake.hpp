@@ -9,6 +9,8 @@
 // (docs/architecture.md).
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/asset.hpp>
 #include <crisp/result.hpp>
 
@@ -99,25 +101,25 @@ struct BakeResult {
 // (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be converted and
 // allow_failed is false; the report inside the message names them). Hostile font bytes never
 // crash the baker.
-Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options);
+CRISP_API Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options);
 
 // font_unsupported, with what to do instead, for the font containers crisp does not bake though
 // FreeType could open them: WOFF, WOFF2 (decompress them first) and PostScript Type 1 (PFA, PFB:
 // convert them to OpenType CFF); success for anything else (TrueType, OpenType, collections).
-Status check_font_container(std::span<const std::byte> font_bytes);
+CRISP_API Status check_font_container(std::span<const std::byte> font_bytes);
 
 // Reads the file, then bake_font. An unreadable file returns ErrorCode::io: a file that is not a
 // regular file, or larger than 256 MiB (docs/limits.md), is refused before it is read.
-Result<BakeResult> bake_font_file(const std::filesystem::path& path, const BakeOptions& options);
+CRISP_API Result<BakeResult> bake_font_file(const std::filesystem::path& path, const BakeOptions& options);
 
 // Parses "wght=700" into a Variation; returns invalid_argument naming the fault otherwise.
-Result<Variation> parse_variation(std::string_view text);
+CRISP_API Result<Variation> parse_variation(std::string_view text);
 
 // Parses code point ranges "U+0020-007E,0x4E00-0x4E10,65" into a sorted list without duplicates.
-Result<std::vector<uint32_t>> parse_codepoint_ranges(std::string_view text);
+CRISP_API Result<std::vector<uint32_t>> parse_codepoint_ranges(std::string_view text);
 
 // A four-character tag as its 32-bit value, and back.
-uint32_t make_tag(std::string_view four_chars);
-std::string tag_to_string(uint32_t tag);
+CRISP_API uint32_t make_tag(std::string_view four_chars);
+CRISP_API std::string tag_to_string(uint32_t tag);
 
 }  // namespace crisp

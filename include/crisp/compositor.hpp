@@ -18,12 +18,14 @@
 //
 // A frame, after the renderer's record() in the same command buffer (or a later one):
 //
-//     compositor.record(command_buffer, renderer.drawn(), renderer.atlas_view(), target);
+//     compositor.record(command_buffer, renderer.drawn_frame(), target);
 //
 // Like the Renderer, the compositor never submits, and the caller must not have more than
 // CompositorCreateInfo::frames_in_flight of its recorded command buffers pending at once; each
 // record*() call takes one frame slot.
 #pragma once
+
+#include <crisp/export.hpp>
 
 #include <crisp/renderer.hpp>
 #include <crisp/result.hpp>
@@ -48,9 +50,9 @@ enum class CompositeMode {
     exact,     // reference: per-pixel linked lists, sorted: the ground truth
 };
 // "tiled", "draw", "unsorted", "wboit", "exact".
-const char* composite_mode_name(CompositeMode mode);
+CRISP_API const char* composite_mode_name(CompositeMode mode);
 // The mode of that name; nullopt for any other string.
-std::optional<CompositeMode> parse_composite_mode(std::string_view name);
+CRISP_API std::optional<CompositeMode> parse_composite_mode(std::string_view name);
 
 // The most layers the tile path's layered way keeps per pixel (CompositorCreateInfo::tile_layers).
 inline constexpr uint32_t kMaxCompositeLayers = 8;
@@ -126,12 +128,6 @@ struct CompositorCreateInfo {
     uint32_t exact_nodes_per_pixel = 16;
 };
 
-class HeadlessContext;
-
-// A CompositorCreateInfo for the objects `context` made (physical device, device, allocator,
-// enabled features), the rest at its defaults. For tools and tests; an engine fills in its own.
-CompositorCreateInfo compositor_create_info(const HeadlessContext& context);
-
 // How the quad passes of the wboit and exact reference modes run (unsorted is always rasterized:
 // it needs the blend unit's submission order).
 enum class QuadPath {
@@ -139,9 +135,9 @@ enum class QuadPath {
     compute,  // one compute invocation per pixel of each 8 x 8 tile of each quad: no rasterizer
 };
 // "raster", "compute".
-const char* quad_path_name(QuadPath path);
+CRISP_API const char* quad_path_name(QuadPath path);
 // The path of that name; nullopt for any other string.
-std::optional<QuadPath> parse_quad_path(std::string_view name);
+CRISP_API std::optional<QuadPath> parse_quad_path(std::string_view name);
 
 // The caller's image the tile path composites into.
 struct CompositeTarget {
@@ -198,9 +194,9 @@ struct CompositorStats {
 // `position` (x, y, z, in world units) under `view_projection` (column-major 4x4, Vulkan clip
 // space with depth in [0, 1], as glm::perspectiveRH_ZO makes). nullopt when the point is behind
 // the eye (w <= 0), outside the depth range, or any input is not finite.
-std::optional<float> depth_from_view_projection(const float view_projection[16], const float position[3]);
+CRISP_API std::optional<float> depth_from_view_projection(const float view_projection[16], const float position[3]);
 
-class Compositor {
+class CRISP_API Compositor {
 public:
     // Creates the tile path's pipelines (for each of kTileTargetFormats the device can store to),
     // the draw path's pipeline when draw_format is set, and the reference modes' target (R32G32B32A32_SFLOAT,
@@ -223,40 +219,38 @@ public:
     // The caller makes sure the GPU is done with the compositor's objects first.
     ~Compositor();
 
-    // The tile path: records one frame compositing `glyphs` (Renderer::drawn(): each instance's
-    // rect, colour, depth and paint order, and where its texels are in the atlas) into `target`,
-    // per channel: out.rgb = light + T * image.rgb, out.a = 1 - (1 - image.a) * min(T), in linear
-    // colour. Pixels no glyph covers are neither read nor written. `atlas_view` is
-    // Renderer::atlas_view(), written before this by earlier commands (the renderer's barrier
-    // makes it readable). The command buffer must be recording, outside a render pass.
-    // Errors: invalid_argument for a null view, a format this compositor cannot store to (the
+    // The tile path: records one frame compositing `frame`'s glyphs (Renderer::drawn_frame(): each
+    // instance's rect, colour, depth and paint order, and where its texels are in the atlas) into
+    // `target`, per channel: out.rgb = light + T * image.rgb, out.a = 1 - (1 - image.a) * min(T),
+    // in linear colour. Pixels no glyph covers are neither read nor written. The atlas was written
+    // before this by earlier commands (the renderer's barrier makes it readable). The command
+    // buffer must be recording, outside a render pass.
+    // Errors: invalid_argument for a frame without an atlas view, a null target view, a format
+    // this compositor cannot store to (the
     // message says why), or a rect outside the image or with a side above 16384; vulkan for a
     // failed allocation; either leaves no commands recorded. Non-finite colours or depths are
     // clamped into range; a glyph whose rect does not lie in the atlas draws nothing where it
     // misses it; rects over 65535 texels a side draw nothing.
-    Status record(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
-                  const CompositeTarget& target);
+    Status record(VkCommandBuffer command_buffer, const DrawnFrame& frame, const CompositeTarget& target);
 
-    // The draw path: records draws of `glyphs`, back to front, into the caller's render pass,
+    // The draw path: records draws of `frame`'s glyphs, back to front, into the caller's render pass,
     // which must be active (begun with vkCmdBeginRendering) with one colour attachment of
     // CompositorCreateInfo::draw_format. `rect` is where text lands, as in CompositeTarget::rect
     // (the viewport and scissor are set to it); crisp sets the pipeline, descriptor set, push
     // constants, viewport and scissor. The atlas must already be readable by fragment shaders
     // (the renderer's record() does that, outside the render pass). Errors: invalid_argument
-    // without a draw pipeline, or for an empty rect or one with a side above 16384; vulkan for a
-    // failed allocation (no commands recorded).
-    Status record_draw(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
-                       const VkRect2D& rect);
+    // without a draw pipeline, for a frame without an atlas view, or for an empty rect or one
+    // with a side above 16384; vulkan for a failed allocation (no commands recorded).
+    Status record_draw(VkCommandBuffer command_buffer, const DrawnFrame& frame, const VkRect2D& rect);
 
     // The reference modes: records one frame composited by params.mode over params.background
     // into the compositor's own target. Same contract as record() for glyphs and atlas; after
     // it the target is readable by fragment and compute shaders and transfers. Errors:
-    // invalid_argument without reference_modes, for a mode that is not a reference mode, or exact
-    // with no node pool; vulkan for a failed Vulkan call; either
+    // invalid_argument without reference_modes, for a frame without an atlas view, for a mode that
+    // is not a reference mode, or exact with no node pool; vulkan for a failed Vulkan call; either
     // leaves no commands recorded. On the compute path a rect over 65535 texels a side draws
     // nothing.
-    Status record_reference(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
-                            const CompositeParams& params);
+    Status record_reference(VkCommandBuffer command_buffer, const DrawnFrame& frame, const CompositeParams& params);
 
     // Takes back the most recent record(), record_draw() or record_reference() when its command
     // buffer will not be submitted (a dropped frame): the bins it made do not count as made, its

@@ -12,9 +12,13 @@
 //     renderer_info.enabled_features = &features;       // and the same chain for crisp
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/result.hpp>
 
 #include <vulkan/vulkan.h>
+
+#include <string>
 
 namespace crisp {
 
@@ -37,8 +41,11 @@ struct CrispFeatureNeeds {
 // GPU lacks a required feature (named), or the loader gives no function crisp queries with, in
 // which case `features` is unchanged. The GPU is queried through `get_instance_proc_addr` (null:
 // the system loader's), as RendererCreateInfo::get_instance_proc_addr.
-Status add_crisp_features(VkInstance instance, VkPhysicalDevice physical_device, VkPhysicalDeviceFeatures2& features,
-                          const CrispFeatureNeeds& needs = {},
-                          PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+CRISP_API Status add_crisp_features(VkInstance instance, VkPhysicalDevice physical_device,
+                                    VkPhysicalDeviceFeatures2& features, const CrispFeatureNeeds& needs = {},
+                                    PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+
+// "VK_ERROR_DEVICE_LOST", for messages; "VkResult -13" for a code this build does not know.
+CRISP_API std::string vk_result_name(VkResult result);
 
 }  // namespace crisp

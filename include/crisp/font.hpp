@@ -11,6 +11,8 @@
 // fonts are thread-safe for shaping), each with its own Layouter.
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/asset.hpp>
 #include <crisp/glyph.hpp>
 #include <crisp/result.hpp>
@@ -23,7 +25,7 @@ struct hb_font_t;
 
 namespace crisp {
 
-class Font {
+class CRISP_API Font {
 public:
     // Takes ownership of `asset` and opens its font bytes with HarfBuzz at the face index and
     // variation-axis values the asset was baked with. `id` is the FontId that every GlyphKey of

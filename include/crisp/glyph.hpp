@@ -5,6 +5,8 @@
 // texels, so they share one atlas entry wherever they are drawn.
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/asset.hpp>
 
 #include <cstddef>
@@ -36,7 +38,7 @@ struct GlyphKey {
     friend bool operator==(const GlyphKey&, const GlyphKey&) = default;
 };
 
-struct GlyphKeyHash {
+struct CRISP_API GlyphKeyHash {
     size_t operator()(const GlyphKey& key) const;
 };
 
@@ -51,7 +53,7 @@ struct GlyphRect {
 
 // The rect of `glyph` at `key`: the pixels its outline bbox touches at the key's size and
 // subpixel offset, plus kGlyphPadding on each side. Empty (0 x 0) for a glyph without curves.
-GlyphRect glyph_rect(const GlyphRecord& glyph, const GlyphKey& key);
+CRISP_API GlyphRect glyph_rect(const GlyphRecord& glyph, const GlyphKey& key);
 
 // Maps a point of a glyph's rect (texel units from the rect's top-left corner, y down) to em
 // (y up). This is the texel-to-em mapping the rasterizer and its CPU reference use.
@@ -61,12 +63,12 @@ struct TexelToEm {
     float offset_x = 0.0f;  // em of the rect's top-left corner
     float offset_y = 0.0f;
 };
-TexelToEm texel_to_em(const GlyphRect& rect, const GlyphKey& key);
+CRISP_API TexelToEm texel_to_em(const GlyphRect& rect, const GlyphKey& key);
 
 // What one sample of every texel of the glyph's rect costs the rasterizer, in curve tests: the
 // sum over the rect's rows of its width times the curves listed in the band of the row's centre.
 // The atlas budgets its samples in these units. 0 for a glyph without curves.
-uint64_t curve_tests_per_sample(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key);
+CRISP_API uint64_t curve_tests_per_sample(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key);
 
 inline float size_to_float(uint32_t fixed) {
     return static_cast<float>(fixed) / static_cast<float>(kSizeOne);

@@ -21,6 +21,8 @@
 //    `subpixel_steps`; its GlyphKey and glyph_rect() give the rect on the target.
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/font.hpp>
 #include <crisp/glyph.hpp>
 #include <crisp/result.hpp>
@@ -143,7 +145,7 @@ struct TextLayout {
 // Lays out text, keeping HarfBuzz buffers and scratch memory between calls so that an engine
 // laying out every frame allocates (almost) nothing once warm. Move-only; not thread-safe: use
 // one per thread (Fonts may be shared).
-class Layouter {
+class CRISP_API Layouter {
 public:
     Layouter();
     Layouter(Layouter&& other) noexcept;
@@ -172,10 +174,10 @@ private:
 };
 
 // One-shot convenience: a temporary Layouter. Same behaviour and errors as Layouter::layout.
-Result<TextLayout> layout_text(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
-                               const LayoutOptions& options);
+CRISP_API Result<TextLayout> layout_text(std::span<const Font* const> fonts, std::string_view utf8,
+                                         const TextStyle& style, const LayoutOptions& options);
 
 // sRGB-encoded component (0..1) to linear light, with the exact piecewise sRGB transfer function.
-float srgb_to_linear(float encoded);
+CRISP_API float srgb_to_linear(float encoded);
 
 }  // namespace crisp

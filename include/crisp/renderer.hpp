@@ -20,6 +20,8 @@
 // shader reads and to transfer reads.
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/atlas.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
@@ -121,12 +123,6 @@ inline constexpr uint32_t kMovingSubpixelSteps = 4;
 // Frames a named draw must rest before its text counts as static again.
 inline constexpr uint32_t kMotionSettleFrames = 8;
 
-class HeadlessContext;
-
-// A RendererCreateInfo for the objects `context` made (instance, devices, queue family,
-// allocator), the rest at its defaults. For tools and tests; an engine fills in its own objects.
-RendererCreateInfo renderer_create_info(const HeadlessContext& context);
-
 // A glyph drawn this frame whose rect holds samples: where its texels are in the atlas.
 // A glyph drawn clipped (draw() with a visible rect) shows only the texels inside that rect:
 // `instance` then describes that part (x, y, width and height narrowed to it), and part_x, part_y
@@ -141,6 +137,17 @@ struct DrawnGlyph {
                            // a split sample in progress hold one more)
     uint32_t part_x = 0;
     uint32_t part_y = 0;
+};
+
+// What a recorded frame hands the compositor (Renderer::drawn_frame(), Compositor::record()): the
+// glyphs drawn with their atlas places, and the atlas they are read from. Tools and tests may make
+// their own (a subset of the glyphs, say) over the same atlas.
+struct DrawnFrame {
+    std::span<const DrawnGlyph> glyphs;
+    // The renderer's atlas image (R16G16B16A16_UINT accumulators, see record_atlas_readback) in
+    // VK_IMAGE_LAYOUT_GENERAL. The barrier at the end of Renderer::record() makes this frame's
+    // writes to it readable by compute and fragment shaders; the compositor records none on it.
+    VkImageView atlas = VK_NULL_HANDLE;
 };
 
 struct RendererStats {
@@ -175,7 +182,7 @@ struct RendererStats {
     uint64_t upload_bytes = 0;    // bytes copied into GPU buffers while recording this frame
 };
 
-class Renderer {
+class CRISP_API Renderer {
 public:
     // Creates the atlas image, buffers and the compute pipeline. Fails with ErrorCode::vulkan when
     // the device is below Vulkan 1.2 or lacks what the rasterizer needs (named in the message:
@@ -256,6 +263,9 @@ public:
     // The glyphs draw()n this frame that hold samples once this frame's work has run, with their
     // atlas positions (valid after record()).
     std::span<const DrawnGlyph> drawn() const;
+    // What the compositor takes for this frame: drawn() and the atlas view (valid after record(),
+    // until the next begin_frame()).
+    DrawnFrame drawn_frame() const;
 
     // True when every glyph drawn this frame holds max_samples: static text has converged and
     // record() schedules no work.

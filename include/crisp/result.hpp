@@ -6,6 +6,8 @@
 // public API; programmer errors (broken preconditions) assert.
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <cassert>
 #include <string>
 #include <utility>
@@ -29,7 +31,7 @@ enum class ErrorCode {
 };
 
 // Short stable name of a code ("asset_invalid"), for logs and JSON.
-const char* error_code_name(ErrorCode code);
+CRISP_API const char* error_code_name(ErrorCode code);
 
 struct Error {
     ErrorCode code = ErrorCode::invalid_argument;

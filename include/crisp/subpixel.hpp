@@ -10,6 +10,8 @@
 //     {"name": "rgb", "r": [0, 0, 0.333, 1], "g": [0.333, 0, 0.667, 1], "b": [0.667, 0, 1, 1]}
 #pragma once
 
+#include <crisp/export.hpp>
+
 #include <crisp/result.hpp>
 
 #include <array>
@@ -33,33 +35,33 @@ struct SubpixelLayout {
 
 // The preset names: gray, rgb, bgr, vrgb, vbgr, qd-oled, woled, pentile (docs/subpixel.md
 // describes each).
-std::span<const std::string_view> subpixel_preset_names();
+CRISP_API std::span<const std::string_view> subpixel_preset_names();
 
 // A preset by name; an unknown name is ErrorCode::invalid_argument listing the known ones.
-Result<SubpixelLayout> subpixel_preset(std::string_view name);
+CRISP_API Result<SubpixelLayout> subpixel_preset(std::string_view name);
 
 // Checks a layout: every coordinate finite, x0 < x1 and y0 < y1, and every rectangle within
 // [-kGlyphPadding, 1 + kGlyphPadding]. Returns ErrorCode::invalid_argument naming the fault.
-Status validate_subpixel_layout(const SubpixelLayout& layout);
+CRISP_API Status validate_subpixel_layout(const SubpixelLayout& layout);
 
 // Parses the JSON form; "name" is optional. Safe for untrusted input: syntax errors name their
 // line and column, other faults name the member ("g[2]: ..."); all are ErrorCode::invalid_argument.
-Result<SubpixelLayout> parse_subpixel_layout(std::string_view json);
+CRISP_API Result<SubpixelLayout> parse_subpixel_layout(std::string_view json);
 
 // Reads and parses a layout file (ErrorCode::io when unreadable; messages name the path).
-Result<SubpixelLayout> load_subpixel_layout_file(const std::filesystem::path& path);
+CRISP_API Result<SubpixelLayout> load_subpixel_layout_file(const std::filesystem::path& path);
 
 // The JSON form of a layout (one line, numbers in their shortest exact form).
-std::string subpixel_layout_to_json(const SubpixelLayout& layout);
+CRISP_API std::string subpixel_layout_to_json(const SubpixelLayout& layout);
 
 // Writes the JSON form atomically, as save_asset_file writes an asset. The layout must be valid.
-Status save_subpixel_layout_file(const SubpixelLayout& layout, const std::filesystem::path& path);
+CRISP_API Status save_subpixel_layout_file(const SubpixelLayout& layout, const std::filesystem::path& path);
 
 // A preset name, or else a layout file: what crisp-render's --layout takes.
-Result<SubpixelLayout> resolve_subpixel_layout(std::string_view name_or_path);
+CRISP_API Result<SubpixelLayout> resolve_subpixel_layout(std::string_view name_or_path);
 
 // True when all three channels sample the same rows (equal y0 and y1): stripe layouts, where one
 // set of ray roots serves the three channels.
-bool shares_sample_rows(const SubpixelLayout& layout);
+CRISP_API bool shares_sample_rows(const SubpixelLayout& layout);
 
 }  // namespace crisp

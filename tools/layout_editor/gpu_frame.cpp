@@ -1,8 +1,7 @@
 #include "gpu_frame.hpp"
+#include "headless_context.hpp"
 
 #include "vk_barriers.hpp"
-
-#include <crisp/vulkan_context.hpp>
 
 #include <utility>
 
@@ -223,17 +222,13 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
     composite_target.format = VK_FORMAT_R8G8B8A8_UNORM;
     composite_target.extent = {width, height};
     composite_target.rect = whole;
-    if (Status s = interface_compositor_->record(cb, interface_renderer_->drawn(), interface_renderer_->atlas_view(),
-                                                 composite_target);
-        !s) {
+    if (Status s = interface_compositor_->record(cb, interface_renderer_->drawn_frame(), composite_target); !s) {
         return fail(s.error());
     }
     image_barrier(functions_, cb, canvas_.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    if (Status s = preview_compositor_->record(cb, preview_renderer_->drawn(), preview_renderer_->atlas_view(),
-                                               composite_target);
-        !s) {
+    if (Status s = preview_compositor_->record(cb, preview_renderer_->drawn_frame(), composite_target); !s) {
         return fail(s.error());
     }
     image_barrier(functions_, cb, canvas_.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,

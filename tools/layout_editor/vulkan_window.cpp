@@ -1,4 +1,5 @@
 #include "vulkan_window.hpp"
+#include "headless_context.hpp"
 
 #include "vk_resources.hpp"
 
@@ -6,7 +7,6 @@
 #include <GLFW/glfw3.h>
 
 #include <crisp/device_features.hpp>
-#include <crisp/vulkan_context.hpp>
 
 #include <cstdio>
 #include <cstring>

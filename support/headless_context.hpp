@@ -1,4 +1,5 @@
-// crisp: a headless Vulkan context for tools and tests, and the buffers and images it creates.
+// crisp support (not installed): a headless Vulkan context for tools and tests, the buffers and
+// images it creates, and the renderer's and compositor's create infos for it.
 //
 // A renderer is created from the caller's Vulkan objects (instance, physical device, device, queue
 // family, queue); an engine already owns those. Tools and tests have no engine, so HeadlessContext
@@ -11,6 +12,9 @@
 // move-only; resources must be destroyed before the context that made them.
 #pragma once
 
+#include <crisp/compositor.hpp>
+#include <crisp/device_features.hpp>
+#include <crisp/renderer.hpp>
 #include <crisp/result.hpp>
 
 #include <vulkan/vulkan.h>
@@ -252,7 +256,12 @@ private:
 // UINT, SINT and SFLOAT. 0 for any other format.
 uint32_t format_texel_size(VkFormat format);
 
-// "VK_ERROR_DEVICE_LOST"; the number as text for codes this build does not know.
-std::string vk_result_name(VkResult result);
+// A RendererCreateInfo for the objects `context` made (instance, devices, queue family,
+// allocator), the rest at its defaults. An engine fills in its own objects.
+RendererCreateInfo renderer_create_info(const HeadlessContext& context);
+
+// A CompositorCreateInfo for the objects `context` made (physical device, device, allocator,
+// enabled features), the rest at its defaults.
+CompositorCreateInfo compositor_create_info(const HeadlessContext& context);
 
 }  // namespace crisp

@@ -54,8 +54,8 @@ std::optional<Error> read_fonts(const json::Value& value, Scene& scene) {
         return fault("fonts", "expected a non-empty array of font asset paths");
     }
     if (value.array.size() > kMaxSceneFonts) {
-        return fault("fonts", "at most " + std::to_string(kMaxSceneFonts) + " fonts, got " +
-                                  std::to_string(value.array.size()));
+        return fault("fonts",
+                     "at most " + std::to_string(kMaxSceneFonts) + " fonts, got " + std::to_string(value.array.size()));
     }
     for (size_t i = 0; i < value.array.size(); ++i) {
         if (!is_usable_name(value.array[i])) {

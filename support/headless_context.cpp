@@ -1,6 +1,7 @@
-// HeadlessContext: instance, validation messenger, device choice and creation, one-off submissions.
-// The buffer and image helpers live in vk_resources.cpp.
-#include <crisp/vulkan_context.hpp>
+// HeadlessContext: instance, validation messenger, device choice and creation, one-off submissions,
+// and the renderer's and compositor's create infos for it. Its buffers and images live in
+// headless_resources.cpp.
+#include "headless_context.hpp"
 
 #include "vk_features.hpp"
 #include "vk_resources.hpp"
@@ -633,6 +634,29 @@ Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer
         return vk::vulkan_error("vkResetFences", result);
     }
     return {};
+}
+
+RendererCreateInfo renderer_create_info(const HeadlessContext& context) {
+    RendererCreateInfo info;
+    info.instance = context.instance();
+    info.get_instance_proc_addr = context.get_instance_proc_addr();
+    info.physical_device = context.physical_device();
+    info.device = context.device();
+    info.queue_family = context.queue_family();
+    info.enabled_features = context.enabled_features();
+    info.allocator = context.allocation_callbacks();
+    return info;
+}
+
+CompositorCreateInfo compositor_create_info(const HeadlessContext& context) {
+    CompositorCreateInfo info;
+    info.instance = context.instance();
+    info.get_instance_proc_addr = context.get_instance_proc_addr();
+    info.physical_device = context.physical_device();
+    info.device = context.device();
+    info.allocator = context.allocation_callbacks();
+    info.enabled_features = context.enabled_features();
+    return info;
 }
 
 }  // namespace crisp
