@@ -253,8 +253,10 @@ Status check_font_container(std::span<const std::byte> font_bytes) {
     return {};
 }
 
-Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options) {
-    const auto started = std::chrono::steady_clock::now();
+namespace {
+
+// Refuses options out of range, and font bytes too large or in a container crisp does not bake.
+Status check_options(std::span<const std::byte> font_bytes, const BakeOptions& options) {
     if (!(options.tolerance_em > 0.0f && options.tolerance_em <= 0.1f)) {
         return Error{ErrorCode::invalid_argument, "tolerance must be in (0, 0.1] em"};
     }
@@ -265,13 +267,22 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     if (font_bytes.size() > 0x7FFFFFFF) {
         return Error{ErrorCode::font_unreadable, "the font is larger than 2 GiB"};
     }
-    if (Status supported = check_font_container(font_bytes); !supported) return supported.error();
+    return check_font_container(font_bytes);
+}
 
+// A FreeType library and the face opened in it; the face, declared last, is closed first.
+struct OpenedFace {
+    LibraryHandle library;
+    FaceHandle face;
+};
+
+// Starts FreeType and opens the requested face, refusing a face index past the font's face count.
+Result<OpenedFace> open_face(std::span<const std::byte> font_bytes, const BakeOptions& options) {
     FT_Library raw_library = nullptr;
     if (const FT_Error error = FT_Init_FreeType(&raw_library); error != 0) {
         return Error{ErrorCode::font_unreadable, "cannot start FreeType: " + freetype_error(error)};
     }
-    const LibraryHandle library(raw_library);
+    LibraryHandle library(raw_library);
     const auto* data = reinterpret_cast<const FT_Byte*>(font_bytes.data());
     const auto size = static_cast<FT_Long>(font_bytes.size());
 
@@ -293,8 +304,13 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
         return Error{ErrorCode::font_unreadable,
                      "cannot open face " + std::to_string(options.face_index) + ": " + freetype_error(error)};
     }
-    const FaceHandle face(raw_face);
-    if (!FT_IS_SCALABLE(face.get())) {
+    FaceHandle face(raw_face);
+    return OpenedFace{std::move(library), std::move(face)};
+}
+
+// Refuses a face without outlines, or with units per em or a glyph count outside what OpenType allows.
+Status check_face(FT_Face face) {
+    if (!FT_IS_SCALABLE(face)) {
         return Error{ErrorCode::font_unsupported, "the face has no scalable outlines (bitmap-only font)"};
     }
     const uint32_t units_per_em = face->units_per_EM;
@@ -306,28 +322,36 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     if (glyph_count == 0 || glyph_count > 65536) {
         return Error{ErrorCode::font_unsupported, "the face holds " + std::to_string(glyph_count) + " glyphs"};
     }
+    return {};
+}
 
-    BakeResult result;
-    FontAsset& asset = result.asset;
-    BakeReport& report = result.report;
-    FontInfo& info = asset.info;
+// Fills info from the face (names, variation, metrics) and scales the face to one pixel per font unit.
+Status read_font_info(FT_Library library, FT_Face face, const BakeOptions& options, FontInfo& info) {
     info.family = face->family_name ? face->family_name : "";
     info.style = face->style_name ? face->style_name : "";
-    info.units_per_em = units_per_em;
+    info.units_per_em = face->units_per_EM;
     info.face_index = options.face_index;
     info.tolerance_em = options.tolerance_em;
-    if (Status status = apply_variations(library.get(), face.get(), options, info); !status) return status.error();
+    if (Status status = apply_variations(library, face, options, info); !status) return status;
     // After the variation: FreeType applies MVAR to these.
     info.ascender = face->ascender;
     info.descender = face->descender;
     info.line_gap = std::max(0, face->height - (face->ascender - face->descender));
 
     // One pixel per font unit; see bake_glyph.
-    if (const FT_Error error = FT_Set_Char_Size(face.get(), 0, static_cast<FT_F26Dot6>(units_per_em) * 64, 72, 72);
+    if (const FT_Error error = FT_Set_Char_Size(face, 0, static_cast<FT_F26Dot6>(info.units_per_em) * 64, 72, 72);
         error != 0) {
         return Error{ErrorCode::font_unsupported, "cannot scale the face: " + freetype_error(error)};
     }
+    return {};
+}
 
+// Bakes every requested glyph into the asset, a failed one as an empty record flagged failed, and
+// reports progress; returns how many glyphs were requested.
+uint32_t bake_glyphs(std::span<const std::byte> font_bytes, FT_Face face, const BakeOptions& options,
+                     OutlineCounters& counters, FontAsset& asset, BakeReport& report) {
+    const auto glyph_count = static_cast<uint32_t>(face->num_glyphs);
+    const uint32_t units_per_em = face->units_per_EM;
     std::vector<uint8_t> wanted;
     if (!options.all_glyphs) wanted = requested_glyphs(font_bytes, options.face_index, options.codepoints, glyph_count);
     const uint32_t to_do =
@@ -335,11 +359,10 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
 
     asset.glyphs.assign(glyph_count, GlyphRecord{});
     report.glyph_count = glyph_count;
-    OutlineCounters counters;
     uint32_t done = 0;
     for (uint32_t glyph = 0; glyph < glyph_count; ++glyph) {
         if (!options.all_glyphs && !wanted[glyph]) continue;
-        const GlyphOutcome outcome = bake_glyph(face.get(), glyph, units_per_em, options, counters, asset, report);
+        const GlyphOutcome outcome = bake_glyph(face, glyph, units_per_em, options, counters, asset, report);
         if (outcome.failed) {
             asset.glyphs[glyph] = GlyphRecord{};
             asset.glyphs[glyph].flags = kGlyphBaked | kGlyphFailed;
@@ -353,11 +376,11 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
         ++done;
         if (options.progress && (done % 256 == 0 || done == to_do)) options.progress(done, to_do);
     }
+    return to_do;
+}
 
-    if (counters.cubics > 0) info.flags |= kFontCubic;
-    info.max_deviation_em = static_cast<float>(counters.max_deviation);
-    asset.font_bytes.assign(font_bytes.begin(), font_bytes.end());
-
+// Copies the outline counters into the report, and divides its summed means by what they average over.
+void finish_report(const OutlineCounters& counters, BakeReport& report) {
     report.line_count = counters.lines;
     report.quadratic_count = counters.quadratics;
     report.cubic_count = counters.cubics;
@@ -375,6 +398,30 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     }
     report.mean_curves_per_band =
         report.band_count > 0 ? report.mean_curves_per_band / static_cast<double>(report.band_count) : 0.0;
+}
+
+}  // namespace
+
+Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options) {
+    const auto started = std::chrono::steady_clock::now();
+    if (Status status = check_options(font_bytes, options); !status) return status.error();
+    Result<OpenedFace> opened = open_face(font_bytes, options);
+    if (!opened) return opened.error();
+    const FT_Face face = opened->face.get();
+    if (Status status = check_face(face); !status) return status.error();
+
+    BakeResult result;
+    FontAsset& asset = result.asset;
+    BakeReport& report = result.report;
+    FontInfo& info = asset.info;
+    if (Status status = read_font_info(opened->library.get(), face, options, info); !status) return status.error();
+
+    OutlineCounters counters;
+    const uint32_t to_do = bake_glyphs(font_bytes, face, options, counters, asset, report);
+    if (counters.cubics > 0) info.flags |= kFontCubic;
+    info.max_deviation_em = static_cast<float>(counters.max_deviation);
+    asset.font_bytes.assign(font_bytes.begin(), font_bytes.end());
+    finish_report(counters, report);
 
     if (report.failed_glyphs > 0 && !options.allow_failed) {
         return Error{ErrorCode::glyph_failed, std::to_string(report.failed_glyphs) + " of " + std::to_string(to_do) +
