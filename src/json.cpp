@@ -53,6 +53,30 @@ void append_utf8(std::string& out, uint32_t cp) {
     }
 }
 
+// The character a one-letter JSON escape stands for ('n' for a newline), or '\0' for any other letter.
+char simple_escape(char letter) {
+    switch (letter) {
+        case '"':
+            return '"';
+        case '\\':
+            return '\\';
+        case '/':
+            return '/';
+        case 'b':
+            return '\b';
+        case 'f':
+            return '\f';
+        case 'n':
+            return '\n';
+        case 'r':
+            return '\r';
+        case 't':
+            return '\t';
+        default:
+            return '\0';
+    }
+}
+
 class Parser {
 public:
     explicit Parser(std::string_view text) : text_(text) {}
@@ -237,62 +261,7 @@ private:
                 return false;
             }
             if (c == '\\') {
-                ++pos_;
-                const char e = peek();
-                ++pos_;
-                switch (e) {
-                    case '"':
-                        out += '"';
-                        break;
-                    case '\\':
-                        out += '\\';
-                        break;
-                    case '/':
-                        out += '/';
-                        break;
-                    case 'b':
-                        out += '\b';
-                        break;
-                    case 'f':
-                        out += '\f';
-                        break;
-                    case 'n':
-                        out += '\n';
-                        break;
-                    case 'r':
-                        out += '\r';
-                        break;
-                    case 't':
-                        out += '\t';
-                        break;
-                    case 'u': {
-                        uint32_t cp = 0;
-                        if (!hex4(cp)) return false;
-                        if (cp >= 0xD800 && cp <= 0xDBFF) {
-                            uint32_t low = 0;
-                            if (peek() != '\\' || text_.substr(pos_, 2) != "\\u") {
-                                error_ = "a high surrogate without its low surrogate";
-                                return false;
-                            }
-                            pos_ += 2;
-                            if (!hex4(low)) return false;
-                            if (low < 0xDC00 || low > 0xDFFF) {
-                                error_ = "a high surrogate without its low surrogate";
-                                return false;
-                            }
-                            cp = 0x10000 + ((cp - 0xD800) << 10) + (low - 0xDC00);
-                        } else if (cp >= 0xDC00 && cp <= 0xDFFF) {
-                            error_ = "a lone low surrogate";
-                            return false;
-                        }
-                        append_utf8(out, cp);
-                        break;
-                    }
-                    default:
-                        --pos_;
-                        error_ = "unknown escape";
-                        return false;
-                }
+                if (!parse_escape(out)) return false;
                 continue;
             }
             if (c < 0x80) {
@@ -308,6 +277,48 @@ private:
             out.append(text_.substr(pos_, length));
             pos_ += length;
         }
+    }
+
+    // Appends what the escape at pos_ (its backslash) stands for, and moves past it.
+    bool parse_escape(std::string& out) {
+        ++pos_;
+        const char e = peek();
+        ++pos_;
+        if (e == 'u') return parse_unicode_escape(out);
+        const char unescaped = simple_escape(e);
+        if (unescaped == '\0') {
+            --pos_;
+            error_ = "unknown escape";
+            return false;
+        }
+        out += unescaped;
+        return true;
+    }
+
+    // Appends as UTF-8 the code point of a \uXXXX escape whose hex digits start at pos_, joining a
+    // surrogate pair written as two escapes.
+    bool parse_unicode_escape(std::string& out) {
+        uint32_t cp = 0;
+        if (!hex4(cp)) return false;
+        if (cp >= 0xD800 && cp <= 0xDBFF) {
+            uint32_t low = 0;
+            if (peek() != '\\' || text_.substr(pos_, 2) != "\\u") {
+                error_ = "a high surrogate without its low surrogate";
+                return false;
+            }
+            pos_ += 2;
+            if (!hex4(low)) return false;
+            if (low < 0xDC00 || low > 0xDFFF) {
+                error_ = "a high surrogate without its low surrogate";
+                return false;
+            }
+            cp = 0x10000 + ((cp - 0xD800) << 10) + (low - 0xDC00);
+        } else if (cp >= 0xDC00 && cp <= 0xDFFF) {
+            error_ = "a lone low surrogate";
+            return false;
+        }
+        append_utf8(out, cp);
+        return true;
     }
 
     bool parse_array(Value& value, size_t depth) {
