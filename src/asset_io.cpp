@@ -500,6 +500,79 @@ Status decode_glyphs(std::span<const std::byte> glyf, uint32_t glyph_count, Font
     return {};
 }
 
+// ---------------------------------------------------------------------------------------------
+// Encoding
+
+// An upper bound on the serialized size (each section padded by a whole alignment), reserved at once.
+size_t serialized_capacity(const FontAsset& asset) {
+    const FontInfo& info = asset.info;
+    return kSectionTableEnd + kSectionCount * kSectionAlignment + kMetaFixedSize + info.axes.size() * kAxisRecordSize +
+           info.family.size() + info.style.size() + asset.glyphs.size() * kGlyphRecordSize +
+           asset.points.size() * kPointSize + asset.band_words.size() * kBandWordSize + asset.font_bytes.size();
+}
+
+// Appends the META section: the fixed part, the axis records, then the family and style names.
+void encode_meta(const FontAsset& asset, std::vector<std::byte>& out) {
+    const FontInfo& info = asset.info;
+    append<uint32_t>(out, info.units_per_em);
+    append<int32_t>(out, info.ascender);
+    append<int32_t>(out, info.descender);
+    append<int32_t>(out, info.line_gap);
+    append<uint32_t>(out, info.face_index);
+    append<uint32_t>(out, static_cast<uint32_t>(asset.glyphs.size()));
+    append<uint32_t>(out, info.flags);
+    append<float>(out, info.tolerance_em);
+    append<float>(out, info.max_deviation_em);
+    append<uint32_t>(out, static_cast<uint32_t>(info.axes.size()));
+    append<uint32_t>(out, static_cast<uint32_t>(info.family.size()));
+    append<uint32_t>(out, static_cast<uint32_t>(info.style.size()));
+    for (const AxisValue& axis : info.axes) {
+        append<uint32_t>(out, axis.tag);
+        append<float>(out, axis.value);
+        append<float>(out, axis.minimum);
+        append<float>(out, axis.default_value);
+        append<float>(out, axis.maximum);
+    }
+    append_bytes(out, info.family.data(), info.family.size());
+    append_bytes(out, info.style.data(), info.style.size());
+}
+
+// Appends the GLYF section: one fixed-size record per glyph, field for field.
+void encode_glyphs(const std::vector<GlyphRecord>& glyphs, std::vector<std::byte>& out) {
+    for (const GlyphRecord& glyph : glyphs) {
+        append<float>(out, glyph.advance);
+        append<float>(out, glyph.bearing_x);
+        append<float>(out, glyph.bearing_y);
+        append<float>(out, glyph.bbox_min_x);
+        append<float>(out, glyph.bbox_min_y);
+        append<float>(out, glyph.bbox_max_x);
+        append<float>(out, glyph.bbox_max_y);
+        append<uint32_t>(out, glyph.point_offset);
+        append<uint32_t>(out, glyph.curve_count);
+        append<uint32_t>(out, glyph.band_offset);
+        append<uint16_t>(out, glyph.band_count);
+        append<uint16_t>(out, glyph.band_words);
+        append<uint32_t>(out, glyph.flags);
+    }
+}
+
+// Fills in the header and section table at the start of out, and last the checksum, which covers both.
+void store_header(const std::array<SectionRange, kSectionCount>& sections, std::vector<std::byte>& out) {
+    std::memcpy(out.data(), kMagic, sizeof(kMagic));
+    store<uint32_t>(out, kVersionOffset, kAssetVersion);
+    store<uint32_t>(out, kSectionCountOffset, static_cast<uint32_t>(kSectionCount));
+    store<uint64_t>(out, kFileSizeOffset, out.size());
+    store<uint32_t>(out, kReservedOffset, 0);
+    for (size_t kind = 0; kind < kSectionCount; ++kind) {
+        size_t at = kSectionTableOffset + kind * kSectionEntrySize;
+        std::memcpy(out.data() + at, kSectionTags[kind].data(), 4);
+        store<uint32_t>(out, at + 4, 0);
+        store<uint64_t>(out, at + 8, sections[kind].offset);
+        store<uint64_t>(out, at + 16, sections[kind].size);
+    }
+    store<uint32_t>(out, kChecksumOffset, asset_checksum(out));  // last: it covers everything else
+}
+
 }  // namespace
 
 // -------------------------------------------------------------------------------------------------
@@ -616,13 +689,8 @@ Result<FontAsset> load_asset(std::span<const std::byte> bytes) {
 
 std::vector<std::byte> serialize_asset(const FontAsset& asset) {
     assert(validate_asset(asset).ok() && "serialize_asset needs an asset that validate_asset accepts");
-    const FontInfo& info = asset.info;
-
-    std::vector<std::byte> out(kSectionTableEnd);
-    out.reserve(kSectionTableEnd + kSectionCount * kSectionAlignment + kMetaFixedSize +
-                info.axes.size() * kAxisRecordSize + info.family.size() + info.style.size() +
-                asset.glyphs.size() * kGlyphRecordSize + asset.points.size() * kPointSize +
-                asset.band_words.size() * kBandWordSize + asset.font_bytes.size());
+    std::vector<std::byte> out(kSectionTableEnd);  // the header and section table, filled in last
+    out.reserve(serialized_capacity(asset));
     std::array<SectionRange, kSectionCount> sections;
     auto begin_section = [&](SectionKind kind) {
         out.resize((out.size() + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment);  // zero padding
@@ -631,45 +699,11 @@ std::vector<std::byte> serialize_asset(const FontAsset& asset) {
     auto end_section = [&](SectionKind kind) { sections[kind].size = out.size() - sections[kind].offset; };
 
     begin_section(kSectionMeta);
-    append<uint32_t>(out, info.units_per_em);
-    append<int32_t>(out, info.ascender);
-    append<int32_t>(out, info.descender);
-    append<int32_t>(out, info.line_gap);
-    append<uint32_t>(out, info.face_index);
-    append<uint32_t>(out, static_cast<uint32_t>(asset.glyphs.size()));
-    append<uint32_t>(out, info.flags);
-    append<float>(out, info.tolerance_em);
-    append<float>(out, info.max_deviation_em);
-    append<uint32_t>(out, static_cast<uint32_t>(info.axes.size()));
-    append<uint32_t>(out, static_cast<uint32_t>(info.family.size()));
-    append<uint32_t>(out, static_cast<uint32_t>(info.style.size()));
-    for (const AxisValue& axis : info.axes) {
-        append<uint32_t>(out, axis.tag);
-        append<float>(out, axis.value);
-        append<float>(out, axis.minimum);
-        append<float>(out, axis.default_value);
-        append<float>(out, axis.maximum);
-    }
-    append_bytes(out, info.family.data(), info.family.size());
-    append_bytes(out, info.style.data(), info.style.size());
+    encode_meta(asset, out);
     end_section(kSectionMeta);
 
     begin_section(kSectionGlyf);
-    for (const GlyphRecord& glyph : asset.glyphs) {
-        append<float>(out, glyph.advance);
-        append<float>(out, glyph.bearing_x);
-        append<float>(out, glyph.bearing_y);
-        append<float>(out, glyph.bbox_min_x);
-        append<float>(out, glyph.bbox_min_y);
-        append<float>(out, glyph.bbox_max_x);
-        append<float>(out, glyph.bbox_max_y);
-        append<uint32_t>(out, glyph.point_offset);
-        append<uint32_t>(out, glyph.curve_count);
-        append<uint32_t>(out, glyph.band_offset);
-        append<uint16_t>(out, glyph.band_count);
-        append<uint16_t>(out, glyph.band_words);
-        append<uint32_t>(out, glyph.flags);
-    }
+    encode_glyphs(asset.glyphs, out);
     end_section(kSectionGlyf);
 
     begin_section(kSectionPnts);
@@ -684,19 +718,7 @@ std::vector<std::byte> serialize_asset(const FontAsset& asset) {
     append_bytes(out, asset.font_bytes.data(), asset.font_bytes.size());
     end_section(kSectionFont);
 
-    std::memcpy(out.data(), kMagic, sizeof(kMagic));
-    store<uint32_t>(out, kVersionOffset, kAssetVersion);
-    store<uint32_t>(out, kSectionCountOffset, static_cast<uint32_t>(kSectionCount));
-    store<uint64_t>(out, kFileSizeOffset, out.size());
-    store<uint32_t>(out, kReservedOffset, 0);
-    for (size_t kind = 0; kind < kSectionCount; ++kind) {
-        size_t at = kSectionTableOffset + kind * kSectionEntrySize;
-        std::memcpy(out.data() + at, kSectionTags[kind].data(), 4);
-        store<uint32_t>(out, at + 4, 0);
-        store<uint64_t>(out, at + 8, sections[kind].offset);
-        store<uint64_t>(out, at + 16, sections[kind].size);
-    }
-    store<uint32_t>(out, kChecksumOffset, asset_checksum(out));  // last: it covers everything else
+    store_header(sections, out);
     return out;
 }
 
