@@ -154,11 +154,12 @@ struct DeviceCandidate {
     VkPhysicalDeviceVulkan11Properties vulkan11{};
     VkPhysicalDeviceVulkan12Properties vulkan12{};
     uint32_t queue_family = 0;
+    vk::DeviceFeatures features;  // what its device is created with (unlinked)
 };
 
 // Empty when `candidate` meets every requirement; otherwise what it lacks. Fills the candidate's
-// properties and queue family.
-std::vector<std::string> check_device(const vk::Functions& fn, DeviceCandidate& candidate,
+// properties, queue family and features (`required`, plus what options.crisp_needs adds for it).
+std::vector<std::string> check_device(const vk::Functions& fn, VkInstance instance, DeviceCandidate& candidate,
                                       const HeadlessContextOptions& options, const vk::DeviceFeatures& required) {
     std::vector<std::string> lacks;
     const uint32_t device_version = candidate.properties.apiVersion;
@@ -201,10 +202,20 @@ std::vector<std::string> check_device(const vk::Functions& fn, DeviceCandidate& 
         if (!has_extension(extensions, name.c_str())) lacks.push_back("the device lacks extension " + name);
     }
 
+    candidate.features = required;
+    if (options.crisp_needs) {
+        VkPhysicalDeviceFeatures2* chain = candidate.features.link(true);
+        if (Status s =
+                add_crisp_features(instance, candidate.handle, *chain, *options.crisp_needs, fn.vkGetInstanceProcAddr);
+            !s) {
+            lacks.push_back(s.error().message);
+            return lacks;
+        }
+    }
     const bool vulkan13 =
         meets_version(device_version, VK_API_VERSION_1_3) && meets_version(options.api_version, VK_API_VERSION_1_3);
     const std::vector<std::string> missing =
-        vk::missing_features(required, vk::query_features(fn, candidate.handle, vulkan13));
+        vk::missing_features(candidate.features, vk::query_features(fn, candidate.handle, vulkan13));
     if (!missing.empty()) lacks.push_back("the device lacks " + join(missing, ", "));
 
     const VkSubgroupFeatureFlags wanted_operations = options.required_compute_subgroup_operations;
@@ -260,8 +271,7 @@ struct HeadlessContext::State {
     Status create_instance(const HeadlessContextOptions& options);
     Status create_messenger(const VkDebugUtilsMessengerCreateInfoEXT& info);
     Result<DeviceCandidate> choose_device(const HeadlessContextOptions& options, const vk::DeviceFeatures& required);
-    Status create_device(const DeviceCandidate& chosen, const HeadlessContextOptions& options,
-                         vk::DeviceFeatures required);
+    Status create_device(const DeviceCandidate& chosen, const HeadlessContextOptions& options);
     Status create_submission_objects();
 
     // Destroys in reverse order of creation; create() relies on this to clean up after a failure
@@ -403,7 +413,7 @@ Result<DeviceCandidate> HeadlessContext::State::choose_device(const HeadlessCont
         const std::string name = candidate.properties.deviceName;
         names.push_back(name);
         if (name.find(options.device_name_contains) == std::string::npos) continue;
-        const std::vector<std::string> lacks = check_device(fn, candidate, options, required);
+        const std::vector<std::string> lacks = check_device(fn, instance, candidate, options, required);
         if (!lacks.empty()) {
             rejections.push_back(name + ": " + join(lacks, "; "));
             continue;
@@ -424,9 +434,10 @@ Result<DeviceCandidate> HeadlessContext::State::choose_device(const HeadlessCont
     return *chosen;
 }
 
-// The device from `chosen`, with exactly the required features and extensions, and its queue.
-Status HeadlessContext::State::create_device(const DeviceCandidate& chosen, const HeadlessContextOptions& options,
-                                             vk::DeviceFeatures required) {
+// The device from `chosen`, with exactly its features (the required ones and crisp's) and the
+// required extensions, and its queue.
+Status HeadlessContext::State::create_device(const DeviceCandidate& chosen, const HeadlessContextOptions& options) {
+    vk::DeviceFeatures required = chosen.features;
     physical_device = chosen.handle;
     queue_family = chosen.queue_family;
     properties = chosen.properties;
@@ -505,7 +516,21 @@ Status HeadlessContext::State::create_submission_objects() {
     return {};
 }
 
-Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& options) {
+namespace {
+
+// `given` with what crisp_needs implies: Vulkan 1.3 for the draw path, crisp's subgroup operations.
+HeadlessContextOptions with_crisp_needs(const HeadlessContextOptions& given) {
+    HeadlessContextOptions options = given;
+    if (!options.crisp_needs) return options;
+    if (options.crisp_needs->draw_path) options.api_version = std::max(options.api_version, VK_API_VERSION_1_3);
+    options.required_compute_subgroup_operations |= VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+    return options;
+}
+
+}  // namespace
+
+Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& given) {
+    const HeadlessContextOptions options = with_crisp_needs(given);
     if (!meets_version(options.api_version, VK_API_VERSION_1_2)) {
         return Error{ErrorCode::invalid_argument,
                      "api_version " + vk::version_string(options.api_version) + " is below crisp's floor of 1.2"};
@@ -516,7 +541,7 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessContextOptions& op
     if (Status s = state->create_instance(options); !s) return s.error();
     Result<DeviceCandidate> chosen = state->choose_device(options, *required);
     if (!chosen) return chosen.error();
-    if (Status s = state->create_device(*chosen, options, *required); !s) return s.error();
+    if (Status s = state->create_device(*chosen, options); !s) return s.error();
     if (Status s = state->create_submission_objects(); !s) return s.error();
     return HeadlessContext(std::move(state));
 }

@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -141,6 +142,13 @@ struct HeadlessContextOptions {
     std::vector<std::string> required_extensions;
     // Subgroup operations (VK_SUBGROUP_FEATURE_*_BIT) the device must offer in compute shaders.
     VkSubgroupFeatureFlags required_compute_subgroup_operations = 0;
+    // Also what crisp's parts need, as an engine asks for it: for each candidate device,
+    // add_crisp_features() adds to required_features what `crisp_needs` names (a device that lacks
+    // something is passed over, its rejection saying what), and crisp's compute subgroup
+    // operations (basic, arithmetic) are required. storage_without_format is turned on only where
+    // the device offers it. With draw_path, api_version is raised to at least 1.3 (dynamic
+    // rendering). nullopt: only what the fields above ask for.
+    std::optional<CrispFeatureNeeds> crisp_needs;
 };
 
 // What the validation layer has said so far (warnings and errors only; info and verbose messages

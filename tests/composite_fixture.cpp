@@ -14,29 +14,14 @@
 
 namespace crisp::compositing_test {
 
-// A context with what the compositor needs, 64-bit atomics included (lavapipe has them).
+// A context with what the renderer and every compositor path need.
 Fixture& fixture() {
     static Fixture f = [] {
         Fixture made;
-        VkPhysicalDeviceVulkan13Features vulkan13{};
-        vulkan13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
-        vulkan13.dynamicRendering = VK_TRUE;  // the draw path
-        VkPhysicalDeviceVulkan12Features vulkan12{};
-        vulkan12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
-        vulkan12.pNext = &vulkan13;
-        VkPhysicalDeviceFeatures2 features{};
-        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-        features.pNext = &vulkan12;
-        features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;  // the renderer
-        features.features.fragmentStoresAndAtomics = VK_TRUE;
-        features.features.dualSrcBlend = VK_TRUE;
         HeadlessContextOptions options;
-        options.api_version = VK_API_VERSION_1_3;
         options.validation = true;
         options.synchronization_validation = true;  // the compositor's barriers are what is tested too
-        options.required_features = &features;
-        options.required_compute_subgroup_operations =
-            VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+        options.crisp_needs = CrispFeatureNeeds{.draw_path = true, .reference_modes = true};
         auto context = HeadlessContext::create(options);
         EXPECT_TRUE(context) << (context ? "" : context.error().message);
         if (context) made.context = std::make_unique<HeadlessContext>(std::move(*context));

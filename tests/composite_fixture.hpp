@@ -3,9 +3,9 @@
 // convergence with the per-pixel fragments the shaders see, and the reference modes' read-back.
 #pragma once
 
+#include "headless_context.hpp"
 #include "oit_reference.hpp"
 #include "test_support.hpp"
-#include "headless_context.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/font.hpp>

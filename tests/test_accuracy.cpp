@@ -3,9 +3,9 @@
 // exact area fraction of that channel's sample rectangle covered by the glyph (nonzero rule).
 #include "bands.hpp"
 #include "coverage.hpp"
+#include "headless_context.hpp"
 #include "test_support.hpp"
 #include "utf8.hpp"
-#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>

@@ -2,8 +2,8 @@
 // oit_reference.hpp (built from the same atlas texels), order independence,
 // bound, coplanar paint order, per-channel subpixel compositing and opaque text.
 #include "composite_fixture.hpp"
-#include "oit_reference.hpp"
 #include "headless_context.hpp"
+#include "oit_reference.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>

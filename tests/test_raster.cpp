@@ -1,8 +1,8 @@
 // The GPU rasterizer held to the CPU reference, texel by texel, on lavapipe with validation on.
 #include "coverage.hpp"
+#include "headless_context.hpp"
 #include "test_support.hpp"
 #include "utf8.hpp"
-#include "headless_context.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>

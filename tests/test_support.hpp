@@ -1,8 +1,8 @@
 // Shared by the tests: where the fonts are, and reading files.
 #pragma once
 
-#include "utf8.hpp"
 #include "headless_context.hpp"
+#include "utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
@@ -52,14 +52,11 @@ inline std::unique_ptr<Font> bake_test_font(std::string_view text, FontId id = 1
     return font ? std::make_unique<Font>(std::move(*font)) : nullptr;
 }
 
-// A context with the validation layer on whose device was created with what crisp's renderer
-// needs (shaderStorageBufferArrayDynamicIndexing): crisp checks the device as created.
+// A context with the validation layer on whose device was created with what crisp's renderer and
+// tile path need (add_crisp_features(), as an engine would): crisp checks the device as created.
 inline Result<HeadlessContext> create_renderer_context(HeadlessContextOptions options = {}) {
-    VkPhysicalDeviceFeatures2 features{};
-    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;
     options.validation = true;
-    options.required_features = &features;  // read during create() only
+    options.crisp_needs = CrispFeatureNeeds{};
     return HeadlessContext::create(options);
 }
 

@@ -3,11 +3,11 @@
 // Every test that creates a context with validation on also asserts that the layer stayed silent.
 
 #include "embedded_shaders.hpp"
+#include "headless_context.hpp"
 #include "shared.h"
 #include "test_support.hpp"
 #include "vk_memory.hpp"
 #include "vk_resources.hpp"
-#include "headless_context.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/renderer.hpp>
@@ -475,6 +475,41 @@ TEST_F(VulkanTest, OfferedFeaturesAreEnabled) {
     VkSemaphore semaphore = VK_NULL_HANDLE;
     ASSERT_EQ(vkCreateSemaphore(context.device(), &semaphore_info, nullptr, &semaphore), VK_SUCCESS);
     vkDestroySemaphore(context.device(), semaphore, nullptr);
+    expect_no_validation_messages(context);
+}
+
+// crisp_needs enables what add_crisp_features() adds for the chosen device, as an engine would get
+// it: the parts asked for, storage_without_format only where offered, Vulkan 1.3 for the draw path.
+TEST_F(VulkanTest, CrispNeedsAreEnabledAsAnEngineWould) {
+    HeadlessContextOptions options = validated_options();
+    options.crisp_needs = CrispFeatureNeeds{.draw_path = true, .reference_modes = true, .storage_without_format = true};
+    CRISP_CREATE_CONTEXT(context, options);
+    EXPECT_GE(context.api_version(), VK_API_VERSION_1_3);
+    const VkPhysicalDeviceFeatures2* enabled = context.enabled_features();
+    ASSERT_NE(enabled, nullptr);
+    EXPECT_TRUE(enabled->features.shaderStorageBufferArrayDynamicIndexing);
+    EXPECT_TRUE(enabled->features.dualSrcBlend);
+    EXPECT_TRUE(enabled->features.fragmentStoresAndAtomics);
+    bool dynamic_rendering = false;
+    for (auto* next = static_cast<const VkBaseInStructure*>(enabled->pNext); next; next = next->pNext) {
+        if (next->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES) {
+            dynamic_rendering = reinterpret_cast<const VkPhysicalDeviceVulkan13Features*>(next)->dynamicRendering;
+        }
+    }
+    EXPECT_TRUE(dynamic_rendering);
+    VkPhysicalDeviceFeatures2 offered{};
+    offered.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    vkGetPhysicalDeviceFeatures2(context.physical_device(), &offered);
+    const bool without_format =
+        offered.features.shaderStorageImageReadWithoutFormat && offered.features.shaderStorageImageWriteWithoutFormat;
+    EXPECT_EQ(static_cast<bool>(enabled->features.shaderStorageImageWriteWithoutFormat), without_format);
+    EXPECT_TRUE(context.supports_compute_subgroup_arithmetic());
+
+    // What crisp itself checks: both accept the device as made.
+    EXPECT_TRUE(Renderer::create(renderer_create_info(context)));
+    CompositorCreateInfo compositor_info = compositor_create_info(context);
+    compositor_info.draw_format = VK_FORMAT_R8G8B8A8_UNORM;
+    EXPECT_TRUE(Compositor::create(compositor_info));
     expect_no_validation_messages(context);
 }
 
