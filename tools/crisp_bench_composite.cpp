@@ -46,6 +46,13 @@ static_assert(kDefaultWarmupFrames >= kFramesInFlight);
 // scene) runs its first frames at low clocks: on an H200 the first modes of a scene measured up
 // to 5x slower with 2 warm-up frames alone.
 constexpr double kDefaultWarmupMs = 500.0;
+// Untimed clears of the RGBA32F target recorded before each frame's timed commands. Between two
+// frames the GPU idles while the CPU works (the compositor sorts the quads, the bench checks), and
+// with short frames an H200's clock governor then held the SM clock at 345-900 MHz, lower the
+// longer the run: the tile path's 4-layer time rose from 0.66 to 1.13 ms within 100 frames and
+// depended on the modes that ran before. With 8 clears at 3840x2160 the clock stayed at 1980 MHz
+// (2 were too few); docs/results/h200-composite-tiles-clocks.md.
+constexpr uint32_t kDefaultClockLoad = 8;
 // Layer i is shifted by (i * kShiftStepX mod kShiftRangeX, i * kShiftStepY mod kShiftRangeY)
 // pixels: fractional steps, so that the layers' glyphs overlap partially and at many phases.
 constexpr float kShiftStepX = 1.37f, kShiftRangeX = 5.0f;
@@ -68,6 +75,7 @@ struct Args {
     uint32_t frames = 10;
     uint32_t warmup = kDefaultWarmupFrames;
     double warmup_ms = kDefaultWarmupMs;
+    uint32_t clock_load = kDefaultClockLoad;
     uint32_t samples = 512;
     uint32_t subpixel_steps = 4;
     crisp::QuadPath path = crisp::QuadPath::raster;
@@ -98,6 +106,8 @@ struct Args {
                  "  --frames N         timed frames per mode (default 10)\n"
                  "  --warmup N         untimed frames per mode before them, at least %u (default %u)\n"
                  "  --warmup-ms T      ... and more until T ms have passed (default %g)\n"
+                 "  --clock-load N     untimed clears of the RGBA32F target before each frame's timed\n"
+                 "                     commands, so that the GPU keeps its clocks between frames (default %u)\n"
                  "  --font PATH        a font file, baked at start (default fonts/DejaVuSans.ttf)\n"
                  "  --size PX          pixels per em (default 18)\n"
                  "  --samples N        samples per glyph the text converges to (default 512)\n"
@@ -112,7 +122,7 @@ struct Args {
                  "  --json             print JSON instead of Markdown\n"
                  "  --json-out FILE    also write the JSON to FILE\n"
                  "  -h, --help         this text\n",
-                 kFramesInFlight, kDefaultWarmupFrames, kDefaultWarmupMs);
+                 kFramesInFlight, kDefaultWarmupFrames, kDefaultWarmupMs, kDefaultClockLoad);
     std::exit(code);
 }
 
@@ -181,6 +191,9 @@ Args parse(int argc, char** argv) {
         } else if (arg == "--warmup-ms") {
             args.warmup_ms = number<double>(value());
             if (!(args.warmup_ms >= 0.0 && args.warmup_ms <= 600000.0)) fail("--warmup-ms must be in 0..600000");
+        } else if (arg == "--clock-load") {
+            args.clock_load = number<uint32_t>(value());
+            if (args.clock_load > 1000) fail("--clock-load must be in 0..1000");
         } else if (arg == "--font") {
             args.font = value();
         } else if (arg == "--size") {
@@ -494,15 +507,15 @@ struct Bench {
         if (!s) fail(mode_label(run) + ": " + s.error().message);
     }
 
-    // Clears the tile or draw path's image to the background before the timed commands.
-    void clear_target(VkCommandBuffer cb, const ModeRun& run, const crisp::CompositeParams& params) {
-        const VkImage image = targets.of(run.format).handle();
+    // Clears the target image of `format` to the background.
+    void clear_target(VkCommandBuffer cb, VkFormat format, const crisp::CompositeParams& params) {
+        const VkImage image = targets.of(format).handle();
         const crisp::vk::Functions& fn = context.functions();
         crisp::vk::image_barrier(fn, cb, image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL, kAnyStage, kAnyAccess,
                                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
         VkClearColorValue colour{};
         for (int c = 0; c < 4; ++c) colour.float32[c] = params.background[c];
-        if (run.format == VK_FORMAT_R8G8B8A8_UNORM) {
+        if (format == VK_FORMAT_R8G8B8A8_UNORM) {
             for (int c = 0; c < 3; ++c) colour.float32[c] = kBackgroundSrgb;  // the image holds sRGB codes
         }
         const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
@@ -575,8 +588,10 @@ struct Bench {
                 renderer.draw(scene.glyphs, scene.visible);
             }
             const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
-                if (!is_reference(run)) clear_target(cb, run, params);
-                timer.begin(cb, !is_reference(run));  // the clear is not the mode's cost
+                for (uint32_t k = 0; k < args.clock_load; ++k) clear_target(cb, VK_FORMAT_R32G32B32A32_SFLOAT, params);
+                if (!is_reference(run)) clear_target(cb, run.format, params);  // the tile and draw paths' image
+                // The clears are not the mode's cost.
+                timer.begin(cb, !is_reference(run) || args.clock_load > 0);
                 record(cb, compositor, run, params);
                 timer.end(cb);
                 if (last) read_back(cb, compositor, run);
@@ -629,8 +644,9 @@ void print_json(std::FILE* out, const Args& args, const Header& header, const st
     std::fprintf(out, "  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
                  args.height, crisp::json::quote(args.font).c_str(), static_cast<double>(args.size), args.samples);
     std::fprintf(out,
-                 "  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"timed_frames\": %u,\n",
-                 args.subpixel_steps, args.warmup, args.warmup_ms, args.frames);
+                 "  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"clock_load\": %u,\n"
+                 "  \"timed_frames\": %u,\n",
+                 args.subpixel_steps, args.warmup, args.warmup_ms, args.clock_load, args.frames);
     std::fprintf(out, "  \"background_srgb\": %g,\n  \"target_bytes_per_pixel\": %u,\n  \"scenes\": [\n",
                  static_cast<double>(kBackgroundSrgb), kTargetBytesPerPixel);
     for (size_t s = 0; s < scenes.size(); ++s) {
@@ -689,11 +705,12 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
     for (const std::string& w : header.compositor_warnings) std::printf("Compositor: %s.\n", w.c_str());
     std::printf(
         "GPU ms: median of %u frames after at least %u warm-up frames and %g ms, timestamps around the "
-        "mode's record call alone (frame: the renderer's record() of the converged text too). "
+        "mode's record call alone (frame: the renderer's record() of the converged text too), each frame "
+        "after %u untimed clears of the target that keep the GPU's clocks up. "
         "RMSE and max: 8-bit sRGB codes against %s, over all pixels and channels. B/px: the buffers the "
         "mode uses (CompositorStats::buffer_bytes / pixels: the tile and draw paths' quads and bins, the "
         "reference modes' per-pixel buffers); the target image adds %u B/px (RGBA32F) or 4 (rgba8).\n",
-        args.frames, args.warmup, args.warmup_ms,
+        args.frames, args.warmup, args.warmup_ms, args.clock_load,
         args.cpu_check ? "the exact CPU reference (double precision, every fragment)" : "the exact mode",
         kTargetBytesPerPixel);
     for (const float alpha : args.alphas) {
