@@ -218,9 +218,8 @@ CRISP_CONSTANT(uint, kTileBindingCount, 6u);
 CRISP_CONSTANT(uint, kTileEncodeLinear, 0u);  // float formats: the image holds linear colour
 CRISP_CONSTANT(uint, kTileEncodeSrgb, 1u);    // 8-bit UNORM formats: sRGB-encoded in the shader
 
-// The start of the header buffer; the list of non-empty tiles follows it.
-// The start of the header buffer; the list of busy tiles follows it, then the list of the tiles
-// handed to the layered pass (tiles_x * tiles_y words each).
+// The start of the header buffer; the list of busy tiles follows it (kTileBusyEntryWords words a
+// tile), then the list of the tiles handed to the layered pass (a word a tile).
 struct TileHeader {
     uint dispatch_x;  // VkDispatchIndirectCommand of the exact pass
     uint dispatch_y;
@@ -240,6 +239,13 @@ struct TileHeader {
     uint padding3;
 };
 CRISP_CONSTANT(uint, kTileHeaderWords, 16u);
+// A busy tile's entry: the tile's index in the low kTileBusyIndexBits bits (the scan takes at most
+// 2^20 tiles) and its quad count above them, saturated at kTileBusyCountMax (above any capacity);
+// then the start of its list in the bins. So the tile pass learns what it needs of its tile from
+// one 8-byte load, rather than from the tile's index and then the tile's words.
+CRISP_CONSTANT(uint, kTileBusyEntryWords, 2u);
+CRISP_CONSTANT(uint, kTileBusyIndexBits, 20u);
+CRISP_CONSTANT(uint, kTileBusyCountMax, 4095u);
 CRISP_CONSTANT(uint, kTileLayeredDispatchOffset, 40u);  // bytes
 
 struct TilePushConstants {
@@ -258,6 +264,8 @@ static_assert(sizeof(RasterItem) == 88);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
 static_assert(offsetof(TileHeader, layered_dispatch_x) == kTileLayeredDispatchOffset);
 static_assert(kTileScanBlock == kTileScanInvocations * kTileScanPerInvocation);
+static_assert(kTileScanBlock * kTileScanBlock <= 1u << kTileBusyIndexBits);
+static_assert(kTileMaxCapacity < kTileBusyCountMax && kTileBusyCountMax < 1u << (32 - kTileBusyIndexBits));
 static_assert(kTileScanBlock * kTileScanBlock * kTileSide * kTileSide >= 16384u * 16384u);
 static_assert(sizeof(TilePushConstants) == 32);
 static_assert(sizeof(CompositeQuad) == 64);

@@ -17,8 +17,8 @@ layout(std430, set = 0, binding = kTileBindTiles) buffer Tiles {
 layout(std430, set = 0, binding = kTileBindBins) buffer Bins {
     uint bins[];
 };
-// TileHeader's words, then the indices of the non-empty tiles, then of the tiles the exact pass
-// hands to the layered pass.
+// TileHeader's words, then the non-empty tiles' entries (kTileBusyEntryWords each), then the
+// indices of the tiles the exact pass hands to the layered pass.
 layout(std430, set = 0, binding = kTileBindHeader) buffer Header {
     uint header[];
 };

@@ -246,6 +246,11 @@ void finish_tile(ivec2 pixel, Blend b, bool tail) {
     }
 }
 
+// Where the header buffer's list of the tiles handed to the layered pass starts.
+uint layered_list() {
+    return kTileHeaderWords + kTileBusyEntryWords * tile_total();
+}
+
 // This invocation's pixel of `tile`, in the caller's rect; false past its right or bottom edge.
 bool tile_pixel(uint tile, out ivec2 corner, out ivec2 pixel) {
     corner = ivec2(uvec2(tile % pc.tiles_x, tile / pc.tiles_x) * kTileSide);
@@ -258,26 +263,29 @@ bool tile_pixel(uint tile, out ivec2 corner, out ivec2 pixel) {
 void exact_pass() {
     const uint busy = gl_WorkGroupID.y * kRasterDispatchWidth + gl_WorkGroupID.x;
     if (busy >= header[kHeaderBusyTiles]) return;  // uniform over the workgroup
-    const uint tile = header[kTileHeaderWords + busy];
-    const uint count = tile_words[tile];
+    const uint entry = kTileHeaderWords + kTileBusyEntryWords * busy;
+    const uint tile_and_count = header[entry];
+    const uint start = header[entry + 1u];
+    const uint tile = tile_and_count & ((1u << kTileBusyIndexBits) - 1u);
+    const uint count = tile_and_count >> kTileBusyIndexBits;  // saturated: above kCapacity
     if (count > kCapacity) {
         if (gl_LocalInvocationIndex == 0u) {
             const uint slot = atomicAdd(header[kHeaderLayeredTiles], 1u);
-            header[kTileHeaderWords + tile_total() + slot] = tile;
+            header[layered_list() + slot] = tile;
             if (slot < kRasterDispatchWidth) atomicAdd(header[kHeaderLayeredDispatchX], 1u);
         }
         return;
     }
     ivec2 corner, pixel;
     const bool inside = tile_pixel(tile, corner, pixel);
-    finish_tile(pixel, exact_way(tile_words[tile_total() + tile], count, corner, pixel, inside), false);
+    finish_tile(pixel, exact_way(start, count, corner, pixel, inside), false);
 }
 
 // The layered pass: the overflow list's tiles, workgroup i taking i, i + kRasterDispatchWidth, ...
 void layered_pass() {
     const uint overflowing = header[kHeaderLayeredTiles];
     for (uint i = gl_WorkGroupID.x; i < overflowing; i += kRasterDispatchWidth) {
-        const uint tile = header[kTileHeaderWords + tile_total() + i];
+        const uint tile = header[layered_list() + i];
         ivec2 corner, pixel;
         const bool inside = tile_pixel(tile, corner, pixel);
         bool tail = false;

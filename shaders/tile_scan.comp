@@ -4,7 +4,8 @@
 //   1, blocks: one workgroup scans the block sums (at most kTileScanBlock blocks), and writes the
 //      totals and the tile pass's indirect dispatch;
 //   2, down: each workgroup scans its block again from the block's offset, writing every tile's
-//      list start and the scatter pass's cursor, and the non-empty tiles into the header's list.
+//      list start and the scatter pass's cursor, and the non-empty tiles' entries into the
+//      header's list (index and count, list start: kTileBusyEntryWords words).
 // Each invocation takes kTileScanPerInvocation consecutive tiles (one 16-byte load); loads and
 // stores are coalesced, and the scan inside a workgroup runs in workgroup memory.
 #version 460
@@ -105,7 +106,11 @@ void main() {
         if (t >= tiles) break;
         tile_words[tiles + t] = running.x;
         tile_words[2u * tiles + t] = running.x;
-        if (counts[k] > 0u) header[kTileHeaderWords + running.y] = t;
+        if (counts[k] > 0u) {
+            const uint entry = kTileHeaderWords + kTileBusyEntryWords * running.y;
+            header[entry] = t | (min(counts[k], kTileBusyCountMax) << kTileBusyIndexBits);
+            header[entry + 1u] = running.x;
+        }
         running += uvec2(counts[k], counts[k] > 0u ? 1u : 0u);
     }
 }

@@ -25,9 +25,10 @@ bool is_srgb_encoded(VkFormat format) {
     return format == VK_FORMAT_R8G8B8A8_UNORM || format == VK_FORMAT_B8G8R8A8_UNORM;
 }
 
-// Words of the header buffer: TileHeader, the busy tiles, the tiles handed to the layered pass.
+// Words of the header buffer: TileHeader, the busy tiles' entries, the tiles handed to the layered
+// pass.
 VkDeviceSize header_words(uint32_t tiles) {
-    return gpu::kTileHeaderWords + 2 * VkDeviceSize{tiles};
+    return gpu::kTileHeaderWords + (gpu::kTileBusyEntryWords + 1) * VkDeviceSize{tiles};
 }
 
 // Words of the tiles buffer: count, start and cursor per tile, and two words per scan block.

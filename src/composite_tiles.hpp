@@ -94,7 +94,7 @@ private:
         vk::DeviceBuffer quads;   // host-visible CompositeQuad[]
         vk::DeviceBuffer tiles;   // three planes of tile words
         vk::DeviceBuffer bins;    // quad indices
-        vk::DeviceBuffer header;  // host-visible: TileHeader, then the busy tiles' indices
+        vk::DeviceBuffer header;  // host-visible: TileHeader, then the busy tiles' entries
         VkDescriptorSet set = VK_NULL_HANDLE;
         bool pending = false;
         uint64_t frame = 0;
