@@ -16,18 +16,8 @@ namespace crisp::compositing_test {
 
 // A context with what the renderer and every compositor path need.
 Fixture& fixture() {
-    static Fixture f = [] {
-        Fixture made;
-        HeadlessContextOptions options;
-        options.validation = true;
-        options.synchronization_validation = true;  // the compositor's barriers are what is tested too
-        options.crisp_needs = CrispFeatureNeeds{.draw_path = true, .reference_modes = true};
-        auto context = HeadlessContext::create(options);
-        EXPECT_TRUE(context) << (context ? "" : context.error().message);
-        if (context) made.context = std::make_unique<HeadlessContext>(std::move(*context));
-        made.font = test::bake_test_font("Hamburgefonstiv@&1");
-        return made;
-    }();
+    // Synchronization validation: the compositor's barriers are what is tested too.
+    static Fixture f = test::make_gpu_fixture({.draw_path = true, .reference_modes = true}, true, "Hamburgefonstiv@&1");
     return f;
 }
 

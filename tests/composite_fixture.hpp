@@ -24,10 +24,7 @@ constexpr uint32_t kSamples = 16;  // enough for coverage ramps; quick to conver
 
 constexpr float kBackground[4] = {0.9f, 0.85f, 0.7f, 1.0f};  // linear
 
-struct Fixture {
-    std::unique_ptr<HeadlessContext> context;
-    std::unique_ptr<Font> font;
-};
+using Fixture = test::GpuFixture;
 
 // The shared context (created once) and font.
 Fixture& fixture();

@@ -23,11 +23,8 @@ namespace crisp {
 namespace {
 
 HeadlessContext* context() {
-    static std::unique_ptr<HeadlessContext> made = [] {
-        auto created = test::create_renderer_context();
-        return created ? std::make_unique<HeadlessContext>(std::move(*created)) : nullptr;
-    }();
-    return made.get();
+    static test::GpuFixture fixture = test::make_gpu_fixture({}, false, "");
+    return fixture.context.get();
 }
 
 std::unique_ptr<Font> bake(const std::string& path, std::string_view text, uint32_t face = 0) {

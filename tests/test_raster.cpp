@@ -27,19 +27,10 @@
 namespace crisp {
 namespace {
 
-struct Fixture {
-    std::unique_ptr<HeadlessContext> context;
-    std::unique_ptr<Font> font;
-};
+using Fixture = test::GpuFixture;
 
 Fixture& fixture() {
-    static Fixture f = [] {
-        Fixture made;
-        auto context = test::create_renderer_context();
-        if (context) made.context = std::make_unique<HeadlessContext>(std::move(*context));
-        made.font = test::bake_test_font("Hg@&1");
-        return made;
-    }();
+    static Fixture f = test::make_gpu_fixture({}, false, "Hg@&1");
     return f;
 }
 

@@ -8,6 +8,8 @@
 #include <crisp/font.hpp>
 #include <crisp/renderer.hpp>
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -53,11 +55,36 @@ inline std::unique_ptr<Font> bake_test_font(std::string_view text, FontId id = 1
 }
 
 // A context with the validation layer on whose device was created with what crisp's renderer and
-// tile path need (add_crisp_features(), as an engine would): crisp checks the device as created.
+// tile path need (add_crisp_features(), as an engine would), or options.crisp_needs where given:
+// crisp checks the device as created.
 inline Result<HeadlessContext> create_renderer_context(HeadlessContextOptions options = {}) {
     options.validation = true;
-    options.crisp_needs = CrispFeatureNeeds{};
+    if (!options.crisp_needs) options.crisp_needs = CrispFeatureNeeds{};
     return HeadlessContext::create(options);
+}
+
+// What the GPU tests of one test file share, made once on first use: a context and a font.
+struct GpuFixture {
+    std::unique_ptr<HeadlessContext> context;  // null when no device qualifies (the tests then fail)
+    std::unique_ptr<Font> font;                // null when no text was asked for
+};
+
+// A GpuFixture: a context with the validation layer on (and its synchronization validation when
+// asked for) whose device has what `needs` asks of crisp, and DejaVu Sans with `text`'s glyphs.
+inline GpuFixture make_gpu_fixture(const CrispFeatureNeeds& needs, bool synchronization_validation,
+                                   std::string_view text) {
+    GpuFixture made;
+    HeadlessContextOptions options;
+    options.synchronization_validation = synchronization_validation;
+    options.crisp_needs = needs;
+    auto context = create_renderer_context(options);
+    if (context) {
+        made.context = std::make_unique<HeadlessContext>(std::move(*context));
+    } else {
+        ADD_FAILURE() << "no Vulkan device for the tests: " << context.error().message;
+    }
+    if (!text.empty()) made.font = bake_test_font(text);
+    return made;
 }
 
 // Frames of `draw` (which calls the renderer's draw() after begin_frame()), each recorded and
