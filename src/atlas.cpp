@@ -100,6 +100,17 @@ const char* atlas_status_name(AtlasStatus status) {
     return "unknown";
 }
 
+AtlasBlock atlas_block(uint32_t width, uint32_t height) {
+    // Cells per axis, rounded up to powers of two (bit_ceil(0) is 1: a zero side takes a cell);
+    // then square or 1:2 tall, the shapes an aligned run of the transposed Z-order can take.
+    const auto cells = [](uint32_t texels) {
+        return std::bit_ceil(static_cast<uint32_t>((uint64_t{texels} + kAtlasCellSize - 1) / kAtlasCellSize));
+    };
+    const uint32_t need_x = cells(width), need_y = cells(height);
+    const uint32_t block_y = std::max(need_x, need_y);
+    return AtlasBlock{std::max(need_x, block_y / 2), block_y};
+}
+
 Result<GlyphAtlas> GlyphAtlas::create(const AtlasConfig& config) {
     if (!valid_size(config.width) || !valid_size(config.height))
         return invalid("atlas size " + std::to_string(config.width) + "x" + std::to_string(config.height) +
@@ -353,12 +364,8 @@ AtlasLookup GlyphAtlas::lookup_of(uint32_t id) const {
 AtlasLookup GlyphAtlas::place(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample,
                               const TexelRect& part) {
     AtlasLookup lookup;
-    // Cells per axis, rounded up to powers of two; then the block is made square or 1:2 tall
-    // (the shapes an aligned run of the transposed Z-order can take).
-    const uint64_t need_x = std::bit_ceil((uint64_t{part.width} + kAtlasCellSize - 1) / kAtlasCellSize);
-    const uint64_t need_y = std::bit_ceil((uint64_t{part.height} + kAtlasCellSize - 1) / kAtlasCellSize);
-    const uint64_t block_y = std::max(need_x, need_y);
-    const uint64_t block_x = std::max(need_x, block_y / 2);
+    const AtlasBlock block = atlas_block(part.width, part.height);
+    const uint64_t block_x = block.cells_x, block_y = block.cells_y;
     if (block_x > cells_x_ || block_y > cells_y_) {
         lookup.status = AtlasStatus::too_large;
         ++frame_counters_.failed_too_large;

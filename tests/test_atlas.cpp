@@ -177,9 +177,21 @@ TEST(Atlas, BlockShapes) {
         EXPECT_EQ(entry->height, c.height);
         EXPECT_EQ(lookup.x % c.block_width, 0u);
         EXPECT_EQ(lookup.y % c.block_height, 0u);
+        // What atlas_block() promises for sizing an atlas ahead is what the atlas takes.
+        const AtlasBlock block = atlas_block(c.width, c.height);
+        EXPECT_EQ(block.cells_x * kAtlasCellSize, c.block_width) << c.width << "x" << c.height;
+        EXPECT_EQ(block.cells_y * kAtlasCellSize, c.block_height) << c.width << "x" << c.height;
         // Start each case from an empty atlas: the last case needs all of it.
         atlas = make_atlas(2048, 2048);
     }
+}
+
+TEST(Atlas, BlockOfAnySizeIsDefined) {
+    EXPECT_EQ(atlas_block(0, 0).cells_x, 1u);
+    EXPECT_EQ(atlas_block(0, 0).cells_y, 1u);
+    const AtlasBlock huge = atlas_block(UINT32_MAX, 1);  // (2^32 - 1) / 16 rounds up to 2^28 cells
+    EXPECT_EQ(huge.cells_x, 1u << 28);
+    EXPECT_EQ(huge.cells_y, 1u << 28);
 }
 
 TEST(Atlas, TallGlyphsShareASquareSideBySide) {

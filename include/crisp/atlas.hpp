@@ -87,6 +87,15 @@ enum class AtlasStatus : uint8_t {
 // Short stable name of a status ("atlas_full"), for logs and JSON.
 CRISP_API const char* atlas_status_name(AtlasStatus status);
 
+// The block of cells a rect of width x height texels takes in the atlas: cells per axis rounded up
+// to powers of two, then square or twice as tall as wide. For sizing an atlas before the glyphs
+// arrive. Any sizes are accepted; a zero side takes one cell on that axis.
+struct AtlasBlock {
+    uint32_t cells_x = 0;
+    uint32_t cells_y = 0;
+};
+CRISP_API AtlasBlock atlas_block(uint32_t width, uint32_t height);
+
 // A rectangle of texels within a glyph's rect: (0, 0) is the rect's top-left texel.
 struct TexelRect {
     uint32_t x = 0;
