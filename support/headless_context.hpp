@@ -251,6 +251,13 @@ public:
     // Reads the whole image, which is in `layout` (not UNDEFINED), back as tightly packed rows and
     // leaves it in that layout. Earlier GPU writes from this context's queue are made visible.
     Result<std::vector<std::byte>> read_image(const Image& source, VkImageLayout layout);
+    // Reads `regions` of a single-level colour image made elsewhere (a renderer's atlas), which is
+    // in `layout` (not UNDEFINED) and was made with VK_IMAGE_USAGE_TRANSFER_SRC_BIT, into
+    // `buffer_bytes` bytes laid out as the regions' buffer offsets say, and leaves it in that
+    // layout. Earlier GPU writes from this context's queue are made visible.
+    Result<std::vector<std::byte>> read_image_regions(VkImage source, VkImageLayout layout,
+                                                      std::span<const VkBufferImageCopy> regions,
+                                                      VkDeviceSize buffer_bytes);
 
 private:
     struct State;

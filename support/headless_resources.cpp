@@ -424,23 +424,29 @@ Result<std::vector<std::byte>> HeadlessContext::read_image(const Image& source, 
     if ((source.usage() & VK_IMAGE_USAGE_TRANSFER_SRC_BIT) == 0) {
         return Error{ErrorCode::invalid_argument, "read_image: the image lacks VK_IMAGE_USAGE_TRANSFER_SRC_BIT"};
     }
+    const VkDeviceSize size = VkDeviceSize{source.extent().width} * source.extent().height * texel_size;
+    const VkBufferImageCopy region = whole_image_copy(source.extent());
+    return read_image_regions(source.handle(), layout, std::span(&region, 1), size);
+}
+
+Result<std::vector<std::byte>> HeadlessContext::read_image_regions(VkImage source, VkImageLayout layout,
+                                                                   std::span<const VkBufferImageCopy> regions,
+                                                                   VkDeviceSize buffer_bytes) {
     if (!is_real_layout(layout)) {
         return Error{ErrorCode::invalid_argument,
-                     "read_image: an image in layout UNDEFINED or PREINITIALIZED has no "
-                     "contents to read"};
+                     "read_image: an image in layout UNDEFINED or PREINITIALIZED has no contents to read"};
     }
-    const VkDeviceSize size = VkDeviceSize{source.extent().width} * source.extent().height * texel_size;
-    Result<Buffer> staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
+    if (buffer_bytes == 0) return std::vector<std::byte>{};
+    Result<Buffer> staging = create_buffer(buffer_bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
     if (!staging) return staging.error();
     Status copied = submit_and_wait([&](VkCommandBuffer commands) {
-        image_barrier(functions(), commands, source.handle(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+        image_barrier(functions(), commands, source, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                       VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_TRANSFER_READ_BIT);
-        const VkBufferImageCopy region = whole_image_copy(source.extent());
-        functions().vkCmdCopyImageToBuffer(commands, source.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                           staging->handle(), 1, &region);
+        functions().vkCmdCopyImageToBuffer(commands, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging->handle(),
+                                           static_cast<uint32_t>(regions.size()), regions.data());
         // Back to the caller's layout; later work must wait for the copy's reads.
-        image_barrier(functions(), commands, source.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout,
+        image_barrier(functions(), commands, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout,
                       VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
                       VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
         memory_barrier(functions(), commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,

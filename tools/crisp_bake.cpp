@@ -1,8 +1,7 @@
 // crisp-bake: turns a font into a .crisp asset, or checks an asset.
 #include "cli.hpp"
-#include "file_io.hpp"
-#include "json.hpp"
-#include "utf8.hpp"
+#include "json_writer.hpp"
+#include "output_files.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>
@@ -33,28 +32,15 @@ enum ExitCode : int {
     kExitInvalidAsset = 6,  // --check: the asset is invalid or unreadable
 };
 
-constexpr const char* kUsage = R"(usage: crisp-bake FONT [options]
+constexpr const char* kSynopsis = R"(usage: crisp-bake FONT [options]
        crisp-bake --check ASSET.crisp [--json]
 
 Bakes a font (TrueType, OpenType CFF/CFF2, a collection, a variable font) into a .crisp asset:
 quadratic curves in em units, cut into bands, with the font's metrics and bytes.
 
-options:
-  -o, --output OUT.crisp   where to write the asset (default: FONT's name with .crisp, here)
-  --face N                 face N of a collection (.ttc); default 0
-  --var TAG=VALUE          a variation axis value, e.g. --var wght=700; repeatable
-  --text UTF8              bake only the glyphs this text needs (with ligatures and
-                           alternates shaping can substitute, and .notdef)
-  --codepoints RANGES      the same for code points: U+0020-007E,0x4E00-0x4E10,65
-  --tolerance EM           largest cubic-to-quadratic deviation in em (default 1/4096)
-  --split-y-extrema        split curves at their y-extrema (measured not to pay; see docs)
-  --max-curves N           a glyph with more than N curves fails, 1..4096 (default 4096)
-  --allow-failed           bake failed glyphs as empty glyphs instead of giving up
-  --json                   print the report as JSON on stdout
-  -q, --quiet              no progress bar and no report (errors still go to stderr)
-  --check ASSET            validate an asset and print its summary
-  -h, --help               this text
+)";
 
+constexpr const char* kExitCodes = R"(
 exit codes:
   0 success   2 usage error   3 unreadable or unsupported font   4 output not writable
   5 glyphs failed   6 invalid asset (--check)   1 internal error
@@ -69,101 +55,74 @@ struct Arguments {
     bool quiet = false;
 };
 
-[[noreturn]] void usage_error(const std::string& message) {
-    std::fprintf(stderr, "crisp-bake: %s\n(run crisp-bake --help for usage)\n", message.c_str());
-    std::exit(kExitUsage);
+// Appends a parsed list of code points (or the parser's error) to the bake's.
+template <class Parsed>
+crisp::Status append_codepoints(crisp::BakeOptions& bake, Parsed parsed) {
+    if (!parsed) return parsed.error();
+    bake.codepoints.insert(bake.codepoints.end(), parsed->begin(), parsed->end());
+    return {};
 }
 
-template <class T>
-T parse_number(std::string_view option, std::string_view text) {
-    std::string why;
-    const std::optional<T> value = crisp::cli::parse_number<T>(text, &why);
-    if (!value) usage_error(std::string(option) + ": '" + std::string(text) + "' " + why);
-    return *value;
+void declare_options(crisp::cli::CommandLine& cli, Arguments& args, std::vector<uint32_t>& text_codepoints) {
+    crisp::BakeOptions& bake = args.bake;
+    cli.on_usage_error(kExitUsage, "\n(run crisp-bake --help for usage)").section("options:");
+    cli.text("-o, --output", "OUT.crisp", "where to write the asset (default: FONT's name with .crisp, here)",
+             args.output);
+    cli.number<uint32_t>("--face", "N", "face N of a collection (.ttc); default 0", bake.face_index);
+    cli.option("--var", "TAG=VALUE", "a variation axis value, e.g. --var wght=700; repeatable",
+               [&bake](std::string_view text) -> crisp::Status {
+                   auto variation = crisp::parse_variation(text);
+                   if (!variation) return variation.error();
+                   bake.variations.push_back(*variation);
+                   return {};
+               });
+    cli.codepoints("--text", "UTF8",
+                   "bake only the glyphs this text needs (with ligatures and\n"
+                   "alternates shaping can substitute, and .notdef)",
+                   text_codepoints);
+    cli.option("--codepoints", "RANGES", "the same for code points: U+0020-007E,0x4E00-0x4E10,65",
+               [&bake](std::string_view text) { return append_codepoints(bake, crisp::parse_codepoint_ranges(text)); });
+    cli.number<float>("--tolerance", "EM", "largest cubic-to-quadratic deviation in em (default 1/4096)",
+                      bake.tolerance_em, {0.0f, 0.1f, true, " em"});
+    cli.flag("--split-y-extrema", "split curves at their y-extrema (measured not to pay; see docs)",
+             bake.split_y_extrema);
+    cli.number<uint32_t>("--max-curves", "N", "a glyph with more than N curves fails, 1..4096 (default 4096)",
+                         bake.max_curves_per_glyph, {1, crisp::kMaxCurvesPerGlyph});
+    cli.flag("--allow-failed", "bake failed glyphs as empty glyphs instead of giving up", bake.allow_failed);
+    cli.flag("--json", "print the report as JSON on stdout", args.json);
+    cli.flag("-q, --quiet", "no progress bar and no report (errors still go to stderr)", args.quiet);
+    cli.text("--check", "ASSET", "validate an asset and print its summary", args.check);
+    cli.positional([&args](std::string_view font) -> crisp::Status {
+        if (!args.font.empty()) {
+            return crisp::Error{crisp::ErrorCode::invalid_argument,
+                                "more than one font given ('" + args.font + "' and '" + std::string(font) + "')"};
+        }
+        args.font = font;
+        return {};
+    });
+    cli.epilogue(kExitCodes);
 }
 
 Arguments parse_arguments(int argc, char** argv) {
     Arguments args;
-    bool have_text = false, have_codepoints = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view arg = argv[i];
-        auto value = [&]() -> std::string_view {
-            if (i + 1 >= argc) usage_error(std::string(arg) + " needs a value");
-            return argv[++i];
-        };
-        if (arg == "-h" || arg == "--help") {
-            std::fputs(kUsage, stdout);
-            std::exit(kExitOk);
-        } else if (arg == "-o" || arg == "--output") {
-            args.output = value();
-        } else if (arg == "--face") {
-            args.bake.face_index = parse_number<uint32_t>(arg, value());
-        } else if (arg == "--var") {
-            auto variation = crisp::parse_variation(value());
-            if (!variation) usage_error(variation.error().message);
-            args.bake.variations.push_back(*variation);
-        } else if (arg == "--text") {
-            have_text = true;
-            const auto codepoints = crisp::decode_utf8(value());
-            args.bake.codepoints.insert(args.bake.codepoints.end(), codepoints.begin(), codepoints.end());
-            args.bake.all_glyphs = false;
-        } else if (arg == "--codepoints") {
-            have_codepoints = true;
-            auto codepoints = crisp::parse_codepoint_ranges(value());
-            if (!codepoints) usage_error(codepoints.error().message);
-            args.bake.codepoints.insert(args.bake.codepoints.end(), codepoints->begin(), codepoints->end());
-            args.bake.all_glyphs = false;
-        } else if (arg == "--tolerance") {
-            args.bake.tolerance_em = parse_number<float>(arg, value());
-            if (!(args.bake.tolerance_em > 0.0f && args.bake.tolerance_em <= 0.1f)) {
-                usage_error("--tolerance must be in (0, 0.1] em");
-            }
-        } else if (arg == "--split-y-extrema") {
-            args.bake.split_y_extrema = true;
-        } else if (arg == "--max-curves") {
-            args.bake.max_curves_per_glyph = parse_number<uint32_t>(arg, value());
-            if (args.bake.max_curves_per_glyph == 0 || args.bake.max_curves_per_glyph > crisp::kMaxCurvesPerGlyph) {
-                usage_error("--max-curves must be 1 to " + std::to_string(crisp::kMaxCurvesPerGlyph));
-            }
-        } else if (arg == "--allow-failed") {
-            args.bake.allow_failed = true;
-        } else if (arg == "--json") {
-            args.json = true;
-        } else if (arg == "-q" || arg == "--quiet") {
-            args.quiet = true;
-        } else if (arg == "--check") {
-            args.check = value();
-        } else if (arg.size() > 1 && arg[0] == '-') {
-            usage_error("unknown option " + std::string(arg));
-        } else if (args.font.empty()) {
-            args.font = arg;
-        } else {
-            usage_error("more than one font given ('" + args.font + "' and '" + std::string(arg) + "')");
-        }
-    }
-    if (have_text && have_codepoints) usage_error("--text and --codepoints exclude each other");
+    std::vector<uint32_t> text_codepoints;
+    crisp::cli::CommandLine cli("crisp-bake", kSynopsis);
+    declare_options(cli, args, text_codepoints);
+    cli.parse(argc, argv);
+    if (cli.given("--text") && cli.given("--codepoints")) cli.fail("--text and --codepoints exclude each other");
+    if (cli.given("--text") || cli.given("--codepoints")) args.bake.all_glyphs = false;
+    args.bake.codepoints.insert(args.bake.codepoints.end(), text_codepoints.begin(), text_codepoints.end());
     if (!args.check.empty()) {
-        if (!args.font.empty()) usage_error("--check takes an asset, not a font");
+        if (!args.font.empty()) cli.fail("--check takes an asset, not a font");
         return args;
     }
-    if (args.font.empty()) usage_error("no font given");
+    if (args.font.empty()) cli.fail("no font given");
     if (args.output.empty()) {
         std::string stem = std::filesystem::path(args.font).stem().string();
         if (args.bake.face_index > 0) stem += "-face" + std::to_string(args.bake.face_index);
         args.output = stem + ".crisp";
     }
     return args;
-}
-
-std::string json_string(std::string_view s) {
-    return crisp::json::quote(s);
-}
-
-std::string json_number(double v) {
-    if (!std::isfinite(v)) return "null";
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.9g", v);
-    return buffer;
 }
 
 double peak_rss_bytes() {
@@ -204,15 +163,18 @@ std::string axes_text(const crisp::FontInfo& info) {
     return text;
 }
 
-std::string axes_json(const crisp::FontInfo& info) {
-    std::string text = "[";
+void write_axes(crisp::JsonWriter& json, const crisp::FontInfo& info) {
+    json.key("axes").begin_array();
     for (const crisp::AxisValue& axis : info.axes) {
-        text += (text.size() > 1 ? ", " : "") + std::string("{\"tag\": ") +
-                json_string(crisp::tag_to_string(axis.tag)) + ", \"value\": " + json_number(axis.value) +
-                ", \"min\": " + json_number(axis.minimum) + ", \"default\": " + json_number(axis.default_value) +
-                ", \"max\": " + json_number(axis.maximum) + "}";
+        json.begin_object()
+            .field("tag", crisp::tag_to_string(axis.tag))
+            .field("value", axis.value)
+            .field("min", axis.minimum)
+            .field("default", axis.default_value)
+            .field("max", axis.maximum)
+            .end_object();
     }
-    return text + "]";
+    json.end_array();
 }
 
 int run_check(const Arguments& args) {
@@ -220,9 +182,13 @@ int run_check(const Arguments& args) {
     if (!asset) {
         std::fprintf(stderr, "crisp-bake: %s: %s\n", args.check.c_str(), asset.error().message.c_str());
         if (args.json) {
-            std::printf("{\"valid\": false, \"error\": %s, \"message\": %s}\n",
-                        json_string(crisp::error_code_name(asset.error().code)).c_str(),
-                        json_string(asset.error().message).c_str());
+            crisp::JsonWriter json;
+            json.begin_object()
+                .field("valid", false)
+                .field("error", crisp::error_code_name(asset.error().code))
+                .field("message", asset.error().message)
+                .end_object();
+            std::fputs(json.line().c_str(), stdout);
         }
         return kExitInvalidAsset;
     }
@@ -236,19 +202,31 @@ int run_check(const Arguments& args) {
         bands += glyph.band_count;
     }
     if (args.json) {
-        std::printf(
-            "{\"valid\": true, \"family\": %s, \"style\": %s, \"units_per_em\": %u, \"face_index\": %u, "
-            "\"ascender\": %d, \"descender\": %d, \"line_gap\": %d, \"cubic\": %s, \"axes\": %s, "
-            "\"glyphs\": %zu, \"baked_glyphs\": %llu, \"failed_glyphs\": %llu, \"outlined_glyphs\": %llu, "
-            "\"curve_slots\": %llu, \"points\": %zu, \"bands\": %llu, \"band_words\": %zu, "
-            "\"font_bytes\": %zu, \"tolerance_em\": %s, \"max_deviation_em\": %s}\n",
-            json_string(info.family).c_str(), json_string(info.style).c_str(), info.units_per_em, info.face_index,
-            info.ascender, info.descender, info.line_gap, (info.flags & crisp::kFontCubic) ? "true" : "false",
-            axes_json(info).c_str(), asset->glyphs.size(), static_cast<unsigned long long>(baked),
-            static_cast<unsigned long long>(failed), static_cast<unsigned long long>(outlined),
-            static_cast<unsigned long long>(slots), asset->points.size(), static_cast<unsigned long long>(bands),
-            asset->band_words.size(), asset->font_bytes.size(), json_number(info.tolerance_em).c_str(),
-            json_number(info.max_deviation_em).c_str());
+        crisp::JsonWriter json;
+        json.begin_object()
+            .field("valid", true)
+            .field("family", info.family)
+            .field("style", info.style)
+            .field("units_per_em", info.units_per_em)
+            .field("face_index", info.face_index)
+            .field("ascender", info.ascender)
+            .field("descender", info.descender)
+            .field("line_gap", info.line_gap)
+            .field("cubic", (info.flags & crisp::kFontCubic) != 0);
+        write_axes(json, info);
+        json.field("glyphs", asset->glyphs.size())
+            .field("baked_glyphs", baked)
+            .field("failed_glyphs", failed)
+            .field("outlined_glyphs", outlined)
+            .field("curve_slots", slots)
+            .field("points", asset->points.size())
+            .field("bands", bands)
+            .field("band_words", asset->band_words.size())
+            .field("font_bytes", asset->font_bytes.size())
+            .field("tolerance_em", info.tolerance_em)
+            .field("max_deviation_em", info.max_deviation_em)
+            .end_object();
+        std::fputs(json.line().c_str(), stdout);
     } else if (!args.quiet) {
         std::printf("%s: valid crisp asset (version %u)\n", args.check.c_str(), crisp::kAssetVersion);
         std::printf("  font        %s %s, face %u, %u units per em%s\n", crisp::cli::printable(info.family).c_str(),
@@ -270,40 +248,58 @@ int run_check(const Arguments& args) {
     return kExitOk;
 }
 
+crisp::JsonWriter report_json(const Arguments& args, const crisp::FontInfo& info, const crisp::BakeReport& r) {
+    const double px16 = 16.0;
+    crisp::JsonWriter json;
+    json.begin_object()
+        .field("font", args.font)
+        .field("face_index", info.face_index)
+        .field("family", info.family)
+        .field("style", info.style)
+        .field("units_per_em", info.units_per_em);
+    write_axes(json, info);
+    json.field("output", args.output)
+        .field("glyphs", r.glyph_count)
+        .field("baked_glyphs", r.baked_glyphs)
+        .field("empty_glyphs", r.empty_glyphs)
+        .field("failed_glyphs", r.failed_glyphs)
+        .field("failed_glyph_ids", r.failed_glyph_ids)
+        .field("curves", r.curve_count)
+        .field("lines", r.line_count)
+        .field("quadratics", r.quadratic_count)
+        .field("cubics", r.cubic_count)
+        .field("cubic_pieces", r.cubic_pieces)
+        .field("dropped_zero_length", r.dropped_zero_length)
+        .field("closed_contours", r.closed_contours)
+        .field("y_splits", r.y_splits);
+    json.key("curves_per_glyph").begin_object();
+    json.field("mean", r.mean_curves_per_glyph).field("max", r.max_curves_per_glyph).end_object();
+    json.key("bands").begin_object();
+    json.field("total", r.band_count)
+        .field("max_per_glyph", r.max_bands_per_glyph)
+        .field("max_curves_per_band", r.max_curves_per_band)
+        .field("mean_curves_per_band", r.mean_curves_per_band)
+        .field("mean_curve_tests_per_ray", r.mean_curve_tests_per_ray)
+        .end_object();
+    json.key("cubic_lowering").begin_object();
+    json.field("tolerance_em", info.tolerance_em)
+        .field("max_deviation_em", r.max_deviation_em)
+        .field("max_deviation_px_at_16px", r.max_deviation_em * px16)
+        .field("seed_split_max_deviation_em", r.seed_max_deviation_em)
+        .field("seed_split_max_deviation_px_at_16px", r.seed_max_deviation_em * px16)
+        .field("seed_split_pieces", r.seed_cubic_pieces)
+        .end_object();
+    json.field("asset_bytes", r.asset_bytes)
+        .field("seconds", r.seconds)
+        .field("peak_rss_bytes", peak_rss_bytes())
+        .end_object();
+    return json;
+}
+
 void print_report(const Arguments& args, const crisp::FontInfo& info, const crisp::BakeReport& r) {
     const double px16 = 16.0;
     if (args.json) {
-        std::string failed = "[";
-        for (const uint32_t id : r.failed_glyph_ids) failed += (failed.size() > 1 ? ", " : "") + std::to_string(id);
-        failed += "]";
-        std::printf(
-            "{\"font\": %s, \"face_index\": %u, \"family\": %s, \"style\": %s, \"units_per_em\": %u, \"axes\": %s, "
-            "\"output\": %s, \"glyphs\": %u, \"baked_glyphs\": %u, \"empty_glyphs\": %u, \"failed_glyphs\": %u, "
-            "\"failed_glyph_ids\": %s, \"curves\": %llu, \"lines\": %llu, \"quadratics\": %llu, \"cubics\": %llu, "
-            "\"cubic_pieces\": %llu, \"dropped_zero_length\": %llu, \"closed_contours\": %llu, \"y_splits\": %llu, "
-            "\"curves_per_glyph\": {\"mean\": %s, \"max\": %u}, "
-            "\"bands\": {\"total\": %llu, \"max_per_glyph\": %u, \"max_curves_per_band\": %u, "
-            "\"mean_curves_per_band\": %s, \"mean_curve_tests_per_ray\": %s}, "
-            "\"cubic_lowering\": {\"tolerance_em\": %s, \"max_deviation_em\": %s, \"max_deviation_px_at_16px\": %s, "
-            "\"seed_split_max_deviation_em\": %s, \"seed_split_max_deviation_px_at_16px\": %s, \"seed_split_pieces\": "
-            "%llu}, "
-            "\"asset_bytes\": %llu, \"seconds\": %s, \"peak_rss_bytes\": %s}\n",
-            json_string(args.font).c_str(), info.face_index, json_string(info.family).c_str(),
-            json_string(info.style).c_str(), info.units_per_em, axes_json(info).c_str(),
-            json_string(args.output).c_str(), r.glyph_count, r.baked_glyphs, r.empty_glyphs, r.failed_glyphs,
-            failed.c_str(), static_cast<unsigned long long>(r.curve_count),
-            static_cast<unsigned long long>(r.line_count), static_cast<unsigned long long>(r.quadratic_count),
-            static_cast<unsigned long long>(r.cubic_count), static_cast<unsigned long long>(r.cubic_pieces),
-            static_cast<unsigned long long>(r.dropped_zero_length), static_cast<unsigned long long>(r.closed_contours),
-            static_cast<unsigned long long>(r.y_splits), json_number(r.mean_curves_per_glyph).c_str(),
-            r.max_curves_per_glyph, static_cast<unsigned long long>(r.band_count), r.max_bands_per_glyph,
-            r.max_curves_per_band, json_number(r.mean_curves_per_band).c_str(),
-            json_number(r.mean_curve_tests_per_ray).c_str(),
-            json_number(static_cast<double>(info.tolerance_em)).c_str(), json_number(r.max_deviation_em).c_str(),
-            json_number(r.max_deviation_em * px16).c_str(), json_number(r.seed_max_deviation_em).c_str(),
-            json_number(r.seed_max_deviation_em * px16).c_str(), static_cast<unsigned long long>(r.seed_cubic_pieces),
-            static_cast<unsigned long long>(r.asset_bytes), json_number(r.seconds).c_str(),
-            json_number(peak_rss_bytes()).c_str());
+        std::fputs(report_json(args, info, r).line().c_str(), stdout);
         return;
     }
     if (args.quiet) return;
@@ -364,8 +360,8 @@ int main(int argc, char** argv) {
 
     if (!args.quiet && isatty(STDERR_FILENO)) args.bake.progress = draw_progress;
     // Before any work: an output that cannot or must not be written (a device, a directory, the input).
-    const std::filesystem::path input(args.font);
-    if (const crisp::Status checked = crisp::check_output_path(args.output, std::span(&input, 1)); !checked) {
+    crisp::OutputFiles output({args.font});
+    if (const crisp::Status checked = output.add(args.output); !checked) {
         std::fprintf(stderr, "crisp-bake: %s\n", checked.error().message.c_str());
         return kExitOutput;
     }
@@ -378,7 +374,8 @@ int main(int argc, char** argv) {
     crisp::BakeResult& result = *baked;
     const std::vector<std::byte> bytes = crisp::serialize_asset(result.asset);
     result.report.asset_bytes = bytes.size();
-    if (const crisp::Status status = crisp::write_file_atomically(args.output, bytes); !status) {
+    const std::span<const std::byte> contents[] = {bytes};
+    if (const crisp::Status status = output.write(contents); !status) {
         std::fprintf(stderr, "crisp-bake: %s\n", status.error().message.c_str());
         return kExitOutput;
     }

@@ -2,12 +2,12 @@
 // GPU with crisp::Compositor into a PNG and, on request, reads the atlas back for a PFM of the
 // text's coverage. The text comes from the command line or from a scene file.
 #include "cli.hpp"
-#include "file_io.hpp"
 #include "gpu_tools.hpp"
-#include "image_io.hpp"
-#include "json.hpp"
-#include "scene.hpp"
 #include "headless_context.hpp"
+#include "image_io.hpp"
+#include "json_writer.hpp"
+#include "output_files.hpp"
+#include "scene.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/atlas.hpp>
@@ -66,54 +66,16 @@ constexpr uint32_t kMinAtlasSide = 256;
 constexpr uint32_t kAtlasTexelBytes = 8;    // R16G16B16A16_UINT
 constexpr uint32_t kTargetTexelBytes = 16;  // the compositor's R32G32B32A32_SFLOAT
 
-constexpr const char* kUsage = R"(usage: crisp-render --font A.crisp [--font B.crisp ...] --text UTF8 --size PX
+constexpr const char* kSynopsis = R"(usage: crisp-render --font A.crisp [--font B.crisp ...] --text UTF8 --size PX
                     --origin X,Y --canvas W,H -o OUT.png [options]
        crisp-render --scene SCENE.json -o OUT.png [options]
 
 Renders text with crisp's GPU rasterizer, frame after frame until every glyph holds its samples,
 then composites the glyphs over the background on the GPU (crisp::Compositor), in linear light.
 
-the text (all required, unless --scene gives it):
-  --font FILE.crisp        a font asset (crisp-bake makes them); repeat for a fallback chain
-  --text UTF8              the text; line breaks start new lines
-  --size PX                pixels per em, in (0, 4096]
-  --origin X,Y             pen position of the first glyph on its baseline, canvas pixels, y down;
-                           fractional values are kept (quantized to 1/256 px), never rounded
-  --canvas W,H             image size in pixels, each 1..16384
-  --scene SCENE.json       a scene file instead (docs/scene-format.md): fonts, canvas, background,
-                           layout and runs of text with colours and depths; none of --font, --text,
-                           --size, --origin, --canvas, --color, --background, --layout may be given
+)";
 
-required:
-  -o, --output OUT.png     the composited image, 8-bit sRGB
-
-options:
-  --layout NAME|FILE.json  subpixel layout: gray, rgb, bgr, vrgb, vbgr, qd-oled, woled, pentile,
-                           or a layout file (default: rgb)
-  --samples N              samples per glyph texel and channel, 1..1023 (default 512)
-  --color R,G,B[,A]        text colour, sRGB components in [0, 1], straight alpha (default 0,0,0,1)
-  --background R,G,B[,A]   background, the same way (default 1,1,1,1); with alpha below 1 the PNG
-                           has an alpha channel
-  --composite MODE         how the glyphs are blended over what is behind them: tiled (screen
-                           tiles in workgroup memory, exact front to back; the default), draw
-                           (sorted quads blended in a render pass), or a reference mode: unsorted
-                           (paint order, no OIT), wboit (weighted blended OIT) or exact
-                           (per-pixel sorted lists)
-  --backdrop KIND          tiled and draw: what the text is drawn over, in the canvas image:
-                           flat (the background colour; the default), gradient (a ramp from the
-                           background to its complement with soft stripes) or photo (smooth colour
-                           fields and fine detail, like a photograph)
-  --path raster|compute    wboit and exact: how their glyph passes run, rasterized quads
-                           (default) or compute over 8x8 tiles of each quad; the same image
-  --coverage-out OUT.pfm   the text's linear coverage per channel as a PFM image
-  --json                   print the report as one JSON object on stdout (compositor notes go
-                           into it instead of stderr)
-  -q, --quiet              no report on stdout, no notes or warnings on stderr (errors still)
-  --validate               turn on the Vulkan validation layer (always on in debug builds); any
-                           warning or error it reports fails the run (exit 5)
-  --device NAME            use the Vulkan device whose name contains NAME
-  -h, --help               this text
-
+constexpr const char* kExitCodes = R"(
 exit codes:
   0 success   2 usage error   3 font asset cannot be loaded   4 output not writable
   5 Vulkan unavailable or failed, or validation messages   6 bad --layout or scene layout
@@ -134,7 +96,6 @@ struct Arguments {
     crisp::CompositeMode composite = crisp::CompositeMode::tiled;
     std::string backdrop = "flat";
     crisp::QuadPath path = crisp::QuadPath::raster;
-    bool path_given = false;
     std::string output;
     std::string coverage_output;
     bool json = false;
@@ -147,208 +108,207 @@ struct Arguments {
     std::string device;
 };
 
-[[noreturn]] void usage_error(const std::string& message) {
-    std::fprintf(stderr, "crisp-render: %s\n(run crisp-render --help for usage)\n", message.c_str());
-    std::exit(kExitUsage);
-}
-
 [[noreturn]] void fail(int code, const std::string& message) {
     std::fprintf(stderr, "crisp-render: %s\n", message.c_str());
     std::exit(code);
 }
 
-template <class T>
-T parse_number(std::string_view option, std::string_view text) {
-    std::string why;
-    const std::optional<T> value = crisp::cli::parse_number<T>(text, &why);
-    if (!value) usage_error(std::string(option) + ": '" + std::string(text) + "' " + why);
-    return *value;
-}
-
-template <class T>
-std::vector<T> parse_list(std::string_view option, std::string_view text) {
-    std::vector<T> values;
-    for (;;) {
-        const size_t comma = text.find(',');
-        values.push_back(parse_number<T>(option, text.substr(0, comma)));
-        if (comma == std::string_view::npos) break;
-        text.remove_prefix(comma + 1);
-    }
-    return values;
-}
-
-std::array<float, 4> parse_color(std::string_view option, std::string_view text) {
-    const std::vector<float> values = parse_list<float>(option, text);
-    if (values.size() != 3 && values.size() != 4) {
-        usage_error(std::string(option) + " takes R,G,B or R,G,B,A, not '" + std::string(text) + "'");
+// "R,G,B" or "R,G,B,A", each in [0, 1], alpha 1 when not given.
+crisp::Result<std::array<float, 4>> parse_color(std::string_view option, std::string_view text) {
+    const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>(option, text);
+    if (!values) return values.error();
+    auto refuse = [&](const std::string& why) { return crisp::Error{crisp::ErrorCode::invalid_argument, why}; };
+    if (values->size() != 3 && values->size() != 4) {
+        return refuse(std::string(option) + " takes R,G,B or R,G,B,A, not '" + std::string(text) + "'");
     }
     std::array<float, 4> color = {0.0f, 0.0f, 0.0f, 1.0f};
-    for (size_t i = 0; i < values.size(); ++i) {
-        if (!(values[i] >= 0.0f && values[i] <= 1.0f)) {
-            usage_error(std::string(option) + ": components are in [0, 1] (sRGB, straight alpha); '" +
-                        std::string(text) + "' is not");
+    for (size_t i = 0; i < values->size(); ++i) {
+        if (!((*values)[i] >= 0.0f && (*values)[i] <= 1.0f)) {
+            return refuse(std::string(option) + ": components are in [0, 1] (sRGB, straight alpha); '" +
+                          std::string(text) + "' is not");
         }
-        color[i] = values[i];
+        color[i] = (*values)[i];
     }
     return color;
 }
 
-Arguments parse_arguments(int argc, char** argv) {
-    Arguments args;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view arg = argv[i];
-        auto value = [&]() -> std::string_view {
-            if (i + 1 >= argc) usage_error(std::string(arg) + " needs a value");
-            return argv[++i];
-        };
-        if (arg == "-h" || arg == "--help") {
-            std::fputs(kUsage, stdout);
-            std::exit(kExitOk);
-        } else if (arg == "--font") {
-            args.fonts.emplace_back(value());
-        } else if (arg == "--text") {
-            args.text = std::string(value());
-        } else if (arg == "--size") {
-            const auto size = parse_number<float>(arg, value());
-            if (!(size > 0.0f && size <= crisp::kMaxTextSize)) usage_error("--size must be in (0, 4096] pixels per em");
-            args.size = size;
-        } else if (arg == "--origin") {
-            const std::string_view text = value();
-            const std::vector<float> xy = parse_list<float>(arg, text);
-            if (xy.size() != 2) usage_error("--origin takes X,Y, not '" + std::string(text) + "'");
-            args.origin = std::array<float, 2>{xy[0], xy[1]};
-        } else if (arg == "--canvas") {
-            const std::string_view text = value();
-            const std::vector<uint32_t> wh = parse_list<uint32_t>(arg, text);
-            if (wh.size() != 2) usage_error("--canvas takes W,H, not '" + std::string(text) + "'");
-            if (wh[0] < 1 || wh[0] > kMaxCanvas || wh[1] < 1 || wh[1] > kMaxCanvas) {
-                usage_error("--canvas: width and height are each 1..16384, not '" + std::string(text) + "'");
-            }
-            args.canvas = std::array<uint32_t, 2>{wh[0], wh[1]};
-        } else if (arg == "--layout") {
-            args.layout = std::string(value());
-        } else if (arg == "--samples") {
-            args.samples = parse_number<uint32_t>(arg, value());
-            if (args.samples < 1 || args.samples > crisp::kMaxRendererSamples) {
-                usage_error("--samples must be in 1.." + std::to_string(crisp::kMaxRendererSamples));
-            }
-        } else if (arg == "--color") {
-            args.color = parse_color(arg, value());
-        } else if (arg == "--background") {
-            args.background = parse_color(arg, value());
-        } else if (arg == "--scene") {
-            args.scene = value();
-            if (args.scene.empty()) usage_error("--scene needs a file name");
-        } else if (arg == "--composite") {
-            const std::string_view name = value();
-            const std::optional<crisp::CompositeMode> mode = crisp::parse_composite_mode(name);
-            if (!mode) {
-                usage_error("--composite takes tiled, draw, unsorted, wboit or exact, not '" +
-                            std::string(name) + "'");
-            }
-            args.composite = *mode;
-        } else if (arg == "--backdrop") {
-            args.backdrop = value();
-            if (args.backdrop != "flat" && args.backdrop != "gradient" && args.backdrop != "photo") {
-                usage_error("--backdrop takes flat, gradient or photo, not '" + args.backdrop + "'");
-            }
-        } else if (arg == "--path") {
-            const std::string_view name = value();
-            const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(name);
-            if (!path) usage_error("--path takes raster or compute, not '" + std::string(name) + "'");
-            args.path = *path;
-            args.path_given = true;
-        } else if (arg == "-o" || arg == "--output") {
-            args.output = value();
-        } else if (arg == "--coverage-out") {
-            args.coverage_output = value();
-        } else if (arg == "--json") {
-            args.json = true;
-        } else if (arg == "-q" || arg == "--quiet") {
-            args.quiet = true;
-        } else if (arg == "--validate") {
-            args.validate = true;
-        } else if (arg == "--device") {
-            args.device = value();
-        } else {
-            usage_error("unexpected argument '" + std::string(arg) + "'");
-        }
+// An option whose value `parse` turns into `target` (an optional), or refuses.
+template <class T, class Parse>
+crisp::cli::CommandLine::Apply store(std::optional<T>& target, Parse parse) {
+    return [&target, parse](std::string_view text) -> crisp::Status {
+        crisp::Result<T> value = parse(text);
+        if (!value) return value.error();
+        target = *value;
+        return {};
+    };
+}
+
+crisp::Result<std::array<float, 2>> parse_origin(std::string_view text) {
+    const crisp::Result<std::vector<float>> xy = crisp::cli::parse_number_list<float>("--origin", text);
+    if (!xy) return xy.error();
+    if (xy->size() != 2)
+        return crisp::Error{crisp::ErrorCode::invalid_argument, "--origin takes X,Y, not '" + std::string(text) + "'"};
+    return std::array<float, 2>{(*xy)[0], (*xy)[1]};
+}
+
+crisp::Result<std::array<uint32_t, 2>> parse_canvas(std::string_view text) {
+    const crisp::Result<std::vector<uint32_t>> wh = crisp::cli::parse_number_list<uint32_t>("--canvas", text);
+    if (!wh) return wh.error();
+    auto refuse = [&](const std::string& why) { return crisp::Error{crisp::ErrorCode::invalid_argument, why}; };
+    if (wh->size() != 2) return refuse("--canvas takes W,H, not '" + std::string(text) + "'");
+    const uint32_t w = (*wh)[0], h = (*wh)[1];
+    if (w < 1 || w > kMaxCanvas || h < 1 || h > kMaxCanvas) {
+        return refuse("--canvas: width and height are each 1..16384, not '" + std::string(text) + "'");
     }
+    return std::array<uint32_t, 2>{w, h};
+}
+
+// The text the command line describes (or --scene), as --help lists it.
+void declare_text_options(crisp::cli::CommandLine& cli, Arguments& args) {
+    cli.section("the text (all required, unless --scene gives it):");
+    cli.repeated("--font", "FILE.crisp", "a font asset (crisp-bake makes them); repeat for a fallback chain",
+                 args.fonts);
+    cli.text("--text", "UTF8", "the text; line breaks start new lines", args.text);
+    cli.number<float>("--size", "PX", "pixels per em, in (0, 4096]", args.size,
+                      {0.0f, crisp::kMaxTextSize, true, " pixels per em"});
+    cli.option("--origin", "X,Y",
+               "pen position of the first glyph on its baseline, canvas pixels, y down;\n"
+               "fractional values are kept (quantized to 1/256 px), never rounded",
+               store(args.origin, parse_origin));
+    cli.option("--canvas", "W,H", "image size in pixels, each 1..16384", store(args.canvas, parse_canvas));
+    cli.option("--scene", "SCENE.json",
+               "a scene file instead (docs/scene-format.md): fonts, canvas, background,\n"
+               "layout and runs of text with colours and depths; none of --font, --text,\n"
+               "--size, --origin, --canvas, --color, --background, --layout may be given",
+               [&args](std::string_view name) -> crisp::Status {
+                   if (name.empty())
+                       return crisp::Error{crisp::ErrorCode::invalid_argument, "--scene needs a file name"};
+                   args.scene = name;
+                   return {};
+               });
+    cli.section("required:");
+    cli.text("-o, --output", "OUT.png", "the composited image, 8-bit sRGB", args.output);
+}
+
+// How it is rendered and composited, what is reported, and on which device.
+void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
+    using crisp::CompositeMode;
+    cli.section("options:");
+    cli.text("--layout", "NAME|FILE.json",
+             "subpixel layout: gray, rgb, bgr, vrgb, vbgr, qd-oled, woled, pentile,\n"
+             "or a layout file (default: rgb)",
+             args.layout);
+    cli.number<uint32_t>("--samples", "N", "samples per glyph texel and channel, 1..1023 (default 512)", args.samples,
+                         {1, crisp::kMaxRendererSamples});
+    auto color = [](const char* option) {
+        return [option](std::string_view text) { return parse_color(option, text); };
+    };
+    cli.option("--color", "R,G,B[,A]", "text colour, sRGB components in [0, 1], straight alpha (default 0,0,0,1)",
+               store(args.color, color("--color")));
+    cli.option("--background", "R,G,B[,A]",
+               "background, the same way (default 1,1,1,1); with alpha below 1 the PNG\n"
+               "has an alpha channel",
+               store(args.background, color("--background")));
+    cli.choice<CompositeMode>("--composite", "MODE",
+                              "how the glyphs are blended over what is behind them: tiled (screen\n"
+                              "tiles in workgroup memory, exact front to back; the default), draw\n"
+                              "(sorted quads blended in a render pass), or a reference mode: unsorted\n"
+                              "(paint order, no OIT), wboit (weighted blended OIT) or exact\n"
+                              "(per-pixel sorted lists)",
+                              args.composite,
+                              {CompositeMode::tiled, CompositeMode::draw, CompositeMode::unsorted, CompositeMode::wboit,
+                               CompositeMode::exact},
+                              [](const CompositeMode& mode) { return std::string(crisp::composite_mode_name(mode)); });
+    cli.choice("--backdrop", "KIND",
+               "tiled and draw: what the text is drawn over, in the canvas image:\n"
+               "flat (the background colour; the default), gradient (a ramp from the\n"
+               "background to its complement with soft stripes) or photo (smooth colour\n"
+               "fields and fine detail, like a photograph)",
+               args.backdrop, {"flat", "gradient", "photo"});
+    cli.choice<crisp::QuadPath>("--path", "raster|compute",
+                                "wboit and exact: how their glyph passes run, rasterized quads\n"
+                                "(default) or compute over 8x8 tiles of each quad; the same image",
+                                args.path, {crisp::QuadPath::raster, crisp::QuadPath::compute},
+                                [](const crisp::QuadPath& path) { return std::string(crisp::quad_path_name(path)); });
+    cli.text("--coverage-out", "OUT.pfm", "the text's linear coverage per channel as a PFM image",
+             args.coverage_output);
+    cli.flag("--json", "print the report as one JSON object on stdout (compositor notes go\ninto it instead of stderr)",
+             args.json);
+    cli.flag("-q, --quiet", "no report on stdout, no notes or warnings on stderr (errors still)", args.quiet);
+    cli.flag("--validate",
+             "turn on the Vulkan validation layer (always on in debug builds); any\n"
+             "warning or error it reports fails the run (exit 5)",
+             args.validate);
+    cli.text("--device", "NAME", "use the Vulkan device whose name contains NAME", args.device);
+}
+
+// With --scene, none of what the scene says may be given; without, all of the text's options must be.
+void check_text_source(const crisp::cli::CommandLine& cli, const Arguments& args) {
     if (!args.scene.empty()) {
         // The scene says all of these; a second source would leave one of them ignored.
         std::string given;
-        const std::pair<bool, const char*> options[] = {
-            {!args.fonts.empty(), "--font"},
-            {args.text.has_value(), "--text"},
-            {args.size.has_value(), "--size"},
-            {args.origin.has_value(), "--origin"},
-            {args.canvas.has_value(), "--canvas"},
-            {args.color.has_value(), "--color"},
-            {args.background.has_value(), "--background"},
-            {args.layout.has_value(), "--layout"},
-        };
-        for (const auto& [present, name] : options) {
-            if (present) given += std::string(given.empty() ? "" : ", ") + name;
+        for (const char* name :
+             {"--font", "--text", "--size", "--origin", "--canvas", "--color", "--background", "--layout"}) {
+            if (cli.given(name)) given += std::string(given.empty() ? "" : ", ") + name;
         }
         if (!given.empty()) {
-            usage_error("--scene gives the text, fonts, canvas, colours and layout: " + given +
-                        " must not be given with it");
+            cli.fail("--scene gives the text, fonts, canvas, colours and layout: " + given +
+                     " must not be given with it");
         }
-    } else {
-        if (args.fonts.empty()) usage_error("no --font given (or --scene)");
-        if (args.fonts.size() > crisp::kMaxSceneFonts) {
-            usage_error("at most " + std::to_string(crisp::kMaxSceneFonts) + " fonts, not " +
-                        std::to_string(args.fonts.size()));
-        }
-        if (!args.text) usage_error("no --text given");
-        if (!args.size) usage_error("no --size given");
-        if (!args.origin) usage_error("no --origin given");
-        if (!args.canvas) usage_error("no --canvas given");
+        return;
     }
-    if (args.output.empty()) usage_error("no output given (-o OUT.png)");
-    if (args.path_given && args.composite != crisp::CompositeMode::wboit &&
+    if (args.fonts.empty()) cli.fail("no --font given (or --scene)");
+    if (args.fonts.size() > crisp::kMaxSceneFonts) {
+        cli.fail("at most " + std::to_string(crisp::kMaxSceneFonts) + " fonts, not " +
+                 std::to_string(args.fonts.size()));
+    }
+    if (!args.text) cli.fail("no --text given");
+    if (!args.size) cli.fail("no --size given");
+    if (!args.origin) cli.fail("no --origin given");
+    if (!args.canvas) cli.fail("no --canvas given");
+}
+
+Arguments parse_arguments(int argc, char** argv) {
+    Arguments args;
+    crisp::cli::CommandLine cli("crisp-render", kSynopsis);
+    cli.on_usage_error(kExitUsage, "\n(run crisp-render --help for usage)").epilogue(kExitCodes);
+    declare_text_options(cli, args);
+    declare_render_options(cli, args);
+    cli.parse(argc, argv);
+    check_text_source(cli, args);
+    if (args.output.empty()) cli.fail("no output given (-o OUT.png)");
+    if (cli.given("--path") && args.composite != crisp::CompositeMode::wboit &&
         args.composite != crisp::CompositeMode::exact) {
-        usage_error("--path applies to --composite wboit and exact only (tiled always computes; draw and unsorted "
-                    "are always rasterized)");
+        cli.fail(
+            "--path applies to --composite wboit and exact only (tiled always computes; draw and unsorted "
+            "are always rasterized)");
     }
     if (args.backdrop != "flat" && args.composite != crisp::CompositeMode::tiled &&
         args.composite != crisp::CompositeMode::draw) {
-        usage_error("--backdrop applies to --composite tiled and draw only (the reference modes draw over a flat "
-                    "background)");
+        cli.fail(
+            "--backdrop applies to --composite tiled and draw only (the reference modes draw over a flat "
+            "background)");
     }
     if (!args.coverage_output.empty() && std::filesystem::path(args.coverage_output).lexically_normal() ==
                                              std::filesystem::path(args.output).lexically_normal()) {
-        usage_error("-o and --coverage-out name the same file");
+        cli.fail("-o and --coverage-out name the same file");
     }
     return args;
 }
 
-// Refuses, before any rendering, an output that cannot be written (its directory missing), must not
-// be replaced (a device node, directory, FIFO), or is one of the inputs.
-void check_output_path(const std::string& path, const Arguments& args) {
+// The outputs (-o, then --coverage-out), refused before any rendering when one cannot be written
+// (its directory missing), must not be replaced (a device node, directory, FIFO), or is one of
+// the inputs.
+crisp::OutputFiles declare_outputs(const Arguments& args) {
     std::vector<std::filesystem::path> inputs(args.fonts.begin(), args.fonts.end());
     if (!args.scene.empty()) inputs.emplace_back(args.scene);
     if (args.layout) inputs.emplace_back(*args.layout);
-    if (const crisp::Status checked = crisp::check_output_path(path, inputs); !checked) {
-        fail(kExitOutput, checked.error().message);
+    crisp::OutputFiles outputs(std::move(inputs));
+    for (const std::string& path : {args.output, args.coverage_output}) {
+        if (path.empty()) continue;
+        if (const crisp::Status checked = outputs.add(path); !checked) fail(kExitOutput, checked.error().message);
     }
-}
-
-// ---- JSON, by hand
-
-std::string json_string(std::string_view s) {
-    return crisp::json::quote(s);
-}
-
-std::string json_number(double v) {
-    if (!std::isfinite(v)) return "null";
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.9g", v);
-    return buffer;
-}
-
-std::string json_uint(uint64_t v) {
-    return std::to_string(v);
+    return outputs;
 }
 
 // ---- Rendering
@@ -634,63 +594,17 @@ int read_atlas_rects(crisp::HeadlessContext& context, const crisp::Renderer& ren
         regions.push_back(region);
         texel_count += size_t{glyph.instance.width} * glyph.instance.height;
     }
-    crisp::Result<crisp::Buffer> buffer = context.create_buffer(
-        texel_count * kAtlasTexelBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
-    if (!buffer) {
-        std::fprintf(stderr, "crisp-render: cannot make the atlas readback buffer: %s\n",
-                     buffer.error().message.c_str());
-        return exit_code_for_vulkan(buffer.error());
-    }
-    const VkImage atlas_image = renderer.atlas_image();
-    const crisp::Status copied = context.submit_and_wait([&](VkCommandBuffer command_buffer) {
-        // record() made the atlas readable by transfers; this barrier also orders the copy after
-        // the last frame's dispatch and the compositor's reads (earlier submissions) and moves the
-        // atlas to the layout copies are fast in, and the next one returns it to GENERAL, where the
-        // renderer keeps it.
-        VkImageMemoryBarrier image_barriers[2]{};
-        for (VkImageMemoryBarrier& barrier : image_barriers) {
-            barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-            barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-            barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-            barrier.image = atlas_image;
-            barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        }
-        VkImageMemoryBarrier& to_copy = image_barriers[0];
-        to_copy.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-        to_copy.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-        to_copy.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
-        to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-        VkImageMemoryBarrier& to_general = image_barriers[1];
-        to_general.srcAccessMask = 0;  // the copy only read
-        to_general.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-        to_general.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-        to_general.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-        vkCmdPipelineBarrier(command_buffer,
-                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT |
-                                 VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &to_copy);
-        vkCmdCopyImageToBuffer(command_buffer, atlas_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer->handle(),
-                               static_cast<uint32_t>(regions.size()), regions.data());
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                             nullptr, 0, nullptr, 1, &to_general);
-        VkBufferMemoryBarrier to_host{};
-        to_host.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
-        to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.buffer = buffer->handle();
-        to_host.offset = 0;
-        to_host.size = VK_WHOLE_SIZE;
-        vkCmdPipelineBarrier(command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr,
-                             1, &to_host, 0, nullptr);
-    });
-    if (!copied) {
-        std::fprintf(stderr, "crisp-render: reading the atlas back: %s\n", copied.error().message.c_str());
-        return exit_code_for_vulkan(copied.error());
+    // record() made the atlas readable by transfers; the read orders the copy after the last
+    // frame's dispatch and the compositor's reads (earlier submissions) and returns the atlas to
+    // GENERAL, where the renderer keeps it.
+    const crisp::Result<std::vector<std::byte>> texels = context.read_image_regions(
+        renderer.atlas_image(), VK_IMAGE_LAYOUT_GENERAL, regions, texel_count * kAtlasTexelBytes);
+    if (!texels) {
+        std::fprintf(stderr, "crisp-render: reading the atlas back: %s\n", texels.error().message.c_str());
+        return exit_code_for_vulkan(texels.error());
     }
     report.texels.resize(texel_count * 4);
-    std::memcpy(report.texels.data(), buffer->mapped().data(), texel_count * kAtlasTexelBytes);
+    std::memcpy(report.texels.data(), texels->data(), texel_count * kAtlasTexelBytes);
     report.readback_ms = milliseconds_since(readback_start);
     return kExitOk;
 }
@@ -840,95 +754,119 @@ bool has_overlap(const CompositeReport& c) {
     return c.stats.measured && (is_exact(c) || is_tiled(c));
 }
 
-std::string json_composite(const Arguments& args, const CompositeReport& c) {
+void write_composite(crisp::JsonWriter& json, const Arguments& args, const CompositeReport& c) {
     const crisp::CompositorStats& s = c.stats;
-    const bool exact = is_exact(c);
-    auto uint_or_null = [](bool present, uint64_t v) { return present ? json_uint(v) : std::string("null"); };
-    std::string out = "{\"mode\": " + json_string(crisp::composite_mode_name(s.mode));
-    out += ", \"path\": " + json_string(crisp::quad_path_name(s.path));
-    out += ", \"storage_without_format\": " + std::string(c.storage_without_format ? "true" : "false");
-    out += ", \"quads\": " + json_uint(s.quads);
-    out += ", \"bins_reused\": " + std::string(s.bins_reused ? "true" : "false");
-    out += ", \"buffer_bytes\": " + json_uint(s.buffer_bytes);
-    out += ", \"measured\": " + std::string(s.measured ? "true" : "false");
-    out += ", \"max_overlap\": " + uint_or_null(has_overlap(c), s.max_overlap);
-    out += ", \"tail_pixels\": " + uint_or_null(s.measured && is_tiled(c), s.tail_pixels);
+    const bool exact = s.measured && is_exact(c);
     const bool tiles = s.measured && is_tiled(c);
-    out += ", \"tiles\": " + (tiles ? "{\"busy\": " + json_uint(s.busy_tiles) + ", \"exact\": " +
-                                           json_uint(s.exact_tiles) + ", \"layered\": " +
-                                           json_uint(s.layered_tiles) + ", \"pairs\": " + json_uint(s.tile_pairs) + "}"
-                                     : std::string("null"));
-    out += ", \"backdrop\": " + json_string(args.backdrop);
-    out += ", \"exact_lost_nodes\": " + uint_or_null(s.measured && exact, s.exact_lost_nodes);
-    out += ", \"exact_dropped\": " + uint_or_null(s.measured && exact, s.exact_dropped);
-    out += ", \"frame_ms\": [";
-    for (size_t i = 0; i < c.frame_ms.size(); ++i) out += (i ? ", " : "") + json_number(c.frame_ms[i]);
-    out += "], \"ms\": " + json_number(c.frame_ms.empty() ? 0.0 : c.frame_ms.back());
-    out += ", \"warnings\": [";
-    for (size_t i = 0; i < c.warnings.size(); ++i) out += (i ? ", " : "") + json_string(c.warnings[i]);
-    return out + "]}";
+    auto when = [](bool present, uint64_t v) { return present ? std::optional<uint64_t>(v) : std::nullopt; };
+    json.begin_object()
+        .field("mode", crisp::composite_mode_name(s.mode))
+        .field("path", crisp::quad_path_name(s.path))
+        .field("storage_without_format", c.storage_without_format)
+        .field("quads", s.quads)
+        .field("bins_reused", s.bins_reused)
+        .field("buffer_bytes", s.buffer_bytes)
+        .field("measured", s.measured)
+        .field("max_overlap", when(has_overlap(c), s.max_overlap))
+        .field("tail_pixels", when(tiles, s.tail_pixels))
+        .key("tiles");
+    if (tiles) {
+        json.begin_object()
+            .field("busy", s.busy_tiles)
+            .field("exact", s.exact_tiles)
+            .field("layered", s.layered_tiles)
+            .field("pairs", s.tile_pairs)
+            .end_object();
+    } else {
+        json.null();
+    }
+    json.field("backdrop", args.backdrop)
+        .field("exact_lost_nodes", when(exact, s.exact_lost_nodes))
+        .field("exact_dropped", when(exact, s.exact_dropped))
+        .field("frame_ms", c.frame_ms)
+        .field("ms", c.frame_ms.empty() ? 0.0 : c.frame_ms.back())
+        .field("warnings", c.warnings)
+        .end_object();
+}
+
+void write_glyphs_and_timings(crisp::JsonWriter& json, const Summary& s) {
+    const Job& job = *s.job;
+    const RenderReport& r = *s.render;
+    const crisp::RendererStats& last = r.last_frame;
+    json.key("glyphs").begin_object();
+    json.field("laid_out", job.laid_out)
+        .field("culled", s.culled_glyphs)
+        .field("drawn", last.drawn_glyphs)
+        .field("skipped", last.skipped_glyphs)
+        .field("failed", last.failed_glyphs)
+        .field("unknown_fonts", last.unknown_fonts)
+        .field("missing", job.missing)
+        .field("blank", job.blank)
+        .field("out_of_range", job.out_of_range)
+        .end_object();
+    json.field("total_samples", r.total_samples).field("total_curve_tests", r.total_curve_tests);
+    json.key("composite");
+    write_composite(json, *s.args, r.composite);
+    double frame_total = 0.0;
+    for (const double ms : r.frame_ms) frame_total += ms;
+    const std::vector<double>& composite_ms = r.composite.frame_ms;
+    json.key("timings").begin_object();
+    json.field("frame_ms", r.frame_ms)
+        .field("frames_ms", frame_total)
+        .field("mean_frame_ms", r.frames ? frame_total / static_cast<double>(r.frames) : 0.0)
+        .field("composite_ms", composite_ms.empty() ? 0.0 : composite_ms.back())
+        .field("readback_ms", r.readback_ms)
+        .field("write_ms", s.write_ms)
+        .field("total_ms", s.total_ms)
+        .end_object();
+}
+
+// A string, or null where it is empty.
+std::optional<std::string> unless_empty(const std::string& text) {
+    return text.empty() ? std::nullopt : std::optional<std::string>(text);
 }
 
 void print_json(const Summary& s) {
     const Arguments& args = *s.args;
     const Job& job = *s.job;
     const RenderReport& r = *s.render;
-    const CompositeReport& c = r.composite;
-    std::string frame_ms = "[";
-    for (size_t i = 0; i < r.frame_ms.size(); ++i) frame_ms += (i ? ", " : "") + json_number(r.frame_ms[i]);
-    frame_ms += "]";
-    double frame_total = 0.0;
-    for (const double ms : r.frame_ms) frame_total += ms;
-    const crisp::RendererStats& last = r.last_frame;
-    std::string out = "{";
-    out += "\"frames\": " + json_uint(r.frames);
-    out += ", \"converged\": " + std::string(r.converged ? "true" : "false");
-    out += ", \"samples\": {\"target\": " + json_uint(args.samples) + ", \"min\": " + json_uint(r.min_samples) +
-           ", \"max\": " + json_uint(r.max_samples) + "}";
-    out += ", \"glyphs\": {\"laid_out\": " + json_uint(job.laid_out) + ", \"culled\": " + json_uint(s.culled_glyphs) +
-           ", \"drawn\": " + json_uint(last.drawn_glyphs) + ", \"skipped\": " + json_uint(last.skipped_glyphs) +
-           ", \"failed\": " + json_uint(last.failed_glyphs) + ", \"unknown_fonts\": " + json_uint(last.unknown_fonts) +
-           ", \"missing\": " + json_uint(job.missing) + ", \"blank\": " + json_uint(job.blank) +
-           ", \"out_of_range\": " + json_uint(job.out_of_range) + "}";
-    out += ", \"total_samples\": " + json_uint(r.total_samples);
-    out += ", \"total_curve_tests\": " + json_uint(r.total_curve_tests);
-    out += ", \"composite\": " + json_composite(args, c);
-    out += ", \"timings\": {\"frame_ms\": " + frame_ms + ", \"frames_ms\": " + json_number(frame_total) +
-           ", \"mean_frame_ms\": " + json_number(r.frames ? frame_total / static_cast<double>(r.frames) : 0.0) +
-           ", \"composite_ms\": " + json_number(c.frame_ms.empty() ? 0.0 : c.frame_ms.back()) +
-           ", \"readback_ms\": " + json_number(r.readback_ms) + ", \"write_ms\": " + json_number(s.write_ms) +
-           ", \"total_ms\": " + json_number(s.total_ms) + "}";
-    out += ", \"atlas\": {\"width\": " + json_uint(r.atlas_side) + ", \"height\": " + json_uint(r.atlas_side) +
-           ", \"occupancy\": " + json_number(static_cast<double>(r.atlas.occupancy)) +
-           ", \"resident\": " + json_uint(r.atlas.resident_glyphs) +
-           ", \"allocations\": " + json_uint(r.atlas.total.allocations) +
-           ", \"evictions\": " + json_uint(r.atlas.total.evictions) +
-           ", \"failed_full\": " + json_uint(r.atlas.total.failed_full) +
-           ", \"failed_too_large\": " + json_uint(r.atlas.total.failed_too_large) +
-           ", \"budget_overruns\": " + json_uint(r.atlas.total.budget_overruns) + "}";
-    out += ", \"device\": {\"name\": " + json_string(s.context->device_name()) +
-           ", \"driver\": " + json_string(s.context->driver_name()) +
-           ", \"driver_info\": " + json_string(s.context->driver_info()) + "}";
-    out += ", \"layout\": " + json_string(job.layout.name);
-    out += ", \"scene\": " + (args.scene.empty() ? std::string("null") : json_string(args.scene));
-    out += ", \"runs\": " + json_uint(job.scene.runs.size());
+    crisp::JsonWriter json;
+    json.begin_object().field("frames", r.frames).field("converged", r.converged);
+    json.key("samples").begin_object();
+    json.field("target", args.samples).field("min", r.min_samples).field("max", r.max_samples).end_object();
+    write_glyphs_and_timings(json, s);
+    json.key("atlas").begin_object();
+    json.field("width", r.atlas_side)
+        .field("height", r.atlas_side)
+        .field("occupancy", r.atlas.occupancy)
+        .field("resident", r.atlas.resident_glyphs)
+        .field("allocations", r.atlas.total.allocations)
+        .field("evictions", r.atlas.total.evictions)
+        .field("failed_full", r.atlas.total.failed_full)
+        .field("failed_too_large", r.atlas.total.failed_too_large)
+        .field("budget_overruns", r.atlas.total.budget_overruns)
+        .end_object();
+    json.key("device").begin_object();
+    json.field("name", s.context->device_name())
+        .field("driver", s.context->driver_name())
+        .field("driver_info", s.context->driver_info())
+        .end_object();
+    json.field("layout", job.layout.name).field("scene", unless_empty(args.scene)).field("runs", job.scene.runs.size());
+    json.field("size", args.scene.empty() ? args.size : std::nullopt).key("origin");
     if (args.scene.empty()) {
-        out += ", \"size\": " + json_number(static_cast<double>(*args.size));
-        out += ", \"origin\": [" + json_number(static_cast<double>((*args.origin)[0])) + ", " +
-               json_number(static_cast<double>((*args.origin)[1])) + "]";
+        json.begin_array().value((*args.origin)[0]).value((*args.origin)[1]).end_array();
     } else {
-        out += ", \"size\": null, \"origin\": null";
+        json.null();
     }
-    out += ", \"canvas\": {\"width\": " + json_uint(job.scene.width) + ", \"height\": " + json_uint(job.scene.height) +
-           "}";
-    out += ", \"outputs\": {\"png\": " + json_string(args.output) +
-           ", \"coverage\": " + (args.coverage_output.empty() ? "null" : json_string(args.coverage_output)) + "}";
+    json.key("canvas").begin_object().field("width", job.scene.width).field("height", job.scene.height).end_object();
+    json.key("outputs").begin_object();
+    json.field("png", args.output).field("coverage", unless_empty(args.coverage_output)).end_object();
     if (args.validate) {
-        out += ", \"validation\": {\"warnings\": " + json_uint(s.validation.warnings) +
-               ", \"errors\": " + json_uint(s.validation.errors) + "}";
+        json.key("validation").begin_object();
+        json.field("warnings", s.validation.warnings).field("errors", s.validation.errors).end_object();
     }
-    out += "}\n";
-    std::fputs(out.c_str(), stdout);
+    json.end_object();
+    std::fputs(json.line().c_str(), stdout);
 }
 
 // "tiled, compute path, max overlap 3, 30 tiles (30 exact, 0 layered), 1.2 ms"
@@ -1039,11 +977,9 @@ void lay_out(const Arguments& args, Job& job) {
     }
 }
 
-int run(const Arguments& args) {
-    const auto start = std::chrono::steady_clock::now();
-    check_output_path(args.output, args);
-    if (!args.coverage_output.empty()) check_output_path(args.coverage_output, args);
-
+// The scene (from --scene, or the one run the command line describes), its layout and fonts,
+// and its runs laid out; exits on a failure.
+Job load_job(const Arguments& args) {
     Job job;
     if (args.scene.empty()) {
         job.scene = scene_from_arguments(args);
@@ -1070,55 +1006,36 @@ int run(const Arguments& args) {
         job.fonts.push_back(std::move(*font));
     }
     lay_out(args, job);
+    return job;
+}
 
-    RenderReport report;
-    crisp::HeadlessContextOptions options;
-    options.validation = args.validate;
-    options.device_name_contains = args.device;
-    crisp::Result<crisp::HeadlessContext> context =
-        crisp::tools::create_context(options, report.composite.storage_without_format);
-    if (!context) fail(exit_code_for_vulkan(context.error()), "Vulkan: " + context.error().message);
-
-    if (const int code = render(*context, args, job, report); code != kExitOk) return code;
-    // The renderer and compositor are gone: every message the validation layer had for them has arrived.
-    Summary summary;
-    summary.validation = context->validation_messages();
-
-    const uint32_t width = job.scene.width, height = job.scene.height;
-    const auto write_start = std::chrono::steady_clock::now();
-    // Both outputs are encoded, then put in place together: a failure replaces neither. Errors
-    // return (the context is destroyed on the way out), never exit with live Vulkan objects.
+// Encodes the PNG (and the PFM), then puts both in place together: a failure replaces neither.
+// Errors return (the context is destroyed on the way out), never exit with live Vulkan objects.
+int write_outputs(const crisp::OutputFiles& outputs, const Arguments& args, const Job& job, RenderReport& report) {
     auto write_failed = [](const crisp::Error& error) {
         std::fprintf(stderr, "crisp-render: %s\n", error.message.c_str());
         return error.code == crisp::ErrorCode::io ? kExitOutput : kExitInternal;
     };
+    const uint32_t width = job.scene.width, height = job.scene.height;
     const bool opaque = job.scene.background[3] >= 1.0f;
     crisp::Result<std::vector<std::byte>> png =
         crisp::encode_png_srgb8(width, height, opaque ? 3 : 4, png_pixels(report.composite.target, opaque));
     report.composite.target = {};
     if (!png) return write_failed(png.error());
-    std::vector<crisp::OutputFile> outputs = {{args.output, *png}};
+    std::vector<std::span<const std::byte>> contents = {*png};
     crisp::Result<std::vector<std::byte>> pfm = std::vector<std::byte>{};
     if (!args.coverage_output.empty()) {
         pfm = crisp::encode_pfm(width, height, coverage_image(width, height, report));
         if (!pfm) return write_failed(pfm.error());
-        outputs.push_back({args.coverage_output, *pfm});
+        contents.push_back(*pfm);
     }
-    if (crisp::Status status = crisp::write_files_atomically(outputs); !status) return write_failed(status.error());
-    summary.write_ms = milliseconds_since(write_start);
-    summary.total_ms = milliseconds_since(start);
+    if (crisp::Status status = outputs.write(contents); !status) return write_failed(status.error());
+    return kExitOk;
+}
 
-    summary.args = &args;
-    summary.context = &*context;
-    summary.job = &job;
-    summary.render = &report;
-    summary.culled_glyphs = static_cast<uint32_t>(job.laid_out - job.glyphs.size());
-    if (args.json) {
-        print_json(summary);
-    } else if (!args.quiet) {
-        print_human(summary);
-    }
-
+// The compositor's notes and what the image lacks, on stderr; the exit code of glyphs not drawn
+// or of validation messages.
+int report_problems(const Arguments& args, const RenderReport& report, const crisp::ValidationMessages& validation) {
     const CompositeReport& composite = report.composite;
     if (!args.quiet && !args.json) {
         for (const std::string& warning : composite.warnings) {
@@ -1143,7 +1060,6 @@ int run(const Arguments& args) {
                      report.last_frame.failed_glyphs, report.last_frame.unknown_fonts);
         code = kExitInternal;
     }
-    const crisp::ValidationMessages& validation = summary.validation;
     if (validation.warnings + validation.errors > 0) {
         std::fprintf(stderr, "crisp-render: the validation layer reported %u errors and %u warnings:\n",
                      validation.errors, validation.warnings);
@@ -1151,6 +1067,42 @@ int run(const Arguments& args) {
         code = kExitVulkan;
     }
     return code;
+}
+
+int run(const Arguments& args) {
+    const auto start = std::chrono::steady_clock::now();
+    const crisp::OutputFiles outputs = declare_outputs(args);
+    const Job job = load_job(args);
+
+    RenderReport report;
+    crisp::HeadlessContextOptions options;
+    options.validation = args.validate;
+    options.device_name_contains = args.device;
+    crisp::Result<crisp::HeadlessContext> context =
+        crisp::tools::create_context(options, report.composite.storage_without_format);
+    if (!context) fail(exit_code_for_vulkan(context.error()), "Vulkan: " + context.error().message);
+
+    if (const int code = render(*context, args, job, report); code != kExitOk) return code;
+    // The renderer and compositor are gone: every message the validation layer had for them has arrived.
+    Summary summary;
+    summary.validation = context->validation_messages();
+
+    const auto write_start = std::chrono::steady_clock::now();
+    if (const int code = write_outputs(outputs, args, job, report); code != kExitOk) return code;
+    summary.write_ms = milliseconds_since(write_start);
+    summary.total_ms = milliseconds_since(start);
+
+    summary.args = &args;
+    summary.context = &*context;
+    summary.job = &job;
+    summary.render = &report;
+    summary.culled_glyphs = static_cast<uint32_t>(job.laid_out - job.glyphs.size());
+    if (args.json) {
+        print_json(summary);
+    } else if (!args.quiet) {
+        print_human(summary);
+    }
+    return report_problems(args, report, summary.validation);
 }
 
 }  // namespace
