@@ -6,6 +6,8 @@
 // in a warm atlas, allocation and eviction throughput, and how many atlas entries a page of text
 // needs at each subpixel quantization. Each timed case is warmed up, then timed N times; the
 // tables show the median and the fastest run.
+#include "cli.hpp"
+
 #include <crisp/atlas.hpp>
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
@@ -41,49 +43,29 @@ struct Args {
     std::string only;  // run only the cases whose name contains this
 };
 
-void usage(FILE* out) {
-    std::fprintf(out,
-                 "usage: crisp-bench-cpu [options]\n"
-                 "Measures crisp's CPU run time: text layout (HarfBuzz shaping, bidi, fallback, line breaking,\n"
-                 "glyph keys) and the glyph atlas (look-up, allocation, eviction, reuse), and prints Markdown\n"
-                 "tables of median and fastest times.\n\n"
-                 "  --dejavu PATH   DejaVu Sans (default fonts/DejaVuSans.ttf, run from the repository root)\n"
-                 "  --inter PATH    Inter Regular, first font of the fallback chain (default fonts/Inter-Regular.otf)\n"
-                 "  --cjk PATH      Noto Sans CJK collection, third font of the chain\n"
-                 "                  (default /usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc)\n"
-                 "  --runs N        timed runs per case (default 21)\n"
-                 "  --warmup N      untimed runs first (default 3)\n"
-                 "  --only TEXT     run only the cases whose name contains TEXT\n"
-                 "  --help          this text\n");
-}
-
-bool parse(int argc, char** argv, Args& args) {
-    for (int i = 1; i < argc; ++i) {
-        const std::string arg = argv[i];
-        auto value = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-        const char* v = nullptr;
-        if (arg == "--help" || arg == "-h") {
-            usage(stdout);
-            std::exit(0);
-        } else if (arg == "--dejavu" && (v = value())) {
-            args.dejavu = v;
-        } else if (arg == "--inter" && (v = value())) {
-            args.inter = v;
-        } else if (arg == "--cjk" && (v = value())) {
-            args.cjk = v;
-        } else if (arg == "--runs" && (v = value())) {
-            args.runs = std::max(1, std::atoi(v));
-        } else if (arg == "--warmup" && (v = value())) {
-            args.warmup = std::max(0, std::atoi(v));
-        } else if (arg == "--only" && (v = value())) {
-            args.only = v;
-        } else {
-            std::fprintf(stderr, "crisp-bench-cpu: bad argument '%s'\n", arg.c_str());
-            usage(stderr);
-            return false;
-        }
-    }
-    return true;
+// Parses the command line; prints --help, or the help on stderr and exits 2 on a usage error.
+Args parse(int argc, char** argv) {
+    Args args;
+    crisp::cli::CommandLine cli(
+        "crisp-bench-cpu",
+        "usage: crisp-bench-cpu [options]\n"
+        "Measures crisp's CPU run time: text layout (HarfBuzz shaping, bidi, fallback, line breaking,\n"
+        "glyph keys) and the glyph atlas (look-up, allocation, eviction, reuse), and prints Markdown\n"
+        "tables of median and fastest times.\n\n");
+    cli.on_usage_error(2, "", true);
+    cli.text("--dejavu", "PATH", "DejaVu Sans (default fonts/DejaVuSans.ttf, run from the repository root)",
+             args.dejavu);
+    cli.text("--inter", "PATH", "Inter Regular, first font of the fallback chain (default fonts/Inter-Regular.otf)",
+             args.inter);
+    cli.text("--cjk", "PATH",
+             "Noto Sans CJK collection, third font of the chain\n"
+             "(default /usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc)",
+             args.cjk);
+    cli.number<int>("--runs", "N", "timed runs per case (default 21)", args.runs, {1, 1000000});
+    cli.number<int>("--warmup", "N", "untimed runs first (default 3)", args.warmup, {0, 1000000});
+    cli.text("--only", "TEXT", "run only the cases whose name contains TEXT", args.only);
+    cli.parse(argc, argv);
+    return args;
 }
 
 std::unique_ptr<crisp::Font> load(const std::string& path, crisp::FontId id, std::vector<uint32_t> codepoints) {
@@ -208,189 +190,57 @@ std::string cpu_model() {
     return "unknown CPU";
 }
 
-}  // namespace
+void print_row(const std::string& name, size_t strings, size_t glyphs, Measurement m) {
+    std::printf("| %s | %zu | %zu | %.3f | %.3f | %.1f |\n", name.c_str(), strings, glyphs, m.median_ms, m.fastest_ms,
+                m.median_ms * 1e6 / static_cast<double>(std::max<size_t>(glyphs, 1)));
+    std::fflush(stdout);
+}
 
-int main(int argc, char** argv) {
-    Args args;
-    if (!parse(argc, argv, args)) return 2;
+void print_atlas_row(const std::string& name, size_t glyphs, Measurement m) {
+    std::printf("| %s | %zu | %.3f | %.3f | %.1f |\n", name.c_str(), glyphs, m.median_ms, m.fastest_ms,
+                m.median_ms * 1e6 / static_cast<double>(std::max<size_t>(glyphs, 1)));
+    std::fflush(stdout);
+}
 
-    const auto bake_start = Clock::now();
-    auto dejavu = load(args.dejavu, 1, {});
-    auto inter = load(args.inter, 2, {});
-    // A subset: the CJK characters the frame uses, like an asset pipeline would bake.
-    auto cjk = load(args.cjk, 3, {0x8A2D, 0x5B9A, 0x4FDD, 0x5B58, 0x6F22, 0x5B57});
-    if (!dejavu || !inter || !cjk) return 1;
-    const double bake_ms = std::chrono::duration<double, std::milli>(Clock::now() - bake_start).count();
+// The baked fonts and the scratch state the cases share; each group of cases prints its table.
+class Bench {
+public:
+    Bench(const Args& args, const crisp::Font& dejavu, const crisp::Font& inter, const crisp::Font& cjk)
+        : args_(args), all_fonts_{&dejavu, &inter, &cjk}, one_{&dejavu}, chain_{&inter, &dejavu, &cjk} {}
 
-    const std::vector<const crisp::Font*> one = {dejavu.get()};
-    const std::vector<const crisp::Font*> chain = {inter.get(), dejavu.get(), cjk.get()};
-
-    std::printf("Machine: %s, %u hardware threads (one used). Compiler: %s. Fonts baked in %.0f ms.\n\n",
-                cpu_model().c_str(), std::max(1u, static_cast<unsigned>(std::thread::hardware_concurrency())),
-                __VERSION__, bake_ms);
-    std::printf("| case | strings | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|\n");
-
-    auto row = [](const char* name, size_t strings, size_t glyphs, Measurement m) {
-        std::printf("| %s | %zu | %zu | %.3f | %.3f | %.1f |\n", name, strings, glyphs, m.median_ms, m.fastest_ms,
-                    m.median_ms * 1e6 / static_cast<double>(std::max<size_t>(glyphs, 1)));
-        std::fflush(stdout);
-    };
-
-    crisp::Layouter layouter;
-    crisp::TextLayout layout;
-    std::vector<crisp::GlyphInstance> frame;  // what an engine would upload
-
-    auto ui_case = [&](const char* name, const std::vector<Label>& labels, const std::vector<const crisp::Font*>& fonts,
-                       bool snap, bool reuse) {
-        if (std::string(name).find(args.only) == std::string::npos) return;
-        size_t glyphs = 0;
-        const Measurement m = measure(args.warmup, args.runs, [&] {
-            frame.clear();
-            for (const Label& label : labels) {
-                crisp::LayoutOptions options = label.options;
-                options.snap_to_pixels = snap;
-                options.first_paint_order = static_cast<uint32_t>(frame.size());
-                if (reuse) {
-                    if (!layouter.layout(fonts, label.text, label.style, options, layout)) std::abort();
-                    frame.insert(frame.end(), layout.glyphs.begin(), layout.glyphs.end());
-                } else {
-                    auto fresh = crisp::layout_text(fonts, label.text, label.style, options);
-                    if (!fresh) std::abort();
-                    frame.insert(frame.end(), fresh->glyphs.begin(), fresh->glyphs.end());
-                }
-            }
-            glyphs = frame.size();
-        });
-        row(name, labels.size(), glyphs, m);
-    };
-
-    // The floor: HarfBuzz alone shaping the same strings (one run each, no bidi, no fallback, no
-    // line breaking, no keys), to show what crisp's layout adds on top.
-    auto harfbuzz_case = [&](const char* name, const std::vector<Label>& labels, const crisp::Font& font) {
-        if (std::string(name).find(args.only) == std::string::npos) return;
-        hb_buffer_t* buffer = hb_buffer_create();
-        size_t glyphs = 0;
-        const Measurement m = measure(args.warmup, args.runs, [&] {
-            glyphs = 0;
-            for (const Label& label : labels) {
-                hb_buffer_clear_contents(buffer);
-                hb_buffer_add_utf8(buffer, label.text.data(), static_cast<int>(label.text.size()), 0,
-                                   static_cast<int>(label.text.size()));
-                hb_buffer_guess_segment_properties(buffer);
-                hb_shape(font.harfbuzz_font(), buffer, nullptr, 0);
-                glyphs += hb_buffer_get_length(buffer);
-            }
-        });
-        hb_buffer_destroy(buffer);
-        row(name, labels.size(), glyphs, m);
-    };
-
-    const std::vector<Label> latin = ui_frame(false, 10'000, one);
-    harfbuzz_case("UI frame, DejaVu Sans, bare hb_shape (floor; glyphs shaped, spaces included)", latin, *dejavu);
-    const std::vector<Label> mixed = ui_frame(true, 10'000, chain);
-    ui_case("UI frame, DejaVu Sans, reused Layouter", latin, one, false, true);
-    ui_case("UI frame, DejaVu Sans, snapped pens", latin, one, true, true);
-    ui_case("UI frame, DejaVu Sans, layout_text (fresh Layouter per string)", latin, one, false, false);
-    const std::vector<const crisp::Font*> inter_only = {inter.get()};
-    harfbuzz_case("UI frame, Inter, bare hb_shape (floor; glyphs shaped, spaces included)", latin, *inter);
-    ui_case("UI frame, Inter (CFF, many OpenType features)", latin, inter_only, false, true);
-    ui_case("UI frame, Latin only, Inter > DejaVu > Noto CJK", latin, chain, false, true);
-    ui_case("UI frame, multilingual, Inter > DejaVu > Noto CJK", mixed, chain, false, true);
-
-    std::string warm_note;
-    // ---- The atlas: the UI frame laid out and looked up in a warm atlas, every frame.
-    std::printf("\n| atlas case | glyphs | median ms | fastest ms | ns per glyph (median) |\n");
-    std::printf("|---|---:|---:|---:|---:|\n");
-    auto atlas_row = [](const char* name, size_t glyphs, Measurement m) {
-        std::printf("| %s | %zu | %.3f | %.3f | %.1f |\n", name, glyphs, m.median_ms, m.fastest_ms,
-                    m.median_ms * 1e6 / static_cast<double>(std::max<size_t>(glyphs, 1)));
-        std::fflush(stdout);
-    };
-    const std::vector<const crisp::Font*> all_fonts = {dejavu.get(), inter.get(), cjk.get()};
-    auto font_of = [&](crisp::FontId id) -> const crisp::Font& { return *all_fonts[id - 1]; };
-    auto acquire_all = [&](crisp::GlyphAtlas& atlas, const std::vector<crisp::GlyphInstance>& glyphs) {
-        for (const crisp::GlyphInstance& glyph : glyphs) {
-            uint64_t cost = 0;
-            if (atlas.find(glyph.key) == crisp::kNoAtlasEntry) {  // only a new glyph needs its cost
-                const crisp::Font& font = font_of(glyph.key.font);
-                cost = crisp::curve_tests_per_sample(font.asset(), font.asset().glyphs[glyph.key.glyph], glyph.key);
-            }
-            atlas.acquire(glyph.key, glyph.width, glyph.height, cost);
-        }
-        atlas.schedule();
-    };
-    if (std::string("UI frame + warm atlas").find(args.only) != std::string::npos) {
-        auto atlas = crisp::GlyphAtlas::create();
-        if (!atlas) std::abort();
-        auto layout_frame = [&](const std::vector<const crisp::Font*>& fonts) {
-            frame.clear();
-            for (const Label& label : latin) {
-                crisp::LayoutOptions options = label.options;
-                options.first_paint_order = static_cast<uint32_t>(frame.size());
-                if (!layouter.layout(fonts, label.text, label.style, options, layout)) std::abort();
-                frame.insert(frame.end(), layout.glyphs.begin(), layout.glyphs.end());
-            }
-        };
-        atlas->begin_frame();
-        layout_frame(one);
-        acquire_all(*atlas, frame);  // the atlas is warm from here on
-        const Measurement lookup_only = measure(args.warmup, args.runs, [&] {
-            atlas->begin_frame();
-            acquire_all(*atlas, frame);
-        });
-        atlas_row("UI frame, atlas look-up only (warm, DejaVu Sans)", frame.size(), lookup_only);
-        const Measurement whole = measure(args.warmup, args.runs, [&] {
-            atlas->begin_frame();
-            layout_frame(one);
-            acquire_all(*atlas, frame);
-        });
-        atlas_row("UI frame, layout + atlas look-up + schedule (warm, DejaVu Sans)", frame.size(), whole);
-        warm_note = "The warm atlas holds " + std::to_string(atlas->stats().resident_glyphs) + " glyphs, " +
-                    std::to_string(atlas->stats().used_cells) + " of its 16384 cells.";
+    // Layout: the UI frame with one font and with the fallback chain, against bare hb_shape.
+    void layout_cases() {
+        std::printf("| case | strings | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
+        std::printf("|---|---:|---:|---:|---:|---:|\n");
+        const crisp::Font& dejavu = *all_fonts_[0];
+        const crisp::Font& inter = *all_fonts_[1];
+        latin_ = ui_frame(false, 10'000, one_);
+        harfbuzz_case("UI frame, DejaVu Sans, bare hb_shape (floor; glyphs shaped, spaces included)", latin_, dejavu);
+        const std::vector<Label> mixed = ui_frame(true, 10'000, chain_);
+        ui_case("UI frame, DejaVu Sans, reused Layouter", latin_, one_, false, true);
+        ui_case("UI frame, DejaVu Sans, snapped pens", latin_, one_, true, true);
+        ui_case("UI frame, DejaVu Sans, layout_text (fresh Layouter per string)", latin_, one_, false, false);
+        const std::vector<const crisp::Font*> inter_only = {&inter};
+        harfbuzz_case("UI frame, Inter, bare hb_shape (floor; glyphs shaped, spaces included)", latin_, inter);
+        ui_case("UI frame, Inter (CFF, many OpenType features)", latin_, inter_only, false, true);
+        ui_case("UI frame, Latin only, Inter > DejaVu > Noto CJK", latin_, chain_, false, true);
+        ui_case("UI frame, multilingual, Inter > DejaVu > Noto CJK", mixed, chain_, false, true);
     }
 
-    // ---- Allocation and eviction throughput: a small atlas and far more distinct glyphs than fit,
-    // so nearly every acquire allocates and most allocations evict.
-    if (std::string("allocation and eviction").find(args.only) != std::string::npos) {
-        crisp::AtlasConfig config;
-        config.width = config.height = 512;
-        auto atlas = crisp::GlyphAtlas::create(config);
-        if (!atlas) std::abort();
-        std::mt19937 random(12345);
-        std::uniform_int_distribution<uint32_t> side(4, 40);
-        std::vector<std::array<uint32_t, 3>> requests;  // glyph id, width, height
-        for (uint32_t i = 0; i < 200'000; ++i) requests.push_back({i, side(random), side(random) + 8});
-        size_t next = 0;
-        const size_t per_frame = 500;
-        const Measurement m = measure(args.warmup, args.runs, [&] {
-            for (int f = 0; f < 10; ++f) {
-                atlas->begin_frame();
-                for (size_t k = 0; k < per_frame; ++k, next = (next + 1) % requests.size()) {
-                    crisp::GlyphKey key;
-                    key.font = 1;
-                    key.glyph = requests[next][0];
-                    key.size_x = key.size_y = 16 * crisp::kSizeOne;
-                    atlas->acquire(key, requests[next][1], requests[next][2], 1000);
-                }
-                atlas->schedule();
-            }
-        });
-        const crisp::AtlasCounters& total = atlas->stats().total;
-        char name[200];
-        std::snprintf(name, sizeof name,
-                      "allocation and eviction, 512x512 atlas, 10 frames of 500 new 4-40 px glyphs "
-                      "(%.0f %% of acquires evicted)",
-                      100.0 * static_cast<double>(total.evictions) /
-                          static_cast<double>(std::max<uint64_t>(total.allocations, 1)));
-        atlas_row(name, 10 * per_frame, m);
+    // The atlas: the UI frame looked up in a warm atlas, and allocation and eviction throughput.
+    void atlas_cases() {
+        std::printf("\n| atlas case | glyphs | median ms | fastest ms | ns per glyph (median) |\n");
+        std::printf("|---|---:|---:|---:|---:|\n");
+        std::string warm_note;
+        if (selected("UI frame + warm atlas")) warm_note = warm_atlas_case();
+        if (selected("allocation and eviction")) eviction_case();
+        if (!warm_note.empty()) std::printf("\n%s\n", warm_note.c_str());
     }
 
-    if (!warm_note.empty()) std::printf("\n%s\n", warm_note.c_str());
-
-    // ---- Reuse against subpixel quantization: a page of real text at 16 px, wrapped at 900 px,
-    // and how many distinct atlas entries (and cells) it needs at each quantization.
-    if (std::string("subpixel quantization").find(args.only) != std::string::npos) {
+    // Reuse against subpixel quantization: a page of real text at 16 px, wrapped at 900 px, and
+    // how many distinct atlas entries (and cells) it needs at each quantization.
+    void quantization_case() {
+        if (!selected("subpixel quantization")) return;
         const char* page_text =
             "It was the best of times, it was the worst of times, it was the age of wisdom, it was the age of "
             "foolishness, it was the epoch of belief, it was the epoch of incredulity, it was the season of Light, "
@@ -410,51 +260,206 @@ int main(int argc, char** argv) {
             options.origin_y = 20.0f;
             options.wrap_width = 900.0f;
             options.subpixel_steps = steps;
-            if (!layouter.layout(one, page, {.size = 16.0f}, options, layout)) std::abort();
+            if (!layouter_.layout(one_, page, {.size = 16.0f}, options, layout_)) std::abort();
             auto atlas = crisp::GlyphAtlas::create();
             if (!atlas) std::abort();
             atlas->begin_frame();
-            acquire_all(*atlas, layout.glyphs);
+            acquire_all(*atlas, layout_.glyphs);
             const crisp::AtlasStats& stats = atlas->stats();
-            std::printf("| %u | %zu | %u | %.2f | %u |\n", steps, layout.glyphs.size(), stats.resident_glyphs,
-                        static_cast<double>(layout.glyphs.size()) / std::max(1u, stats.resident_glyphs),
+            std::printf("| %u | %zu | %u | %.2f | %u |\n", steps, layout_.glyphs.size(), stats.resident_glyphs,
+                        static_cast<double>(layout_.glyphs.size()) / std::max(1u, stats.resident_glyphs),
                         stats.used_cells);
         }
         std::printf("\n");
     }
 
-    std::printf("\n| large text | strings | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|\n");
-    std::string million;
-    million.reserve(1'000'100);
-    const std::string words = "Lorem ipsum dolor sit amet, consectetur adipiscing elit, sed do eiusmod tempor. ";
-    while (million.size() < 1'000'000) million += words;
-    million.resize(1'000'000);
-    std::string columns = million;
-    for (size_t i = 80; i < columns.size(); i += 81) columns[i] = '\n';
-    std::string multilingual;
-    const std::string sentence =
-        "Hello \u05E9\u05DC\u05D5\u05DD \u0645\u0631\u062D\u0628\u0627 \u041F\u0440\u0438\u0432\u0435\u0442 "
-        "\u6F22\u5B57 world, 123. ";
-    while (multilingual.size() < 1'000'000) multilingual += sentence;
+    // A million characters: one paragraph, 80-column lines, one line, and mixed scripts.
+    void large_text_cases() {
+        std::printf("\n| large text | strings | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
+        std::printf("|---|---:|---:|---:|---:|---:|\n");
+        std::string million;
+        million.reserve(1'000'100);
+        const std::string words = "Lorem ipsum dolor sit amet, consectetur adipiscing elit, sed do eiusmod tempor. ";
+        while (million.size() < 1'000'000) million += words;
+        million.resize(1'000'000);
+        std::string columns = million;
+        for (size_t i = 80; i < columns.size(); i += 81) columns[i] = '\n';
+        std::string multilingual;
+        const std::string sentence =
+            "Hello \u05E9\u05DC\u05D5\u05DD \u0645\u0631\u062D\u0628\u0627 \u041F\u0440\u0438\u0432\u0435\u0442 "
+            "\u6F22\u5B57 world, 123. ";
+        while (multilingual.size() < 1'000'000) multilingual += sentence;
+        big_case("1M characters, one paragraph wrapped at 1000 px, DejaVu Sans", million, one_, 1000.0f);
+        big_case("1M characters, 80-column lines, DejaVu Sans", columns, one_, 0.0f);
+        big_case("1M characters, one unwrapped line, DejaVu Sans", million, one_, 0.0f);
+        big_case("1M bytes mixed LTR/RTL/CJK, wrapped at 1000 px, Inter > DejaVu > Noto CJK", multilingual, chain_,
+                 1000.0f);
+    }
 
-    auto big_case = [&](const char* name, const std::string& text, const std::vector<const crisp::Font*>& fonts,
-                        float wrap) {
-        if (std::string(name).find(args.only) == std::string::npos) return;
-        const int runs = std::max(1, args.runs / 4);
+private:
+    bool selected(const std::string& name) const { return name.find(args_.only) != std::string::npos; }
+
+    // Lays out every label into frame_, as an engine would before uploading it.
+    void layout_labels(const std::vector<Label>& labels, const std::vector<const crisp::Font*>& fonts, bool snap,
+                       bool reuse) {
+        frame_.clear();
+        for (const Label& label : labels) {
+            crisp::LayoutOptions options = label.options;
+            options.snap_to_pixels = snap;
+            options.first_paint_order = static_cast<uint32_t>(frame_.size());
+            if (reuse) {
+                if (!layouter_.layout(fonts, label.text, label.style, options, layout_)) std::abort();
+                frame_.insert(frame_.end(), layout_.glyphs.begin(), layout_.glyphs.end());
+            } else {
+                auto fresh = crisp::layout_text(fonts, label.text, label.style, options);
+                if (!fresh) std::abort();
+                frame_.insert(frame_.end(), fresh->glyphs.begin(), fresh->glyphs.end());
+            }
+        }
+    }
+
+    void ui_case(const char* name, const std::vector<Label>& labels, const std::vector<const crisp::Font*>& fonts,
+                 bool snap, bool reuse) {
+        if (!selected(name)) return;
+        const Measurement m = measure(args_.warmup, args_.runs, [&] { layout_labels(labels, fonts, snap, reuse); });
+        print_row(name, labels.size(), frame_.size(), m);
+    }
+
+    // The floor: HarfBuzz alone shaping the same strings (one run each, no bidi, no fallback, no
+    // line breaking, no keys), to show what crisp's layout adds on top.
+    void harfbuzz_case(const char* name, const std::vector<Label>& labels, const crisp::Font& font) {
+        if (!selected(name)) return;
+        hb_buffer_t* buffer = hb_buffer_create();
+        size_t glyphs = 0;
+        const Measurement m = measure(args_.warmup, args_.runs, [&] {
+            glyphs = 0;
+            for (const Label& label : labels) {
+                hb_buffer_clear_contents(buffer);
+                hb_buffer_add_utf8(buffer, label.text.data(), static_cast<int>(label.text.size()), 0,
+                                   static_cast<int>(label.text.size()));
+                hb_buffer_guess_segment_properties(buffer);
+                hb_shape(font.harfbuzz_font(), buffer, nullptr, 0);
+                glyphs += hb_buffer_get_length(buffer);
+            }
+        });
+        hb_buffer_destroy(buffer);
+        print_row(name, labels.size(), glyphs, m);
+    }
+
+    void big_case(const char* name, const std::string& text, const std::vector<const crisp::Font*>& fonts, float wrap) {
+        if (!selected(name)) return;
+        const int runs = std::max(1, args_.runs / 4);
         crisp::LayoutOptions options;
         options.wrap_width = wrap;
         const Measurement m = measure(1, runs, [&] {
-            if (!layouter.layout(fonts, text, {.size = 14.0f}, options, layout)) std::abort();
+            if (!layouter_.layout(fonts, text, {.size = 14.0f}, options, layout_)) std::abort();
         });
         char label[160];
         std::snprintf(label, sizeof(label), "%s (%zu bytes, %zu lines, widest %.2g px)", name, text.size(),
-                      layout.lines.size(), static_cast<double>(layout.width));
-        row(label, 1, layout.glyphs.size(), m);
-    };
-    big_case("1M characters, one paragraph wrapped at 1000 px, DejaVu Sans", million, one, 1000.0f);
-    big_case("1M characters, 80-column lines, DejaVu Sans", columns, one, 0.0f);
-    big_case("1M characters, one unwrapped line, DejaVu Sans", million, one, 0.0f);
-    big_case("1M bytes mixed LTR/RTL/CJK, wrapped at 1000 px, Inter > DejaVu > Noto CJK", multilingual, chain, 1000.0f);
+                      layout_.lines.size(), static_cast<double>(layout_.width));
+        print_row(label, 1, layout_.glyphs.size(), m);
+    }
+
+    void acquire_all(crisp::GlyphAtlas& atlas, const std::vector<crisp::GlyphInstance>& glyphs) const {
+        for (const crisp::GlyphInstance& glyph : glyphs) {
+            uint64_t cost = 0;
+            if (atlas.find(glyph.key) == crisp::kNoAtlasEntry) {  // only a new glyph needs its cost
+                const crisp::Font& font = *all_fonts_[glyph.key.font - 1];
+                cost = crisp::curve_tests_per_sample(font.asset(), font.asset().glyphs[glyph.key.glyph], glyph.key);
+            }
+            atlas.acquire(glyph.key, glyph.width, glyph.height, cost);
+        }
+        atlas.schedule();
+    }
+
+    // The UI frame laid out and looked up in a warm atlas, every frame; returns a note on the atlas.
+    std::string warm_atlas_case() {
+        auto atlas = crisp::GlyphAtlas::create();
+        if (!atlas) std::abort();
+        atlas->begin_frame();
+        layout_labels(latin_, one_, false, true);
+        acquire_all(*atlas, frame_);  // the atlas is warm from here on
+        const Measurement lookup_only = measure(args_.warmup, args_.runs, [&] {
+            atlas->begin_frame();
+            acquire_all(*atlas, frame_);
+        });
+        print_atlas_row("UI frame, atlas look-up only (warm, DejaVu Sans)", frame_.size(), lookup_only);
+        const Measurement whole = measure(args_.warmup, args_.runs, [&] {
+            atlas->begin_frame();
+            layout_labels(latin_, one_, false, true);
+            acquire_all(*atlas, frame_);
+        });
+        print_atlas_row("UI frame, layout + atlas look-up + schedule (warm, DejaVu Sans)", frame_.size(), whole);
+        return "The warm atlas holds " + std::to_string(atlas->stats().resident_glyphs) + " glyphs, " +
+               std::to_string(atlas->stats().used_cells) + " of its 16384 cells.";
+    }
+
+    // A small atlas and far more distinct glyphs than fit, so nearly every acquire allocates and
+    // most allocations evict.
+    void eviction_case() {
+        crisp::AtlasConfig config;
+        config.width = config.height = 512;
+        auto atlas = crisp::GlyphAtlas::create(config);
+        if (!atlas) std::abort();
+        std::mt19937 random(12345);
+        std::uniform_int_distribution<uint32_t> side(4, 40);
+        std::vector<std::array<uint32_t, 3>> requests;  // glyph id, width, height
+        for (uint32_t i = 0; i < 200'000; ++i) requests.push_back({i, side(random), side(random) + 8});
+        size_t next = 0;
+        const size_t per_frame = 500;
+        const Measurement m = measure(args_.warmup, args_.runs, [&] {
+            for (int f = 0; f < 10; ++f) {
+                atlas->begin_frame();
+                for (size_t k = 0; k < per_frame; ++k, next = (next + 1) % requests.size()) {
+                    crisp::GlyphKey key;
+                    key.font = 1;
+                    key.glyph = requests[next][0];
+                    key.size_x = key.size_y = 16 * crisp::kSizeOne;
+                    atlas->acquire(key, requests[next][1], requests[next][2], 1000);
+                }
+                atlas->schedule();
+            }
+        });
+        const crisp::AtlasCounters& total = atlas->stats().total;
+        char name[200];
+        std::snprintf(name, sizeof name,
+                      "allocation and eviction, 512x512 atlas, 10 frames of 500 new 4-40 px glyphs "
+                      "(%.0f %% of acquires evicted)",
+                      100.0 * static_cast<double>(total.evictions) /
+                          static_cast<double>(std::max<uint64_t>(total.allocations, 1)));
+        print_atlas_row(name, 10 * per_frame, m);
+    }
+
+    const Args& args_;
+    std::vector<const crisp::Font*> all_fonts_;  // by FontId - 1
+    std::vector<const crisp::Font*> one_;        // DejaVu Sans alone
+    std::vector<const crisp::Font*> chain_;      // Inter > DejaVu Sans > Noto Sans CJK
+    std::vector<Label> latin_;                   // the Latin UI frame
+    crisp::Layouter layouter_;
+    crisp::TextLayout layout_;
+    std::vector<crisp::GlyphInstance> frame_;  // what an engine would upload
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const Args args = parse(argc, argv);
+
+    const auto bake_start = Clock::now();
+    auto dejavu = load(args.dejavu, 1, {});
+    auto inter = load(args.inter, 2, {});
+    // A subset: the CJK characters the frame uses, like an asset pipeline would bake.
+    auto cjk = load(args.cjk, 3, {0x8A2D, 0x5B9A, 0x4FDD, 0x5B58, 0x6F22, 0x5B57});
+    if (!dejavu || !inter || !cjk) return 1;
+    const double bake_ms = std::chrono::duration<double, std::milli>(Clock::now() - bake_start).count();
+
+    std::printf("Machine: %s, %u hardware threads (one used). Compiler: %s. Fonts baked in %.0f ms.\n\n",
+                cpu_model().c_str(), std::max(1u, static_cast<unsigned>(std::thread::hardware_concurrency())),
+                __VERSION__, bake_ms);
+    Bench bench(args, *dejavu, *inter, *cjk);
+    bench.layout_cases();
+    bench.atlas_cases();
+    bench.quantization_case();
+    bench.large_text_cases();
     return 0;
 }

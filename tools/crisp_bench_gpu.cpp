@@ -32,71 +32,39 @@ struct Args {
     bool validate = false;
 };
 
-[[noreturn]] void usage(int code) {
-    std::fprintf(code ? stderr : stdout,
-                 "usage: crisp-bench-gpu [options]\n"
-                 "Fills a canvas with text and measures the rasterizer's GPU time per frame, from new text\n"
-                 "(8 samples per glyph) to converged static text, with timestamp queries.\n\n"
-                 "  --font PATH        a font file, baked at start (default fonts/DejaVuSans.ttf)\n"
-                 "  --size PX          pixels per em (default 16)\n"
-                 "  --canvas WxH       canvas filled with lines of text (default 1920x1080)\n"
-                 "  --layout NAME      subpixel layout preset or file (default rgb)\n"
-                 "  --samples N        samples per glyph to converge to (default 512)\n"
-                 "  --frames N         stop after N frames even if not converged (default 1000)\n"
-                 "  --atlas-budget MIB let the 2048x2048 atlas grow to MIB mebibytes (default 0: it does not)\n"
-                 "  --no-shared-rows   solve roots per channel even where channels share rows\n"
-                 "  --device TEXT      pick a device whose name contains TEXT\n"
-                 "  --validate         turn the validation layer on\n"
-                 "  --help             this text\n");
-    std::exit(code);
-}
-
-template <class T>
-T number(const std::string& text) {
-    const std::optional<T> value = crisp::cli::parse_number<T>(text);
-    if (!value) {
-        std::fprintf(stderr, "crisp-bench-gpu: '%s' is not a valid number\n", text.c_str());
-        usage(2);
-    }
-    return *value;
-}
-
+// Parses the command line; prints --help, or the help on stderr and exits 2 on a usage error.
 Args parse(int argc, char** argv) {
     Args args;
-    for (int i = 1; i < argc; ++i) {
-        const std::string arg = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) usage(2);
-            return argv[++i];
-        };
-        if (arg == "--help" || arg == "-h")
-            usage(0);
-        else if (arg == "--font")
-            args.font = value();
-        else if (arg == "--size")
-            args.size = number<float>(value());
-        else if (arg == "--layout")
-            args.layout = value();
-        else if (arg == "--samples")
-            args.samples = number<uint32_t>(value());
-        else if (arg == "--frames")
-            args.max_frames = number<uint32_t>(value());
-        else if (arg == "--atlas-budget")
-            args.atlas_budget_mib = number<uint32_t>(value());
-        else if (arg == "--device")
-            args.device = value();
-        else if (arg == "--no-shared-rows")
-            args.no_shared_rows = true;
-        else if (arg == "--validate")
-            args.validate = true;
-        else if (arg == "--canvas") {
-            const std::string v = value();
-            if (std::sscanf(v.c_str(), "%ux%u", &args.width, &args.height) != 2) usage(2);
-        } else {
-            std::fprintf(stderr, "crisp-bench-gpu: unknown argument %s\n", arg.c_str());
-            usage(2);
-        }
-    }
+    crisp::cli::CommandLine cli(
+        "crisp-bench-gpu",
+        "usage: crisp-bench-gpu [options]\n"
+        "Fills a canvas with text and measures the rasterizer's GPU time per frame, from new text\n"
+        "(8 samples per glyph) to converged static text, with timestamp queries.\n\n");
+    cli.on_usage_error(2, "", true);
+    cli.text("--font", "PATH", "a font file, baked at start (default fonts/DejaVuSans.ttf)", args.font);
+    cli.number<float>("--size", "PX", "pixels per em (default 16)", args.size);
+    cli.option("--canvas", "WxH", "canvas filled with lines of text (default 1920x1080)",
+               [&args](std::string_view text) -> crisp::Status {
+                   auto sides = crisp::cli::parse_number_list<uint32_t>("--canvas", text, 'x');
+                   if (!sides) return sides.error();
+                   if (sides->size() != 2) {
+                       return crisp::Error{crisp::ErrorCode::invalid_argument,
+                                           "--canvas: '" + crisp::cli::printable(text) + "' is not WxH"};
+                   }
+                   args.width = (*sides)[0];
+                   args.height = (*sides)[1];
+                   return {};
+               });
+    cli.text("--layout", "NAME", "subpixel layout preset or file (default rgb)", args.layout);
+    cli.number<uint32_t>("--samples", "N", "samples per glyph to converge to (default 512)", args.samples);
+    cli.number<uint32_t>("--frames", "N", "stop after N frames even if not converged (default 1000)", args.max_frames);
+    cli.number<uint32_t>("--atlas-budget", "MIB",
+                         "let the 2048x2048 atlas grow to MIB mebibytes (default 0: it does not)",
+                         args.atlas_budget_mib);
+    cli.flag("--no-shared-rows", "solve roots per channel even where channels share rows", args.no_shared_rows);
+    cli.text("--device", "TEXT", "pick a device whose name contains TEXT", args.device);
+    cli.flag("--validate", "turn the validation layer on", args.validate);
+    cli.parse(argc, argv);
     return args;
 }
 
@@ -112,6 +80,103 @@ struct Frame {
     uint64_t curve_tests = 0;
     double gpu_ms = 0.0;
 };
+
+// A screen of prose: lines of text at the given size until the canvas is full.
+std::vector<crisp::GlyphInstance> screen_of_text(const Args& args, const crisp::Font& font) {
+    const std::string prose =
+        "It was the best of times, it was the worst of times, it was the age of wisdom, it was the age of "
+        "foolishness, it was the epoch of belief, it was the epoch of incredulity, it was the season of Light, "
+        "it was the season of Darkness, it was the spring of hope, it was the winter of despair. ";
+    std::string text;
+    while (text.size() < 400000) text += prose;
+    const crisp::Font* fonts[] = {&font};
+    crisp::TextStyle style;
+    style.size = args.size;
+    crisp::LayoutOptions layout_options;
+    layout_options.origin_x = 4.25f;
+    layout_options.origin_y = args.size;
+    layout_options.wrap_width = static_cast<float>(args.width) - 8.0f;
+    auto laid = crisp::layout_text(fonts, text, style, layout_options);
+    if (!laid) fail(laid.error().message);
+    std::vector<crisp::GlyphInstance> screen;
+    for (const crisp::GlyphInstance& g : laid->glyphs) {
+        if (g.y + static_cast<int32_t>(g.height) <= static_cast<int32_t>(args.height)) screen.push_back(g);
+    }
+    return screen;
+}
+
+crisp::Renderer make_renderer(const crisp::HeadlessContext& context, const Args& args,
+                              const crisp::SubpixelLayout& layout, const crisp::Font& font) {
+    crisp::RendererCreateInfo info = crisp::renderer_create_info(context);
+    info.atlas.max_samples = args.samples;
+    info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: the benchmark measures raw throughput
+    info.layout = layout;
+    info.atlas_memory_budget = uint64_t{args.atlas_budget_mib} << 20;
+    info.shared_row_roots = !args.no_shared_rows;
+    auto renderer = crisp::Renderer::create(info);
+    if (!renderer) fail(renderer.error().message);
+    if (auto s = renderer->add_font(font); !s) fail(s.error().message);
+    return std::move(*renderer);
+}
+
+// Draws the screen frame after frame, each timed on the GPU, until it converges or max_frames.
+std::vector<Frame> run_frames(crisp::HeadlessContext& context, crisp::Renderer& renderer,
+                              const std::vector<crisp::GlyphInstance>& screen, uint32_t max_frames) {
+    auto timer = crisp::tools::GpuTimer::create(context);
+    if (!timer) fail(timer.error().message);
+    std::vector<Frame> frames;
+    for (uint32_t f = 0; f < max_frames; ++f) {
+        renderer.begin_frame();
+        renderer.draw(screen);
+        const auto status = context.submit_and_wait([&](VkCommandBuffer cb) {
+            timer->begin(cb);
+            if (auto s = renderer.record(cb); !s) fail(s.error().message);
+            timer->end(cb);
+        });
+        if (!status) fail(status.error().message);
+        const crisp::Result<double> gpu_ms = timer->milliseconds();
+        if (!gpu_ms) fail(gpu_ms.error().message);
+        Frame frame;
+        frame.index = f;
+        frame.samples = renderer.stats().samples;
+        frame.items = renderer.stats().work_items;
+        frame.curve_tests = renderer.stats().curve_tests;
+        frame.gpu_ms = *gpu_ms;
+        frames.push_back(frame);
+        if (renderer.converged() && frame.items == 0) break;
+    }
+    return frames;
+}
+
+void print_markdown(const Args& args, const crisp::HeadlessContext& context, const crisp::Renderer& renderer,
+                    const std::string& layout_name, size_t screen_glyphs, const std::vector<Frame>& frames) {
+    const crisp::AtlasStats& atlas = renderer.atlas().stats();
+    const crisp::RendererStats& last = renderer.stats();
+    std::printf(
+        "Device: %s, driver %s (%s). Canvas %ux%u, %s at %.4g px, layout %s%s, %zu glyphs on screen, "
+        "%u atlas entries (%ux%u atlas, %u of %u cells). Last frame: %u glyphs drawn, %u failed, %u at "
+        "coarser subpixel steps (%u per pixel).\n\n",
+        context.device_name().c_str(), context.driver_name().c_str(), context.driver_info().c_str(), args.width,
+        args.height, args.font.c_str(), static_cast<double>(args.size), layout_name.c_str(),
+        args.no_shared_rows ? " (roots per channel)" : "", screen_glyphs, atlas.resident_glyphs,
+        renderer.atlas().config().width, renderer.atlas().config().height, atlas.used_cells, atlas.usable_cells,
+        last.drawn_glyphs, last.failed_glyphs, last.coarsened_glyphs, last.subpixel_steps);
+    std::printf(
+        "| frame | samples per glyph added | glyphs refined | curve tests (estimate) | GPU ms | "
+        "curve tests per second |\n|---:|---:|---:|---:|---:|---:|\n");
+    double total_ms = 0.0;
+    for (const Frame& f : frames) {
+        total_ms += f.gpu_ms;
+        const bool show = f.index < 6 || f.index + 1 == frames.size() || (f.index & (f.index - 1)) == 0;
+        if (!show) continue;
+        std::printf("| %u | %.3g | %u | %.3g | %.3f | %.3g |\n", f.index + 1,
+                    f.items ? static_cast<double>(f.samples) / f.items : 0.0, f.items,
+                    static_cast<double>(f.curve_tests), f.gpu_ms,
+                    f.gpu_ms > 0 ? static_cast<double>(f.curve_tests) / (f.gpu_ms * 1e-3) : 0.0);
+    }
+    std::printf("\n%zu frames, %.1f ms of GPU time in all; converged: %s.\n", frames.size(), total_ms,
+                renderer.converged() ? "yes" : "no");
+}
 
 }  // namespace
 
@@ -130,89 +195,12 @@ int main(int argc, char** argv) {
     if (!font) fail(font.error().message);
     auto layout = crisp::resolve_subpixel_layout(args.layout);
     if (!layout) fail(layout.error().message);
-
-    crisp::RendererCreateInfo info = crisp::renderer_create_info(*context);
-    info.atlas.max_samples = args.samples;
-    info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: the benchmark measures raw throughput
-    info.layout = *layout;
-    info.atlas_memory_budget = uint64_t{args.atlas_budget_mib} << 20;
-    info.shared_row_roots = !args.no_shared_rows;
-    auto renderer = crisp::Renderer::create(info);
-    if (!renderer) fail(renderer.error().message);
-    if (auto s = renderer->add_font(*font); !s) fail(s.error().message);
-
-    // A screen of prose: lines of text at the given size until the canvas is full.
-    const std::string prose =
-        "It was the best of times, it was the worst of times, it was the age of wisdom, it was the age of "
-        "foolishness, it was the epoch of belief, it was the epoch of incredulity, it was the season of Light, "
-        "it was the season of Darkness, it was the spring of hope, it was the winter of despair. ";
-    std::string text;
-    while (text.size() < 400000) text += prose;
-    const crisp::Font* fonts[] = {&*font};
-    crisp::TextStyle style;
-    style.size = args.size;
-    crisp::LayoutOptions layout_options;
-    layout_options.origin_x = 4.25f;
-    layout_options.origin_y = args.size;
-    layout_options.wrap_width = static_cast<float>(args.width) - 8.0f;
-    auto laid = crisp::layout_text(fonts, text, style, layout_options);
-    if (!laid) fail(laid.error().message);
-    std::vector<crisp::GlyphInstance> screen;
-    for (const crisp::GlyphInstance& g : laid->glyphs) {
-        if (g.y + static_cast<int32_t>(g.height) <= static_cast<int32_t>(args.height)) screen.push_back(g);
+    {
+        crisp::Renderer renderer = make_renderer(*context, args, *layout, *font);
+        const std::vector<crisp::GlyphInstance> screen = screen_of_text(args, *font);
+        const std::vector<Frame> frames = run_frames(*context, renderer, screen, args.max_frames);
+        print_markdown(args, *context, renderer, layout->name, screen.size(), frames);
     }
-
-    auto timer = crisp::tools::GpuTimer::create(*context);
-    if (!timer) fail(timer.error().message);
-
-    std::vector<Frame> frames;
-    for (uint32_t f = 0; f < args.max_frames; ++f) {
-        renderer->begin_frame();
-        renderer->draw(screen);
-        const auto status = context->submit_and_wait([&](VkCommandBuffer cb) {
-            timer->begin(cb);
-            if (auto s = renderer->record(cb); !s) fail(s.error().message);
-            timer->end(cb);
-        });
-        if (!status) fail(status.error().message);
-        const crisp::Result<double> gpu_ms = timer->milliseconds();
-        if (!gpu_ms) fail(gpu_ms.error().message);
-        Frame frame;
-        frame.index = f;
-        frame.samples = renderer->stats().samples;
-        frame.items = renderer->stats().work_items;
-        frame.curve_tests = renderer->stats().curve_tests;
-        frame.gpu_ms = *gpu_ms;
-        frames.push_back(frame);
-        if (renderer->converged() && frame.items == 0) break;
-    }
-
-    const crisp::AtlasStats& atlas = renderer->atlas().stats();
-    const crisp::RendererStats& last = renderer->stats();
-    std::printf(
-        "Device: %s, driver %s (%s). Canvas %ux%u, %s at %.4g px, layout %s%s, %zu glyphs on screen, "
-        "%u atlas entries (%ux%u atlas, %u of %u cells). Last frame: %u glyphs drawn, %u failed, %u at "
-        "coarser subpixel steps (%u per pixel).\n\n",
-        context->device_name().c_str(), context->driver_name().c_str(), context->driver_info().c_str(), args.width,
-        args.height, args.font.c_str(), static_cast<double>(args.size), layout->name.c_str(),
-        args.no_shared_rows ? " (roots per channel)" : "", screen.size(), atlas.resident_glyphs,
-        renderer->atlas().config().width, renderer->atlas().config().height, atlas.used_cells, atlas.usable_cells,
-        last.drawn_glyphs, last.failed_glyphs, last.coarsened_glyphs, last.subpixel_steps);
-    std::printf(
-        "| frame | samples per glyph added | glyphs refined | curve tests (estimate) | GPU ms | "
-        "curve tests per second |\n|---:|---:|---:|---:|---:|---:|\n");
-    double total_ms = 0.0;
-    for (const Frame& f : frames) {
-        total_ms += f.gpu_ms;
-        const bool show = f.index < 6 || f.index + 1 == frames.size() || (f.index & (f.index - 1)) == 0;
-        if (!show) continue;
-        std::printf("| %u | %.3g | %u | %.3g | %.3f | %.3g |\n", f.index + 1,
-                    f.items ? static_cast<double>(f.samples) / f.items : 0.0, f.items,
-                    static_cast<double>(f.curve_tests), f.gpu_ms,
-                    f.gpu_ms > 0 ? static_cast<double>(f.curve_tests) / (f.gpu_ms * 1e-3) : 0.0);
-    }
-    std::printf("\n%zu frames, %.1f ms of GPU time in all; converged: %s.\n", frames.size(), total_ms,
-                renderer->converged() ? "yes" : "no");
     const auto messages = context->validation_messages();
     if (messages.errors + messages.warnings > 0) {
         for (const auto& m : messages.recent) std::fprintf(stderr, "%s\n", m.c_str());
