@@ -7,7 +7,7 @@
 // (docs/benchmarks-cpu.md); --json-out writes JSON too.
 #include "cli.hpp"
 #include "gpu_tools.hpp"
-#include "json.hpp"
+#include "json_writer.hpp"
 #include "vk_barriers.hpp"
 #include "vk_resources.hpp"
 #include "headless_context.hpp"
@@ -56,7 +56,7 @@ constexpr VkFormat kTargetFormat = VK_FORMAT_R8G8B8A8_UNORM;
     std::exit(1);
 }
 
-// ---- Options: one table gives both --help and the parsing.
+// ---- Options
 
 struct Args {
     std::string font = "fonts/DejaVuSans.ttf";
@@ -70,108 +70,43 @@ struct Args {
     bool validate = false;
 };
 
-[[noreturn]] void refuse(const std::string& message) {
-    std::fprintf(stderr, "crisp-bench-frame: %s (--help lists the options)\n", message.c_str());
-    std::exit(2);
+crisp::Status parse_canvas(Args& args, std::string_view text) {
+    const std::vector<std::string_view> sides = crisp::cli::split(text, 'x');
+    if (sides.size() != 2) {
+        return crisp::Error{crisp::ErrorCode::invalid_argument,
+                            "--canvas: '" + crisp::cli::printable(text) + "' is not WxH"};
+    }
+    const crisp::cli::Range<uint32_t> range{64, 16384};
+    for (auto [side, target] : {std::pair{sides[0], &args.width}, std::pair{sides[1], &args.height}}) {
+        crisp::Result<uint32_t> value = crisp::cli::CommandLine::checked_number<uint32_t>("--canvas", side, range);
+        if (!value) return value.error();
+        *target = *value;
+    }
+    return {};
 }
 
-template <class T>
-T number(std::string_view option, const std::string& text, T low, T high) {
-    std::string why;
-    const std::optional<T> value = crisp::cli::parse_number<T>(text, &why);
-    if (!value) refuse(std::string(option) + ": '" + crisp::cli::printable(text) + "' " + why);
-    if (!(*value >= low && *value <= high)) {
-        char range[64];
-        std::snprintf(range, sizeof range, "%.10g..%.10g", static_cast<double>(low), static_cast<double>(high));
-        refuse(std::string(option) + " must be in " + range);
-    }
-    return *value;
-}
-
-std::vector<std::string> split(const std::string& list, char separator) {
-    std::vector<std::string> parts;
-    size_t begin = 0;
-    while (true) {
-        const size_t end = list.find(separator, begin);
-        parts.push_back(list.substr(begin, end == std::string::npos ? std::string::npos : end - begin));
-        if (end == std::string::npos) return parts;
-        begin = end + 1;
-    }
-}
-
-struct Option {
-    const char* name;
-    const char* value;  // what follows the option in --help; nullptr for a flag
-    const char* help;   // lines after the first are indented under it
-    void (*apply)(Args& args, const std::string& value);
-};
-
-const Option kOptions[] = {
-    {"--font", "PATH", "a font file, baked at start (default fonts/DejaVuSans.ttf, from the repository root)",
-     [](Args& a, const std::string& v) { a.font = v; }},
-    {"--size", "PX", "pixels per em of every label (default 16)",
-     [](Args& a, const std::string& v) { a.size = number<float>("--size", v, 4.0f, 256.0f); }},
-    {"--canvas", "WxH", "the RGBA8 storage image composited into (default 1920x1080)",
-     [](Args& a, const std::string& v) {
-         const std::vector<std::string> sides = split(v, 'x');
-         if (sides.size() != 2) refuse("--canvas: '" + crisp::cli::printable(v) + "' is not WxH");
-         a.width = number<uint32_t>("--canvas", sides[0], 64, 16384);
-         a.height = number<uint32_t>("--canvas", sides[1], 64, 16384);
-     }},
-    {"--warmup", "N", "untimed frames per variant first (default 100)",
-     [](Args& a, const std::string& v) { a.warmup = number<uint32_t>("--warmup", v, 0, 1000000); }},
-    {"--frames", "N", "timed frames per variant (default 1000)",
-     [](Args& a, const std::string& v) { a.frames = number<uint32_t>("--frames", v, 1, 1000000); }},
-    {"--variants", "LIST",
-     "comma-separated, from static (nothing changes), changed (3 strings laid out\n"
-     "again every frame) and moving (as changed, and every label moves every frame)\n"
-     "(default static,changed,moving)",
-     [](Args& a, const std::string& v) { a.variants = split(v, ','); }},
-    {"--device", "TEXT", "pick a device whose name contains TEXT", [](Args& a, const std::string& v) { a.device = v; }},
-    {"--json-out", "FILE", "also write the results as JSON to FILE",
-     [](Args& a, const std::string& v) { a.json_out = v; }},
-    {"--validate", nullptr, "turn the validation layer on (to check the tool; the times then mean little)",
-     [](Args& a, const std::string&) { a.validate = true; }},
-};
-
-void print_usage(std::FILE* out) {
-    std::fprintf(out,
-                 "usage: crisp-bench-frame [options]\n"
-                 "Measures the CPU time of one frame of UI text on the calling thread: 8 labels laid out once,\n"
-                 "3 of them laid out again every frame, all 8 drawn with DrawOptions, then Renderer::record and\n"
-                 "Compositor::record (the tile path) into per-frame command buffers, 2 frames in flight. Timed:\n"
-                 "begin_frame() through the end of compositor.record(); not timed: vkBegin/EndCommandBuffer,\n"
-                 "submits and fence waits. Prints Markdown tables (median, p90, p99, max per phase).\n\n");
-    constexpr int kColumn = 18;
-    for (const Option& o : kOptions) {
-        const std::string head = std::string(o.name) + (o.value ? std::string(" ") + o.value : "");
-        std::fprintf(out, "  %-*s", kColumn, head.c_str());
-        for (const char* c = o.help; *c; ++c) {
-            std::fputc(*c, out);
-            if (*c == '\n') std::fprintf(out, "  %-*s", kColumn, "");
-        }
-        std::fputc('\n', out);
-    }
-    std::fprintf(out, "  %-*s%s\n", kColumn, "-h, --help", "this text");
-}
-
-Args parse(int argc, char** argv) {
-    Args args;
-    for (int i = 1; i < argc; ++i) {
-        const std::string arg = argv[i];
-        if (arg == "--help" || arg == "-h") {
-            print_usage(stdout);
-            std::exit(0);
-        }
-        const Option* option = nullptr;
-        for (const Option& o : kOptions) {
-            if (arg == o.name) option = &o;
-        }
-        if (!option) refuse("unknown option '" + crisp::cli::printable(arg) + "'");
-        if (option->value && i + 1 >= argc) refuse(arg + " needs a value (" + option->value + ")");
-        option->apply(args, option->value ? argv[++i] : "");
-    }
-    return args;
+void declare_options(crisp::cli::CommandLine& cli, Args& args) {
+    cli.on_usage_error(2, " (--help lists the options)");
+    cli.text("--font", "PATH", "a font file, baked at start (default fonts/DejaVuSans.ttf, from the repository root)",
+             args.font);
+    cli.number<float>("--size", "PX", "pixels per em of every label (default 16)", args.size, {4.0f, 256.0f});
+    cli.option("--canvas", "WxH", "the RGBA8 storage image composited into (default 1920x1080)",
+               [&args](std::string_view text) { return parse_canvas(args, text); });
+    cli.number<uint32_t>("--warmup", "N", "untimed frames per variant first (default 100)", args.warmup, {0, 1000000});
+    cli.number<uint32_t>("--frames", "N", "timed frames per variant (default 1000)", args.frames, {1, 1000000});
+    cli.option("--variants", "LIST",
+               "comma-separated, from static (nothing changes), changed (3 strings laid out\n"
+               "again every frame) and moving (as changed, and every label moves every frame)\n"
+               "(default static,changed,moving)",
+               [&args](std::string_view text) {
+                   const std::vector<std::string_view> names = crisp::cli::split(text, ',');
+                   args.variants.assign(names.begin(), names.end());
+                   return crisp::Status{};
+               });
+    cli.text("--device", "TEXT", "pick a device whose name contains TEXT", args.device);
+    cli.text("--json-out", "FILE", "also write the results as JSON to FILE", args.json_out);
+    cli.flag("--validate", "turn the validation layer on (to check the tool; the times then mean little)",
+             args.validate);
 }
 
 // ---- The scene
@@ -434,6 +369,18 @@ struct VariantResult {
     size_t label_glyphs = 0;  // glyph instances of the 8 labels in the first frame
 };
 
+// The thread and wall-clock times of one frame's phases.
+struct FrameTimes {
+    std::array<double, kPhaseCount> phase_us{};
+    double thread_cpu_us = 0.0;
+};
+
+// A variant's renderer and the compositor of its tile path.
+struct Engine {
+    crisp::Renderer renderer;
+    crisp::Compositor compositor;
+};
+
 struct Bench {
     const Args& args;
     crisp::HeadlessContext& context;
@@ -441,8 +388,7 @@ struct Bench {
     FrameSlots& slots;
     const crisp::Image& target;
 
-    // One variant: a new renderer and compositor, the labels laid out, warm-up frames, timed frames.
-    VariantResult run(const Variant& variant) {
+    Engine make_engine() const {
         crisp::RendererCreateInfo renderer_info = crisp::renderer_create_info(context);
         renderer_info.frames_in_flight = kFramesInFlight;
         auto renderer = crisp::Renderer::create(renderer_info);
@@ -453,7 +399,61 @@ struct Bench {
         auto compositor = crisp::Compositor::create(compositor_info);
         if (!compositor) fail(compositor.error().message);
         if (!compositor->supports_target_format(kTargetFormat)) fail("the device cannot store to R8G8B8A8_UNORM");
+        return Engine{std::move(*renderer), std::move(*compositor)};
+    }
 
+    // The timed part of a frame: begin_frame and the changed labels' layouts, the draws, and both
+    // record() calls into `cb`.
+    static FrameTimes time_frame(Engine& engine, crisp::Layouter& layouter, Labels& labels,
+                                 std::span<const crisp::Font* const> fonts, const crisp::TextStyle& style,
+                                 bool change_strings, std::span<const crisp::DrawOptions> options,
+                                 const crisp::CompositeTarget& composite_target, VkCommandBuffer cb) {
+        std::array<Clock::time_point, kPhaseCount + 1> stamps;
+        const double cpu_start = thread_cpu_us();
+        stamps[0] = Clock::now();
+        engine.renderer.begin_frame();
+        if (change_strings) {
+            for (size_t i : labels.counters) labels.lay_out(layouter, fonts, style, i);
+        }
+        stamps[1] = Clock::now();
+        for (size_t i = 0; i < kLabels.size(); ++i) engine.renderer.draw(labels.laid[i].glyphs, options[i]);
+        stamps[2] = Clock::now();
+        if (crisp::Status s = engine.renderer.record(cb); !s) fail(s.error().message);
+        stamps[3] = Clock::now();
+        if (crisp::Status s = engine.compositor.record(cb, engine.renderer.drawn_frame(), composite_target); !s) {
+            fail(s.error().message);
+        }
+        stamps[4] = Clock::now();
+        FrameTimes times;
+        times.thread_cpu_us = thread_cpu_us() - cpu_start;
+        for (size_t p = 0; p < kPhaseCount; ++p) {
+            times.phase_us[p] = std::chrono::duration<double, std::micro>(stamps[p + 1] - stamps[p]).count();
+        }
+        return times;
+    }
+
+    // Adds a timed frame's times and what the renderer and compositor did in it.
+    static void tally(VariantResult& result, const FrameTimes& times, const Engine& engine) {
+        double total = 0.0;
+        for (size_t p = 0; p < kPhaseCount; ++p) {
+            result.phase_us[p].push_back(times.phase_us[p]);
+            total += times.phase_us[p];
+        }
+        result.total_us.push_back(total);
+        result.thread_cpu_us.push_back(times.thread_cpu_us);
+        const crisp::RendererStats& stats = engine.renderer.stats();
+        (stats.work_items > 0 ? result.total_us_with_work : result.total_us_without_work).push_back(total);
+        result.drawn_glyphs += stats.drawn_glyphs;
+        result.moving_glyphs += stats.moving_glyphs;
+        result.work_items += stats.work_items;
+        result.frames_with_work += stats.work_items > 0 ? 1u : 0u;
+        result.frames_bins_reused += engine.compositor.stats().bins_reused ? 1u : 0u;
+        result.quads += engine.compositor.stats().quads;
+    }
+
+    // One variant: a new renderer and compositor, the labels laid out, warm-up frames, timed frames.
+    VariantResult run(const Variant& variant) {
+        Engine engine = make_engine();
         const crisp::Font* fonts[] = {&font};
         crisp::TextStyle style;
         style.size = args.size;
@@ -483,43 +483,10 @@ struct Bench {
                                       crisp::vk::kShaderAccess);
             if (variant.change_strings) labels.write_counters(frame);
             for (size_t i = 0; i < kLabels.size(); ++i) options[i] = draw_options(i, frame, variant.move, visible);
-
-            std::array<Clock::time_point, kPhaseCount + 1> stamps;
-            const double cpu_start = thread_cpu_us();
-            stamps[0] = Clock::now();
-            renderer->begin_frame();
-            if (variant.change_strings) {
-                for (size_t i : labels.counters) labels.lay_out(layouter, fonts, style, i);
-            }
-            stamps[1] = Clock::now();
-            for (size_t i = 0; i < kLabels.size(); ++i) renderer->draw(labels.laid[i].glyphs, options[i]);
-            stamps[2] = Clock::now();
-            if (crisp::Status s = renderer->record(*cb); !s) fail(s.error().message);
-            stamps[3] = Clock::now();
-            if (crisp::Status s = compositor->record(*cb, renderer->drawn_frame(), composite_target); !s) {
-                fail(s.error().message);
-            }
-            stamps[4] = Clock::now();
-            const double cpu_end = thread_cpu_us();
-
+            const FrameTimes times = time_frame(engine, layouter, labels, fonts, style, variant.change_strings, options,
+                                                composite_target, *cb);
             if (crisp::Status s = slots.submit(frame); !s) fail(s.error().message);
-            if (frame < args.warmup) continue;
-            double total = 0.0;
-            for (size_t p = 0; p < kPhaseCount; ++p) {
-                const double us = std::chrono::duration<double, std::micro>(stamps[p + 1] - stamps[p]).count();
-                result.phase_us[p].push_back(us);
-                total += us;
-            }
-            result.total_us.push_back(total);
-            result.thread_cpu_us.push_back(cpu_end - cpu_start);
-            const crisp::RendererStats& stats = renderer->stats();
-            (stats.work_items > 0 ? result.total_us_with_work : result.total_us_without_work).push_back(total);
-            result.drawn_glyphs += stats.drawn_glyphs;
-            result.moving_glyphs += stats.moving_glyphs;
-            result.work_items += stats.work_items;
-            result.frames_with_work += stats.work_items > 0 ? 1u : 0u;
-            result.frames_bins_reused += compositor->stats().bins_reused ? 1u : 0u;
-            result.quads += compositor->stats().quads;
+            if (frame >= args.warmup) tally(result, times, engine);
         }
         // The renderer and the compositor go once the GPU is done with them.
         if (crisp::Status s = slots.wait_all(); !s) fail(s.error().message);
@@ -647,91 +614,89 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Va
     }
 }
 
-using NumberField = std::pair<const char*, double>;
-
-// A JSON object of named numbers.
-void append_numbers(std::string& out, std::span<const NumberField> fields) {
-    out += "{";
-    for (size_t i = 0; i < fields.size(); ++i) {
-        out += i ? ", " : "";
-        out += crisp::json::quote(fields[i].first) + ": ";
-        crisp::json::append_number(out, fields[i].second);
-    }
-    out += "}";
+void write_summary(crisp::JsonWriter& json, std::string_view key, const std::vector<double>& values) {
+    const Summary s = summarize(values);
+    json.key(key).begin_object();
+    json.field("median", s.median).field("p90", s.p90).field("p99", s.p99).field("max", s.max).field("mean", s.mean);
+    json.end_object();
 }
 
-void append_summary(std::string& out, const Summary& s) {
-    const NumberField fields[] = {
-        {"median", s.median}, {"p90", s.p90}, {"p99", s.p99}, {"max", s.max}, {"mean", s.mean}};
-    append_numbers(out, fields);
+void write_variant(crisp::JsonWriter& json, const Args& args, const VariantResult& r) {
+    json.begin_object()
+        .field("name", r.variant->name)
+        .field("description", r.variant->description)
+        .field("label_glyphs", r.label_glyphs);
+    write_summary(json, "total_us", r.total_us);
+    write_summary(json, "thread_cpu_us", r.thread_cpu_us);
+    for (size_t p = 0; p < kPhaseCount; ++p) write_summary(json, std::string(kPhaseKeys[p]) + "_us", r.phase_us[p]);
+    json.key("per_frame").begin_object();
+    json.field("drawn_glyphs", per_frame(r.drawn_glyphs, args.frames))
+        .field("moving_glyphs", per_frame(r.moving_glyphs, args.frames))
+        .field("work_items", per_frame(r.work_items, args.frames))
+        .field("quads", per_frame(r.quads, args.frames))
+        .end_object();
+    json.field("frames_with_raster_work", r.frames_with_work);
+    if (!r.total_us_with_work.empty()) write_summary(json, "total_us_frames_with_raster_work", r.total_us_with_work);
+    if (!r.total_us_without_work.empty()) {
+        write_summary(json, "total_us_frames_without_raster_work", r.total_us_without_work);
+    }
+    json.field("frames_with_bins_reused", r.frames_bins_reused);
+    json.key("frame_us").begin_array();
+    for (const double us : r.total_us) json.value(std::round(us * 1000.0) / 1000.0);
+    json.end_array().end_object();
 }
 
-std::string to_json(const Args& args, const Header& header, const std::vector<VariantResult>& results) {
-    using crisp::json::quote;
-    std::string out = "{\n  \"tool\": \"crisp-bench-frame\",\n";
-    out += "  \"device\": " + quote(header.device) + ",\n  \"driver\": " + quote(header.driver) + ",\n";
-    out += "  \"api_version\": " + quote(header.api) + ",\n  \"cpu\": " + quote(header.cpu) + ",\n";
-    out += "  \"hardware_threads\": " + std::to_string(std::thread::hardware_concurrency()) + ",\n";
-    out += "  \"thread_cpu_clock_read_us\": ";
-    crisp::json::append_number(out, header.cpu_clock_read_us);
-    out += ",\n  \"build\": " + quote(header.build) + ",\n  \"font\": " + quote(args.font) + ",\n  \"size\": ";
-    crisp::json::append_number(out, static_cast<double>(args.size));
-    out += ",\n  \"canvas\": [" + std::to_string(args.width) + ", " + std::to_string(args.height) + "],\n";
-    out += "  \"frames_in_flight\": " + std::to_string(kFramesInFlight) + ",\n";
-    out += "  \"warmup_frames\": " + std::to_string(args.warmup) + ",\n";
-    out += "  \"timed_frames\": " + std::to_string(args.frames) + ",\n";
-    out += std::string("  \"validation\": ") + (args.validate ? "true" : "false") + ",\n  \"variants\": [\n";
-    for (size_t v = 0; v < results.size(); ++v) {
-        const VariantResult& r = results[v];
-        out += "    {\"name\": " + quote(r.variant->name) + ", \"description\": " + quote(r.variant->description);
-        out += ", \"label_glyphs\": " + std::to_string(r.label_glyphs) + ",\n     \"total_us\": ";
-        append_summary(out, summarize(r.total_us));
-        out += ",\n     \"thread_cpu_us\": ";
-        append_summary(out, summarize(r.thread_cpu_us));
-        for (size_t p = 0; p < kPhaseCount; ++p) {
-            out += ",\n     \"" + std::string(kPhaseKeys[p]) + "_us\": ";
-            append_summary(out, summarize(r.phase_us[p]));
-        }
-        const NumberField per_frame_fields[] = {
-            {"drawn_glyphs", per_frame(r.drawn_glyphs, args.frames)},
-            {"moving_glyphs", per_frame(r.moving_glyphs, args.frames)},
-            {"work_items", per_frame(r.work_items, args.frames)},
-            {"quads", per_frame(r.quads, args.frames)},
-        };
-        out += ",\n     \"per_frame\": ";
-        append_numbers(out, per_frame_fields);
-        out += ",\n     \"frames_with_raster_work\": " + std::to_string(r.frames_with_work);
-        if (!r.total_us_with_work.empty()) {
-            out += ", \"total_us_frames_with_raster_work\": ";
-            append_summary(out, summarize(r.total_us_with_work));
-        }
-        if (!r.total_us_without_work.empty()) {
-            out += ", \"total_us_frames_without_raster_work\": ";
-            append_summary(out, summarize(r.total_us_without_work));
-        }
-        out += ", \"frames_with_bins_reused\": " + std::to_string(r.frames_bins_reused);
-        out += ",\n     \"frame_us\": [";
-        for (size_t f = 0; f < r.total_us.size(); ++f) {
-            if (f) out += ", ";
-            crisp::json::append_number(out, std::round(r.total_us[f] * 1000.0) / 1000.0);
-        }
-        out += v + 1 < results.size() ? "]},\n" : "]}\n";
+crisp::JsonWriter to_json(const Args& args, const Header& header, const std::vector<VariantResult>& results) {
+    crisp::JsonWriter json;
+    json.begin_object()
+        .field("tool", "crisp-bench-frame")
+        .field("device", header.device)
+        .field("driver", header.driver)
+        .field("api_version", header.api)
+        .field("cpu", header.cpu)
+        .field("hardware_threads", std::thread::hardware_concurrency())
+        .field("thread_cpu_clock_read_us", header.cpu_clock_read_us)
+        .field("build", header.build)
+        .field("font", args.font)
+        .field("size", args.size);
+    json.key("canvas").begin_array().value(args.width).value(args.height).end_array();
+    json.field("frames_in_flight", kFramesInFlight)
+        .field("warmup_frames", args.warmup)
+        .field("timed_frames", args.frames)
+        .field("validation", args.validate);
+    json.key("variants").begin_array();
+    for (const VariantResult& r : results) write_variant(json, args, r);
+    json.end_array().end_object();
+    return json;
+}
+
+// Parses the command line and the variants it names; exits on --help or a usage error (2).
+Args parse(int argc, char** argv, std::vector<const Variant*>& variants) {
+    Args args;
+    crisp::cli::CommandLine cli(
+        "crisp-bench-frame",
+        "usage: crisp-bench-frame [options]\n"
+        "Measures the CPU time of one frame of UI text on the calling thread: 8 labels laid out once,\n"
+        "3 of them laid out again every frame, all 8 drawn with DrawOptions, then Renderer::record and\n"
+        "Compositor::record (the tile path) into per-frame command buffers, 2 frames in flight. Timed:\n"
+        "begin_frame() through the end of compositor.record(); not timed: vkBegin/EndCommandBuffer,\n"
+        "submits and fence waits. Prints Markdown tables (median, p90, p99, max per phase).\n\n");
+    declare_options(cli, args);
+    cli.parse(argc, argv);
+    for (const std::string& name : args.variants) {
+        const auto* found =
+            std::find_if(std::begin(kVariants), std::end(kVariants), [&](const Variant& v) { return name == v.name; });
+        if (found == std::end(kVariants)) cli.fail("--variants: unknown variant '" + crisp::cli::printable(name) + "'");
+        variants.push_back(found);
     }
-    out += "  ]\n}\n";
-    return out;
+    return args;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    const Args args = parse(argc, argv);
     std::vector<const Variant*> variants;
-    for (const std::string& name : args.variants) {
-        const auto* found =
-            std::find_if(std::begin(kVariants), std::end(kVariants), [&](const Variant& v) { return name == v.name; });
-        if (found == std::end(kVariants)) refuse("--variants: unknown variant '" + crisp::cli::printable(name) + "'");
-        variants.push_back(found);
-    }
+    const Args args = parse(argc, argv, variants);
 
     crisp::HeadlessContextOptions context_options;
     context_options.validation = args.validate;
@@ -780,9 +745,7 @@ int main(int argc, char** argv) {
     header.cpu_clock_read_us = thread_cpu_clock_cost_us();
     print_markdown(args, header, results);
     if (!args.json_out.empty()) {
-        std::ofstream out(args.json_out, std::ios::binary);
-        out << to_json(args, header, results);
-        if (!out.flush()) fail("cannot write " + crisp::cli::printable(args.json_out));
+        if (crisp::Status s = to_json(args, header, results).write_file(args.json_out); !s) fail(s.error().message);
     }
     const crisp::ValidationMessages messages = context->validation_messages();
     if (messages.errors + messages.warnings > 0) {
