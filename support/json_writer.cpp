@@ -4,6 +4,7 @@
 #include "json.hpp"
 
 #include <cassert>
+#include <charconv>
 #include <cmath>
 #include <span>
 
@@ -90,6 +91,15 @@ JsonWriter& JsonWriter::real(double n) {
     if (!std::isfinite(n)) return null();
     before_value();
     json::append_number(out_, n);
+    return *this;
+}
+
+JsonWriter& JsonWriter::real(float n) {
+    if (!std::isfinite(n)) return null();
+    before_value();
+    char buffer[32];
+    const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, n);
+    out_.append(buffer, ec == std::errc() ? end : buffer);
     return *this;
 }
 

@@ -28,8 +28,8 @@ public:
     JsonWriter& key(std::string_view name);
 
     // A value: a string (escaped; ill-formed UTF-8 becomes U+FFFD), a boolean, an integer (exact),
-    // a floating-point number (the shortest form that reads back the same; null if not finite),
-    // or null (an empty optional).
+    // a floating-point number (the shortest form that reads back the same value of its type; null
+    // if not finite), or null (an empty optional).
     JsonWriter& null();
     JsonWriter& value(std::string_view text);
     JsonWriter& value(const char* text) { return value(std::string_view(text)); }
@@ -38,6 +38,8 @@ public:
     requires std::is_arithmetic_v<T> JsonWriter& value(T number) {
         if constexpr (std::is_same_v<T, bool>) {
             return boolean(number);
+        } else if constexpr (std::is_same_v<T, float>) {
+            return real(number);
         } else if constexpr (std::is_floating_point_v<T>) {
             return real(static_cast<double>(number));
         } else if constexpr (std::is_signed_v<T>) {
@@ -77,6 +79,7 @@ private:
     JsonWriter& integer(int64_t n);
     JsonWriter& unsigned_integer(uint64_t n);
     JsonWriter& real(double n);
+    JsonWriter& real(float n);  // the shortest form that reads back the same float: 0.9, not 0.899999976
     void before_value();
 
     std::string out_;

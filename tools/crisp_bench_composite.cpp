@@ -10,7 +10,7 @@
 #include "vk_barriers.hpp"
 #include "vk_resources.hpp"
 #include "image_io.hpp"
-#include "json.hpp"
+#include "json_writer.hpp"
 #include "oit_reference.hpp"
 #include "headless_context.hpp"
 
@@ -88,154 +88,93 @@ struct Args {
     bool validate_sync = false;
 };
 
-[[noreturn]] void usage(int code) {
-    std::fprintf(code ? stderr : stdout,
-                 "usage: crisp-bench-composite [options]\n"
-                 "For scenes of N overlapping layers of text, measures each compositing mode's GPU time\n"
-                 "(timestamp queries around its record call), its error against the exact CPU reference (or,\n"
-                 "with --no-cpu-check, the exact mode) in 8-bit sRGB codes, and its bytes per pixel.\n"
-                 "Progress goes to stderr.\n\n"
-                 "  --modes LIST       modes, comma-separated, from tiled (the tile path into RGBA32F; static\n"
-                 "                     text: the bins are reused), tiled-rebin (binned every frame),\n"
-                 "                     tiled-rgba8 (into R8G8B8A8_UNORM), frame (the renderer's converged\n"
-                 "                     frame and the tile path together), draw (the draw path, RGBA32F),\n"
-                 "                     exact, unsorted and wboit (default: all of them)\n"
-                 "  --layers LIST      layer counts, comma-separated (default 1,2,4,8,16,32)\n"
-                 "  --alphas LIST      text alphas, comma-separated, in (0, 1] (default 0.9,0.3)\n"
-                 "  --canvas W,H       target size, also WxH (default 512,256)\n"
-                 "  --frames N         timed frames per mode (default 10)\n"
-                 "  --warmup N         untimed frames per mode before them, at least %u (default %u)\n"
-                 "  --warmup-ms T      ... and more until T ms have passed (default %g)\n"
-                 "  --clock-load N     untimed clears of the RGBA32F target before each frame's timed\n"
-                 "                     commands, so that the GPU keeps its clocks between frames (default %u)\n"
-                 "  --font PATH        a font file, baked at start (default fonts/DejaVuSans.ttf)\n"
-                 "  --size PX          pixels per em (default 18)\n"
-                 "  --samples N        samples per glyph the text converges to (default 512)\n"
-                 "  --subpixel-steps N subpixel positions per pixel in glyph keys (default 4)\n"
-                 "  --layout NAME      subpixel layout preset or file (default rgb)\n"
-                 "  --path NAME        quad passes of wboit and exact: raster or compute\n"
-                 "                     (default raster; unsorted is always rasterized)\n"
-                 "  --no-cpu-check     skip checking the exact mode against the CPU reference\n"
-                 "  --device TEXT      pick a device whose name contains TEXT\n"
-                 "  --validate         turn the validation layer on\n"
-                 "  --validate-sync    the validation layer with synchronization validation\n"
-                 "  --json             print JSON instead of Markdown\n"
-                 "  --json-out FILE    also write the JSON to FILE\n"
-                 "  -h, --help         this text\n",
-                 kFramesInFlight, kDefaultWarmupFrames, kDefaultWarmupMs, kDefaultClockLoad);
-    std::exit(code);
+// A comma-separated list of numbers, each within `range`, into `target`.
+template <class T>
+crisp::cli::CommandLine::Apply number_list(std::vector<T>& target, const char* option, crisp::cli::Range<T> range) {
+    return [&target, option, range](std::string_view text) -> crisp::Status {
+        target.clear();
+        for (const std::string_view item : crisp::cli::split(text, ',')) {
+            crisp::Result<T> value = crisp::cli::CommandLine::checked_number<T>(option, item, range);
+            if (!value) return value.error();
+            target.push_back(*value);
+        }
+        return {};
+    };
+}
+
+// --canvas W,H or WxH, each side 16..16384.
+crisp::Status parse_canvas(Args& args, std::string_view text) {
+    auto size =
+        crisp::cli::parse_number_list<uint32_t>("--canvas", text, text.find('x') != std::string_view::npos ? 'x' : ',');
+    if (!size) return size.error();
+    if (size->size() != 2 || (*size)[0] < 16 || (*size)[1] < 16 || (*size)[0] > 16384 || (*size)[1] > 16384) {
+        return crisp::Error{crisp::ErrorCode::invalid_argument, "--canvas: W,H each in 16..16384"};
+    }
+    args.width = (*size)[0];
+    args.height = (*size)[1];
+    return {};
+}
+
+// What is measured: the modes, the scenes and the frames.
+void declare_measure_options(crisp::cli::CommandLine& cli, Args& args) {
+    cli.option("--modes", "LIST",
+               "modes, comma-separated, from tiled (the tile path into RGBA32F; static\n"
+               "text: the bins are reused), tiled-rebin (binned every frame),\n"
+               "tiled-rgba8 (into R8G8B8A8_UNORM), frame (the renderer's converged\n"
+               "frame and the tile path together), draw (the draw path, RGBA32F),\n"
+               "exact, unsorted and wboit (default: all of them)",
+               [&args](std::string_view text) {
+                   const std::vector<std::string_view> modes = crisp::cli::split(text, ',');
+                   args.modes.assign(modes.begin(), modes.end());
+                   return crisp::Status{};
+               });
+    cli.option("--layers", "LIST", "layer counts, comma-separated (default 1,2,4,8,16,32)",
+               number_list<uint32_t>(args.layers, "--layers", {1, 1024}));
+    cli.option("--alphas", "LIST", "text alphas, comma-separated, in (0, 1] (default 0.9,0.3)",
+               number_list<float>(args.alphas, "--alphas", {0.0f, 1.0f, true}));
+    cli.option("--canvas", "W,H", "target size, also WxH (default 512,256)",
+               [&args](std::string_view text) { return parse_canvas(args, text); });
+    cli.number<uint32_t>("--frames", "N", "timed frames per mode (default 10)", args.frames, {1, 1000000});
+    cli.number<uint32_t>("--warmup", "N",
+                         "untimed frames per mode before them, at least " + std::to_string(kFramesInFlight) +
+                             " (default " + std::to_string(kDefaultWarmupFrames) + ")",
+                         args.warmup, {kFramesInFlight, 1000000});
+    cli.number<double>(
+        "--warmup-ms", "T",
+        "... and more until T ms have passed (default " + std::to_string(static_cast<int>(kDefaultWarmupMs)) + ")",
+        args.warmup_ms, {0.0, 600000.0});
+    cli.number<uint32_t>("--clock-load", "N",
+                         "untimed clears of the RGBA32F target before each frame's timed\n"
+                         "commands, so that the GPU keeps its clocks between frames (default " +
+                             std::to_string(kDefaultClockLoad) + ")",
+                         args.clock_load, {0, 1000});
+}
+
+// The text, the device and the output.
+void declare_setup_options(crisp::cli::CommandLine& cli, Args& args) {
+    cli.text("--font", "PATH", "a font file, baked at start (default fonts/DejaVuSans.ttf)", args.font);
+    cli.number<float>("--size", "PX", "pixels per em (default 18)", args.size, {4.0f, 256.0f});
+    cli.number<uint32_t>("--samples", "N", "samples per glyph the text converges to (default 512)", args.samples);
+    cli.number<uint32_t>("--subpixel-steps", "N", "subpixel positions per pixel in glyph keys (default 4)",
+                         args.subpixel_steps);
+    cli.text("--layout", "NAME", "subpixel layout preset or file (default rgb)", args.layout);
+    cli.choice<crisp::QuadPath>("--path", "NAME",
+                                "quad passes of wboit and exact: raster or compute\n"
+                                "(default raster; unsorted is always rasterized)",
+                                args.path, {crisp::QuadPath::raster, crisp::QuadPath::compute},
+                                [](const crisp::QuadPath& path) { return std::string(crisp::quad_path_name(path)); });
+    cli.flag("--no-cpu-check", "skip checking the exact mode against the CPU reference", args.cpu_check, false);
+    cli.text("--device", "TEXT", "pick a device whose name contains TEXT", args.device);
+    cli.flag("--validate", "turn the validation layer on", args.validate);
+    cli.flag("--validate-sync", "the validation layer with synchronization validation",
+             [&args] { args.validate = args.validate_sync = true; });
+    cli.flag("--json", "print JSON instead of Markdown", args.json);
+    cli.text("--json-out", "FILE", "also write the JSON to FILE", args.json_out);
 }
 
 [[noreturn]] void fail(const std::string& message) {
     std::fprintf(stderr, "crisp-bench-composite: %s\n", message.c_str());
     std::exit(1);
-}
-
-template <class T>
-T number(const std::string& text) {
-    const std::optional<T> value = crisp::cli::parse_number<T>(text);
-    if (!value) {
-        std::fprintf(stderr, "crisp-bench-composite: '%s' is not a valid number\n", text.c_str());
-        usage(2);
-    }
-    return *value;
-}
-
-template <class T>
-std::vector<T> number_list(const std::string& text, char separator = ',') {
-    std::vector<T> values;
-    size_t begin = 0;
-    while (true) {
-        const size_t end = text.find(separator, begin);
-        values.push_back(number<T>(text.substr(begin, end == std::string::npos ? std::string::npos : end - begin)));
-        if (end == std::string::npos) break;
-        begin = end + 1;
-    }
-    return values;
-}
-
-Args parse(int argc, char** argv) {
-    Args args;
-    for (int i = 1; i < argc; ++i) {
-        const std::string arg = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) usage(2);
-            return argv[++i];
-        };
-        if (arg == "--help" || arg == "-h") {
-            usage(0);
-        } else if (arg == "--layers") {
-            args.layers = number_list<uint32_t>(value());
-            for (uint32_t n : args.layers) {
-                if (n < 1 || n > 1024) fail("--layers: each count must be in 1..1024");
-            }
-        } else if (arg == "--alphas") {
-            args.alphas = number_list<float>(value());
-            for (float a : args.alphas) {
-                if (!(a > 0.0f && a <= 1.0f)) fail("--alphas: each alpha must be in (0, 1]");
-            }
-        } else if (arg == "--canvas") {
-            const std::string v = value();
-            const std::vector<uint32_t> size = number_list<uint32_t>(v, v.find('x') != std::string::npos ? 'x' : ',');
-            if (size.size() != 2 || size[0] < 16 || size[1] < 16 || size[0] > 16384 || size[1] > 16384) {
-                fail("--canvas: W,H each in 16..16384");
-            }
-            args.width = size[0];
-            args.height = size[1];
-        } else if (arg == "--frames") {
-            args.frames = number<uint32_t>(value());
-            if (args.frames < 1) fail("--frames must be at least 1");
-        } else if (arg == "--warmup") {
-            args.warmup = number<uint32_t>(value());
-            if (args.warmup < kFramesInFlight) fail("--warmup must be at least " + std::to_string(kFramesInFlight));
-        } else if (arg == "--warmup-ms") {
-            args.warmup_ms = number<double>(value());
-            if (!(args.warmup_ms >= 0.0 && args.warmup_ms <= 600000.0)) fail("--warmup-ms must be in 0..600000");
-        } else if (arg == "--clock-load") {
-            args.clock_load = number<uint32_t>(value());
-            if (args.clock_load > 1000) fail("--clock-load must be in 0..1000");
-        } else if (arg == "--font") {
-            args.font = value();
-        } else if (arg == "--size") {
-            args.size = number<float>(value());
-            if (!(args.size >= 4.0f && args.size <= 256.0f)) fail("--size must be in 4..256");
-        } else if (arg == "--samples") {
-            args.samples = number<uint32_t>(value());
-        } else if (arg == "--subpixel-steps") {
-            args.subpixel_steps = number<uint32_t>(value());
-        } else if (arg == "--layout") {
-            args.layout = value();
-        } else if (arg == "--path") {
-            const std::optional<crisp::QuadPath> path = crisp::parse_quad_path(value());
-            if (!path) fail("--path: raster or compute");
-            args.path = *path;
-        } else if (arg == "--modes") {
-            args.modes.clear();
-            const std::string list = value();
-            size_t begin = 0;
-            while (begin <= list.size()) {
-                const size_t end = std::min(list.find(',', begin), list.size());
-                args.modes.push_back(list.substr(begin, end - begin));
-                begin = end + 1;
-            }
-        } else if (arg == "--no-cpu-check") {
-            args.cpu_check = false;
-        } else if (arg == "--device") {
-            args.device = value();
-        } else if (arg == "--validate") {
-            args.validate = true;
-        } else if (arg == "--validate-sync") {
-            args.validate = args.validate_sync = true;
-        } else if (arg == "--json") {
-            args.json = true;
-        } else if (arg == "--json-out") {
-            args.json_out = value();
-        } else {
-            std::fprintf(stderr, "crisp-bench-composite: unknown argument %s\n", arg.c_str());
-            usage(2);
-        }
-    }
-    return args;
 }
 
 // ---- Device
@@ -631,66 +570,75 @@ double buffer_bytes_per_pixel(const Measurement& m, const Args& args) {
     return static_cast<double>(m.stats.buffer_bytes) / (static_cast<double>(args.width) * args.height);
 }
 
-void print_json(std::FILE* out, const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
-                const std::vector<std::string>& warnings) {
-    std::fprintf(out,
-                 "{\n  \"device\": %s,\n  \"driver_name\": %s,\n  \"driver_info\": %s,\n  \"driver_version\": %u,\n",
-                 crisp::json::quote(header.device).c_str(), crisp::json::quote(header.driver_name).c_str(),
-                 crisp::json::quote(header.driver_info).c_str(), header.driver_version);
-    std::fprintf(out, "  \"api_version\": %s,\n  \"storage_without_format\": %s,\n  \"layout\": %s,\n",
-                 crisp::json::quote(header.api).c_str(), header.storage_without_format ? "true" : "false",
-                 crisp::json::quote(header.layout).c_str());
-    std::fprintf(out, "  \"quad_path\": %s,\n", crisp::json::quote(crisp::quad_path_name(args.path)).c_str());
-    std::fprintf(out, "  \"canvas\": [%u, %u],\n  \"font\": %s,\n  \"size\": %g,\n  \"samples\": %u,\n", args.width,
-                 args.height, crisp::json::quote(args.font).c_str(), static_cast<double>(args.size), args.samples);
-    std::fprintf(out,
-                 "  \"subpixel_steps\": %u,\n  \"warmup_frames\": %u,\n  \"warmup_ms\": %g,\n  \"clock_load\": %u,\n"
-                 "  \"timed_frames\": %u,\n",
-                 args.subpixel_steps, args.warmup, args.warmup_ms, args.clock_load, args.frames);
-    std::fprintf(out, "  \"background_srgb\": %g,\n  \"target_bytes_per_pixel\": %u,\n  \"scenes\": [\n",
-                 static_cast<double>(kBackgroundSrgb), kTargetBytesPerPixel);
-    for (size_t s = 0; s < scenes.size(); ++s) {
-        const SceneResult& r = scenes[s];
-        std::fprintf(out,
-                     "    {\"layers\": %u, \"alpha\": %g, \"glyphs\": %zu, \"drawn_glyphs\": %zu, "
-                     "\"converge_frames\": %u, \"exact_nodes_per_pixel\": %u,\n",
-                     r.layers, static_cast<double>(r.alpha), r.glyphs, r.drawn, r.converge_frames,
-                     r.exact_nodes_per_pixel);
-        if (r.cpu) {
-            std::fprintf(out,
-                         "     \"cpu_fragments\": %llu, \"cpu_max_overlap\": %u, "
-                         "\"exact_vs_cpu\": {\"rmse\": %.6g, \"max\": %d},\n",
-                         static_cast<unsigned long long>(r.cpu->fragments), r.cpu->max_overlap, r.exact_vs_cpu.rmse,
-                         r.exact_vs_cpu.max);
-        }
-        std::fprintf(out, "     \"modes\": [\n");
-        for (size_t i = 0; i < r.modes.size(); ++i) {
-            const Measurement& m = r.modes[i];
-            std::fprintf(out,
-                         "       {\"mode\": %s, "
-                         "\"warmup_frames\": %u, \"gpu_ms_median\": %.6g, \"gpu_ms\": [",
-                         crisp::json::quote(crisp::composite_mode_name(m.run.mode)).c_str(), m.warmup_frames,
-                         m.median_ms);
-            for (size_t f = 0; f < m.gpu_ms.size(); ++f) std::fprintf(out, "%s%.6g", f ? ", " : "", m.gpu_ms[f]);
-            std::fprintf(out,
-                         "], \"rmse\": %.6g, \"max\": %d, \"buffer_bytes\": %llu, \"buffer_bytes_per_pixel\": %.6g, "
-                         "\"quads\": %u, \"bins_reused\": %s, \"measured\": %s, \"max_overlap\": %u, "
-                         "\"tail_pixels\": %u, \"exact_lost_nodes\": %llu, \"exact_dropped\": %llu, \"label\": %s, "
-                         "\"busy_tiles\": %u, \"exact_tiles\": %u, \"layered_tiles\": %u, \"tile_pairs\": %u}%s\n",
-                         m.error.rmse, m.error.max, static_cast<unsigned long long>(m.stats.buffer_bytes),
-                         buffer_bytes_per_pixel(m, args), m.stats.quads, m.stats.bins_reused ? "true" : "false",
-                         m.stats.measured ? "true" : "false", m.stats.max_overlap, m.stats.tail_pixels,
-                         static_cast<unsigned long long>(m.stats.exact_lost_nodes),
-                         static_cast<unsigned long long>(m.stats.exact_dropped),
-                         crisp::json::quote(mode_label(m.run)).c_str(), m.stats.busy_tiles, m.stats.exact_tiles,
-                         m.stats.layered_tiles, m.stats.tile_pairs, i + 1 < r.modes.size() ? "," : "");
-        }
-        std::fprintf(out, "     ]}%s\n", s + 1 < scenes.size() ? "," : "");
+void write_mode(crisp::JsonWriter& json, const Args& args, const Measurement& m) {
+    json.begin_object()
+        .field("mode", crisp::composite_mode_name(m.run.mode))
+        .field("warmup_frames", m.warmup_frames)
+        .field("gpu_ms_median", m.median_ms)
+        .field("gpu_ms", m.gpu_ms)
+        .field("rmse", m.error.rmse)
+        .field("max", m.error.max)
+        .field("buffer_bytes", m.stats.buffer_bytes)
+        .field("buffer_bytes_per_pixel", buffer_bytes_per_pixel(m, args))
+        .field("quads", m.stats.quads)
+        .field("bins_reused", m.stats.bins_reused)
+        .field("measured", m.stats.measured)
+        .field("max_overlap", m.stats.max_overlap)
+        .field("tail_pixels", m.stats.tail_pixels)
+        .field("exact_lost_nodes", m.stats.exact_lost_nodes)
+        .field("exact_dropped", m.stats.exact_dropped)
+        .field("label", mode_label(m.run))
+        .field("busy_tiles", m.stats.busy_tiles)
+        .field("exact_tiles", m.stats.exact_tiles)
+        .field("layered_tiles", m.stats.layered_tiles)
+        .field("tile_pairs", m.stats.tile_pairs)
+        .end_object();
+}
+
+void write_scene(crisp::JsonWriter& json, const Args& args, const SceneResult& r) {
+    json.begin_object()
+        .field("layers", r.layers)
+        .field("alpha", r.alpha)
+        .field("glyphs", r.glyphs)
+        .field("drawn_glyphs", r.drawn)
+        .field("converge_frames", r.converge_frames)
+        .field("exact_nodes_per_pixel", r.exact_nodes_per_pixel);
+    if (r.cpu) {
+        json.field("cpu_fragments", r.cpu->fragments).field("cpu_max_overlap", r.cpu->max_overlap).key("exact_vs_cpu");
+        json.begin_object().field("rmse", r.exact_vs_cpu.rmse).field("max", r.exact_vs_cpu.max).end_object();
     }
-    std::fprintf(out, "  ],\n  \"warnings\": [");
-    for (size_t i = 0; i < warnings.size(); ++i)
-        std::fprintf(out, "%s%s", i ? ", " : "", crisp::json::quote(warnings[i]).c_str());
-    std::fprintf(out, "]\n}\n");
+    json.key("modes").begin_array();
+    for (const Measurement& m : r.modes) write_mode(json, args, m);
+    json.end_array().end_object();
+}
+
+crisp::JsonWriter to_json(const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
+                          const std::vector<std::string>& warnings) {
+    crisp::JsonWriter json;
+    json.begin_object()
+        .field("device", header.device)
+        .field("driver_name", header.driver_name)
+        .field("driver_info", header.driver_info)
+        .field("driver_version", header.driver_version)
+        .field("api_version", header.api)
+        .field("storage_without_format", header.storage_without_format)
+        .field("layout", header.layout)
+        .field("quad_path", crisp::quad_path_name(args.path));
+    json.key("canvas").begin_array().value(args.width).value(args.height).end_array();
+    json.field("font", args.font)
+        .field("size", args.size)
+        .field("samples", args.samples)
+        .field("subpixel_steps", args.subpixel_steps)
+        .field("warmup_frames", args.warmup)
+        .field("warmup_ms", args.warmup_ms)
+        .field("clock_load", args.clock_load)
+        .field("timed_frames", args.frames)
+        .field("background_srgb", kBackgroundSrgb)
+        .field("target_bytes_per_pixel", kTargetBytesPerPixel);
+    json.key("scenes").begin_array();
+    for (const SceneResult& r : scenes) write_scene(json, args, r);
+    json.end_array().field("warnings", warnings).end_object();
+    return json;
 }
 
 void print_markdown(const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
@@ -771,36 +719,46 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
     }
 }
 
-}  // namespace
+// Parses the command line and the modes it names; exits on --help or a usage error (2).
+Args parse(int argc, char** argv, std::vector<ModeRun>& runs) {
+    Args args;
+    crisp::cli::CommandLine cli(
+        "crisp-bench-composite",
+        "usage: crisp-bench-composite [options]\n"
+        "For scenes of N overlapping layers of text, measures each compositing mode's GPU time\n"
+        "(timestamp queries around its record call), its error against the exact CPU reference (or,\n"
+        "with --no-cpu-check, the exact mode) in 8-bit sRGB codes, and its bytes per pixel.\n"
+        "Progress goes to stderr.\n\n");
+    cli.on_usage_error(2, "", true);
+    declare_measure_options(cli, args);
+    declare_setup_options(cli, args);
+    cli.parse(argc, argv);
+    for (const std::string& name : args.modes) {
+        const std::optional<ModeRun> run = parse_mode_run(name);
+        if (!run) cli.fail("--modes: unknown mode '" + crisp::cli::printable(name) + "'");
+        runs.push_back(*run);
+    }
+    const bool exact =
+        std::any_of(runs.begin(), runs.end(), [](const ModeRun& r) { return r.mode == crisp::CompositeMode::exact; });
+    if (!args.cpu_check && !exact) cli.fail("--no-cpu-check needs the exact mode as the reference");
+    return args;
+}
 
-int main(int argc, char** argv) {
-    const Args args = parse(argc, argv);
-
-    crisp::HeadlessContextOptions options;
-    options.validation = args.validate;
-    options.synchronization_validation = args.validate_sync;
-    options.device_name_contains = args.device;
-    bool storage_without_format = false;
-    auto context = crisp::tools::create_context(options, storage_without_format);
-    if (!context) fail(context.error().message);
-
-    auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});
-    if (!baked) fail(baked.error().message);
-    auto font = crisp::Font::create(std::move(baked->asset), 1);
-    if (!font) fail(font.error().message);
-    auto layout = crisp::resolve_subpixel_layout(args.layout);
-    if (!layout) fail(layout.error().message);
-
-    crisp::RendererCreateInfo info = crisp::renderer_create_info(*context);
+crisp::Renderer make_renderer(const crisp::HeadlessContext& context, const Args& args,
+                              const crisp::SubpixelLayout& layout, const crisp::Font& font) {
+    crisp::RendererCreateInfo info = crisp::renderer_create_info(context);
     info.frames_in_flight = kFramesInFlight;
     info.atlas.max_samples = args.samples;
     info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: converge in as few frames as the ramp allows
-    info.layout = *layout;
+    info.layout = layout;
     auto renderer = crisp::Renderer::create(info);
     if (!renderer) fail(renderer.error().message);
-    if (auto s = renderer->add_font(*font); !s) fail(s.error().message);
+    if (auto s = renderer->add_font(font); !s) fail(s.error().message);
+    return std::move(*renderer);
+}
 
-    // Enough prose to fill the canvas: lines at the given size, generously estimated.
+// Enough prose to fill the canvas: lines at the given size, generously estimated.
+std::string prose_for(const Args& args) {
     const std::string prose =
         "The quick brown fox jumps over the lazy dog. Pack my box with five dozen liquor jugs. Sphinx of "
         "black quartz, judge my vow! How vexingly quick daft zebras jump; 0123456789. ";
@@ -808,35 +766,11 @@ int main(int argc, char** argv) {
                               (static_cast<double>(args.height) / static_cast<double>(args.size) + 1.0);
     std::string text;
     while (static_cast<double>(text.size()) < characters) text += prose;
+    return text;
+}
 
-    auto timer = crisp::tools::GpuTimer::create(*context);
-    if (!timer) fail(timer.error().message);
-
-    const size_t pixels = size_t{args.width} * args.height;
-    auto target_readback = context->create_buffer(pixels * 4 * sizeof(float), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                  crisp::MemoryUsage::readback);
-    if (!target_readback) fail(target_readback.error().message);
-    const crisp::AtlasConfig& atlas_config = renderer->atlas().config();
-    std::optional<crisp::Buffer> atlas_readback;
-    if (args.cpu_check) {
-        auto buffer = context->create_buffer(size_t{atlas_config.width} * atlas_config.height * 4 * sizeof(uint16_t),
-                                             VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
-        if (!buffer) fail(buffer.error().message);
-        atlas_readback = std::move(*buffer);
-    }
-
-    std::vector<ModeRun> runs;
-    for (const std::string& name : args.modes) {
-        const std::optional<ModeRun> run = parse_mode_run(name);
-        if (!run) fail("--modes: unknown mode '" + name + "'");
-        runs.push_back(*run);
-    }
-    const bool reference_modes = std::any_of(runs.begin(), runs.end(), is_reference);
-    const auto exact_run =
-        std::find_if(runs.begin(), runs.end(), [](const ModeRun& r) { return r.mode == crisp::CompositeMode::exact; });
-    if (!args.cpu_check && exact_run == runs.end()) fail("--no-cpu-check needs the exact mode as the reference");
-
-    Targets targets;
+// The tile and draw paths' target images, zeroed and in GENERAL, where the frames keep them.
+void make_targets(crisp::HeadlessContext& context, const Args& args, Targets& targets) {
     struct TargetDesc {
         crisp::Image* image;
         VkFormat format;
@@ -853,128 +787,192 @@ int main(int argc, char** argv) {
         desc.width = args.width;
         desc.height = args.height;
         desc.usage = d.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-        auto made = context->create_image(desc);
+        auto made = context.create_image(desc);
         if (!made) fail(made.error().message);
         *d.image = std::move(*made);
-        // To GENERAL, where the frames keep it.
         const std::vector<std::byte> zeros(size_t{args.width} * args.height * crisp::format_texel_size(d.format));
-        if (crisp::Status st = context->upload(*d.image, zeros, VK_IMAGE_LAYOUT_GENERAL); !st) fail(st.error().message);
+        if (crisp::Status st = context.upload(*d.image, zeros, VK_IMAGE_LAYOUT_GENERAL); !st) fail(st.error().message);
+    }
+}
+
+Header make_header(const crisp::HeadlessContext& context, bool storage_without_format, const std::string& layout) {
+    Header header;
+    header.device = context.device_name();
+    header.driver_name = context.driver_name();
+    header.driver_info = context.driver_info();
+    header.driver_version = context.driver_version();
+    header.api = crisp::vk::version_string(context.api_version());
+    header.storage_without_format = storage_without_format;
+    header.layout = layout;
+    return header;
+}
+
+// One scene after another: the text converged, a compositor for it, every mode measured, and
+// each mode's error against the reference.
+struct SceneRunner {
+    const Args& args;
+    crisp::HeadlessContext& context;
+    crisp::Renderer& renderer;
+    Bench& bench;
+    Header& header;
+    const crisp::Font& font;
+    const std::string& text;
+    const std::vector<ModeRun>& runs;
+    crisp::Buffer* atlas_readback;  // with the CPU check only
+    uint64_t pool_cap;              // exact nodes per pixel the device's buffers allow
+
+    // The compositor of every mode, and one that bins every frame (tiled-rebin).
+    std::pair<crisp::Compositor, crisp::Compositor> make_compositors(uint32_t exact_nodes_per_pixel) {
+        crisp::CompositorCreateInfo info = crisp::compositor_create_info(context);
+        info.width = args.width;
+        info.height = args.height;
+        info.frames_in_flight = kFramesInFlight;
+        info.exact_nodes_per_pixel = exact_nodes_per_pixel;
+        info.reference_modes = std::any_of(runs.begin(), runs.end(), is_reference);
+        info.draw_format = VK_FORMAT_R32G32B32A32_SFLOAT;
+        auto compositor = crisp::Compositor::create(info);
+        if (!compositor) fail(compositor.error().message);
+        info.reuse_static_bins = false;
+        info.reference_modes = false;
+        auto rebinning = crisp::Compositor::create(info);
+        if (!rebinning) fail(rebinning.error().message);
+        for (const std::string& w : compositor->warnings()) {
+            std::vector<std::string>& seen = header.compositor_warnings;
+            if (std::find(seen.begin(), seen.end(), w) == seen.end()) seen.push_back(w);
+        }
+        return {std::move(*compositor), std::move(*rebinning)};
     }
 
+    // Each mode's error against the exact CPU reference (or, without it, the exact mode).
+    void compare_modes(SceneResult& result, const Measurement* exact, const std::string& name) {
+        if (!args.cpu_check) {
+            for (Measurement& m : result.modes) m.error = compare(m.codes, exact->codes);
+            return;
+        }
+        std::fprintf(stderr, "%s: CPU reference\n", name.c_str());
+        const crisp::Status status = context.submit_and_wait(
+            [&](VkCommandBuffer cb) { renderer.record_atlas_readback(cb, atlas_readback->handle()); });
+        if (!status) fail(status.error().message);
+        const crisp::AtlasConfig& atlas_config = renderer.atlas().config();
+        std::vector<uint16_t> atlas(size_t{atlas_config.width} * atlas_config.height * 4);
+        std::memcpy(atlas.data(), atlas_readback->mapped().data(), atlas.size() * sizeof(uint16_t));
+        const float grey = crisp::srgb_to_linear(kBackgroundSrgb);
+        result.cpu =
+            cpu_exact(renderer.drawn(), atlas, atlas_config.width, args.width, args.height, {grey, grey, grey});
+        if (exact) result.exact_vs_cpu = compare(exact->codes, result.cpu->codes);
+        for (Measurement& m : result.modes) m.error = compare(m.codes, result.cpu->codes);
+        result.cpu->codes = {};
+    }
+
+    SceneResult run(uint32_t layers, float alpha) {
+        const std::string name = std::to_string(layers) + " layers, alpha " + std::to_string(alpha).substr(0, 4);
+        std::fprintf(stderr, "%s: laying out\n", name.c_str());
+        const Scene scene = make_scene(args, font, text, layers, alpha);
+        SceneResult result;
+        result.layers = layers;
+        result.alpha = alpha;
+        result.glyphs = scene.glyphs.size();
+        std::fprintf(stderr, "%s: %zu glyphs, converging\n", name.c_str(), scene.glyphs.size());
+        result.converge_frames = converge(context, renderer, scene);
+        if (!renderer.converged()) bench.warn(name + ": the text did not converge");
+        result.drawn = renderer.drawn().size();
+        if (renderer.stats().failed_glyphs > 0) {
+            bench.warn(name + ": " + std::to_string(renderer.stats().failed_glyphs) +
+                       " glyphs did not fit the atlas and are not drawn");
+        }
+
+        // The pool holds every fragment when it has a node per texel of every rect.
+        const uint64_t pixels = uint64_t{args.width} * args.height;
+        const uint64_t wanted = std::max<uint64_t>(1, (scene.rect_texels + pixels - 1) / pixels);
+        result.exact_nodes_per_pixel = static_cast<uint32_t>(std::min(wanted, pool_cap));
+        if (wanted > pool_cap) {
+            bench.warn(name + ": the exact node pool is capped at " + std::to_string(pool_cap) +
+                       " nodes per pixel (64, or maxStorageBufferRange) below the " + std::to_string(wanted) +
+                       " the rects could need");
+        }
+        auto [compositor, rebinning] = make_compositors(result.exact_nodes_per_pixel);
+        for (const ModeRun& run : runs) {
+            std::fprintf(stderr, "%s: %s\n", name.c_str(), mode_label(run).c_str());
+            result.modes.push_back(bench.measure(run.rebin ? rebinning : compositor, scene, name, run));
+        }
+        const Measurement* exact = nullptr;
+        for (const Measurement& m : result.modes) {
+            if (m.run.mode == crisp::CompositeMode::exact) exact = &m;
+        }
+        if (exact && (exact->stats.exact_lost_nodes > 0 || exact->stats.exact_dropped > 0)) {
+            bench.warn(name + ": the exact mode lost " + std::to_string(exact->stats.exact_lost_nodes) +
+                       " fragments (node pool) and dropped " + std::to_string(exact->stats.exact_dropped) +
+                       " (past 64 per pixel): it is not exact here");
+        }
+        if (exact && !exact->stats.measured) bench.warn(name + ": the exact mode's stats were not measured");
+        compare_modes(result, exact, name);
+        for (Measurement& m : result.modes) m.codes = {};
+        return result;
+    }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<ModeRun> runs;
+    const Args args = parse(argc, argv, runs);
+
+    crisp::HeadlessContextOptions options;
+    options.validation = args.validate;
+    options.synchronization_validation = args.validate_sync;
+    options.device_name_contains = args.device;
+    bool storage_without_format = false;
+    auto context = crisp::tools::create_context(options, storage_without_format);
+    if (!context) fail(context.error().message);
+
+    auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});
+    if (!baked) fail(baked.error().message);
+    auto font = crisp::Font::create(std::move(baked->asset), 1);
+    if (!font) fail(font.error().message);
+    auto layout = crisp::resolve_subpixel_layout(args.layout);
+    if (!layout) fail(layout.error().message);
+    crisp::Renderer renderer = make_renderer(*context, args, *layout, *font);
+    const std::string text = prose_for(args);
+
+    auto timer = crisp::tools::GpuTimer::create(*context);
+    if (!timer) fail(timer.error().message);
+    const size_t pixels = size_t{args.width} * args.height;
+    auto target_readback = context->create_buffer(pixels * 4 * sizeof(float), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                  crisp::MemoryUsage::readback);
+    if (!target_readback) fail(target_readback.error().message);
+    std::optional<crisp::Buffer> atlas_readback;
+    if (args.cpu_check) {
+        const crisp::AtlasConfig& atlas_config = renderer.atlas().config();
+        auto buffer = context->create_buffer(size_t{atlas_config.width} * atlas_config.height * 4 * sizeof(uint16_t),
+                                             VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
+        if (!buffer) fail(buffer.error().message);
+        atlas_readback = std::move(*buffer);
+    }
+    Targets targets;
+    make_targets(*context, args, targets);
+
     std::vector<std::string> warnings;
-    Bench bench{args, *context, *renderer, *timer, *target_readback, targets, warnings};
-
-    Header header;
-    header.device = context->device_name();
-    header.driver_name = context->driver_name();
-    header.driver_info = context->driver_info();
-    header.driver_version = context->driver_version();
-    header.api = crisp::vk::version_string(context->api_version());
-    header.storage_without_format = storage_without_format;
-    header.layout = layout->name;
-
+    Bench bench{args, *context, renderer, *timer, *target_readback, targets, warnings};
+    Header header = make_header(*context, storage_without_format, layout->name);
     const uint64_t range = context->properties().limits.maxStorageBufferRange;
     const uint64_t pool_cap =
         std::min<uint64_t>(crisp::kMaxExactFragmentsPerPixel, range / (uint64_t{kExactNodeBytes} * pixels));
-    const crisp::oit::LinearRgb background = {crisp::srgb_to_linear(kBackgroundSrgb),
-                                              crisp::srgb_to_linear(kBackgroundSrgb),
-                                              crisp::srgb_to_linear(kBackgroundSrgb)};
-
+    SceneRunner scenes{
+        args,    *context, renderer, bench, header, *font, text, runs, atlas_readback ? &*atlas_readback : nullptr,
+        pool_cap};
     std::vector<SceneResult> results;
     for (const uint32_t layers : args.layers) {
-        for (const float alpha : args.alphas) {
-            const std::string name = std::to_string(layers) + " layers, alpha " + std::to_string(alpha).substr(0, 4);
-            std::fprintf(stderr, "%s: laying out\n", name.c_str());
-            const Scene scene = make_scene(args, *font, text, layers, alpha);
-            SceneResult result;
-            result.layers = layers;
-            result.alpha = alpha;
-            result.glyphs = scene.glyphs.size();
-            std::fprintf(stderr, "%s: %zu glyphs, converging\n", name.c_str(), scene.glyphs.size());
-            result.converge_frames = converge(*context, *renderer, scene);
-            if (!renderer->converged()) bench.warn(name + ": the text did not converge");
-            result.drawn = renderer->drawn().size();
-            if (renderer->stats().failed_glyphs > 0) {
-                bench.warn(name + ": " + std::to_string(renderer->stats().failed_glyphs) +
-                           " glyphs did not fit the atlas and are not drawn");
-            }
-
-            // The pool holds every fragment when it has a node per texel of every rect.
-            const uint64_t wanted = std::max<uint64_t>(1, (scene.rect_texels + pixels - 1) / pixels);
-            result.exact_nodes_per_pixel = static_cast<uint32_t>(std::min(wanted, pool_cap));
-            if (wanted > pool_cap) {
-                bench.warn(name + ": the exact node pool is capped at " + std::to_string(pool_cap) +
-                           " nodes per pixel (64, or maxStorageBufferRange) below the " + std::to_string(wanted) +
-                           " the rects could need");
-            }
-            crisp::CompositorCreateInfo compositor_info = crisp::compositor_create_info(*context);
-            compositor_info.width = args.width;
-            compositor_info.height = args.height;
-            compositor_info.frames_in_flight = kFramesInFlight;
-            compositor_info.exact_nodes_per_pixel = result.exact_nodes_per_pixel;
-            compositor_info.reference_modes = reference_modes;
-            compositor_info.draw_format = VK_FORMAT_R32G32B32A32_SFLOAT;
-            auto compositor = crisp::Compositor::create(compositor_info);
-            if (!compositor) fail(compositor.error().message);
-            compositor_info.reuse_static_bins = false;
-            compositor_info.reference_modes = false;
-            auto rebinning = crisp::Compositor::create(compositor_info);
-            if (!rebinning) fail(rebinning.error().message);
-            for (const std::string& w : compositor->warnings()) {
-                if (std::find(header.compositor_warnings.begin(), header.compositor_warnings.end(), w) ==
-                    header.compositor_warnings.end()) {
-                    header.compositor_warnings.push_back(w);
-                }
-            }
-
-            for (const ModeRun& run : runs) {
-                std::fprintf(stderr, "%s: %s\n", name.c_str(), mode_label(run).c_str());
-                result.modes.push_back(bench.measure(run.rebin ? *rebinning : *compositor, scene, name, run));
-            }
-            const Measurement* exact = nullptr;
-            for (const Measurement& m : result.modes) {
-                if (m.run.mode == crisp::CompositeMode::exact) exact = &m;
-            }
-            if (exact && (exact->stats.exact_lost_nodes > 0 || exact->stats.exact_dropped > 0)) {
-                bench.warn(name + ": the exact mode lost " + std::to_string(exact->stats.exact_lost_nodes) +
-                           " fragments (node pool) and dropped " + std::to_string(exact->stats.exact_dropped) +
-                           " (past 64 per pixel): it is not exact here");
-            }
-            if (exact && !exact->stats.measured) bench.warn(name + ": the exact mode's stats were not measured");
-            if (!args.cpu_check) {
-                for (Measurement& m : result.modes) m.error = compare(m.codes, exact->codes);
-            }
-
-            if (args.cpu_check) {
-                std::fprintf(stderr, "%s: CPU reference\n", name.c_str());
-                const crisp::Status status = context->submit_and_wait(
-                    [&](VkCommandBuffer cb) { renderer->record_atlas_readback(cb, atlas_readback->handle()); });
-                if (!status) fail(status.error().message);
-                std::vector<uint16_t> atlas(size_t{atlas_config.width} * atlas_config.height * 4);
-                std::memcpy(atlas.data(), atlas_readback->mapped().data(), atlas.size() * sizeof(uint16_t));
-                result.cpu =
-                    cpu_exact(renderer->drawn(), atlas, atlas_config.width, args.width, args.height, background);
-                if (exact) result.exact_vs_cpu = compare(exact->codes, result.cpu->codes);
-                for (Measurement& m : result.modes) m.error = compare(m.codes, result.cpu->codes);
-                result.cpu->codes = {};
-            }
-            for (Measurement& m : result.modes) {
-                m.codes = {};
-            }
-            results.push_back(std::move(result));
-        }
+        for (const float alpha : args.alphas) results.push_back(scenes.run(layers, alpha));
     }
 
+    const crisp::JsonWriter json = to_json(args, header, results, warnings);
     if (args.json) {
-        print_json(stdout, args, header, results, warnings);
+        std::fputs(json.line().c_str(), stdout);
     } else {
         print_markdown(args, header, results, warnings);
     }
     if (!args.json_out.empty()) {
-        std::FILE* file = std::fopen(args.json_out.c_str(), "w");
-        if (!file) fail("cannot write " + args.json_out);
-        print_json(file, args, header, results, warnings);
-        if (std::fclose(file) != 0) fail("cannot write " + args.json_out);
+        if (crisp::Status s = json.write_file(args.json_out); !s) fail(s.error().message);
     }
     const auto messages = context->validation_messages();
     if (messages.errors + messages.warnings > 0) {
