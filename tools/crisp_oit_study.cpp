@@ -1,5 +1,6 @@
 // Measures every compositing mode of src/oit_reference against composite_exact on random text-like
 // pixels and prints a Markdown table (docs/oit.md). No GPU. Usage: crisp-oit-study [pixels] [seed]
+#include "cli.hpp"
 #include "oit_reference.hpp"
 
 #include <algorithm>
@@ -71,11 +72,40 @@ struct Error {
     double rmse() const { return samples ? std::sqrt(sum_squares / static_cast<double>(samples)) : 0.0; }
 };
 
+// [pixels] [seed], both optional; exits on --help or a usage error (2).
+void parse(int argc, char** argv, size_t& pixels, unsigned& seed) {
+    crisp::cli::CommandLine cli(
+        "crisp-oit-study",
+        "usage: crisp-oit-study [PIXELS [SEED]]\n"
+        "Measures every compositing mode of the OIT references against the exact one on random\n"
+        "text-like pixels (PIXELS per scene, default 20000; SEED, default 1) and prints a\n"
+        "Markdown table. No GPU.\n\n");
+    cli.on_usage_error(2, " (--help lists the options)");
+    int given = 0;
+    cli.positional([&](std::string_view text) -> crisp::Status {
+        const char* name = given == 0 ? "PIXELS" : "SEED";
+        crisp::Result<uint64_t> value = crisp::cli::CommandLine::checked_number<uint64_t>(
+            name, text, crisp::cli::Range<uint64_t>{given == 0 ? 1u : 0u, given == 0 ? 100000000u : UINT32_MAX});
+        if (!value) return value.error();
+        if (given == 0)
+            pixels = *value;
+        else if (given == 1)
+            seed = static_cast<unsigned>(*value);
+        else
+            return crisp::Error{crisp::ErrorCode::invalid_argument,
+                                "unexpected argument '" + crisp::cli::printable(text) + "'"};
+        ++given;
+        return {};
+    });
+    cli.parse(argc, argv);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-    const size_t pixels = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 20000;
-    const unsigned seed = argc > 2 ? static_cast<unsigned>(std::strtoul(argv[2], nullptr, 10)) : 1u;
+    size_t pixels = 20000;
+    unsigned seed = 1;
+    parse(argc, argv, pixels, seed);
     const Scene scenes[] = {
         {"a=0.9", 0.9f, false}, {"a=0.3", 0.3f, false}, {"a=0.9 coplanar", 0.9f, true}, {"a=0.3 coplanar", 0.3f, true}};
     constexpr uint32_t kLayerCounts[] = {1, 2, 4, 8};

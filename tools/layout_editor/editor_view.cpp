@@ -1,6 +1,7 @@
 #include "editor_view.hpp"
 
 #include "cli.hpp"
+#include "json_writer.hpp"
 
 #include <GLFW/glfw3.h>
 
@@ -82,13 +83,6 @@ void button(Canvas& canvas, std::vector<TextItem>& text, const Rect& rect, const
     text.push_back({label, rect.x + 8.0f, rect.y + 19.0f, 13.0f, enabled ? kPanelText : Color{120, 120, 124}});
 }
 
-std::string json_rect(const Rect& r) {
-    char buffer[96];
-    std::snprintf(buffer, sizeof buffer, "[%g, %g, %g, %g]", static_cast<double>(r.x), static_cast<double>(r.y),
-                  static_cast<double>(r.width), static_cast<double>(r.height));
-    return buffer;
-}
-
 }  // namespace
 
 EditorView::EditorView(LayoutModel& model, std::filesystem::path path)
@@ -109,41 +103,40 @@ std::vector<EditorView::Field> EditorView::fields() const {
 }
 
 std::string EditorView::geometry_json() {
-    std::string out = "{\"window\": [" + std::to_string(kWindowWidth) + ", " + std::to_string(kWindowHeight) + "]";
-    out += ", \"pixel_origin\": [" + format_number(kPixelOriginX) + ", " + format_number(kPixelOriginY) + "]";
-    out += ", \"pixel_scale\": " + format_number(kMagnifiedPixelScale);
-    char step[32];
-    std::snprintf(step, sizeof step, "%.9g", static_cast<double>(kEditStep));
-    out += ", \"edit_step\": " + std::string(step);
-    out += ", \"presets\": {";
+    crisp::JsonWriter json;
+    auto rect = [&json](std::string_view key, const Rect& r) {
+        json.key(key).begin_array().value(r.x).value(r.y).value(r.width).value(r.height).end_array();
+    };
+    json.begin_object();
+    json.key("window").begin_array().value(kWindowWidth).value(kWindowHeight).end_array();
+    json.key("pixel_origin").begin_array().value(kPixelOriginX).value(kPixelOriginY).end_array();
+    json.field("pixel_scale", kMagnifiedPixelScale).field("edit_step", kEditStep);
+    json.key("presets").begin_object();
     const auto names = subpixel_preset_names();
-    for (size_t i = 0; i < names.size(); ++i) {
-        out += (i ? ", \"" : "\"") + std::string(names[i]) + "\": " + json_rect(preset_button(i));
-    }
-    out += "}, \"commands\": {";
-    for (size_t i = 0; i < 4; ++i) out += (i ? ", \"" : "\"") + std::string(kCommands[i]) + "\": " + json_rect(command_button(i));
-    out += "}, \"fields\": {";
+    for (size_t i = 0; i < names.size(); ++i) rect(names[i], preset_button(i));
+    json.end_object().key("commands").begin_object();
+    for (size_t i = 0; i < 4; ++i) rect(kCommands[i], command_button(i));
+    json.end_object().key("fields").begin_object();
     for (int channel = 0; channel < 3; ++channel) {
         for (int coordinate = 0; coordinate < 4; ++coordinate) {
-            const Rect rect{kFieldsX + static_cast<float>(coordinate) * kFieldStrideX,
-                            kFieldsY + static_cast<float>(channel) * kFieldStrideY, kFieldWidth, kFieldHeight};
-            out += std::string(channel + coordinate ? ", \"" : "\"") + "rgb"[channel] + "." +
-                   kCoordinateNames[coordinate] + "\": " + json_rect(rect);
+            rect(std::string(1, "rgb"[channel]) + "." + kCoordinateNames[coordinate],
+                 {kFieldsX + static_cast<float>(coordinate) * kFieldStrideX,
+                  kFieldsY + static_cast<float>(channel) * kFieldStrideY, kFieldWidth, kFieldHeight});
         }
     }
-    out += "}, \"path_field\": " + json_rect(kPathField);
-    out += ", \"magnified_pixel\": " +
-           json_rect({kPixelOriginX - kMagnifiedPixelScale, kPixelOriginY - kMagnifiedPixelScale,
-                      3 * kMagnifiedPixelScale, 3 * kMagnifiedPixelScale});
-    out += ", \"preview\": " + json_rect({kLightPanel.x, kLightPanel.y, kDarkPanel.x + kDarkPanel.width - kLightPanel.x,
-                                          kLightStrip.y + kLightStrip.height - kLightPanel.y});
+    json.end_object();
+    rect("path_field", kPathField);
+    rect("magnified_pixel", {kPixelOriginX - kMagnifiedPixelScale, kPixelOriginY - kMagnifiedPixelScale,
+                             3 * kMagnifiedPixelScale, 3 * kMagnifiedPixelScale});
+    rect("preview", {kLightPanel.x, kLightPanel.y, kDarkPanel.x + kDarkPanel.width - kLightPanel.x,
+                     kLightStrip.y + kLightStrip.height - kLightPanel.y});
     // The paragraphs only: no moving text, so they change only when the layout does.
-    out += ", \"preview_paragraphs\": " +
-           json_rect({kLightPanel.x, kLightPanel.y, kDarkPanel.x + kDarkPanel.width - kLightPanel.x, kLightPanel.height});
-    out += ", \"rendered_pixels\": " + json_rect(kRenderedView);
-    out += ", \"status\": " + json_rect(kStatusBar);
-    out += "}";
-    return out;
+    rect("preview_paragraphs",
+         {kLightPanel.x, kLightPanel.y, kDarkPanel.x + kDarkPanel.width - kLightPanel.x, kLightPanel.height});
+    rect("rendered_pixels", kRenderedView);
+    rect("status", kStatusBar);
+    json.end_object();
+    return json.text();
 }
 
 void EditorView::report(std::string text, bool error) {

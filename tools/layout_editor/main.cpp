@@ -34,24 +34,14 @@ constexpr int kExitVulkan = 3;
 constexpr int kExitValidation = 4;
 constexpr int kExitScreenshot = 5;
 
-constexpr const char* kUsage = R"(Usage: crisp-layout-editor [options]
+constexpr const char* kSynopsis = R"(Usage: crisp-layout-editor [options]
 
 Shows a subpixel layout (the sample rectangle of each colour channel within a pixel) magnified,
 lets you drag, nudge and type its rectangles, and previews text rendered by crisp with it.
 
-Options:
-  --layout FILE|PRESET  start from a layout file (JSON, docs/subpixel.md) or a preset (gray, rgb,
-                        bgr, vrgb, vbgr, qd-oled, woled, pentile); default rgb. A file that does
-                        not load is reported in the window and the editor starts from rgb.
-  --save-to FILE        where Save (Ctrl+S) writes; default: the --layout file
-  --font FILE           the font for all text (TrueType/OpenType); default: DejaVu Sans
-  --frames N            quit after N frames
-  --screenshot PATH     with --frames: write the window's last frame as a PNG, then quit
-  --validation          turn on VK_LAYER_KHRONOS_validation; any warning or error it reports
-                        makes the exit code 4 (also: CRISP_VALIDATION=1 in the environment)
-  --print-geometry      print the widgets' positions as JSON and quit (for scripted input)
-  --help                this text
+)";
 
+constexpr const char* kExitCodes = R"(
 Exit codes: 0 success; 1 bad command line; 2 the font could not be loaded; 3 no window or no
 Vulkan device (or a Vulkan failure); 4 the validation layer reported a message; 5 the screenshot
 could not be written.
@@ -67,47 +57,30 @@ struct Args {
     bool print_geometry = false;
 };
 
-[[noreturn]] void usage_error(const std::string& message) {
-    std::fprintf(stderr, "crisp-layout-editor: %s (see --help)\n", crisp::cli::printable(message).c_str());
-    std::exit(kExitUsage);
-}
-
 Args parse_args(int argc, char** argv) {
     Args args;
     const char* env = std::getenv("CRISP_VALIDATION");
     args.validation = env && std::strcmp(env, "0") != 0 && env[0] != '\0';
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view arg = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) usage_error(std::string(arg) + " needs a value");
-            return argv[++i];
-        };
-        if (arg == "--help" || arg == "-h") {
-            std::fputs(kUsage, stdout);
-            std::exit(kExitOk);
-        } else if (arg == "--layout") {
-            args.layout = value();
-        } else if (arg == "--save-to") {
-            args.save_to = value();
-        } else if (arg == "--font") {
-            args.font = value();
-        } else if (arg == "--frames") {
-            const std::string text = value();
-            std::string why;
-            const std::optional<uint64_t> frames = crisp::cli::parse_number<uint64_t>(text, &why);
-            if (!frames || *frames == 0) usage_error("--frames " + text + ": " + (frames ? "must be at least 1" : why));
-            args.frames = *frames;
-        } else if (arg == "--screenshot") {
-            args.screenshot = value();
-        } else if (arg == "--validation") {
-            args.validation = true;
-        } else if (arg == "--print-geometry") {
-            args.print_geometry = true;
-        } else {
-            usage_error("unknown argument " + std::string(arg));
-        }
-    }
-    if (!args.screenshot.empty() && args.frames == 0) usage_error("--screenshot needs --frames N");
+    crisp::cli::CommandLine cli("crisp-layout-editor", kSynopsis);
+    cli.on_usage_error(kExitUsage, " (see --help)").section("Options:").epilogue(kExitCodes);
+    cli.text("--layout", "FILE|PRESET",
+             "start from a layout file (JSON, docs/subpixel.md) or a preset (gray, rgb,\n"
+             "bgr, vrgb, vbgr, qd-oled, woled, pentile); default rgb. A file that does\n"
+             "not load is reported in the window and the editor starts from rgb.",
+             args.layout);
+    cli.text("--save-to", "FILE", "where Save (Ctrl+S) writes; default: the --layout file", args.save_to);
+    cli.text("--font", "FILE", "the font for all text (TrueType/OpenType); default: DejaVu Sans", args.font);
+    cli.number<uint64_t>("--frames", "N", "quit after N frames", args.frames, {1, UINT64_MAX});
+    cli.text("--screenshot", "PATH", "with --frames: write the window's last frame as a PNG, then quit",
+             args.screenshot);
+    cli.flag("--validation",
+             "turn on VK_LAYER_KHRONOS_validation; any warning or error it reports\n"
+             "makes the exit code 4 (also: CRISP_VALIDATION=1 in the environment)",
+             args.validation);
+    cli.flag("--print-geometry", "print the widgets' positions as JSON and quit (for scripted input)",
+             args.print_geometry);
+    cli.parse(argc, argv);
+    if (!args.screenshot.empty() && args.frames == 0) cli.fail("--screenshot needs --frames N");
     return args;
 }
 
