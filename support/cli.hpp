@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -184,9 +185,13 @@ public:
     // The --help text.
     std::string help() const;
 
-    // "OPTION must be in LOW..HIGH" (or "(LOW, HIGH]"), with the range's unit.
+    // "OPTION must be in LOW..HIGH" (or "(LOW, HIGH]", or "at least LOW" where HIGH is T's
+    // largest value), with the range's unit.
     template <class T>
     static std::string out_of_range(std::string_view option, const Range<T>& range) {
+        if (range.high == std::numeric_limits<T>::max() && !range.low_open) {
+            return std::string(option) + " must be at least " + std::to_string(range.low) + range.unit;
+        }
         return range_message(option, static_cast<double>(range.low), static_cast<double>(range.high), range.low_open,
                              range.unit);
     }
