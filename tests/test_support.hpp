@@ -1,6 +1,7 @@
 // Shared by the tests: where the fonts are, and reading files.
 #pragma once
 
+#include "harness.hpp"
 #include "headless_context.hpp"
 #include "utf8.hpp"
 
@@ -25,11 +26,7 @@
 
 namespace crisp::test {
 
-// One texel of the atlas as Renderer::record_atlas_readback() copies it: the red, green and blue
-// hits in kCoverageOne units, then the sample count.
-struct Texel {
-    uint16_t r, g, b, count;
-};
+using harness::Texel;
 
 inline std::string source_path(const std::string& relative) {
     return std::string(CRISP_SOURCE_DIR) + "/" + relative;
@@ -87,44 +84,9 @@ inline GpuFixture make_gpu_fixture(const CrispFeatureNeeds& needs, bool synchron
     return made;
 }
 
-// Frames of `draw` (which calls the renderer's draw() after begin_frame()), each recorded and
-// submitted on `context` and followed by `after()`, until the renderer converges or `max_frames`
-// were rendered. Returns the frames rendered, or the first failure of a record() or submission.
-template <class Draw, class After>
-Result<uint32_t> render_until_converged(HeadlessContext& context, Renderer& renderer, uint32_t max_frames, Draw&& draw,
-                                        After&& after) {
-    uint32_t frames = 0;
-    do {
-        renderer.begin_frame();
-        draw();
-        Status recorded;
-        const Status submitted = context.submit_and_wait([&](VkCommandBuffer cb) { recorded = renderer.record(cb); });
-        if (!recorded) return recorded.error();
-        if (!submitted) return submitted.error();
-        after();
-        ++frames;
-    } while (!renderer.converged() && frames < max_frames);
-    return frames;
-}
-template <class Draw>
-Result<uint32_t> render_until_converged(HeadlessContext& context, Renderer& renderer, uint32_t max_frames,
-                                        Draw&& draw) {
-    return render_until_converged(context, renderer, max_frames, draw, [] {});
-}
-
-// The renderer's whole atlas, read back through `context`.
-inline Result<std::vector<Texel>> read_atlas(HeadlessContext& context, const Renderer& renderer) {
-    const AtlasConfig& config = renderer.atlas().config();
-    const VkDeviceSize bytes = VkDeviceSize{config.width} * config.height * sizeof(Texel);
-    auto readback = context.create_buffer(bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::readback);
-    if (!readback) return readback.error();
-    const Status copied =
-        context.submit_and_wait([&](VkCommandBuffer cb) { renderer.record_atlas_readback(cb, readback->handle()); });
-    if (!copied) return copied.error();
-    std::vector<Texel> texels(size_t{config.width} * config.height);
-    std::memcpy(texels.data(), readback->mapped().data(), bytes);
-    return texels;
-}
+// The harness tools use too (support/harness.hpp).
+using harness::read_atlas;
+using harness::render_until_converged;
 
 inline std::vector<std::byte> read_file(const std::string& path) {
     std::ifstream file(path, std::ios::binary);

@@ -233,16 +233,10 @@ Scene make_scene(const Args& args, const crisp::Font& font, const std::string& t
 
 // Draws the scene until every glyph holds its samples; returns the frames it took.
 uint32_t converge(crisp::HeadlessContext& context, crisp::Renderer& renderer, const Scene& scene) {
-    for (uint32_t f = 0; f < kMaxConvergeFrames; ++f) {
-        renderer.begin_frame();
-        renderer.draw(scene.glyphs, scene.visible);
-        const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
-            if (crisp::Status s = renderer.record(cb); !s) fail(s.error().message);
-        });
-        if (!status) fail(status.error().message);
-        if (renderer.converged()) return f + 1;
-    }
-    return kMaxConvergeFrames;
+    crisp::Result<uint32_t> frames = crisp::harness::render_until_converged(
+        context, renderer, kMaxConvergeFrames, [&] { renderer.draw(scene.glyphs, scene.visible); });
+    if (!frames) fail(frames.error().message);
+    return *frames;
 }
 
 // ---- Images and errors

@@ -20,7 +20,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -60,7 +59,7 @@ constexpr size_t kMaxGlyphs = size_t{4} << 20;
 constexpr uint32_t kMaxCanvas = 16384;
 // The default schedule reaches kMaxRendererSamples in about 1030 frames; far more means the
 // renderer stopped making progress.
-constexpr uint64_t kMaxFrames = 100000;
+constexpr uint32_t kMaxFrames = 100000;
 // Smallest atlas side the tool asks for; it grows to hold every glyph of the text at once.
 constexpr uint32_t kMinAtlasSide = 256;
 constexpr uint32_t kAtlasTexelBytes = 8;    // R16G16B16A16_UINT
@@ -318,16 +317,6 @@ int exit_code_for_vulkan(const crisp::Error& error) {
     return vulkan ? kExitVulkan : kExitInternal;
 }
 
-// The atlas block a rect takes (see atlas.hpp): cells rounded up to powers of two per axis, then
-// square or twice as tall as wide.
-std::pair<uint32_t, uint32_t> block_cells(uint32_t width, uint32_t height) {
-    uint32_t w = std::bit_ceil((width + crisp::kAtlasCellSize - 1) / crisp::kAtlasCellSize);
-    uint32_t h = std::bit_ceil((height + crisp::kAtlasCellSize - 1) / crisp::kAtlasCellSize);
-    if (w > h) h = w;
-    if (h > 2 * w) w = h / 2;
-    return {w, h};
-}
-
 // The side of a square atlas that holds every distinct glyph of the text at once, with room to
 // spare for the allocator's alignment.
 uint32_t atlas_side_for(std::span<const crisp::GlyphInstance> glyphs) {
@@ -336,10 +325,10 @@ uint32_t atlas_side_for(std::span<const crisp::GlyphInstance> glyphs) {
     uint32_t widest = 1, tallest = 1;
     for (const crisp::GlyphInstance& glyph : glyphs) {
         if (glyph.width == 0 || glyph.height == 0 || !keys.insert(glyph.key).second) continue;
-        const auto [w, h] = block_cells(glyph.width, glyph.height);
-        cells += uint64_t{w} * h;
-        widest = std::max(widest, w);
-        tallest = std::max(tallest, h);
+        const crisp::AtlasBlock block = crisp::atlas_block(glyph.width, glyph.height);
+        cells += uint64_t{block.cells_x} * block.cells_y;
+        widest = std::max(widest, block.cells_x);
+        tallest = std::max(tallest, block.cells_y);
     }
     uint32_t side = kMinAtlasSide;
     while (side < crisp::kAtlasMaxSize &&
@@ -632,33 +621,29 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
     }
 
     const auto render_start = std::chrono::steady_clock::now();
-    do {
-        if (report.frames == kMaxFrames) {
-            std::fprintf(stderr, "crisp-render: the renderer did not converge in %llu frames\n",
-                         static_cast<unsigned long long>(kMaxFrames));
-            return kExitInternal;
-        }
-        const auto frame_start = std::chrono::steady_clock::now();
-        renderer.begin_frame();
-        renderer.draw(job.glyphs, VkRect2D{{0, 0}, {job.scene.width, job.scene.height}});
-        crisp::Status recorded;
-        const crisp::Status submitted = context.submit_and_wait(
-            [&](VkCommandBuffer command_buffer) { recorded = renderer.record(command_buffer); });
-        report.frame_ms.push_back(milliseconds_since(frame_start));
-        ++report.frames;
-        if (!recorded) {
-            std::fprintf(stderr, "crisp-render: frame %llu: %s\n", static_cast<unsigned long long>(report.frames),
-                         recorded.error().message.c_str());
-            return exit_code_for_vulkan(recorded.error());
-        }
-        if (!submitted) {
-            std::fprintf(stderr, "crisp-render: frame %llu: %s\n", static_cast<unsigned long long>(report.frames),
-                         submitted.error().message.c_str());
-            return exit_code_for_vulkan(submitted.error());
-        }
-        report.total_samples += renderer.stats().samples;
-        report.total_curve_tests += renderer.stats().curve_tests;
-    } while (!renderer.converged());
+    auto frame_start = render_start;
+    const crisp::Result<uint32_t> frames = crisp::harness::render_until_converged(
+        context, renderer, kMaxFrames,
+        [&] {
+            frame_start = std::chrono::steady_clock::now();
+            renderer.draw(job.glyphs, VkRect2D{{0, 0}, {job.scene.width, job.scene.height}});
+        },
+        [&] {
+            report.frame_ms.push_back(milliseconds_since(frame_start));
+            report.total_samples += renderer.stats().samples;
+            report.total_curve_tests += renderer.stats().curve_tests;
+        });
+    if (!frames) {
+        std::fprintf(stderr, "crisp-render: frame %llu: %s\n",
+                     static_cast<unsigned long long>(report.frame_ms.size() + 1), frames.error().message.c_str());
+        return exit_code_for_vulkan(frames.error());
+    }
+    report.frames = *frames;
+    if (!renderer.converged()) {
+        std::fprintf(stderr, "crisp-render: the renderer did not converge in %llu frames\n",
+                     static_cast<unsigned long long>(kMaxFrames));
+        return kExitInternal;
+    }
     report.render_ms = milliseconds_since(render_start);
     report.converged = true;
     report.last_frame = renderer.stats();

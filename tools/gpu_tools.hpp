@@ -1,7 +1,8 @@
-// Shared by crisp's GPU tools: a headless context with what the renderer and the compositor need
-// (docs/vulkan.md), and a GPU timer from timestamp queries.
+// Shared by crisp's GPU tools: the support harness's context (what the renderer and the compositor
+// need, docs/vulkan.md), dynamic rendering over an image, and a GPU timer from timestamp queries.
 #pragma once
 
+#include "harness.hpp"
 #include "headless_context.hpp"
 
 #include <crisp/result.hpp>
@@ -16,39 +17,7 @@
 
 namespace crisp::tools {
 
-// A context from `options` (validation, device name) plus the features crisp's renderer and
-// compositor need (docs/vulkan.md), with shaderStorageImageReadWithoutFormat and WriteWithoutFormat
-// (B8G8R8A8 tile targets) where a device offers them: `storage_without_format` says whether they
-// are on. When neither attempt finds a device, the error is the second's (it names what else is
-// missing), prefixed by the first's.
-inline Result<HeadlessContext> create_context(HeadlessContextOptions options, bool& storage_without_format) {
-    auto attempt = [&](bool without_format) {
-        VkPhysicalDeviceVulkan13Features vulkan13{};
-        vulkan13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
-        vulkan13.dynamicRendering = VK_TRUE;  // the compositor's draw path
-        VkPhysicalDeviceFeatures2 features{};
-        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-        features.pNext = &vulkan13;
-        features.features.shaderStorageBufferArrayDynamicIndexing = VK_TRUE;  // the renderer
-        features.features.fragmentStoresAndAtomics = VK_TRUE;                // the reference modes
-        features.features.dualSrcBlend = VK_TRUE;                             // unsorted, the draw path
-        features.features.shaderStorageImageReadWithoutFormat = without_format ? VK_TRUE : VK_FALSE;
-        features.features.shaderStorageImageWriteWithoutFormat = without_format ? VK_TRUE : VK_FALSE;
-        HeadlessContextOptions with = options;
-        with.api_version = std::max<uint32_t>(with.api_version, VK_API_VERSION_1_3);
-        with.required_features = &features;  // read during create() only
-        with.required_compute_subgroup_operations = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
-        return HeadlessContext::create(with);
-    };
-    storage_without_format = true;
-    Result<HeadlessContext> context = attempt(true);
-    if (context) return context;
-    const std::string first = context.error().message;
-    storage_without_format = false;
-    context = attempt(false);
-    if (context) return context;
-    return Error{context.error().code, first + "; without format-less storage images: " + context.error().message};
-}
+using harness::create_context;  // the context every GPU tool makes (support/harness.hpp)
 
 // Begins dynamic rendering into one colour attachment, `view` in GENERAL layout, keeping what it
 // holds (loadOp LOAD) and storing the result: where crisp's draw path composites, as an
