@@ -94,13 +94,22 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
     }
     std::unique_ptr<VulkanWindow> self(new VulkanWindow());
     self->options_ = options;
+    if (Status s = self->create_instance(); !s) return s.error();
+    if (Status s = self->create_window(); !s) return s.error();
+    if (Status s = self->choose_device(); !s) return s.error();
+    if (Status s = self->create_device(); !s) return s.error();
+    if (Status s = self->create_swapchain(); !s) return s.error();
+    return self;
+}
 
-    // The instance: GLFW's surface extensions, debug utils with validation.
+// The instance: GLFW's surface extensions, and with validation the layer and a messenger that
+// counts its messages (chained into the instance info too, so that instance creation is covered).
+Status VulkanWindow::create_instance() {
     uint32_t glfw_count = 0;
     const char** glfw_extensions = glfwGetRequiredInstanceExtensions(&glfw_count);
     std::vector<const char*> extensions(glfw_extensions, glfw_extensions + glfw_count);
     std::vector<const char*> layers;
-    if (options.validation) {
+    if (options_.validation) {
         if (!has_layer("VK_LAYER_KHRONOS_validation")) {
             return Error{
                 ErrorCode::vulkan,
@@ -121,50 +130,55 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
                             VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                             VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     messenger.pfnUserCallback = on_validation_message;
-    messenger.pUserData = &self->validation_messages_;
+    messenger.pUserData = &validation_messages_;
     VkInstanceCreateInfo instance_info{};
     instance_info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
-    instance_info.pNext = options.validation ? &messenger : nullptr;  // also covers vkCreateInstance
+    instance_info.pNext = options_.validation ? &messenger : nullptr;
     instance_info.pApplicationInfo = &app;
     instance_info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
     instance_info.ppEnabledExtensionNames = extensions.data();
     instance_info.enabledLayerCount = static_cast<uint32_t>(layers.size());
     instance_info.ppEnabledLayerNames = layers.data();
-    if (VkResult r = vkCreateInstance(&instance_info, nullptr, &self->instance_); r != VK_SUCCESS) {
+    if (VkResult r = vkCreateInstance(&instance_info, nullptr, &instance_); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateInstance", r);
     }
-    if (options.validation) {
-        auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(self->instance_, "vkCreateDebugUtilsMessengerEXT"));
-        if (!create_messenger) return Error{ErrorCode::vulkan, "vkCreateDebugUtilsMessengerEXT is missing"};
-        if (VkResult r = create_messenger(self->instance_, &messenger, nullptr, &self->messenger_); r != VK_SUCCESS) {
-            return vk::vulkan_error("vkCreateDebugUtilsMessengerEXT", r);
-        }
+    if (!options_.validation) return {};
+    auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+    if (!create_messenger) return Error{ErrorCode::vulkan, "vkCreateDebugUtilsMessengerEXT is missing"};
+    if (VkResult r = create_messenger(instance_, &messenger, nullptr, &messenger_); r != VK_SUCCESS) {
+        return vk::vulkan_error("vkCreateDebugUtilsMessengerEXT", r);
     }
+    return {};
+}
 
-    // The window (fixed size: the editor's widgets sit at fixed positions) and its surface.
+// The window (fixed size: the editor's widgets sit at fixed positions), its input callbacks and
+// its surface.
+Status VulkanWindow::create_window() {
     glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
     glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
-    self->window_ = glfwCreateWindow(static_cast<int>(options.width), static_cast<int>(options.height),
-                                     options.title.c_str(), nullptr, nullptr);
-    if (!self->window_) return Error{ErrorCode::vulkan, "glfwCreateWindow failed"};
-    glfwSetWindowPos(self->window_, 0, 0);
-    glfwSetWindowUserPointer(self->window_, self.get());
-    glfwSetCursorPosCallback(self->window_, WindowCallbacks::cursor);
-    glfwSetMouseButtonCallback(self->window_, WindowCallbacks::button);
-    glfwSetKeyCallback(self->window_, WindowCallbacks::key);
-    glfwSetCharCallback(self->window_, WindowCallbacks::character);
-    if (VkResult r = glfwCreateWindowSurface(self->instance_, self->window_, nullptr, &self->surface_);
-        r != VK_SUCCESS) {
+    window_ = glfwCreateWindow(static_cast<int>(options_.width), static_cast<int>(options_.height),
+                               options_.title.c_str(), nullptr, nullptr);
+    if (!window_) return Error{ErrorCode::vulkan, "glfwCreateWindow failed"};
+    glfwSetWindowPos(window_, 0, 0);
+    glfwSetWindowUserPointer(window_, this);
+    glfwSetCursorPosCallback(window_, WindowCallbacks::cursor);
+    glfwSetMouseButtonCallback(window_, WindowCallbacks::button);
+    glfwSetKeyCallback(window_, WindowCallbacks::key);
+    glfwSetCharCallback(window_, WindowCallbacks::character);
+    if (VkResult r = glfwCreateWindowSurface(instance_, window_, nullptr, &surface_); r != VK_SUCCESS) {
         return vk::vulkan_error("glfwCreateWindowSurface", r);
     }
+    return {};
+}
 
-    // The device: the first with a queue family that computes, draws and presents, at Vulkan 1.2
-    // or later (the renderer's floor), with the swapchain extension.
+// The device: the first with a queue family that computes, draws and presents, at Vulkan 1.2 or
+// later (the renderer's floor).
+Status VulkanWindow::choose_device() {
     uint32_t device_count = 0;
-    vkEnumeratePhysicalDevices(self->instance_, &device_count, nullptr);
+    vkEnumeratePhysicalDevices(instance_, &device_count, nullptr);
     std::vector<VkPhysicalDevice> devices(device_count);
-    vkEnumeratePhysicalDevices(self->instance_, &device_count, devices.data());
+    vkEnumeratePhysicalDevices(instance_, &device_count, devices.data());
     std::string rejected;
     for (VkPhysicalDevice candidate : devices) {
         VkPhysicalDeviceProperties properties{};
@@ -180,60 +194,60 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
         for (uint32_t family = 0; family < family_count; ++family) {
             const VkQueueFlags needed = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
             VkBool32 presents = VK_FALSE;
-            vkGetPhysicalDeviceSurfaceSupportKHR(candidate, family, self->surface_, &presents);
+            vkGetPhysicalDeviceSurfaceSupportKHR(candidate, family, surface_, &presents);
             if ((families[family].queueFlags & needed) == needed && presents) {
-                self->physical_device_ = candidate;
-                self->queue_family_ = family;
-                self->timestamp_valid_bits_ = families[family].timestampValidBits;
+                physical_device_ = candidate;
+                queue_family_ = family;
+                timestamp_valid_bits_ = families[family].timestampValidBits;
                 break;
             }
         }
-        if (self->physical_device_) break;
+        if (physical_device_) break;
         rejected += std::string(properties.deviceName) + ": no queue that computes, draws and presents; ";
     }
-    if (!self->physical_device_) {
+    if (!physical_device_) {
         return Error{ErrorCode::vulkan, "no Vulkan device can show the editor: " +
                                             (rejected.empty() ? std::string("no devices") : rejected)};
     }
-    vkGetPhysicalDeviceProperties(self->physical_device_, &self->properties_);
-    vkGetPhysicalDeviceMemoryProperties(self->physical_device_, &self->memory_properties_);
+    vkGetPhysicalDeviceProperties(physical_device_, &properties_);
+    vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+    return {};
+}
 
+// The device with the swapchain extension and what crisp's renderer and tile path need (and
+// B8G8R8A8 storage views where the GPU has them: crisp is then told what it was created with), its
+// queue, and the semaphore that orders rendering after image acquisition.
+Status VulkanWindow::create_device() {
     const float priority = 1.0f;
     VkDeviceQueueCreateInfo queue_info{};
     queue_info.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
-    queue_info.queueFamilyIndex = self->queue_family_;
+    queue_info.queueFamilyIndex = queue_family_;
     queue_info.queueCount = 1;
     queue_info.pQueuePriorities = &priority;
-    // What crisp's renderer and tile path need, and B8G8R8A8 storage views where the GPU has them;
-    // crisp is then told what the device was created with.
-    self->features_ = VkPhysicalDeviceFeatures2{};
-    self->features_.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    if (Status s = add_crisp_features(self->instance_, self->physical_device_, self->features_,
-                                      {.storage_without_format = true});
-        !s) {
+    features_ = VkPhysicalDeviceFeatures2{};
+    features_.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    if (Status s = add_crisp_features(instance_, physical_device_, features_, {.storage_without_format = true}); !s) {
         return s.error();
     }
-    self->storage_without_format_ = self->features_.features.shaderStorageImageWriteWithoutFormat == VK_TRUE;
+    storage_without_format_ = features_.features.shaderStorageImageWriteWithoutFormat == VK_TRUE;
     const char* device_extensions[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
     VkDeviceCreateInfo device_info{};
     device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
     device_info.queueCreateInfoCount = 1;
     device_info.pQueueCreateInfos = &queue_info;
-    device_info.pNext = &self->features_;
+    device_info.pNext = &features_;
     device_info.enabledExtensionCount = 1;
     device_info.ppEnabledExtensionNames = device_extensions;
-    if (VkResult r = vkCreateDevice(self->physical_device_, &device_info, nullptr, &self->device_); r != VK_SUCCESS) {
+    if (VkResult r = vkCreateDevice(physical_device_, &device_info, nullptr, &device_); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateDevice", r);
     }
-    vkGetDeviceQueue(self->device_, self->queue_family_, 0, &self->queue_);
-
+    vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
     VkSemaphoreCreateInfo semaphore_info{};
     semaphore_info.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
-    if (VkResult r = vkCreateSemaphore(self->device_, &semaphore_info, nullptr, &self->image_ready_); r != VK_SUCCESS) {
+    if (VkResult r = vkCreateSemaphore(device_, &semaphore_info, nullptr, &image_ready_); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateSemaphore", r);
     }
-    if (Status status = self->create_swapchain(); !status) return status.error();
-    return self;
+    return {};
 }
 
 Status VulkanWindow::create_swapchain() {

@@ -84,6 +84,11 @@ public:
 
 private:
     VulkanWindow() = default;
+    // create()'s steps, in order; each leaves what it made for the destructor on failure.
+    Status create_instance();
+    Status create_window();
+    Status choose_device();
+    Status create_device();
     Status create_swapchain();
     void destroy_swapchain();
     friend struct WindowCallbacks;
