@@ -1,10 +1,18 @@
-// Adds point samples of glyph outlines into the atlas accumulators.
+// Adds row samples (or point samples) of glyph outlines into the atlas accumulators.
 //
 // Each workgroup takes 64 texels of one glyph (the work items tile the dispatch; an item covers a
-// part of a glyph's rect, or a range of that part's texels), each invocation one texel. For every sample it places one point per colour channel inside that channel's
-// subpixel rectangle (the R2 sequence, continued across frames), casts a ray towards +x from each
-// and counts the nonzero winding number over the curves of the bands the subgroup touches, using
-// Lengyel's root classification. A covered sample adds kRasterCoverageOne to its channel.
+// part of a glyph's rect, or a range of that part's texels), each invocation one texel.
+//
+// Row samples (the default): sample n is, per colour channel, a horizontal segment across that
+// channel's subpixel rectangle at the height frac(radical_inverse_2(n) + kRasterRowOffset) of it
+// (continued across frames). The roots of each curve of the bands the subgroup touches on that
+// row (Lengyel's root classification, as for points) give the winding at the segment's start and
+// the crossings inside it, which are sorted and walked: the covered length under the nonzero rule
+// is exact, overlapping contours included. The covered fraction adds up to kRasterCoverageOne,
+// dithered to whole units by the R2 x offset of n.
+//
+// Point samples: one point per channel inside its rectangle (the R2 sequence), a ray towards +x,
+// and the nonzero winding number; a covered sample adds kRasterCoverageOne.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
@@ -91,6 +99,113 @@ ivec3 winding_row(vec2 p0, vec2 p1, vec2 p2, float y, vec3 xs) {
     return w;
 }
 
+// ---- Row samples.
+
+// Per channel, the row segment of the sample being walked: [row_start, row_end] in em, the
+// winding just right of row_start (the crossings right of it), and the crossings inside
+// (row_start, row_end) sorted by x. At most kRasterRowCrossings are kept, the leftmost; when one
+// more comes, the rightmost is dropped and row_more says that the segment goes on from the last
+// crossing kept, in another pass.
+float row_start[3];
+float row_end[3];
+int row_winding[3];
+uint row_count[3];
+bool row_more[3];
+float row_x[3][kRasterRowCrossings];
+int row_direction[3][kRasterRowCrossings];
+
+void row_crossing(uint c, float x, int direction) {
+    if (!(x > row_start[c])) return;
+    row_winding[c] += direction;
+    if (!(x < row_end[c])) return;
+    uint n = row_count[c];
+    if (n == kRasterRowCrossings) {
+        row_more[c] = true;
+        if (!(x < row_x[c][n - 1u])) return;
+        --n;  // drop the rightmost: every crossing dropped lies at or right of every one kept
+    }
+    row_count[c] = n + 1u;
+    while (n > 0u && row_x[c][n - 1u] > x) {
+        row_x[c][n] = row_x[c][n - 1u];
+        row_direction[c][n] = row_direction[c][n - 1u];
+        --n;
+    }
+    row_x[c][n] = x;
+    row_direction[c][n] = direction;
+}
+
+// The crossings of one curve with the row at height y (absolute em), added to the channels of
+// `mask`. The roots are Lengyel's, as in winding(); x(t) is absolute, so one solve serves every
+// channel on the row.
+void row_curve(vec2 p0, vec2 p1, vec2 p2, float y, uint mask) {
+    p0.y -= y;
+    p1.y -= y;
+    p2.y -= y;
+    uint shift = (floatBitsToUint(p0.y) >> 31) | ((floatBitsToUint(p1.y) >> 30) & 2u) |
+                 ((floatBitsToUint(p2.y) >> 29) & 4u);
+    uint code = (0x2E74u >> shift) & 0x0101u;
+    if (code == 0u) return;
+    float ay = p0.y - 2.0 * p1.y + p2.y;
+    float by = p0.y - p1.y;
+    float d = sqrt(max(by * by - ay * p0.y, 0.0));
+    float t1, t2;
+    if (abs(ay) < kLinearEpsilon) {
+        t1 = t2 = p0.y / (2.0 * by);
+    } else {
+        t1 = (by - d) / ay;
+        t2 = (by + d) / ay;
+    }
+    float ax = p0.x - 2.0 * p1.x + p2.x;
+    float bx = p0.x - p1.x;
+    float x1 = (ax * t1 - 2.0 * bx) * t1 + p0.x;
+    float x2 = (ax * t2 - 2.0 * bx) * t2 + p0.x;
+    // Two roots that meet (a tangent, or a curve that misses the row) cancel exactly: skipping them
+    // keeps the walk the same whichever band range the curves come from (the CPU reference reads
+    // only the sample's band).
+    if (code == 0x0101u && x1 == x2) return;
+    for (uint c = 0u; c < 3u; ++c) {
+        if ((mask & (1u << c)) == 0u) continue;
+        if ((code & 1u) != 0u) row_crossing(c, x1, 1);
+        if (code > 1u) row_crossing(c, x2, -1);
+    }
+}
+
+// The covered length of the part of channel c's segment this pass saw: up to its end, or up to
+// its last crossing kept when more follow (row_start then moves there for the next pass).
+float row_walk(uint c) {
+    int w = row_winding[c];
+    float at = row_start[c];
+    float length = 0.0;
+    for (uint i = 0u; i < row_count[c]; ++i) {
+        float x = row_x[c][i];
+        if (w != 0) length += x - at;
+        w -= row_direction[c][i];
+        at = x;
+    }
+    if (row_more[c]) {
+        row_start[c] = at;
+    } else if (w != 0) {
+        length += row_end[c] - at;
+    }
+    return length;
+}
+
+// The covered fraction of a segment of `length` em in kRasterCoverageOne units, dithered: the
+// fraction's remainder becomes one more unit when it is at least 1 - dither, so that over samples
+// with equidistributed dithers the sum's quantization error stays below a unit or two instead of
+// growing with the sample count. Empty and full segments stay exactly 0 and kRasterCoverageOne.
+uint row_units(float covered, float length, float dither) {
+    if (!(length > 0.0)) return 0u;
+    float units = floor((covered / length) * float(kRasterCoverageOne) + dither);
+    return uint(clamp(units, 0.0, float(kRasterCoverageOne)));
+}
+
+// The height of row sample n within the rect, in [0, 1): the base-2 radical inverse of n (exact
+// in float) plus kRasterRowOffset, wrapped.
+float row_height(uint n) {
+    return fract(float(bitfieldReverse(n)) * (1.0 / 4294967296.0) + kRasterRowOffset);
+}
+
 uint band_of(RasterItem item, float y) {
     float height = (item.bbox_max_y - item.bbox_min_y) / float(item.band_count);
     if (!(height > 0.0)) return 0u;
@@ -110,21 +225,11 @@ uint find_item(uint workgroup) {
     return lo;
 }
 
-void main() {
-    uint workgroup = gl_WorkGroupID.y * kRasterDispatchWidth + gl_WorkGroupID.x;
-    if (workgroup >= pc.workgroup_count) return;
-    RasterItem item = items[find_item(workgroup)];
-    uint local = (workgroup - item.first_workgroup) * kRasterWorkgroupSize + gl_LocalInvocationIndex;
-    if (local >= item.texel_count) return;
-    local += item.first_texel;
-    uint tx = local % item.width;
-    uint ty = local / item.width;
-    ivec2 texel = ivec2(item.atlas_x + tx, item.atlas_y + ty);
-    tx += item.part_x;  // from here on, texels of the glyph rect
-    ty += item.part_y;
-    uvec4 sums = item.first_sample == 0u ? uvec4(0u) : imageLoad(atlas, texel);
+// The item's point samples of texel (tx, ty) of the glyph rect: kRasterCoverageOne per covered
+// sample and channel.
+uvec3 point_samples(RasterItem item, uint tx, uint ty) {
     uint font = item.font;
-
+    uvec3 sums = uvec3(0u);
     for (uint k = 0u; k < item.sample_count; ++k) {
         // R2: frac(0.5 + n * (1/g, 1/g^2)), g the plastic number. n stays far below 2^24.
         float n = float(item.first_sample + k);
@@ -165,7 +270,100 @@ void main() {
                 }
             }
         }
-        sums.rgb += uvec3(notEqual(w, ivec3(0))) * kRasterCoverageOne;
+        sums += uvec3(notEqual(w, ivec3(0))) * kRasterCoverageOne;
+    }
+    return sums;
+}
+
+// The item's row samples of texel (tx, ty) of the glyph rect: per sample and channel, the covered
+// fraction of the channel's segment in kRasterCoverageOne units.
+uvec3 row_samples(RasterItem item, uint tx, uint ty) {
+    uint font = item.font;
+    uvec3 sums = uvec3(0u);
+    for (uint k = 0u; k < item.sample_count; ++k) {
+        uint n = item.first_sample + k;
+        float v = row_height(n);
+        // The R2 x offset of n, free now that rows need no x: the dither of the quantization.
+        float dither = fract(0.5 + float(n) * 0.7548776662466927);
+        float ys[3];
+        float lengths[3];
+        uint lo_band = 0xFFFFFFFFu, hi_band = 0u;
+        for (uint c = 0u; c < 3u; ++c) {
+            vec4 rect = pc.channel_rects[c];
+            float py = float(ty) + (rect.y + (rect.w - rect.y) * v);
+            ys[c] = item.offset_y + item.scale_y * py;
+            row_start[c] = item.offset_x + item.scale_x * (float(tx) + rect.x);
+            row_end[c] = item.offset_x + item.scale_x * (float(tx) + rect.z);
+            lengths[c] = row_end[c] - row_start[c];
+            uint band = band_of(item, ys[c]);
+            lo_band = min(lo_band, band);
+            hi_band = max(hi_band, band);
+        }
+        // Uniform band range across the subgroup, so the curve loop and its loads are uniform.
+        lo_band = subgroupMin(lo_band);
+        hi_band = subgroupMax(hi_band);
+
+        // Channels whose segment is still being walked; a pass per kRasterRowCrossings crossings.
+        float covered[3] = float[3](0.0, 0.0, 0.0);
+        uint pending = 7u;
+        while (pending != 0u) {
+            for (uint c = 0u; c < 3u; ++c) {
+                row_winding[c] = 0;
+                row_count[c] = 0u;
+                row_more[c] = false;
+            }
+            for (uint word = 0u; word < item.band_words; ++word) {
+                uint bits = 0u;
+                for (uint band = lo_band; band <= hi_band; ++band) {
+                    bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
+                }
+                while (bits != 0u) {
+                    uint bit = findLSB(bits);
+                    bits &= bits - 1u;
+                    uint first = item.point_offset + 2u * (word * 32u + bit);
+                    vec2 p0 = fonts_points[font].points[first];
+                    vec2 p1 = fonts_points[font].points[first + 1u];
+                    vec2 p2 = fonts_points[font].points[first + 2u];
+                    if (pc.shared_rows != 0u) {
+                        row_curve(p0, p1, p2, ys[0], pending);
+                    } else {
+                        for (uint c = 0u; c < 3u; ++c) {
+                            if ((pending & (1u << c)) != 0u) row_curve(p0, p1, p2, ys[c], 1u << c);
+                        }
+                    }
+                }
+            }
+            uint next = 0u;
+            for (uint c = 0u; c < 3u; ++c) {
+                if ((pending & (1u << c)) == 0u) continue;
+                covered[c] += row_walk(c);
+                if (row_more[c]) next |= 1u << c;
+            }
+            pending = next;
+        }
+        for (uint c = 0u; c < 3u; ++c) sums[c] += row_units(covered[c], lengths[c], dither);
+    }
+    return sums;
+}
+
+void main() {
+    uint workgroup = gl_WorkGroupID.y * kRasterDispatchWidth + gl_WorkGroupID.x;
+    if (workgroup >= pc.workgroup_count) return;
+    RasterItem item = items[find_item(workgroup)];
+    uint local = (workgroup - item.first_workgroup) * kRasterWorkgroupSize + gl_LocalInvocationIndex;
+    if (local >= item.texel_count) return;
+    local += item.first_texel;
+    uint tx = local % item.width;
+    uint ty = local / item.width;
+    ivec2 texel = ivec2(item.atlas_x + tx, item.atlas_y + ty);
+    tx += item.part_x;  // from here on, texels of the glyph rect
+    ty += item.part_y;
+    uvec4 sums = item.first_sample == 0u ? uvec4(0u) : imageLoad(atlas, texel);
+
+    if (pc.sample_kind == kRasterSampleRows) {
+        sums.rgb += row_samples(item, tx, ty);
+    } else {
+        sums.rgb += point_samples(item, tx, ty);
     }
     sums.a += item.sample_count;
     imageStore(atlas, texel, sums);

@@ -43,14 +43,24 @@ struct SelftestResult {
     uint subgroup_size;  // gl_SubgroupSize
 };
 
-// ---- raster.comp: adds point samples of glyph outlines into the atlas accumulators.
+// ---- raster.comp: adds row (or point) samples of glyph outlines into the atlas accumulators.
 
 // Invocations per workgroup; a workgroup rasterizes 64 texels of one glyph, row-major, so the
 // bands a subgroup touches stay few.
 CRISP_CONSTANT(uint, kRasterWorkgroupSize, 64u);
-// One covered sample adds this to its channel's accumulator (fixed point, so that fractional
-// coverage from row spans fits later); alpha counts samples. 1023 samples fill 16 bits.
+// One covered sample adds this to its channel's accumulator (fixed point: a row sample adds its
+// covered fraction, dithered to a whole unit); alpha counts samples. 1023 samples fill 16 bits.
 CRISP_CONSTANT(uint, kRasterCoverageOne, 64u);
+// Sample kinds (RasterPushConstants::sample_kind).
+CRISP_CONSTANT(uint, kRasterSampleRows, 0u);    // a segment across the channel's rect, its covered length exact
+CRISP_CONSTANT(uint, kRasterSamplePoints, 1u);  // a point, covered or not
+// Crossings inside one row segment a channel keeps in registers, sorted by x; a segment with more
+// is finished by further passes over the curves, each from the last crossing kept (exact).
+CRISP_CONSTANT(uint, kRasterRowCrossings, 8u);
+// Row sample n sits at height frac(radical_inverse_2(n) + kRasterRowOffset) of the channel's rect:
+// 1/16 + 1/128 + 1/1024 puts the first 64 and the first 512 samples within 1/1024 of their strata's
+// centres and the first 8 within 9/1024 (docs/rasterizer.md, "Row samples", says why not 8 too).
+CRISP_CONSTANT(float, kRasterRowOffset, 0.0712890625f);
 // Storage buffers of curve points and of band bitsets, one each per font: with the work items
 // 17 storage buffers, within the 32 per stage that lavapipe and desktop drivers offer.
 CRISP_CONSTANT(uint, kRasterFontPages, 8u);  // font pages, each several fonts' points and bands
@@ -93,7 +103,7 @@ struct RasterPushConstants {
     uint item_count;
     uint workgroup_count;  // workgroups that have work (the dispatch may round up)
     uint shared_rows;      // 1: the three rects share their rows, one set of roots serves all
-    uint padding;
+    uint sample_kind;      // kRasterSampleRows or kRasterSamplePoints
 };
 
 

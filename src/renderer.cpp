@@ -22,6 +22,8 @@ namespace {
 
 constexpr VkFormat kAtlasFormat = VK_FORMAT_R16G16B16A16_UINT;
 static_assert(kCoverageOne == gpu::kRasterCoverageOne);
+static_assert(static_cast<uint32_t>(SampleKind::rows) == gpu::kRasterSampleRows);
+static_assert(static_cast<uint32_t>(SampleKind::points) == gpu::kRasterSamplePoints);
 static_assert(kRendererFontPages == gpu::kRasterFontPages);
 // vkCmdUpdateBuffer takes at most this many bytes a call.
 constexpr VkDeviceSize kUpdateChunk = 65536;
@@ -107,6 +109,7 @@ struct CRISP_HIDDEN Renderer::State {
     VkDeviceSize max_storage_buffer_range = 0;
     uint32_t frames_in_flight = 2;
     bool shared_row_roots = true;
+    SampleKind sample_kind = SampleKind::rows;
 
     GlyphAtlas atlas;
     SubpixelLayout layout;
@@ -557,6 +560,11 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
                                                       " is above the " + std::to_string(kMaxRendererSamples) +
                                                       " the 16-bit accumulators hold"};
     }
+    if (info.sample_kind != SampleKind::rows && info.sample_kind != SampleKind::points) {
+        return Error{ErrorCode::invalid_argument, "renderer: sample_kind " +
+                                                      std::to_string(static_cast<uint32_t>(info.sample_kind)) +
+                                                      " is neither rows (0) nor points (1)"};
+    }
     SubpixelLayout layout = info.layout;
     if (layout.name.empty() && layout == SubpixelLayout{}) layout = *subpixel_preset("rgb");
     if (Status s = validate_subpixel_layout(layout); !s) return s.error();
@@ -603,6 +611,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     state->allocator = info.allocator;
     state->frames_in_flight = info.frames_in_flight;
     state->shared_row_roots = info.shared_row_roots;
+    state->sample_kind = info.sample_kind;
     state->max_storage_buffer_range = properties.limits.maxStorageBufferRange;
     state->max_image_side = properties.limits.maxImageDimension2D;
     state->atlas_budget = info.atlas_memory_budget;
@@ -791,6 +800,10 @@ Status Renderer::set_subpixel_layout(const SubpixelLayout& layout) {
 
 const SubpixelLayout& Renderer::subpixel_layout() const {
     return state_->layout;
+}
+
+SampleKind Renderer::sample_kind() const {
+    return state_->sample_kind;
 }
 
 void Renderer::abandon_frame() {
@@ -1087,6 +1100,7 @@ void Renderer::State::record_raster_dispatch(VkCommandBuffer command_buffer, uin
     push.item_count = static_cast<uint32_t>(item_data.size());
     push.workgroup_count = workgroups;
     push.shared_rows = shared_row_roots && shares_sample_rows(layout) ? 1u : 0u;
+    push.sample_kind = sample_kind == SampleKind::points ? gpu::kRasterSamplePoints : gpu::kRasterSampleRows;
     fn.vkCmdPushConstants(command_buffer, descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
                           &push);
     const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);

@@ -1,5 +1,7 @@
 #include "coverage.hpp"
 
+#include "shared.h"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -16,6 +18,10 @@
 #endif
 
 namespace crisp {
+
+static_assert(kRowCrossings == gpu::kRasterRowCrossings);
+static_assert(static_cast<float>(kRowOffset) == gpu::kRasterRowOffset);
+static_assert(kRowOffset == 1.0 / 16 + 1.0 / 128 + 1.0 / 1024);
 
 // -------------------------------------------------------------------------------------------------
 // 1. The sample function.
@@ -53,18 +59,21 @@ namespace crisp {
 // Slug's linear case solves the tangent at t = 0 rather than the curve: its crossing is off by up
 // to |a| < kLinearEpsilon in y, and a curve that starts flat (b == 0) divides by zero and loses
 // its crossing. RootSolver::stable avoids both; docs/coverage.md measures the difference.
+namespace {
+
+// The root code of the curve whose control heights relative to the ray are y1, y2, y3, and its two
+// roots t1 (running down) and t2 (running up) when the code is not 0.
 template <class Real>
-int curve_winding(Real x1, Real y1, Real x2, Real y2, Real x3, Real y3, RootSolver solver) {
+unsigned classified_roots(Real y1, Real y2, Real y3, RootSolver solver, Real& t1, Real& t2) {
     const unsigned shift = (std::signbit(y1) ? 1u : 0u) | (std::signbit(y2) ? 2u : 0u) | (std::signbit(y3) ? 4u : 0u);
     const unsigned code = (0x2E74u >> shift) & 0x0101u;
-    if (code == 0u) return 0;
+    if (code == 0u) return 0u;
 
     const Real two = 2;
     const Real zero = 0;
     const Real a = y1 - y2 * two + y3;
     const Real b = y1 - y2;
     const Real c = y1;
-    Real t1 = 0, t2 = 0;
     if (solver == RootSolver::slug) {
         if (std::abs(a) < static_cast<Real>(kLinearEpsilon)) {
             t1 = t2 = c / (b * two);
@@ -88,7 +97,18 @@ int curve_winding(Real x1, Real y1, Real x2, Real y2, Real x3, Real y3, RootSolv
             t2 = b <= zero ? c / (b - d) : (b + d) / a;
         }
     }
+    return code;
+}
 
+}  // namespace
+
+template <class Real>
+int curve_winding(Real x1, Real y1, Real x2, Real y2, Real x3, Real y3, RootSolver solver) {
+    Real t1 = 0, t2 = 0;
+    const unsigned code = classified_roots(y1, y2, y3, solver, t1, t2);
+    if (code == 0u) return 0;
+    const Real two = 2;
+    const Real zero = 0;
     const Real ax = x1 - x2 * two + x3;
     const Real bx = x1 - x2;
     const Real cx = x1;
@@ -212,6 +232,188 @@ double coverage_points(const FontAsset& asset, const GlyphRecord& glyph, double 
         if (winding_number_banded<double>(asset, glyph, x, y) != 0) ++hits;
     }
     return static_cast<double>(hits) / static_cast<double>(sample_count);
+}
+
+// Row samples: shaders/raster.comp's row_crossing(), row_curve() and row_walk(), operation for
+// operation (Real = float).
+
+double radical_inverse_2(uint32_t n) {
+    uint32_t reversed = 0;
+    for (int bit = 0; bit < 32; ++bit) reversed |= ((n >> bit) & 1u) << (31 - bit);
+    return static_cast<double>(reversed) * 0x1p-32;
+}
+
+double row_height(uint32_t n) {
+    const double v = radical_inverse_2(n) + kRowOffset;
+    return v - std::floor(v);
+}
+
+float row_dither(uint32_t n) {
+    const float u = 0.5f + static_cast<float>(n) * static_cast<float>(kR2StepX);
+    return u - std::floor(u);
+}
+
+namespace {
+
+// One channel's segment being walked: the shader's row_* arrays.
+template <class Real>
+struct RowSpan {
+    Real start = 0, end = 0;
+    int winding = 0;  // just right of start
+    uint32_t count = 0;
+    bool more = false;
+    std::array<Real, kRowCrossings> x{};
+    std::array<int, kRowCrossings> direction{};
+
+    void cross(Real at, int dir) {
+        if (!(at > start)) return;
+        winding += dir;
+        if (!(at < end)) return;
+        uint32_t n = count;
+        if (n == kRowCrossings) {
+            more = true;
+            if (!(at < x[n - 1])) return;
+            --n;  // every crossing dropped lies at or right of every one kept
+        }
+        count = n + 1;
+        while (n > 0 && x[n - 1] > at) {
+            x[n] = x[n - 1];
+            direction[n] = direction[n - 1];
+            --n;
+        }
+        x[n] = at;
+        direction[n] = dir;
+    }
+
+    Real walk() {
+        int w = winding;
+        Real at = start, length = 0;
+        for (uint32_t i = 0; i < count; ++i) {
+            if (w != 0) length += x[i] - at;
+            w -= direction[i];
+            at = x[i];
+        }
+        if (more) {
+            start = at;
+        } else if (w != 0) {
+            length += end - at;
+        }
+        return length;
+    }
+};
+
+// The crossings of one curve (absolute em) with the row at height y.
+template <class Real>
+void row_curve(RowSpan<Real>& span, Real p0x, Real p0y, Real p1x, Real p1y, Real p2x, Real p2y, Real y) {
+    Real t1 = 0, t2 = 0;
+    const unsigned code = classified_roots<Real>(p0y - y, p1y - y, p2y - y, RootSolver::slug, t1, t2);
+    if (code == 0u) return;
+    const Real two = 2;
+    const Real ax = p0x - p1x * two + p2x;
+    const Real bx = p0x - p1x;
+    const Real x1 = (ax * t1 - bx * two) * t1 + p0x;
+    const Real x2 = (ax * t2 - bx * two) * t2 + p0x;
+    // Two roots that meet (a tangent, or a curve that misses the row) cancel exactly: skipping them
+    // keeps the walk the same whichever band range the curves come from.
+    if (code == 0x0101u && x1 == x2) return;
+    if ((code & 1u) != 0u) span.cross(x1, +1);
+    if (code > 1u) span.cross(x2, -1);
+}
+
+// Passes of `for_each_curve(visit)` (visit takes the six coordinates) until the segment is walked.
+template <class Real, class ForEachCurve>
+Real row_length(ForEachCurve&& for_each_curve, Real y, Real x0, Real x1, uint32_t* passes) {
+    RowSpan<Real> span;
+    span.start = x0;
+    span.end = x1;
+    Real covered = 0;
+    uint32_t pass_count = 0;
+    do {
+        span.winding = 0;
+        span.count = 0;
+        span.more = false;
+        for_each_curve([&](Real p0x, Real p0y, Real p1x, Real p1y, Real p2x, Real p2y) {
+            row_curve(span, p0x, p0y, p1x, p1y, p2x, p2y, y);
+        });
+        covered += span.walk();
+        ++pass_count;
+    } while (span.more);
+    if (passes) *passes = pass_count;
+    return covered;
+}
+
+}  // namespace
+
+template <class Real>
+Real row_covered_length(std::span<const Quad> curves, Real y, Real x0, Real x1, uint32_t* passes) {
+    auto each = [&](auto&& visit) {
+        for (const Quad& q : curves) {
+            visit(static_cast<Real>(q.p0.x), static_cast<Real>(q.p0.y), static_cast<Real>(q.p1.x),
+                  static_cast<Real>(q.p1.y), static_cast<Real>(q.p2.x), static_cast<Real>(q.p2.y));
+        }
+    };
+    return row_length<Real>(each, y, x0, x1, passes);
+}
+
+template <class Real>
+Real row_covered_length_banded(const FontAsset& asset, const GlyphRecord& glyph, Real y, Real x0, Real x1,
+                               uint32_t* passes) {
+    if (glyph.band_count == 0 || glyph.band_words == 0) {
+        if (passes) *passes = 1;
+        return 0;
+    }
+    const uint32_t band = FontAsset::band_of(glyph, static_cast<float>(y));
+    const uint32_t* words = &asset.band_words[glyph.band_offset + size_t{band} * glyph.band_words];
+    const Point* points = &asset.points[glyph.point_offset];
+    auto each = [&](auto&& visit) {
+        for (uint32_t word = 0; word < glyph.band_words; ++word) {
+            for (uint32_t bits = words[word]; bits != 0u; bits &= bits - 1u) {
+                const Point* p = points + 2 * size_t{word * 32u + static_cast<uint32_t>(std::countr_zero(bits))};
+                visit(static_cast<Real>(p[0].x), static_cast<Real>(p[0].y), static_cast<Real>(p[1].x),
+                      static_cast<Real>(p[1].y), static_cast<Real>(p[2].x), static_cast<Real>(p[2].y));
+            }
+        }
+    };
+    return row_length<Real>(each, y, x0, x1, passes);
+}
+
+template <class Real>
+uint32_t row_units(Real covered, Real length, Real dither, uint32_t one) {
+    if (!(length > Real(0))) return 0;
+    const Real units = std::floor((covered / length) * static_cast<Real>(one) + dither);
+    return static_cast<uint32_t>(std::clamp(units, Real(0), static_cast<Real>(one)));
+}
+
+template float row_covered_length<float>(std::span<const Quad>, float, float, float, uint32_t*);
+template double row_covered_length<double>(std::span<const Quad>, double, double, double, uint32_t*);
+template float row_covered_length_banded<float>(const FontAsset&, const GlyphRecord&, float, float, float, uint32_t*);
+template double row_covered_length_banded<double>(const FontAsset&, const GlyphRecord&, double, double, double,
+                                                  uint32_t*);
+template uint32_t row_units<float>(float, float, float, uint32_t);
+template uint32_t row_units<double>(double, double, double, uint32_t);
+
+uint32_t row_sample_units(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map,
+                          const SampleRect& rect, uint32_t tx, uint32_t ty, uint32_t n, uint32_t* passes) {
+    const auto v = static_cast<float>(row_height(n));
+    const float py = static_cast<float>(ty) + (rect.y0 + (rect.y1 - rect.y0) * v);
+    const float y = map.offset_y + map.scale_y * py;
+    const float start = map.offset_x + map.scale_x * (static_cast<float>(tx) + rect.x0);
+    const float end = map.offset_x + map.scale_x * (static_cast<float>(tx) + rect.x1);
+    const float covered = row_covered_length_banded<float>(asset, glyph, y, start, end, passes);
+    return row_units<float>(covered, end - start, row_dither(n), 64);
+}
+
+double coverage_rows(const FontAsset& asset, const GlyphRecord& glyph, double x0, double y0, double x1, double y1,
+                     uint32_t sample_count, uint32_t first_sample, bool quantized) {
+    if (sample_count == 0 || !(x1 > x0)) return 0.0;
+    double sum = 0.0;
+    for (uint32_t i = 0; i < sample_count; ++i) {
+        const uint32_t n = first_sample + i;
+        const double y = y0 + row_height(n) * (y1 - y0);
+        const double covered = row_covered_length_banded<double>(asset, glyph, y, x0, x1);
+        sum += quantized ? row_units<double>(covered, x1 - x0, row_dither(n), 64) / 64.0 : covered / (x1 - x0);
+    }
+    return sum / static_cast<double>(sample_count);
 }
 
 // -------------------------------------------------------------------------------------------------

@@ -2,8 +2,10 @@
 //
 // 1. Sample coverage: the nonzero winding number of a ray cast from a point sample towards +x,
 //    with Eric Lengyel's root classification (the "Slug" method), exactly as the compute shader
-//    evaluates it; and the mean of such point hits over R2-placed samples, which is what the atlas
-//    accumulates. A float instantiation repeats the shader's operations in the shader's order.
+//    evaluates it; and the mean of such point hits over R2-placed samples. Row samples: the
+//    covered length of a horizontal segment under the nonzero rule, from the same roots sorted
+//    along the row, and its mean over van der Corput rows. Float instantiations repeat the
+//    shader's operations in the shader's order.
 // 2. Exact coverage: the area fraction of a rectangle covered by a glyph under the nonzero rule,
 //    from sorted crossings integrated over y. It shares no code with (1) and is what (1) converges
 //    to as samples grow.
@@ -19,6 +21,8 @@
 #include "curves.hpp"
 
 #include <crisp/asset.hpp>
+#include <crisp/glyph.hpp>
+#include <crisp/subpixel.hpp>
 
 #include <cstdint>
 #include <span>
@@ -77,6 +81,56 @@ std::vector<Quad> listed_quads(const FontAsset& asset, const GlyphRecord& glyph)
 
 // Offset of R2 sample n within a unit square, in [0, 1)^2, computed in double.
 Vec2 r2_offset(uint32_t n);
+
+// ---- Row samples (shaders/raster.comp's row_samples(); docs/coverage.md, "Row samples").
+
+// Crossings inside one segment kept at once (gpu::kRasterRowCrossings): a segment with more is
+// finished by further passes over the curves, each from the last crossing kept. Exact either way.
+inline constexpr uint32_t kRowCrossings = 8;
+// Row sample n sits at height frac(radical_inverse_2(n) + kRowOffset) of the rect
+// (gpu::kRasterRowOffset): 1/16 + 1/128 + 1/1024, 73/1024.
+inline constexpr double kRowOffset = 0.0712890625;
+
+// The base-2 radical inverse of n (van der Corput): n's bits mirrored about the binary point.
+double radical_inverse_2(uint32_t n);
+// Height of row sample n within a rect, in [0, 1): exact in float as in double for n < 2^23.
+double row_height(uint32_t n);
+// The quantization dither of row sample n, frac(0.5 + n * kR2StepX), computed in float as the
+// shader does.
+float row_dither(uint32_t n);
+
+// The covered length under the nonzero rule of the segment [x0, x1] at height y over the given
+// curves: the winding at x0 from the roots right of it, then the roots inside (x0, x1) sorted
+// and walked, kRowCrossings at a time. Real = float mirrors the shader (curves rounded to float);
+// double is the reference. `passes`, when given, receives how many passes over the curves the
+// segment took (1 unless more than kRowCrossings crossings lie inside it).
+template <class Real>
+Real row_covered_length(std::span<const Quad> curves, Real y, Real x0, Real x1, uint32_t* passes = nullptr);
+
+// The same over the curves listed in the band FontAsset::band_of(glyph, float(y)), as the shader.
+template <class Real>
+Real row_covered_length_banded(const FontAsset& asset, const GlyphRecord& glyph, Real y, Real x0, Real x1,
+                               uint32_t* passes = nullptr);
+
+// What a row sample adds to its channel's accumulator: the covered fraction covered / length in
+// `one` units, floor(fraction * one + dither), clamped to [0, one]; 0 for a segment of no length.
+// Real = float is the shader's arithmetic.
+template <class Real>
+uint32_t row_units(Real covered, Real length, Real dither, uint32_t one);
+
+// What row sample n of texel (tx, ty) of a glyph rect (mapped to em by `map`) adds to the channel
+// whose sample rectangle is `rect` (pixel units, y down), in float as shaders/raster.comp computes
+// it: the segment across the rect at height row_height(n), its banded covered length, and
+// row_units(..., row_dither(n), 64). `passes` as in row_covered_length.
+uint32_t row_sample_units(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map,
+                          const SampleRect& rect, uint32_t tx, uint32_t ty, uint32_t n, uint32_t* passes = nullptr);
+
+// Mean over the row samples first_sample .. first_sample + sample_count - 1 of the covered fraction
+// of the segment [x0, x1] at height y0 + row_height(n) (y1 - y0), in double. `quantized`: each
+// sample's fraction as the atlas holds it, row_units(..., double(row_dither(n)), 64) / 64;
+// otherwise exact. 0 when sample_count is 0.
+double coverage_rows(const FontAsset& asset, const GlyphRecord& glyph, double x0, double y0, double x1, double y1,
+                     uint32_t sample_count, uint32_t first_sample = 0, bool quantized = true);
 
 // Fraction of the samples first_sample .. first_sample + sample_count - 1, placed by R2 in the em
 // rectangle [x0, x1] x [y0, y1] (offset (u, v) maps to (x0 + u (x1 - x0), y0 + v (y1 - y0))), whose

@@ -1,5 +1,7 @@
 // crisp: the GPU renderer. It rasterizes glyph outlines into the atlas image with a compute shader,
-// adding R2-distributed point samples per subpixel channel for as long as a glyph stays on screen.
+// adding samples per subpixel channel for as long as a glyph stays on screen: row samples (a
+// segment across the channel's sample rectangle whose covered length is exact) by default, or
+// point samples.
 //
 // A Renderer is created from the caller's Vulkan objects and records its work into command buffers
 // the caller gives; it never submits on its own. A frame whose command buffer is not submitted
@@ -14,8 +16,8 @@
 // pending on the GPU at once: the renderer reuses its per-frame resources after that many frames.
 //
 // The atlas image (RendererCreateInfo::atlas sets its size) is VK_FORMAT_R16G16B16A16_UINT, kept in
-// VK_IMAGE_LAYOUT_GENERAL. Each texel holds the hits of its red, green and blue samples in units of
-// kCoverageOne per hit, and its sample count in alpha: a channel's coverage is
+// VK_IMAGE_LAYOUT_GENERAL. Each texel holds the coverage of its red, green and blue samples in units
+// of kCoverageOne per fully covered sample, and its sample count in alpha: a channel's coverage is
 // value / (kCoverageOne * alpha). After record() the image is made visible to fragment and compute
 // shader reads and to transfer reads.
 #pragma once
@@ -37,7 +39,8 @@
 
 namespace crisp {
 
-// Fixed-point units of one covered sample in the atlas accumulators.
+// Fixed-point units of one covered sample in the atlas accumulators. A row sample adds its covered
+// fraction times kCoverageOne, dithered to a whole unit; a point sample adds 0 or kCoverageOne.
 inline constexpr uint32_t kCoverageOne = 64;
 // The most samples a texel can hold: 65535 / kCoverageOne.
 inline constexpr uint32_t kMaxRendererSamples = 1023;
@@ -51,6 +54,16 @@ inline constexpr uint32_t kRendererFontPages = 8;
 struct DeviceMemoryUse {
     uint32_t allocations = 0;
     uint64_t bytes = 0;
+};
+
+// What one sample of a texel's channel is (docs/rasterizer.md, "Row samples").
+enum class SampleKind : uint32_t {
+    // A horizontal segment across the channel's sample rectangle, at a height stratified over the
+    // samples (van der Corput): its covered length under the nonzero rule is exact, so only y is
+    // sampled. The default: at 8 and 64 samples its error is a fraction of points'.
+    rows = 0,
+    // A point (R2 sequence), covered or not: the seed's sample, kept to compare against.
+    points = 1,
 };
 
 struct RendererCreateInfo {
@@ -88,6 +101,9 @@ struct RendererCreateInfo {
     // Where the three channels sample the same rows (stripe layouts), solve each curve's roots
     // once for all three. Off only to measure what it saves.
     bool shared_row_roots = true;
+    // Row samples by default; points to measure against. Any other value: create() returns
+    // invalid_argument.
+    SampleKind sample_kind = SampleKind::rows;
 };
 
 // How one draw() call shows its glyphs, without a new layout: where, in which colour, at which depth,
@@ -189,7 +205,8 @@ public:
     // shaderStorageBufferArrayDynamicIndexing, storage images of R16G16B16A16_UINT, subgroup
     // arithmetic in compute shaders, 1 + 2 * kRendererFontPages storage buffers per stage), and with
     // ErrorCode::invalid_argument for a bad atlas config (see GlyphAtlas::create), max_samples above
-    // kMaxRendererSamples, frames_in_flight outside 1..8, or an invalid layout.
+    // kMaxRendererSamples, frames_in_flight outside 1..8, an invalid layout, or a sample_kind
+    // that is neither rows nor points.
     static Result<Renderer> create(const RendererCreateInfo& info);
 
     Renderer(Renderer&&) noexcept;
@@ -219,6 +236,8 @@ public:
     // sample schedule. An invalid layout is refused (invalid_argument) and the old one stays.
     Status set_subpixel_layout(const SubpixelLayout& layout);
     const SubpixelLayout& subpixel_layout() const;
+    // What each sample is (RendererCreateInfo::sample_kind), fixed at create().
+    SampleKind sample_kind() const;
 
     // Starts a frame: unpins the atlas and forgets last frame's drawn glyphs.
     void begin_frame();
