@@ -1077,5 +1077,310 @@ TEST(Coverage, PointSamplesConvergeToExactCoverage) {
     }
 }
 
+// =================================================================================================
+// Row samples: the covered length of a segment under the nonzero rule.
+
+// The covered length of [x0, x1] at height y one infinitesimal below the row (Slug's convention),
+// by the textbook crossing test on the polygons' edges: crossings sorted, winding walked.
+double polygon_row_length(const std::vector<Polygon>& polygons, double y, double x0, double x1) {
+    const double below = y - kBelow;
+    std::vector<std::pair<double, int>> crossings;
+    for (const Polygon& polygon : polygons) {
+        for (size_t i = 0; i < polygon.size(); ++i) {
+            const Vec2 a = polygon[i], b = polygon[(i + 1) % polygon.size()];
+            if ((a.y < below) == (b.y < below)) continue;
+            crossings.push_back({a.x + (below - a.y) * (b.x - a.x) / (b.y - a.y), b.y < a.y ? +1 : -1});
+        }
+    }
+    std::sort(crossings.begin(), crossings.end());
+    int winding = 0;
+    for (const auto& [x, direction] : crossings) {
+        if (x > x0) winding += direction;
+    }
+    double length = 0.0, at = x0;
+    for (const auto& [x, direction] : crossings) {
+        if (!(x > x0)) continue;
+        const double clipped = std::min(x, x1);
+        if (winding != 0) length += clipped - at;
+        at = clipped;
+        winding -= direction;
+    }
+    if (winding != 0) length += x1 - at;
+    return length;
+}
+
+// Every form of the row function (double and float, the curves and the bands) on `shape` at row y.
+void expect_row_length(const Shape& shape, double y, double x0, double x1, double expected, double tolerance,
+                       double float_tolerance = 0.0) {
+    SCOPED_TRACE(testing::Message() << "row " << y << ", [" << x0 << ", " << x1 << "]");
+    EXPECT_NEAR(row_covered_length<double>(shape.curves, y, x0, x1), expected, tolerance);
+    EXPECT_NEAR(row_covered_length_banded<double>(shape.asset, shape.glyph(), y, x0, x1), expected, tolerance);
+    const auto yf = static_cast<float>(y), x0f = static_cast<float>(x0), x1f = static_cast<float>(x1);
+    float_tolerance = std::max({float_tolerance, tolerance, 4e-7 * (1.0 + std::fabs(x1))});
+    EXPECT_NEAR(row_covered_length<float>(shape.curves, yf, x0f, x1f), expected, float_tolerance);
+    EXPECT_NEAR(row_covered_length_banded<float>(shape.asset, shape.glyph(), yf, x0f, x1f), expected, float_tolerance);
+}
+
+TEST(RowSamples, SequenceIsStratifiedAtEveryPowerOfTwo) {
+    EXPECT_EQ(radical_inverse_2(0), 0.0);
+    EXPECT_EQ(radical_inverse_2(1), 0.5);
+    EXPECT_EQ(radical_inverse_2(6), 0.375);
+    for (uint32_t count = 1; count <= 512; count *= 2) {
+        std::vector<int> strata(count, 0);
+        double worst_offset = 0.0;
+        for (uint32_t n = 0; n < count; ++n) {
+            const double v = row_height(n);
+            ASSERT_TRUE(v >= 0.0 && v < 1.0);
+            EXPECT_EQ(static_cast<double>(static_cast<float>(v)), v);  // the shader's float is exact
+            const auto stratum = static_cast<size_t>(v * count);
+            ++strata[stratum];
+            worst_offset = std::max(worst_offset, std::fabs(v - (static_cast<double>(stratum) + 0.5) / count));
+        }
+        for (int in_stratum : strata) EXPECT_EQ(in_stratum, 1) << count << " samples";
+        // 73/1024: the 64 and 512 sets within 1/1024 of their strata's centres, the first frame's 8
+        // within 9/1024 (docs/rasterizer.md).
+        if (count == 64 || count == 512) {
+            EXPECT_LE(worst_offset, 1.0 / 1024) << count << " samples";
+        }
+        if (count == 8) {
+            EXPECT_LE(worst_offset, 9.0 / 1024);
+        }
+    }
+    // Frames after the first continue the sequence: samples 8..15 fill the eighths' other halves.
+    for (uint32_t n = 8; n < 16; ++n) EXPECT_EQ(static_cast<int>(row_height(n) * 16) % 2, 0);
+}
+
+TEST(RowSamples, HardCasePolygonsMatchTheCrossingTest) {
+    const Polygon square = rectangle(1, 1, 3, 3);
+    const std::vector<std::pair<const char*, std::vector<Polygon>>> cases = {
+        {"square, counter-clockwise", {square}},
+        {"square, clockwise", {reversed(square)}},
+        {"diamond", {{{2, 0}, {4, 2}, {2, 4}, {0, 2}}}},
+        {"crown", {{{0, 0}, {6, 0}, {6, 2}, {6, 4}, {5, 2}, {4, 4}, {3, 2}, {2, 4}, {1, 2}, {0, 4}}}},
+        {"staircase", {{{0, 0}, {4, 0}, {4, 1}, {3, 1}, {3, 2}, {2, 2}, {2, 3}, {0, 3}}}},
+        {"overlapping squares, same direction", {rectangle(0, 0, 3, 3), rectangle(1, 1, 4, 4)}},
+        {"the same square twice", {rectangle(0, 0, 3, 3), rectangle(0, 0, 3, 3)}},
+        {"overlapping squares, opposite directions", {rectangle(0, 0, 3, 3), reversed(rectangle(1, 1, 4, 4))}},
+        {"ring with an island",
+         {reversed(rectangle(0, 0, 4, 4)), rectangle(1, 1, 3, 3), reversed(rectangle(1.5, 1.5, 2.5, 2.5))}},
+        {"bow-tie", {{{0, 0}, {2, 2}, {2, 0}, {0, 2}}}},
+    };
+    int rows = 0;
+    for (const auto& [name, polygons] : cases) {
+        SCOPED_TRACE(name);
+        const Shape shape = make_polygon_shape(polygons);
+        std::vector<double> heights;
+        for (const Polygon& polygon : polygons) {
+            for (const Vec2 p : polygon) {
+                heights.push_back(p.y);  // rows through vertices and horizontal edges
+                heights.push_back(p.y + 0x1p-12);
+                heights.push_back(p.y - 0x1p-12);
+            }
+        }
+        heights.push_back(1.3125);
+        // Segments ending on vertices, on edges (crossings exactly at x0 or x1), and between.
+        for (const double y : heights) {
+            for (const auto& [x0, x1] : {std::pair{-1.0, 7.0},
+                                         {0.0, 1.0},
+                                         {1.0, 3.0},
+                                         {0.5, 3.5},
+                                         {2.0, 4.0},
+                                         {1.5, 2.5},
+                                         {0.25, 0.375},
+                                         {3.0, 6.0}}) {
+                // The truth is taken kBelow under the row: slanted edges move it by about that much.
+                expect_row_length(shape, y, x0, x1, polygon_row_length(polygons, y, x0, x1), 1e-8);
+                ++rows;
+            }
+        }
+    }
+    EXPECT_GT(rows, 500);
+}
+
+TEST(RowSamples, OverlappingContoursCountTheirUnionNotTheirSum) {
+    // Both squares wind the same way: across the overlap the winding is 2, and the row [0.5, 3.5]
+    // at y = 2 crosses both squares' left and right edges inside the segment. Summing signed
+    // coverage per contour would give 2.5 + 2.5 = 5 (more than the segment); the union is 3.
+    const Shape same = make_polygon_shape({rectangle(0, 0, 3, 3), rectangle(1, 1, 4, 4)});
+    expect_row_length(same, 2.0, 0.5, 3.5, 3.0, 0.0);
+    expect_row_length(same, 2.0, -1.0, 5.0, 4.0, 0.0);
+    // The same square twice: winding 2 everywhere inside, covered once.
+    const Shape twice = make_polygon_shape({rectangle(0, 0, 3, 3), rectangle(0, 0, 3, 3)});
+    expect_row_length(twice, 1.5, -1.0, 2.0, 2.0, 0.0);
+    // Opposite directions: the overlap winds 0 and is a hole.
+    const Shape opposite = make_polygon_shape({rectangle(0, 0, 3, 3), reversed(rectangle(1, 1, 4, 4))});
+    expect_row_length(opposite, 2.0, 0.5, 3.5, 1.0, 0.0);
+    EXPECT_EQ(row_units<float>(3.0f, 3.0f, 0.999f, 64), 64u);
+    EXPECT_EQ(row_units<float>(0.0f, 3.0f, 0.999f, 64), 0u);
+}
+
+TEST(RowSamples, SegmentsEndingExactlyOnARoot) {
+    const Shape square = make_polygon_shape({rectangle(1, 1, 3, 3)});
+    for (const double y : {1.0, 2.0, 3.0}) {  // the bottom edge row is not covered, the top one is
+        const double inside = (y > 1.0) ? 1.0 : 0.0;
+        expect_row_length(square, y, 1.0, 2.0, inside, 0.0);      // x0 on the left edge's crossing
+        expect_row_length(square, y, 0.0, 1.0, 0.0, 0.0);         // x1 on it
+        expect_row_length(square, y, 2.0, 3.0, inside, 0.0);      // x1 on the right edge's crossing
+        expect_row_length(square, y, 3.0, 4.0, 0.0, 0.0);         // x0 on it
+        expect_row_length(square, y, 1.0, 3.0, 2 * inside, 0.0);  // both ends on crossings
+    }
+    // A slanted edge: the diamond's crossing at y = 1 is x = 1 (left) and 3 (right).
+    const Shape diamond = make_polygon_shape({{{2, 0}, {4, 2}, {2, 4}, {0, 2}}});
+    expect_row_length(diamond, 1.0, 1.0, 3.0, 2.0, 0.0);
+    expect_row_length(diamond, 1.0, 1.0, 1.5, 0.5, 0.0);
+    expect_row_length(diamond, 1.0, 0.5, 1.0, 0.0, 0.0);
+}
+
+TEST(RowSamples, HorizontalTangentsAtTheRowHeight) {
+    // An arch tangent to y = 2 at its apex (2, 2), a bowl tangent to y = 0 at (2, 0), and lenses
+    // and circles whose extrema lie on the rows: the truth is the area of a strip just below the
+    // row divided by its height (exact coverage), where the covered length varies as sqrt(depth).
+    const std::vector<std::pair<const char*, std::vector<Contour>>> cases = {
+        {"arch", {{Quad{{4, 0}, {2, 4}, {0, 0}}, line_to_quad({0, 0}, {4, 0})}}},
+        {"bowl",
+         {{Quad{{0, 2}, {2, -2}, {4, 2}}, line_to_quad({4, 2}, {4, 3}), line_to_quad({4, 3}, {0, 3}),
+           line_to_quad({0, 3}, {0, 2})}}},
+        {"overlapping lenses",
+         {{Quad{{0, 0}, {2, 3}, {4, 0}}, Quad{{4, 0}, {2, -3}, {0, 0}}},
+          {Quad{{1, 0.5}, {3, 3.5}, {5, 0.5}}, Quad{{5, 0.5}, {3, -2.5}, {1, 0.5}}}}},
+        {"self-intersecting curves",
+         {{Quad{{0, 0}, {4, 1}, {4, 4}}, Quad{{4, 4}, {2, 2}, {4, 0}}, Quad{{4, 0}, {0, 2}, {0, 4}},
+           line_to_quad({0, 4}, {0, 0})}}},
+    };
+    constexpr double kStrip = 0x1p-40;
+    for (const auto& [name, contours] : cases) {
+        SCOPED_TRACE(name);
+        const Shape shape = make_shape(contours);
+        const ExactCoverage exact(shape.curves);
+        for (const double y : {0.0, 2.0, 1.5, 2.0 - 0x1p-12, 0.5, 2.0 + 0x1p-12, 2.0 - 0x1p-23, 0x1p-30, 2.25}) {
+            for (const auto& [x0, x1] : {std::pair{-1.0, 6.0}, {1.5, 2.5}, {2.0, 2.0 + 0x1p-10}, {0.75, 3.25}}) {
+                const double truth = exact.area(x0, y - kStrip, x1, y) / kStrip;
+                // At an extremum the strip's mean length is off by about sqrt(kStrip) = 1e-6. In
+                // float, a row within 1e-9 of a tangent loses the discriminant (b^2 - a c cancels):
+                // the crossings, sqrt(1e-9) apart, are missed, as point samples miss them there.
+                expect_row_length(shape, y, x0, x1, truth, 1e-5, 2e-4);
+            }
+        }
+        // At the apex row itself the arch touches the row in one point: nothing is covered.
+        if (std::string_view(name) == "arch") expect_row_length(shape, 2.0, 0.0, 4.0, 0.0, 0.0);
+    }
+}
+
+TEST(RowSamples, MoreCrossingsThanTheRegistersHoldTakeMorePassesAndStayExact) {
+    // A comb of 13 bars 0.05 wide every 0.1 (26 crossings inside [-0.01, 1.3]), and a second comb
+    // of the same direction overlapping each bar by half, so that the winding reaches 2 across
+    // pass boundaries: the union must come out, whatever pass a crossing falls in.
+    std::vector<Polygon> comb, overlapping;
+    for (int i = 0; i < 13; ++i) {
+        const double x = 0.1 * i;
+        comb.push_back(rectangle(on_grid({x, 0}).x, 0, on_grid({x + 0.05, 0}).x, 1));
+        overlapping.push_back(comb.back());
+        overlapping.push_back(rectangle(on_grid({x + 0.025, 0}).x, 0.25, on_grid({x + 0.075, 0}).x, 1));
+    }
+    for (const auto* polygons : {&comb, &overlapping}) {
+        const Shape shape = make_polygon_shape(*polygons);
+        for (const double y : {0.5, 1.0, 0.25}) {
+            const double truth = polygon_row_length(*polygons, y, -0.01, 1.3);
+            uint32_t passes = 0, float_passes = 0;
+            EXPECT_NEAR(row_covered_length<double>(shape.curves, y, -0.01, 1.3, &passes), truth, 1e-12);
+            EXPECT_NEAR(row_covered_length_banded<float>(shape.asset, shape.glyph(), static_cast<float>(y), -0.01f,
+                                                         1.3f, &float_passes),
+                        truth, 1e-5);
+            const size_t crossings = 2 * polygons->size() - (y < 0.25 + 1e-9 && polygons == &overlapping ? 13 * 2 : 0);
+            EXPECT_GE(passes, (crossings + kRowCrossings - 1) / kRowCrossings) << y;
+            EXPECT_GT(passes, 2u);
+            EXPECT_EQ(float_passes, passes);
+            expect_row_length(shape, y, -0.01, 1.3, truth, 1e-12);
+        }
+    }
+    // More than kRowCrossings crossings at one x: the pass after them starts there.
+    std::vector<Polygon> stacked;
+    for (int i = 0; i < 6; ++i) stacked.push_back(rectangle(1, 0, 2, 1));
+    const Shape shape = make_polygon_shape(stacked);
+    uint32_t passes = 0;
+    EXPECT_EQ(row_covered_length<double>(shape.curves, 0.5, 0.0, 3.0, &passes), 1.0);
+    EXPECT_GT(passes, 1u);
+}
+
+// Row samples against point samples, both against exact area coverage over pixel boxes: mean
+// absolute error per touched pixel and the worst pixel, at 8 (the first frame), 64 and 512 samples.
+// Rows are as the atlas holds them (quantized to 1/64 with the dither). docs/coverage.md and
+// docs/results/lavapipe-row-samples.md record the table this prints.
+TEST(RowSamples, ConvergeToExactCoverageFasterThanPoints) {
+    const FontKey variable{test::kInterVariable, 0, "Ak$", false};  // overlapping contours
+    std::vector<RealGlyph> glyphs;
+    for (const FontKey& key : {kDejaVu, kInter, variable}) {
+        for (RealGlyph& glyph : real_glyphs(key)) {
+            if (glyph.label.rfind("U+006C", 0) == 0 || glyph.label.rfind("U+0040 of Inter", 0) == 0) continue;
+            glyphs.push_back(std::move(glyph));
+        }
+    }
+    constexpr uint32_t kCounts[3] = {8, 64, 512};
+    std::printf("%-28s %5s %6s | %-29s | %-29s | %-29s\n", "glyph", "px/em", "pixels", "8 samples: points / rows",
+                "64: points / rows", "512: points / rows");
+    for (const int size : {7, 16, 40}) {
+        // [kind][count]: all glyphs' errors
+        std::vector<double> all[2][3];
+        for (const RealGlyph& glyph : glyphs) {
+            const GlyphRecord& record = glyph.glyph();
+            const ExactCoverage exact(*glyph.asset, record);
+            const double pixel = 1.0 / size;
+            const auto i0 = static_cast<int>(std::floor(static_cast<double>(record.bbox_min_x) * size));
+            const auto i1 = static_cast<int>(std::ceil(static_cast<double>(record.bbox_max_x) * size));
+            const auto j0 = static_cast<int>(std::floor(static_cast<double>(record.bbox_min_y) * size));
+            const auto j1 = static_cast<int>(std::ceil(static_cast<double>(record.bbox_max_y) * size));
+            const int stride = std::max(1, (i1 - i0) * (j1 - j0) / 600);
+            std::vector<double> errors[2][3];
+            for (int j = j0; j < j1; ++j) {
+                for (int i = i0; i < i1; ++i) {
+                    if ((i * 7 + j * 13) % stride != 0) continue;
+                    const double x0 = i * pixel, y0 = j * pixel, x1 = x0 + pixel, y1 = y0 + pixel;
+                    const double truth = exact.coverage(x0, y0, x1, y1);
+                    double got[2][3];
+                    uint32_t done = 0;
+                    double sums[2] = {0.0, 0.0};
+                    for (size_t k = 0; k < 3; ++k) {
+                        const uint32_t more = kCounts[k] - done;
+                        sums[0] += more * coverage_points(*glyph.asset, record, x0, y0, x1, y1, more, done);
+                        sums[1] += more * coverage_rows(*glyph.asset, record, x0, y0, x1, y1, more, done);
+                        done = kCounts[k];
+                        for (int kind = 0; kind < 2; ++kind) got[kind][k] = sums[kind] / done;
+                    }
+                    if (truth == 0.0 && got[0][2] == 0.0 && got[1][2] == 0.0) continue;  // untouched
+                    for (int kind = 0; kind < 2; ++kind) {
+                        for (size_t k = 0; k < 3; ++k) errors[kind][k].push_back(std::fabs(got[kind][k] - truth));
+                    }
+                }
+            }
+            auto print = [&](const char* label, std::vector<double>(&e)[2][3]) {
+                std::printf("%-28s %5d %6zu", label, size, e[0][0].size());
+                for (size_t k = 0; k < 3; ++k) {
+                    const ErrorStats p = error_stats(e[0][k]), r = error_stats(e[1][k]);
+                    std::printf(" | %.4f %.3f / %.4f %.3f", p.mean, p.max, r.mean, r.max);
+                }
+                std::printf("\n");
+            };
+            print(glyph.label.c_str(), errors);
+            for (int kind = 0; kind < 2; ++kind) {
+                for (size_t k = 0; k < 3; ++k) {
+                    all[kind][k].insert(all[kind][k].end(), errors[kind][k].begin(), errors[kind][k].end());
+                }
+            }
+        }
+        const ErrorStats p8 = error_stats(all[0][0]), r8 = error_stats(all[1][0]);
+        const ErrorStats p64 = error_stats(all[0][1]), r64 = error_stats(all[1][1]);
+        const ErrorStats p512 = error_stats(all[0][2]), r512 = error_stats(all[1][2]);
+        std::printf("%-28s %5d %6zu | %.4f %.3f / %.4f %.3f | %.4f %.3f / %.4f %.3f | %.4f %.3f / %.4f %.3f\n", "all",
+                    size, p8.pixels, p8.mean, p8.max, r8.mean, r8.max, p64.mean, p64.max, r64.mean, r64.max, p512.mean,
+                    p512.max, r512.mean, r512.max);
+        EXPECT_GT(p8.pixels, 100u);
+        // Generous bounds: rows are clearly better at 8 and 64 samples and no worse converged.
+        EXPECT_LT(r8.mean, 0.7 * p8.mean) << size;
+        EXPECT_LT(r8.max, p8.max) << size;
+        EXPECT_LT(r64.mean, 0.5 * p64.mean) << size;
+        EXPECT_LT(r512.mean, p512.mean) << size;
+        EXPECT_LT(r512.max, 0.02) << size;
+    }
+}
 }  // namespace
 }  // namespace crisp

@@ -74,19 +74,62 @@ void gpu_sample(const TexelToEm& map, const SampleRect& rect, uint32_t tx, uint3
 
 struct Comparison {
     uint64_t texels = 0;
-    uint64_t mismatched = 0;   // hit counts differ
-    uint64_t unexplained = 0;  // ... and no sample of the texel lies near an edge
-    uint64_t covered = 0;      // texels with any hit
+    uint64_t mismatched = 0;   // sums differ
+    uint64_t unexplained = 0;  // ... and no sample of the texel lies near an edge (points) or
+                               // rounds differently in double (rows)
+    uint64_t covered = 0;      // texel channels with any coverage
+    uint64_t row_passes = 0;   // rows: passes over the curves beyond one per sample
 };
 
-// Compares every texel of every drawn glyph with the CPU reference: double-precision banded
-// winding at the shader's float sample positions. A differing texel is explained when one of
-// its samples lies within kEdge em of the outline (the winding changes within that distance).
+// A point-sample channel's expected hits: double-precision banded winding at the shader's float
+// sample positions. `near_edge` is set when a sample lies within kEdge em of the outline (the
+// winding changes within that distance).
+uint32_t point_hits(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map, const SampleRect& rect,
+                    uint32_t tx, uint32_t ty, uint32_t samples, bool& near_edge) {
+    constexpr double kEdge = 2e-5;  // em: 1/50 px at 1000 px per em
+    uint32_t hits = 0;
+    for (uint32_t n = 0; n < samples; ++n) {
+        float x = 0, y = 0;
+        gpu_sample(map, rect, tx, ty, n, x, y);
+        const double xd = x, yd = y;
+        const bool hit = winding_number_banded<double>(asset, glyph, xd, yd) != 0;
+        hits += hit;
+        for (const auto& [dx, dy] : {std::pair{kEdge, 0.0}, {-kEdge, 0.0}, {0.0, kEdge}, {0.0, -kEdge}}) {
+            if ((winding_number_banded<double>(asset, glyph, xd + dx, yd + dy) != 0) != hit) near_edge = true;
+        }
+    }
+    return hits * kCoverageOne;
+}
+
+// A row-sample channel's expected sum: the CPU reference in float, the shader's arithmetic.
+// `ambiguous` is set when a sample's units differ in double precision (the GPU may round a last
+// bit differently, e.g. by fusing a multiply-add).
+uint32_t row_sum(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map, const SampleRect& rect,
+                 uint32_t tx, uint32_t ty, uint32_t samples, bool& ambiguous, uint64_t& extra_passes) {
+    uint32_t sum = 0;
+    for (uint32_t n = 0; n < samples; ++n) {
+        uint32_t passes = 1;
+        const uint32_t units = row_sample_units(asset, glyph, map, rect, tx, ty, n, &passes);
+        sum += units;
+        extra_passes += passes - 1;
+        const double v = row_height(n), px = tx, py = ty;
+        const double ry0 = rect.y0, ry1 = rect.y1, rx0 = rect.x0, rx1 = rect.x1;
+        const double ox = map.offset_x, oy = map.offset_y, sx = map.scale_x, sy = map.scale_y;
+        const double y = oy + sy * (py + (ry0 + (ry1 - ry0) * v));
+        const double x0 = ox + sx * (px + rx0);
+        const double x1 = ox + sx * (px + rx1);
+        const double covered = row_covered_length_banded<double>(asset, glyph, y, x0, x1);
+        if (row_units<double>(covered, x1 - x0, row_dither(n), kCoverageOne) != units) ambiguous = true;
+    }
+    return sum;
+}
+
+// Compares every texel of every drawn glyph with the CPU reference of the renderer's sample kind.
 Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, uint32_t samples,
                    const Font* font = nullptr) {
-    constexpr double kEdge = 2e-5;  // em: 1/50 px at 1000 px per em
     const FontAsset& asset = (font ? font : fixture().font.get())->asset();
     const uint32_t width = renderer.atlas().config().width;
+    const bool rows = renderer.sample_kind() == SampleKind::rows;
     Comparison result;
     for (const DrawnGlyph& d : renderer.drawn()) {
         const GlyphRecord& glyph = asset.glyphs[d.instance.key.glyph];
@@ -97,29 +140,20 @@ Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, u
                 const Texel& t = texels[(d.atlas_y + ty) * width + d.atlas_x + tx];
                 EXPECT_EQ(t.count, samples);
                 const uint16_t got[3] = {t.r, t.g, t.b};
-                bool mismatch = false, near_edge = false;
-                for (int c = 0; c < 3; ++c) {
-                    uint32_t hits = 0;
-                    for (uint32_t n = 0; n < samples; ++n) {
-                        float x = 0, y = 0;
-                        gpu_sample(map, renderer.subpixel_layout().channels[static_cast<size_t>(c)], tx + d.part_x,
-                                   ty + d.part_y, n, x, y);
-                        const double xd = x, yd = y;
-                        const bool hit = winding_number_banded<double>(asset, glyph, xd, yd) != 0;
-                        hits += hit;
-                        for (const auto& [dx, dy] :
-                             {std::pair{kEdge, 0.0}, {-kEdge, 0.0}, {0.0, kEdge}, {0.0, -kEdge}}) {
-                            if ((winding_number_banded<double>(asset, glyph, xd + dx, yd + dy) != 0) != hit)
-                                near_edge = true;
-                        }
-                    }
-                    if (got[c] != hits * kCoverageOne) mismatch = true;
+                bool mismatch = false, explained = false;
+                for (size_t c = 0; c < 3; ++c) {
+                    const SampleRect& rect = renderer.subpixel_layout().channels[c];
+                    const uint32_t expected =
+                        rows ? row_sum(asset, glyph, map, rect, tx + d.part_x, ty + d.part_y, samples, explained,
+                                       result.row_passes)
+                             : point_hits(asset, glyph, map, rect, tx + d.part_x, ty + d.part_y, samples, explained);
+                    if (got[c] != expected) mismatch = true;
                     if (got[c] > 0) ++result.covered;
                 }
                 ++result.texels;
                 if (mismatch) {
                     ++result.mismatched;
-                    if (!near_edge) ++result.unexplained;
+                    if (!explained) ++result.unexplained;
                 }
             }
         }
@@ -127,9 +161,10 @@ Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, u
     return result;
 }
 
-Result<Renderer> make_renderer(const SubpixelLayout& layout, uint32_t samples) {
+Result<Renderer> make_renderer(const SubpixelLayout& layout, uint32_t samples, SampleKind kind = SampleKind::rows) {
     const HeadlessContext& context = *fixture().context;
     RendererCreateInfo info = renderer_create_info(context);
+    info.sample_kind = kind;
     info.atlas.width = info.atlas.height = 256;
     info.atlas.max_samples = samples;
     info.layout = layout;
@@ -181,15 +216,15 @@ void expect_no_validation_messages() {
     for (const std::string& text : messages.recent) ADD_FAILURE() << text;
 }
 
-class RasterMatchesReference : public ::testing::TestWithParam<std::tuple<const char*, float, float>> {};
+class RasterMatchesReference : public ::testing::TestWithParam<std::tuple<const char*, float, float, SampleKind>> {};
 
 TEST_P(RasterMatchesReference, TexelByTexel) {
     Fixture& f = fixture();
     ASSERT_TRUE(f.context) << "no Vulkan device";
     ASSERT_TRUE(f.font);
-    const auto [layout_name, size, offset] = GetParam();
+    const auto [layout_name, size, offset, kind] = GetParam();
     constexpr uint32_t kSamples = 24;
-    auto renderer = make_renderer(*subpixel_preset(layout_name), kSamples);
+    auto renderer = make_renderer(*subpixel_preset(layout_name), kSamples, kind);
     ASSERT_TRUE(renderer) << renderer.error().message;
     ASSERT_TRUE(renderer->add_font(*f.font));
     const Font* fonts[] = {f.font.get()};
@@ -205,13 +240,28 @@ TEST_P(RasterMatchesReference, TexelByTexel) {
     EXPECT_TRUE(renderer->converged());
     EXPECT_GE(frames, 4u);  // 8 + 4 + 2 + 1 + ... to 24
     const Comparison result = expect_matches_reference(*renderer, texels, kSamples);
+    std::printf("%s %s: %llu of %llu texels differ, %llu extra row passes\n", layout_name,
+                kind == SampleKind::rows ? "rows" : "points", static_cast<unsigned long long>(result.mismatched),
+                static_cast<unsigned long long>(result.texels), static_cast<unsigned long long>(result.row_passes));
     EXPECT_LT(static_cast<double>(result.mismatched), 0.02 * static_cast<double>(result.texels));
     expect_no_validation_messages();
 }
 
+// Every preset layout with rows (stripes share rows; vrgb, qd-oled, woled and pentile do not),
+// and points on four of them.
 INSTANTIATE_TEST_SUITE_P(Sizes, RasterMatchesReference,
-                         ::testing::Values(std::tuple{"gray", 11.0f, 0.0f}, std::tuple{"rgb", 16.0f, 0.37f},
-                                           std::tuple{"vrgb", 23.5f, 0.71f}, std::tuple{"qd-oled", 40.0f, 0.125f}));
+                         ::testing::Values(std::tuple{"gray", 11.0f, 0.0f, SampleKind::rows},
+                                           std::tuple{"rgb", 16.0f, 0.37f, SampleKind::rows},
+                                           std::tuple{"bgr", 9.0f, 0.5f, SampleKind::rows},
+                                           std::tuple{"vrgb", 23.5f, 0.71f, SampleKind::rows},
+                                           std::tuple{"vbgr", 7.0f, 0.2f, SampleKind::rows},
+                                           std::tuple{"qd-oled", 40.0f, 0.125f, SampleKind::rows},
+                                           std::tuple{"woled", 13.0f, 0.3f, SampleKind::rows},
+                                           std::tuple{"pentile", 12.0f, 0.6f, SampleKind::rows},
+                                           std::tuple{"gray", 11.0f, 0.0f, SampleKind::points},
+                                           std::tuple{"rgb", 16.0f, 0.37f, SampleKind::points},
+                                           std::tuple{"vrgb", 23.5f, 0.71f, SampleKind::points},
+                                           std::tuple{"qd-oled", 40.0f, 0.125f, SampleKind::points}));
 
 TEST(Raster, StaticTextConvergesAndThenSchedulesNoWork) {
     Fixture& f = fixture();
