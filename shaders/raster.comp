@@ -119,19 +119,20 @@ void row_crossing(uint c, float x, int direction) {
     row_winding[c] += direction;
     if (!(x < row_end[c])) return;
     uint n = row_count[c];
-    if (n == kRasterRowCrossings) {
-        row_more[c] = true;
-        if (!(x < row_x[c][n - 1u])) return;
-        --n;  // drop the rightmost: every crossing dropped lies at or right of every one kept
-    }
+    bool full = n == kRasterRowCrossings;
+    if (full) row_more[c] = true;
+    // When full, the rightmost is dropped: every crossing dropped lies at or right of every one kept.
+    if (full && !(x < row_x[c][kRasterRowCrossings - 1u])) return;
+    if (full) n = kRasterRowCrossings - 1u;
     row_count[c] = n + 1u;
-    while (n > 0u && row_x[c][n - 1u] > x) {
-        row_x[c][n] = row_x[c][n - 1u];
-        row_direction[c][n] = row_direction[c][n - 1u];
-        --n;
+    int i = int(n);
+    for (; i > 0; --i) {
+        if (!(row_x[c][i - 1] > x)) break;
+        row_x[c][i] = row_x[c][i - 1];
+        row_direction[c][i] = row_direction[c][i - 1];
     }
-    row_x[c][n] = x;
-    row_direction[c][n] = direction;
+    row_x[c][i] = x;
+    row_direction[c][i] = direction;
 }
 
 // The crossings of one curve with the row at height y (absolute em), added to the channels of
@@ -304,9 +305,11 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
         hi_band = subgroupMax(hi_band);
 
         // Channels whose segment is still being walked; a pass per kRasterRowCrossings crossings.
+        // The subgroup passes together (an invocation done adds nothing), so that the curve loop
+        // and its loads stay uniform.
         float covered[3] = float[3](0.0, 0.0, 0.0);
         uint pending = 7u;
-        while (pending != 0u) {
+        while (subgroupMax(pending) != 0u) {
             for (uint c = 0u; c < 3u; ++c) {
                 row_winding[c] = 0;
                 row_count[c] = 0u;

@@ -44,15 +44,19 @@ struct Accuracy {
     double max = 0.0;
     uint64_t channels = 0;
     bool in_range = true;  // every coverage finite and within [0, 1]
+    uint64_t texels_unlike_reference = 0;  // rows: texel channels whose sum differs from the CPU's
+    uint64_t extra_row_passes = 0;         // rows: passes beyond one per sample (segments with many crossings)
 };
 
 using test::Texel;
 
 // Renders the glyph instances with `samples` samples per glyph and measures the error.
+// Rows: every texel channel is also held to the CPU reference in float, sample for sample.
 Accuracy render_and_measure(const Font& font, std::span<const GlyphInstance> glyphs, const SubpixelLayout& layout,
-                            uint32_t samples, uint32_t atlas_size = 512) {
+                            uint32_t samples, uint32_t atlas_size = 512, SampleKind kind = SampleKind::rows) {
     HeadlessContext& ctx = *context();
     RendererCreateInfo info = renderer_create_info(ctx);
+    info.sample_kind = kind;
     info.atlas.width = info.atlas.height = atlas_size;
     info.atlas.max_samples = samples;
     info.atlas.frame_budget = uint64_t{1} << 40;
@@ -90,6 +94,16 @@ Accuracy render_and_measure(const Font& font, std::span<const GlyphInstance> gly
                     const double yb = oy + sy * (py + static_cast<double>(r.y1));
                     const double truth = exact.coverage(x0, std::min(ya, yb), x1, std::max(ya, yb));
                     const double got = static_cast<double>(sums[c]) / (kCoverageOne * std::max<uint32_t>(t.count, 1));
+                    if (kind == SampleKind::rows) {
+                        uint32_t expected = 0;
+                        for (uint32_t n = 0; n < samples; ++n) {
+                            uint32_t passes = 1;
+                            expected +=
+                                row_sample_units(font.asset(), glyph, map, r, tx + d.part_x, ty + d.part_y, n, &passes);
+                            result.extra_row_passes += passes - 1;
+                        }
+                        if (expected != sums[c]) ++result.texels_unlike_reference;
+                    }
                     if (!std::isfinite(got) || got < 0.0 || got > 1.0) result.in_range = false;
                     if (truth == 0.0 && got == 0.0) continue;
                     errors.push_back(std::fabs(got - truth));
@@ -135,16 +149,24 @@ TEST(Accuracy, ErrorFallsAsSamplesGrow) {
     auto font = bake(test::kDejaVuSans, "g@");
     ASSERT_TRUE(font);
     const auto glyphs = lay_out(*font, "g@", 16.0f, 2.3f, 17.6f);
-    for (const char* layout : {"gray", "rgb"}) {
-        const Accuracy at16 = render_and_measure(*font, glyphs, *subpixel_preset(layout), 16);
-        const Accuracy at512 = render_and_measure(*font, glyphs, *subpixel_preset(layout), 512);
-        report(layout, at16);
-        report(layout, at512);
-        EXPECT_TRUE(at512.in_range);
-        EXPECT_LT(at512.mean, at16.mean / 4);  // points converge about as 1/sqrt(N) or better
-        EXPECT_LT(at512.mean, 0.01);
-        EXPECT_LT(at512.p99, 0.05);
-        EXPECT_LT(at512.max, 0.1);
+    for (const SampleKind kind : {SampleKind::rows, SampleKind::points}) {
+        for (const char* layout : {"gray", "rgb"}) {
+            const std::string what = std::string(layout) + (kind == SampleKind::rows ? " rows" : " points");
+            const Accuracy at8 = render_and_measure(*font, glyphs, *subpixel_preset(layout), 8, 512, kind);
+            const Accuracy at512 = render_and_measure(*font, glyphs, *subpixel_preset(layout), 512, 512, kind);
+            report((what + ", 8 samples").c_str(), at8);
+            report((what + ", 512 samples").c_str(), at512);
+            EXPECT_TRUE(at512.in_range);
+            EXPECT_EQ(at8.texels_unlike_reference + at512.texels_unlike_reference, 0u);
+            EXPECT_LT(at512.mean, at8.mean / 4);  // points converge about as 1/sqrt(N) or better
+            EXPECT_LT(at512.mean, 0.01);
+            EXPECT_LT(at512.p99, 0.05);
+            EXPECT_LT(at512.max, 0.1);
+            if (kind == SampleKind::rows) {  // the first frame of rows: a fraction of points' error
+                EXPECT_LT(at8.mean, 0.02) << layout;
+                EXPECT_LT(at512.max, 0.01) << layout;
+            }
+        }
     }
 }
 
@@ -293,17 +315,27 @@ GlyphInstance place(const Font& font, uint32_t glyph_index, float size, float x,
     return g;
 }
 
-void expect_shape_accurate(const char* what, const std::vector<Contour>& contours, double bound) {
+// Rows and points, on a stripe layout (shared rows) and vrgb; rows also texel for texel against
+// the CPU reference. Returns the row passes beyond one per sample.
+uint64_t expect_shape_accurate(const char* what, const std::vector<Contour>& contours, double bound) {
     uint32_t glyph = 0;
     auto font = with_shape(contours, glyph);
-    ASSERT_TRUE(font) << what;
+    EXPECT_TRUE(font) << what;
+    if (!font) return 0;
     const GlyphInstance instance = place(*font, glyph, 20.0f, 1.25f, 20.0f);
-    for (const char* layout : {"gray", "vrgb"}) {
-        const Accuracy a = render_and_measure(*font, std::span(&instance, 1), *subpixel_preset(layout), 256);
-        report(what, a);
-        EXPECT_TRUE(a.in_range) << what;
-        EXPECT_LT(a.mean, bound) << what << " " << layout;
+    uint64_t extra_passes = 0;
+    for (const SampleKind kind : {SampleKind::rows, SampleKind::points}) {
+        for (const char* layout : {"gray", "vrgb"}) {
+            const Accuracy a =
+                render_and_measure(*font, std::span(&instance, 1), *subpixel_preset(layout), 256, 512, kind);
+            report((std::string(what) + (kind == SampleKind::rows ? ", rows, " : ", points, ") + layout).c_str(), a);
+            EXPECT_TRUE(a.in_range) << what;
+            EXPECT_LT(a.mean, bound) << what << " " << layout;
+            EXPECT_EQ(a.texels_unlike_reference, 0u) << what << " " << layout;
+            extra_passes += a.extra_row_passes;
+        }
     }
+    return extra_passes;
 }
 
 TEST(HardCase, OverlappingSameDirectionContoursNeverExceedOne) {
@@ -351,6 +383,25 @@ TEST(HardCase, CurvesTangentToTheRay) {
     REQUIRE_GPU();
     // Circles touching each other, their tops and bottoms horizontal tangents to sample rows.
     expect_shape_accurate("tangent circles", {circle(0.25, 0.5, 0.25, false), circle(0.75, 0.5, 0.25, false)}, 0.02);
+}
+
+// KNOWN FAILURE, disabled: on lavapipe the shader's later passes (a segment with more than
+// kRasterRowCrossings crossings) under-cover by about 1 % against the CPU reference, which is exact
+// (RowSamples.MoreCrossingsThanTheRegistersHoldTakeMorePassesAndStayExact); with the registers
+// raised to 64 (one pass) the GPU equals the CPU texel for texel. Not yet found.
+TEST(HardCase, DISABLED_RowsWithMoreCrossingsThanTheRegistersHold) {
+    REQUIRE_GPU();
+    // A comb of 24 teeth 0.002 em wide every 0.004 em: at 20 px a pixel's row (0.05 em) crosses
+    // about 25 edges, three times kRasterRowCrossings; a second comb of the same direction
+    // overlaps each tooth by half, so the winding reaches 2 across the passes' boundaries.
+    std::vector<Contour> comb;
+    for (int i = 0; i < 24; ++i) {
+        const double x = 0.3 + 0.004 * i;
+        comb.push_back(polygon({{x, 0.1}, {x + 0.002, 0.1}, {x + 0.002, 0.8}, {x, 0.8}}));
+        comb.push_back(polygon({{x + 0.001, 0.3}, {x + 0.003, 0.3}, {x + 0.003, 0.9}, {x + 0.001, 0.9}}));
+    }
+    const uint64_t extra_passes = expect_shape_accurate("comb", comb, 0.02);
+    EXPECT_GT(extra_passes, 0u);
 }
 
 TEST(HardCase, CollinearAndZeroLengthQuadratics) {

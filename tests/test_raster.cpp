@@ -298,6 +298,11 @@ TEST(Raster, BadConfigurationsAreRefused) {
     auto too_many = make_renderer(*subpixel_preset("rgb"), 2000);
     ASSERT_FALSE(too_many);
     EXPECT_EQ(too_many.error().code, ErrorCode::invalid_argument);
+    RendererCreateInfo unknown_kind = renderer_create_info(*f.context);
+    unknown_kind.sample_kind = static_cast<SampleKind>(7);
+    auto refused = Renderer::create(unknown_kind);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::invalid_argument);
     SubpixelLayout bad = *subpixel_preset("rgb");
     bad.channels[0].x1 = 5.0f;
     EXPECT_FALSE(make_renderer(bad, 16));
