@@ -29,6 +29,7 @@ struct Args {
     uint32_t max_frames = 1000;
     uint32_t atlas_budget_mib = 0;  // 0: the atlas keeps its 2048x2048
     bool no_shared_rows = false;
+    crisp::SampleKind sample_kind = crisp::SampleKind::rows;
     bool validate = false;
 };
 
@@ -62,6 +63,10 @@ Args parse(int argc, char** argv) {
                          "let the 2048x2048 atlas grow to MIB mebibytes (default 0: it does not)",
                          args.atlas_budget_mib);
     cli.flag("--no-shared-rows", "solve roots per channel even where channels share rows", args.no_shared_rows);
+    cli.choice<crisp::SampleKind>(
+        "--sample-kind", "KIND", "rows (exact in x, the default) or points", args.sample_kind,
+        {crisp::SampleKind::rows, crisp::SampleKind::points},
+        [](const crisp::SampleKind& kind) { return std::string(kind == crisp::SampleKind::rows ? "rows" : "points"); });
     cli.text("--device", "TEXT", "pick a device whose name contains TEXT", args.device);
     cli.flag("--validate", "turn the validation layer on", args.validate);
     cli.parse(argc, argv);
@@ -113,6 +118,7 @@ crisp::Renderer make_renderer(const crisp::HeadlessContext& context, const Args&
     info.layout = layout;
     info.atlas_memory_budget = uint64_t{args.atlas_budget_mib} << 20;
     info.shared_row_roots = !args.no_shared_rows;
+    info.sample_kind = args.sample_kind;
     auto renderer = crisp::Renderer::create(info);
     if (!renderer) fail(renderer.error().message);
     if (auto s = renderer->add_font(font); !s) fail(s.error().message);
@@ -153,11 +159,12 @@ void print_markdown(const Args& args, const crisp::HeadlessContext& context, con
     const crisp::AtlasStats& atlas = renderer.atlas().stats();
     const crisp::RendererStats& last = renderer.stats();
     std::printf(
-        "Device: %s, driver %s (%s). Canvas %ux%u, %s at %.4g px, layout %s%s, %zu glyphs on screen, "
+        "Device: %s, driver %s (%s). Canvas %ux%u, %s at %.4g px, %s samples, layout %s%s, %zu glyphs on screen, "
         "%u atlas entries (%ux%u atlas, %u of %u cells). Last frame: %u glyphs drawn, %u failed, %u at "
         "coarser subpixel steps (%u per pixel).\n\n",
         context.device_name().c_str(), context.driver_name().c_str(), context.driver_info().c_str(), args.width,
-        args.height, args.font.c_str(), static_cast<double>(args.size), layout_name.c_str(),
+        args.height, args.font.c_str(), static_cast<double>(args.size),
+        args.sample_kind == crisp::SampleKind::rows ? "row" : "point", layout_name.c_str(),
         args.no_shared_rows ? " (roots per channel)" : "", screen_glyphs, atlas.resident_glyphs,
         renderer.atlas().config().width, renderer.atlas().config().height, atlas.used_cells, atlas.usable_cells,
         last.drawn_glyphs, last.failed_glyphs, last.coarsened_glyphs, last.subpixel_steps);
