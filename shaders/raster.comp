@@ -308,7 +308,8 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
         // The subgroup passes together (an invocation done adds nothing), so that the curve loop
         // and its loads stay uniform.
         float covered[3] = float[3](0.0, 0.0, 0.0);
-        uint pending = 7u;
+        // Equal rects (gray) give three equal walks: the red one stands for all.
+        uint pending = pc.equal_channels != 0u ? 1u : 7u;
         while (subgroupMax(pending) != 0u) {
             for (uint c = 0u; c < 3u; ++c) {
                 row_winding[c] = 0;
@@ -344,7 +345,11 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             }
             pending = next;
         }
-        for (uint c = 0u; c < 3u; ++c) sums[c] += row_units(covered[c], lengths[c], dither);
+        if (pc.equal_channels != 0u) {
+            sums += uvec3(row_units(covered[0], lengths[0], dither));
+        } else {
+            for (uint c = 0u; c < 3u; ++c) sums[c] += row_units(covered[c], lengths[c], dither);
+        }
     }
     return sums;
 }

@@ -104,6 +104,7 @@ struct RasterPushConstants {
     uint workgroup_count;  // workgroups that have work (the dispatch may round up)
     uint shared_rows;      // 1: the three rects share their rows, one set of roots serves all
     uint sample_kind;      // kRasterSampleRows or kRasterSamplePoints
+    uint equal_channels;   // 1: the three rects are one (gray): row samples walk the red one only
 };
 
 
@@ -283,7 +284,7 @@ static_assert(offsetof(CompositeQuad, color) == 48);
 static_assert(sizeof(CompositePushConstants) == 64);
 static_assert(offsetof(CompositePushConstants, width) == 16);
 static_assert(offsetof(RasterItem, first_workgroup) == 84);
-static_assert(sizeof(RasterPushConstants) == 64);
+static_assert(sizeof(RasterPushConstants) == 68);
 static_assert(offsetof(RasterPushConstants, item_count) == 48);
 static_assert(sizeof(SelftestPushConstants) == 8);
 static_assert(offsetof(SelftestPushConstants, seed) == 4);
