@@ -114,6 +114,24 @@ bool row_more[3];
 float row_x[3][kRasterRowCrossings];
 int row_direction[3][kRasterRowCrossings];
 
+// Step j of an insertion of x among the first n (< kRasterRowCrossings) sorted entries: entry j - 1
+// moves up to j when greater than x, otherwise x goes to j and the insertion is done.
+void row_insert_step(uint c, uint j, uint n, float x, int direction, inout bool placed) {
+    if (placed || j > n) return;
+    if (row_x[c][j - 1u] > x) {
+        row_x[c][j] = row_x[c][j - 1u];
+        row_direction[c][j] = row_direction[c][j - 1u];
+    } else {
+        row_x[c][j] = x;
+        row_direction[c][j] = direction;
+        placed = true;
+    }
+}
+
+// row_crossing() writes out its insertion's steps for 8 registers: a shader of this size fails to
+// compile if kRasterRowCrossings changes without them.
+const uint kRowInsertStepsWritten[kRasterRowCrossings == 8u ? 1 : 0] = uint[1](8u);
+
 void row_crossing(uint c, float x, int direction) {
     if (!(x > row_start[c])) return;
     row_winding[c] += direction;
@@ -125,14 +143,26 @@ void row_crossing(uint c, float x, int direction) {
     if (full && !(x < row_x[c][kRasterRowCrossings - 1u])) return;
     if (full) n = kRasterRowCrossings - 1u;
     row_count[c] = n + 1u;
-    int i = int(n);
-    for (; i > 0; --i) {
-        if (!(row_x[c][i - 1] > x)) break;
-        row_x[c][i] = row_x[c][i - 1];
-        row_direction[c][i] = row_direction[c][i - 1];
+    // Written out, not a loop: lavapipe ends every loop of an invocation once their iterations
+    // together reach 65535, and this runs per crossing (see "Loops" in docs/rasterizer.md).
+    bool placed = false;
+    row_insert_step(c, 7u, n, x, direction, placed);
+    row_insert_step(c, 6u, n, x, direction, placed);
+    row_insert_step(c, 5u, n, x, direction, placed);
+    row_insert_step(c, 4u, n, x, direction, placed);
+    row_insert_step(c, 3u, n, x, direction, placed);
+    row_insert_step(c, 2u, n, x, direction, placed);
+    row_insert_step(c, 1u, n, x, direction, placed);
+    if (!placed) {
+        row_x[c][0] = x;
+        row_direction[c][0] = direction;
     }
-    row_x[c][i] = x;
-    row_direction[c][i] = direction;
+}
+
+// The roots of one curve as crossings of channel c's segment.
+void row_roots(uint c, uint code, float x1, float x2) {
+    if ((code & 1u) != 0u) row_crossing(c, x1, 1);
+    if (code > 1u) row_crossing(c, x2, -1);
 }
 
 // The crossings of one curve with the row at height y (absolute em), added to the channels of
@@ -164,11 +194,10 @@ void row_curve(vec2 p0, vec2 p1, vec2 p2, float y, uint mask) {
     // keeps the walk the same whichever band range the curves come from (the CPU reference reads
     // only the sample's band).
     if (code == 0x0101u && x1 == x2) return;
-    for (uint c = 0u; c < 3u; ++c) {
-        if ((mask & (1u << c)) == 0u) continue;
-        if ((code & 1u) != 0u) row_crossing(c, x1, 1);
-        if (code > 1u) row_crossing(c, x2, -1);
-    }
+    // The channels written out, not a loop (as in row_crossing()).
+    if ((mask & 1u) != 0u) row_roots(0u, code, x1, x2);
+    if ((mask & 2u) != 0u) row_roots(1u, code, x1, x2);
+    if ((mask & 4u) != 0u) row_roots(2u, code, x1, x2);
 }
 
 // The covered length of the part of channel c's segment this pass saw: up to its end, or up to
@@ -331,9 +360,10 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                     if (pc.shared_rows != 0u) {
                         row_curve(p0, p1, p2, ys[0], pending);
                     } else {
-                        for (uint c = 0u; c < 3u; ++c) {
-                            if ((pending & (1u << c)) != 0u) row_curve(p0, p1, p2, ys[c], 1u << c);
-                        }
+                        // The channels written out, not a loop (as in row_crossing()).
+                        if ((pending & 1u) != 0u) row_curve(p0, p1, p2, ys[0], 1u);
+                        if ((pending & 2u) != 0u) row_curve(p0, p1, p2, ys[1], 2u);
+                        if ((pending & 4u) != 0u) row_curve(p0, p1, p2, ys[2], 4u);
                     }
                 }
             }
