@@ -411,7 +411,8 @@ double coverage_rows(const FontAsset& asset, const GlyphRecord& glyph, double x0
         const uint32_t n = first_sample + i;
         const double y = y0 + row_height(n) * (y1 - y0);
         const double covered = row_covered_length_banded<double>(asset, glyph, y, x0, x1);
-        sum += quantized ? row_units<double>(covered, x1 - x0, row_dither(n), 64) / 64.0 : covered / (x1 - x0);
+        sum += quantized ? row_units<double>(covered, x1 - x0, static_cast<double>(row_dither(n)), 64) / 64.0
+                         : covered / (x1 - x0);
     }
     return sum / static_cast<double>(sample_count);
 }

@@ -87,7 +87,7 @@ Status apply_variations(FT_Library library, FT_Face face, std::span<const Variat
     for (const Variation& variation : variations) {
         FT_UInt i = 0;
         while (i < mm->num_axis && static_cast<uint32_t>(mm->axis[i].tag) != variation.tag) ++i;
-        const double value = variation.value;
+        const double value = static_cast<double>(variation.value);
         if (i == mm->num_axis) {
             status = Error{ErrorCode::font_unsupported, "the face has no axis '" + tag_name(variation.tag) + "'"};
             break;
