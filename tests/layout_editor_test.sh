@@ -30,6 +30,70 @@ center() {
 r=g["presets"].get(n) or g["commands"][n]; print(int(r[0]+r[2]/2), int(r[1]+r[3]/2))' "$1"
 }
 shot() { xwd -root -silent >"$1" || fail "xwd $1"; }
+# The screenshots' reader and checks: python3 screens.py ready SHOT | compare BEFORE AFTER.
+cat >screens.py <<'PY'
+import json, struct, sys
+
+def read_xwd(path):
+    data = open(path, "rb").read()
+    header = struct.unpack(">25I", data[:100])
+    header_size, width, height = header[0], header[4], header[5]
+    bits_per_pixel, bytes_per_line, byte_order = header[11], header[12], header[7]
+    ncolors = header[19]
+    assert bits_per_pixel == 32, bits_per_pixel
+    pixels = data[header_size + 12 * ncolors:]
+    masks = header[15:18]
+    def at(x, y):
+        off = y * bytes_per_line + 4 * x
+        value = int.from_bytes(pixels[off:off + 4], "little" if byte_order == 0 else "big")
+        return tuple((value & m) >> (m & -m).bit_length() - 1 for m in masks)
+    return width, height, at
+
+def region(g, name):
+    x, y, w, h = (int(v) for v in g[name])
+    return [(px, py) for py in range(y, y + h, 2) for px in range(x, x + w, 2)]
+
+VIEWS = ("magnified_pixel", "preview", "rendered_pixels")
+
+def blank_views(g, image):
+    return [name for name in VIEWS if len(set(image(x, y) for x, y in region(g, name))) <= 20]
+
+g = json.load(open("geometry.json"))
+if sys.argv[1] == "ready":  # ready SHOT: exit 0 once every view is drawn (more than 20 colours)
+    w, h, image = read_xwd(sys.argv[2])
+    sys.exit(1 if blank_views(g, image) else 0)
+
+# compare BEFORE AFTER
+w0, h0, before = read_xwd(sys.argv[2])
+w1, h1, after = read_xwd(sys.argv[3])
+assert (w0, h0) == (w1, h1) == tuple(g["window"]), (w0, h0, w1, h1)
+
+def changed(name):
+    # A sample changed by the edit: some channel moved by more than converging samples move it.
+    points = region(g, name)
+    count = sum(1 for x, y in points if max(abs(a - b) for a, b in zip(before(x, y), after(x, y))) > 40)
+    return count, len(points)
+
+for label, image in (("before", before), ("after", after)):
+    blank = blank_views(g, image)
+    assert not blank, f"{label}: {', '.join(blank)} blank (20 colours or fewer)"
+# The preview's paragraphs (not its moving line, which changes every frame) and both magnified views.
+for name in ("magnified_pixel", "preview_paragraphs", "rendered_pixels"):
+    count, total = changed(name)
+    assert count > total // 500, f"{name}: only {count} of {total} samples changed after the edit"
+    print(f"{name}: {count} of {total} samples changed")
+PY
+# shot_when_drawn FILE SECONDS: frames take a while on lavapipe, longer on a loaded machine, so the
+# screenshot waits SECONDS for the text to converge a little, and then until every view is drawn
+# (checked every 2 s, for at most a minute more; the comparison below names a view left blank).
+shot_when_drawn() {
+  sleep "$2"
+  for _ in $(seq 1 30); do
+    shot "$1"
+    python3 screens.py ready "$1" && return 0
+    sleep 2
+  done
+}
 
 # ---- The --screenshot mode: a PNG of the window after N frames.
 "$editor" --validation --frames 3 --screenshot shot.png 2>screenshot.err
@@ -52,9 +116,7 @@ printf '{"name": "start", "r": [0, 0, 0.25, 1], "g": [0.25, 0, 0.75, 1], "b": [0
 pid=$!
 window=$(timeout 60 xdotool search --sync --name '^crisp layout editor$' | head -n1)
 [ -n "$window" ] || { fail "no editor window"; kill "$pid"; exit 1; }
-# Frames take a while on lavapipe: let text converge a little before the first screenshot.
-sleep 6
-shot before.xwd
+shot_when_drawn before.xwd 6
 xdotool windowfocus --sync "$window" 2>/dev/null || true
 read -r bx by < <(center bgr)
 xdotool mousemove "$bx" "$by" click 1
@@ -87,8 +149,7 @@ sleep 0.5
 xdotool key ctrl+s
 for _ in $(seq 1 60); do [ -f saved.json ] && break; sleep 0.5; done
 [ -f saved.json ] || fail "Ctrl+S wrote no saved.json"
-sleep 6
-shot after.xwd
+shot_when_drawn after.xwd 6
 xdotool key ctrl+q
 for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
 if kill -0 "$pid" 2>/dev/null; then
@@ -122,49 +183,7 @@ PY
   --layout saved.json -o render.png 2>render.err || fail "crisp-render refused the saved layout: $(cat render.err)"
 
 # ---- Screenshots: each region present (not blank) and changed by the edit.
-python3 - before.xwd after.xwd geometry.json <<'PY' || fail "screenshots"
-import json, struct, sys
-
-def read_xwd(path):
-    data = open(path, "rb").read()
-    header = struct.unpack(">25I", data[:100])
-    header_size, width, height = header[0], header[4], header[5]
-    bits_per_pixel, bytes_per_line, byte_order = header[11], header[12], header[7]
-    ncolors = header[19]
-    assert bits_per_pixel == 32, bits_per_pixel
-    pixels = data[header_size + 12 * ncolors:]
-    masks = header[15:18]
-    def at(x, y):
-        off = y * bytes_per_line + 4 * x
-        value = int.from_bytes(pixels[off:off + 4], "little" if byte_order == 0 else "big")
-        return tuple((value & m) >> (m & -m).bit_length() - 1 for m in masks)
-    return width, height, at
-
-g = json.load(open(sys.argv[3]))
-w0, h0, before = read_xwd(sys.argv[1])
-w1, h1, after = read_xwd(sys.argv[2])
-assert (w0, h0) == (w1, h1) == tuple(g["window"]), (w0, h0, w1, h1)
-
-def region(name):
-    x, y, w, h = (int(v) for v in g[name])
-    return [(px, py) for py in range(y, y + h, 2) for px in range(x, x + w, 2)]
-
-def changed(name):
-    # A sample changed by the edit: some channel moved by more than converging samples move it.
-    points = region(name)
-    count = sum(1 for x, y in points if max(abs(a - b) for a, b in zip(before(x, y), after(x, y))) > 40)
-    return count, len(points)
-
-for name in ("magnified_pixel", "preview", "rendered_pixels"):
-    for label, image in (("before", before), ("after", after)):
-        distinct = len(set(image(x, y) for x, y in region(name)))
-        assert distinct > 20, f"{name} {label}: only {distinct} colours: blank?"
-# The preview's paragraphs (not its moving line, which changes every frame) and both magnified views.
-for name in ("magnified_pixel", "preview_paragraphs", "rendered_pixels"):
-    count, total = changed(name)
-    assert count > total // 500, f"{name}: only {count} of {total} samples changed after the edit"
-    print(f"{name}: {count} of {total} samples changed")
-PY
+python3 screens.py compare before.xwd after.xwd || fail "screenshots"
 
 if [ "$failures" -ne 0 ]; then
   echo "$failures check(s) failed; files in $work" >&2
