@@ -101,81 +101,83 @@ ivec3 winding_row(vec2 p0, vec2 p1, vec2 p2, float y, vec3 xs) {
 
 // ---- Row samples.
 
-// Per channel, the row segment of the sample being walked: [row_start, row_end] in em, the
-// winding just right of row_start (the crossings right of it), and the crossings inside
-// (row_start, row_end) sorted by x. At most kRasterRowCrossings are kept, the leftmost; when one
-// more comes, the rightmost is dropped and row_more says that the segment goes on from the last
-// crossing kept, in another pass.
-float row_start[3];
-float row_end[3];
-int row_winding[3];
-uint row_count[3];
-bool row_more[3];
-float row_x[3][kRasterRowCrossings];
-int row_direction[3][kRasterRowCrossings];
+// One channel's row segment of the sample being walked: [start, end] in em, the winding just right
+// of start (the crossings right of it), and the crossings inside (start, end) sorted by x, with
+// their directions as bits (set: -1, running up). At most kRasterRowCrossings are kept, the
+// leftmost; when one more comes, the rightmost is dropped and `more` says that the segment goes on
+// from the last crossing kept, in another pass. Every index into `x` is a compile-time constant
+// (the insertion and the walk are written out), so that the lists can live in registers.
+struct RowList {
+    float start;
+    float end;
+    int winding;
+    uint count;
+    bool more;
+    uint up;
+    float x[kRasterRowCrossings];
+};
 
-// Step j of an insertion of x among the first n (< kRasterRowCrossings) sorted entries: entry j - 1
-// moves up to j when greater than x, otherwise x goes to j and the insertion is done.
-void row_insert_step(uint c, uint j, uint n, float x, int direction, inout bool placed) {
-    if (placed || j > n) return;
-    if (row_x[c][j - 1u] > x) {
-        row_x[c][j] = row_x[c][j - 1u];
-        row_direction[c][j] = row_direction[c][j - 1u];
-    } else {
-        row_x[c][j] = x;
-        row_direction[c][j] = direction;
-        placed = true;
-    }
+// row_crossing() and row_walk() write out their steps for 8 registers: a shader of this size fails
+// to compile if kRasterRowCrossings changes without them.
+const uint kRowStepsWritten[kRasterRowCrossings == 8u ? 1 : 0] = uint[1](8u);
+
+// Step j of an insertion of x at position p among the first n sorted entries (p <= n <
+// kRasterRowCrossings): entries from p on move up one, x goes to p.
+void row_insert_step(inout RowList r, uint j, uint n, uint p, float x) {
+    if (j > p && j <= n) r.x[j] = r.x[j - 1u];
+    else if (j == p) r.x[j] = x;
 }
 
-// row_crossing() writes out its insertion's steps for 8 registers: a shader of this size fails to
-// compile if kRasterRowCrossings changes without them.
-const uint kRowInsertStepsWritten[kRasterRowCrossings == 8u ? 1 : 0] = uint[1](8u);
-
-void row_crossing(uint c, float x, int direction) {
-    if (!(x > row_start[c])) return;
-    row_winding[c] += direction;
-    if (!(x < row_end[c])) return;
-    uint n = row_count[c];
+void row_crossing(inout RowList r, float x, int direction) {
+    if (!(x > r.start)) return;
+    r.winding += direction;
+    if (!(x < r.end)) return;
+    uint n = r.count;
     bool full = n == kRasterRowCrossings;
-    if (full) row_more[c] = true;
+    if (full) r.more = true;
     // When full, the rightmost is dropped: every crossing dropped lies at or right of every one kept.
-    if (full && !(x < row_x[c][kRasterRowCrossings - 1u])) return;
+    if (full && !(x < r.x[kRasterRowCrossings - 1u])) return;
     if (full) n = kRasterRowCrossings - 1u;
-    row_count[c] = n + 1u;
-    // Written out, not a loop: lavapipe ends every loop of an invocation once their iterations
-    // together reach 65535, and this runs per crossing (see "Loops" in docs/rasterizer.md).
-    bool placed = false;
-    row_insert_step(c, 7u, n, x, direction, placed);
-    row_insert_step(c, 6u, n, x, direction, placed);
-    row_insert_step(c, 5u, n, x, direction, placed);
-    row_insert_step(c, 4u, n, x, direction, placed);
-    row_insert_step(c, 3u, n, x, direction, placed);
-    row_insert_step(c, 2u, n, x, direction, placed);
-    row_insert_step(c, 1u, n, x, direction, placed);
-    if (!placed) {
-        row_x[c][0] = x;
-        row_direction[c][0] = direction;
-    }
+    r.count = n + 1u;
+    // x goes after the entries not greater than it (a sorted prefix). Written out, not a loop:
+    // lavapipe ends every loop of an invocation once their iterations together reach 65535, and
+    // this runs per crossing (see "Loops" in docs/rasterizer.md).
+    uint p = uint(n > 0u && !(r.x[0] > x)) + uint(n > 1u && !(r.x[1] > x)) +
+             uint(n > 2u && !(r.x[2] > x)) + uint(n > 3u && !(r.x[3] > x)) +
+             uint(n > 4u && !(r.x[4] > x)) + uint(n > 5u && !(r.x[5] > x)) +
+             uint(n > 6u && !(r.x[6] > x));
+    row_insert_step(r, 7u, n, p, x);
+    row_insert_step(r, 6u, n, p, x);
+    row_insert_step(r, 5u, n, p, x);
+    row_insert_step(r, 4u, n, p, x);
+    row_insert_step(r, 3u, n, p, x);
+    row_insert_step(r, 2u, n, p, x);
+    row_insert_step(r, 1u, n, p, x);
+    if (p == 0u) r.x[0] = x;
+    uint below = (1u << p) - 1u;
+    r.up = (r.up & below) | ((r.up << 1) & ~(below | (1u << p))) | (direction < 0 ? 1u << p : 0u);
 }
 
-// The roots of one curve as crossings of channel c's segment.
-void row_roots(uint c, uint code, float x1, float x2) {
-    if ((code & 1u) != 0u) row_crossing(c, x1, 1);
-    if (code > 1u) row_crossing(c, x2, -1);
+// The roots of one curve as crossings of one segment.
+void row_roots(inout RowList r, uint code, float x1, float x2) {
+    if ((code & 1u) != 0u) row_crossing(r, x1, 1);
+    if (code > 1u) row_crossing(r, x2, -1);
 }
 
-// The crossings of one curve with the row at height y (absolute em), added to the channels of
-// `mask`. The roots are Lengyel's, as in winding(); x(t) is absolute, so one solve serves every
-// channel on the row.
-void row_curve(vec2 p0, vec2 p1, vec2 p2, float y, uint mask) {
+// The crossings of one curve with the row at height y (absolute em): Lengyel's roots as in
+// winding(), as absolute x's, so one solve serves every channel on the row. False when there are
+// none to add.
+bool row_curve(vec2 p0, vec2 p1, vec2 p2, float y, out uint code, out float x1, out float x2) {
+    code = 0u;
+    x1 = 0.0;
+    x2 = 0.0;
     p0.y -= y;
     p1.y -= y;
     p2.y -= y;
     uint shift = (floatBitsToUint(p0.y) >> 31) | ((floatBitsToUint(p1.y) >> 30) & 2u) |
                  ((floatBitsToUint(p2.y) >> 29) & 4u);
-    uint code = (0x2E74u >> shift) & 0x0101u;
-    if (code == 0u) return;
+    code = (0x2E74u >> shift) & 0x0101u;
+    if (code == 0u) return false;
     float ay = p0.y - 2.0 * p1.y + p2.y;
     float by = p0.y - p1.y;
     float d = sqrt(max(by * by - ay * p0.y, 0.0));
@@ -188,36 +190,51 @@ void row_curve(vec2 p0, vec2 p1, vec2 p2, float y, uint mask) {
     }
     float ax = p0.x - 2.0 * p1.x + p2.x;
     float bx = p0.x - p1.x;
-    float x1 = (ax * t1 - 2.0 * bx) * t1 + p0.x;
-    float x2 = (ax * t2 - 2.0 * bx) * t2 + p0.x;
+    x1 = (ax * t1 - 2.0 * bx) * t1 + p0.x;
+    x2 = (ax * t2 - 2.0 * bx) * t2 + p0.x;
     // Two roots that meet (a tangent, or a curve that misses the row) cancel exactly: skipping them
     // keeps the walk the same whichever band range the curves come from (the CPU reference reads
     // only the sample's band).
-    if (code == 0x0101u && x1 == x2) return;
-    // The channels written out, not a loop (as in row_crossing()).
-    if ((mask & 1u) != 0u) row_roots(0u, code, x1, x2);
-    if ((mask & 2u) != 0u) row_roots(1u, code, x1, x2);
-    if ((mask & 4u) != 0u) row_roots(2u, code, x1, x2);
+    return !(code == 0x0101u && x1 == x2);
 }
 
-// The covered length of the part of channel c's segment this pass saw: up to its end, or up to
-// its last crossing kept when more follow (row_start then moves there for the next pass).
-float row_walk(uint c) {
-    int w = row_winding[c];
-    float at = row_start[c];
+// Step i of the walk.
+void row_walk_step(RowList r, uint i, inout int w, inout float at, inout float length) {
+    if (i >= r.count) return;
+    float x = r.x[i];
+    if (w != 0) length += x - at;
+    w -= (r.up & (1u << i)) != 0u ? -1 : 1;
+    at = x;
+}
+
+// The covered length of the part of the segment this pass saw: up to its end, or up to its last
+// crossing kept when more follow (start then moves there for the next pass). Written out, as the
+// insertion, so that the list's indices are constants.
+float row_walk(inout RowList r) {
+    int w = r.winding;
+    float at = r.start;
     float length = 0.0;
-    for (uint i = 0u; i < row_count[c]; ++i) {
-        float x = row_x[c][i];
-        if (w != 0) length += x - at;
-        w -= row_direction[c][i];
-        at = x;
-    }
-    if (row_more[c]) {
-        row_start[c] = at;
+    row_walk_step(r, 0u, w, at, length);
+    row_walk_step(r, 1u, w, at, length);
+    row_walk_step(r, 2u, w, at, length);
+    row_walk_step(r, 3u, w, at, length);
+    row_walk_step(r, 4u, w, at, length);
+    row_walk_step(r, 5u, w, at, length);
+    row_walk_step(r, 6u, w, at, length);
+    row_walk_step(r, 7u, w, at, length);
+    if (r.more) {
+        r.start = at;
     } else if (w != 0) {
-        length += row_end[c] - at;
+        length += r.end - at;
     }
     return length;
+}
+
+void row_begin_pass(inout RowList r) {
+    r.winding = 0;
+    r.count = 0u;
+    r.more = false;
+    r.up = 0u;
 }
 
 // The covered fraction of a segment of `length` em in kRasterCoverageOne units, dithered: the
@@ -315,36 +332,35 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
         float v = row_height(n);
         // The R2 x offset of n, free now that rows need no x: the dither of the quantization.
         float dither = fract(0.5 + float(n) * 0.7548776662466927);
-        float ys[3];
-        float lengths[3];
-        uint lo_band = 0xFFFFFFFFu, hi_band = 0u;
-        for (uint c = 0u; c < 3u; ++c) {
-            vec4 rect = pc.channel_rects[c];
-            float py = float(ty) + (rect.y + (rect.w - rect.y) * v);
-            ys[c] = item.offset_y + item.scale_y * py;
-            row_start[c] = item.offset_x + item.scale_x * (float(tx) + rect.x);
-            row_end[c] = item.offset_x + item.scale_x * (float(tx) + rect.z);
-            lengths[c] = row_end[c] - row_start[c];
-            uint band = band_of(item, ys[c]);
-            lo_band = min(lo_band, band);
-            hi_band = max(hi_band, band);
-        }
+        // The channels written out, not a loop (as in row_crossing()), one list each.
+        RowList r0, r1, r2;
+        vec4 rect = pc.channel_rects[0];
+        float y0 = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
+        r0.start = item.offset_x + item.scale_x * (float(tx) + rect.x);
+        r0.end = item.offset_x + item.scale_x * (float(tx) + rect.z);
+        rect = pc.channel_rects[1];
+        float y1 = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
+        r1.start = item.offset_x + item.scale_x * (float(tx) + rect.x);
+        r1.end = item.offset_x + item.scale_x * (float(tx) + rect.z);
+        rect = pc.channel_rects[2];
+        float y2 = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
+        r2.start = item.offset_x + item.scale_x * (float(tx) + rect.x);
+        r2.end = item.offset_x + item.scale_x * (float(tx) + rect.z);
+        vec3 lengths = vec3(r0.end - r0.start, r1.end - r1.start, r2.end - r2.start);
         // Uniform band range across the subgroup, so the curve loop and its loads are uniform.
-        lo_band = subgroupMin(lo_band);
-        hi_band = subgroupMax(hi_band);
+        uint lo_band = subgroupMin(min(band_of(item, y0), min(band_of(item, y1), band_of(item, y2))));
+        uint hi_band = subgroupMax(max(band_of(item, y0), max(band_of(item, y1), band_of(item, y2))));
 
         // Channels whose segment is still being walked; a pass per kRasterRowCrossings crossings.
         // The subgroup passes together (an invocation done adds nothing), so that the curve loop
         // and its loads stay uniform.
-        float covered[3] = float[3](0.0, 0.0, 0.0);
+        vec3 covered = vec3(0.0);
         // Equal rects (gray) give three equal walks: the red one stands for all.
         uint pending = pc.equal_channels != 0u ? 1u : 7u;
         while (subgroupMax(pending) != 0u) {
-            for (uint c = 0u; c < 3u; ++c) {
-                row_winding[c] = 0;
-                row_count[c] = 0u;
-                row_more[c] = false;
-            }
+            row_begin_pass(r0);
+            row_begin_pass(r1);
+            row_begin_pass(r2);
             for (uint word = 0u; word < item.band_words; ++word) {
                 uint bits = 0u;
                 for (uint band = lo_band; band <= hi_band; ++band) {
@@ -357,28 +373,47 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                     vec2 p0 = fonts_points[font].points[first];
                     vec2 p1 = fonts_points[font].points[first + 1u];
                     vec2 p2 = fonts_points[font].points[first + 2u];
+                    uint code;
+                    float x1, x2;
                     if (pc.shared_rows != 0u) {
-                        row_curve(p0, p1, p2, ys[0], pending);
+                        if (pending != 0u && row_curve(p0, p1, p2, y0, code, x1, x2)) {
+                            if ((pending & 1u) != 0u) row_roots(r0, code, x1, x2);
+                            if ((pending & 2u) != 0u) row_roots(r1, code, x1, x2);
+                            if ((pending & 4u) != 0u) row_roots(r2, code, x1, x2);
+                        }
                     } else {
-                        // The channels written out, not a loop (as in row_crossing()).
-                        if ((pending & 1u) != 0u) row_curve(p0, p1, p2, ys[0], 1u);
-                        if ((pending & 2u) != 0u) row_curve(p0, p1, p2, ys[1], 2u);
-                        if ((pending & 4u) != 0u) row_curve(p0, p1, p2, ys[2], 4u);
+                        if ((pending & 1u) != 0u && row_curve(p0, p1, p2, y0, code, x1, x2)) {
+                            row_roots(r0, code, x1, x2);
+                        }
+                        if ((pending & 2u) != 0u && row_curve(p0, p1, p2, y1, code, x1, x2)) {
+                            row_roots(r1, code, x1, x2);
+                        }
+                        if ((pending & 4u) != 0u && row_curve(p0, p1, p2, y2, code, x1, x2)) {
+                            row_roots(r2, code, x1, x2);
+                        }
                     }
                 }
             }
             uint next = 0u;
-            for (uint c = 0u; c < 3u; ++c) {
-                if ((pending & (1u << c)) == 0u) continue;
-                covered[c] += row_walk(c);
-                if (row_more[c]) next |= 1u << c;
+            if ((pending & 1u) != 0u) {
+                covered[0] += row_walk(r0);
+                if (r0.more) next |= 1u;
+            }
+            if ((pending & 2u) != 0u) {
+                covered[1] += row_walk(r1);
+                if (r1.more) next |= 2u;
+            }
+            if ((pending & 4u) != 0u) {
+                covered[2] += row_walk(r2);
+                if (r2.more) next |= 4u;
             }
             pending = next;
         }
         if (pc.equal_channels != 0u) {
             sums += uvec3(row_units(covered[0], lengths[0], dither));
         } else {
-            for (uint c = 0u; c < 3u; ++c) sums[c] += row_units(covered[c], lengths[c], dither);
+            sums += uvec3(row_units(covered[0], lengths[0], dither), row_units(covered[1], lengths[1], dither),
+                          row_units(covered[2], lengths[2], dither));
         }
     }
     return sums;
