@@ -261,6 +261,17 @@ struct RealGlyph {
     const GlyphRecord& glyph() const { return asset->glyphs[index]; }
 };
 
+// The pixels (at `size` pixels per em, pixel i covering [i, i + 1) / size) the glyph's em bbox
+// touches: columns [i0, i1), rows [j0, j1).
+struct PixelBox {
+    int i0, i1, j0, j1;
+};
+PixelBox pixel_box(const GlyphRecord& record, int size) {
+    const auto low = [size](float em) { return static_cast<int>(std::floor(static_cast<double>(em) * size)); };
+    const auto high = [size](float em) { return static_cast<int>(std::ceil(static_cast<double>(em) * size)); };
+    return {low(record.bbox_min_x), high(record.bbox_max_x), low(record.bbox_min_y), high(record.bbox_max_y)};
+}
+
 struct FontKey {
     std::string path;
     uint32_t face = 0;
@@ -1039,10 +1050,7 @@ TEST(Coverage, PointSamplesConvergeToExactCoverage) {
             const GlyphRecord& record = glyph.glyph();
             const ExactCoverage exact(*glyph.asset, record);
             const double pixel = 1.0 / size;
-            const auto i0 = static_cast<int>(std::floor(static_cast<double>(record.bbox_min_x) * size));
-            const auto i1 = static_cast<int>(std::ceil(static_cast<double>(record.bbox_max_x) * size));
-            const auto j0 = static_cast<int>(std::floor(static_cast<double>(record.bbox_min_y) * size));
-            const auto j1 = static_cast<int>(std::ceil(static_cast<double>(record.bbox_max_y) * size));
+            const auto [i0, i1, j0, j1] = pixel_box(record, size);
             const int count = (i1 - i0) * (j1 - j0);
             const int stride = std::max(1, count / 1500);
             std::vector<double> errors512, errors64;
@@ -1325,10 +1333,7 @@ TEST(RowSamples, ConvergeToExactCoverageFasterThanPoints) {
             const GlyphRecord& record = glyph.glyph();
             const ExactCoverage exact(*glyph.asset, record);
             const double pixel = 1.0 / size;
-            const auto i0 = static_cast<int>(std::floor(static_cast<double>(record.bbox_min_x) * size));
-            const auto i1 = static_cast<int>(std::ceil(static_cast<double>(record.bbox_max_x) * size));
-            const auto j0 = static_cast<int>(std::floor(static_cast<double>(record.bbox_min_y) * size));
-            const auto j1 = static_cast<int>(std::ceil(static_cast<double>(record.bbox_max_y) * size));
+            const auto [i0, i1, j0, j1] = pixel_box(record, size);
             const int stride = std::max(1, (i1 - i0) * (j1 - j0) / 600);
             std::vector<double> errors[2][3];
             for (int j = j0; j < j1; ++j) {
