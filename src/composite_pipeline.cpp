@@ -88,6 +88,7 @@ Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadP
     info.pDynamicState = &dynamic;
     info.layout = desc.layout;
     info.renderPass = desc.render_pass;
+    info.flags = vk::pipeline_create_flags(device);
     VkPipeline pipeline = VK_NULL_HANDLE;
     if (VkResult r = device.fn->vkCreateGraphicsPipelines(device.device, device.pipeline_cache, 1, &info,
                                                           device.allocator, &pipeline);
@@ -95,6 +96,7 @@ Result<VkPipeline> create_quad_pipeline(const vk::DeviceRef& device, const QuadP
         return vk::vulkan_error(std::string("vkCreateGraphicsPipelines (") + desc.what + ")", r);
     }
     vk::name_object(device, VK_OBJECT_TYPE_PIPELINE, pipeline, desc.what);
+    vk::collect_statistics(device, pipeline, desc.what);
     return pipeline;
 }
 

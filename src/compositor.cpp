@@ -135,6 +135,7 @@ struct CRISP_HIDDEN Compositor::State {
     vk::Functions fn;  // the caller's Vulkan entry points (CompositorCreateInfo::get_instance_proc_addr)
     std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory; outlives the paths below
     vk::DeviceRef ref;
+    std::vector<ShaderStatistic> shader_statistics;  // the driver's, where the device enabled them
     bool storage_without_format = false;
     composite::TileCompositor tiles;
     std::unique_ptr<composite::DrawCompositor> draw;            // with draw_format
@@ -196,6 +197,7 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     state->arena =
         std::make_unique<vk::MemoryArena>(state->fn, info.device, info.allocator, state->ref.memory_properties);
     state->ref.arena = state->arena.get();
+    if (enabled->pipeline_executable_info) state->ref.statistics = &state->shader_statistics;
     state->storage_without_format = storage_without_format;
     composite::TileConfig tiles;
     tiles.physical_device = info.physical_device;
@@ -334,6 +336,9 @@ uint32_t Compositor::height() const {
 }
 const CompositorStats& Compositor::stats() const {
     return state_->stats;
+}
+const std::vector<ShaderStatistic>& Compositor::shader_statistics() const {
+    return state_->shader_statistics;
 }
 DeviceMemoryUse Compositor::device_memory() const {
     const State& s = *state_;

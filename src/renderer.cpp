@@ -106,6 +106,7 @@ struct CRISP_HIDDEN Renderer::State {
     vk::Functions fn;  // the caller's Vulkan entry points (RendererCreateInfo::get_instance_proc_addr)
     std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory: declared first, destroyed last
     vk::DeviceRef ref;                       // device, allocator, memory properties, pipeline cache, debug names, arena
+    std::vector<ShaderStatistic> shader_statistics;  // the driver's, where the device enabled them
     VkDeviceSize max_storage_buffer_range = 0;
     uint32_t frames_in_flight = 2;
     bool shared_row_roots = true;
@@ -620,6 +621,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     state->arena =
         std::make_unique<vk::MemoryArena>(state->fn, info.device, info.allocator, state->ref.memory_properties);
     state->ref.arena = state->arena.get();
+    if (enabled->pipeline_executable_info) state->ref.statistics = &state->shader_statistics;
     state->layout = std::move(layout);
     if (Status s = state->create_objects(); !s) return s.error();
     return Renderer(std::move(state));
@@ -1161,6 +1163,9 @@ bool Renderer::converged() const {
 }
 const RendererStats& Renderer::stats() const {
     return state_->stats;
+}
+const std::vector<ShaderStatistic>& Renderer::shader_statistics() const {
+    return state_->shader_statistics;
 }
 DeviceMemoryUse Renderer::device_memory() const {
     const State& s = *state_;

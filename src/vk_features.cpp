@@ -228,6 +228,12 @@ Result<DeviceFeatures> read_enabled_features(const VkPhysicalDeviceFeatures2* ch
                 if (dynamic.dynamicRendering) enabled.vulkan13.dynamicRendering = VK_TRUE;
                 break;
             }
+            case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR: {
+                VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executable{};
+                std::memcpy(&executable, next, sizeof(executable));
+                enabled.pipeline_executable_info = executable.pipelineExecutableInfo == VK_TRUE;
+                break;
+            }
             default:
                 break;  // an extension's structure: not crisp's business
         }

@@ -22,6 +22,9 @@ struct DeviceFeatures {
     VkPhysicalDeviceVulkan11Features vulkan11;
     VkPhysicalDeviceVulkan12Features vulkan12;
     VkPhysicalDeviceVulkan13Features vulkan13;
+    // VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR::pipelineExecutableInfo, read from an
+    // enabled chain only (read_enabled_features); never linked.
+    bool pipeline_executable_info = false;
 
     DeviceFeatures();  // all false, sTypes set, not linked
 

@@ -59,6 +59,10 @@ Status load_functions(PFN_vkGetInstanceProcAddr get_instance_proc_addr, VkInstan
 #undef CRISP_VK_LOAD
     out.vkSetDebugUtilsObjectNameEXT = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
         out.vkGetDeviceProcAddr(device, "vkSetDebugUtilsObjectNameEXT"));
+    out.vkGetPipelineExecutablePropertiesKHR = reinterpret_cast<PFN_vkGetPipelineExecutablePropertiesKHR>(
+        out.vkGetDeviceProcAddr(device, "vkGetPipelineExecutablePropertiesKHR"));
+    out.vkGetPipelineExecutableStatisticsKHR = reinterpret_cast<PFN_vkGetPipelineExecutableStatisticsKHR>(
+        out.vkGetDeviceProcAddr(device, "vkGetPipelineExecutableStatisticsKHR"));
     return {};
 }
 

@@ -109,6 +109,9 @@ struct Functions {
     PFN_vkGetInstanceProcAddr vkGetInstanceProcAddr = nullptr;
     // VK_EXT_debug_utils, where the instance enabled it; null otherwise.
     PFN_vkSetDebugUtilsObjectNameEXT vkSetDebugUtilsObjectNameEXT = nullptr;
+    // VK_KHR_pipeline_executable_properties, where the device enabled it; null otherwise.
+    PFN_vkGetPipelineExecutablePropertiesKHR vkGetPipelineExecutablePropertiesKHR = nullptr;
+    PFN_vkGetPipelineExecutableStatisticsKHR vkGetPipelineExecutableStatisticsKHR = nullptr;
 };
 
 // The system loader's vkGetInstanceProcAddr (libvulkan.so.1, opened once and kept open); null when

@@ -341,6 +341,7 @@ Result<VkPipeline> create_compute_pipeline(const DeviceRef& device, VkShaderModu
     info.stage.pName = "main";
     info.stage.pSpecializationInfo = specialization;
     info.layout = layout;
+    info.flags = pipeline_create_flags(device);
     VkPipeline pipeline = VK_NULL_HANDLE;
     if (VkResult r = device.fn->vkCreateComputePipelines(device.device, device.pipeline_cache, 1, &info,
                                                          device.allocator, &pipeline);
@@ -348,7 +349,72 @@ Result<VkPipeline> create_compute_pipeline(const DeviceRef& device, VkShaderModu
         return vulkan_error(std::string("vkCreateComputePipelines (") + what + ")", r);
     }
     name_object(device, VK_OBJECT_TYPE_PIPELINE, pipeline, what);
+    collect_statistics(device, pipeline, what);
     return pipeline;
+}
+
+VkPipelineCreateFlags pipeline_create_flags(const DeviceRef& device) {
+    return device.statistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
+}
+
+namespace {
+
+double statistic_value(const VkPipelineExecutableStatisticKHR& s) {
+    switch (s.format) {
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR:
+            return s.value.b32 ? 1.0 : 0.0;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR:
+            return static_cast<double>(s.value.i64);
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR:
+            return static_cast<double>(s.value.u64);
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_FLOAT64_KHR:
+            return s.value.f64;
+        default:
+            return 0.0;
+    }
+}
+
+}  // namespace
+
+void collect_statistics(const DeviceRef& device, VkPipeline pipeline, std::string_view what) {
+    const Functions& fn = *device.fn;
+    if (!device.statistics || !fn.vkGetPipelineExecutablePropertiesKHR || !fn.vkGetPipelineExecutableStatisticsKHR) {
+        return;
+    }
+    VkPipelineInfoKHR pipeline_info{};
+    pipeline_info.sType = VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR;
+    pipeline_info.pipeline = pipeline;
+    uint32_t count = 0;
+    if (fn.vkGetPipelineExecutablePropertiesKHR(device.device, &pipeline_info, &count, nullptr) != VK_SUCCESS) return;
+    std::vector<VkPipelineExecutablePropertiesKHR> executables(count);
+    for (auto& e : executables) e.sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR;
+    if (fn.vkGetPipelineExecutablePropertiesKHR(device.device, &pipeline_info, &count, executables.data()) !=
+        VK_SUCCESS) {
+        return;
+    }
+    executables.resize(count);
+    for (uint32_t index = 0; index < count; ++index) {
+        VkPipelineExecutableInfoKHR executable_info{};
+        executable_info.sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR;
+        executable_info.pipeline = pipeline;
+        executable_info.executableIndex = index;
+        uint32_t stat_count = 0;
+        if (fn.vkGetPipelineExecutableStatisticsKHR(device.device, &executable_info, &stat_count, nullptr) !=
+            VK_SUCCESS) {
+            continue;
+        }
+        std::vector<VkPipelineExecutableStatisticKHR> stats(stat_count);
+        for (auto& s : stats) s.sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR;
+        if (fn.vkGetPipelineExecutableStatisticsKHR(device.device, &executable_info, &stat_count, stats.data()) !=
+            VK_SUCCESS) {
+            continue;
+        }
+        stats.resize(stat_count);
+        for (const auto& s : stats) {
+            device.statistics->push_back(
+                ShaderStatistic{std::string(what), executables[index].name, s.name, s.description, statistic_value(s)});
+        }
+    }
 }
 
 Result<VkShaderModule> create_embedded_shader(const DeviceRef& device, std::string_view name) {

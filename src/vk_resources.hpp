@@ -3,6 +3,7 @@
 
 #include "vk_functions.hpp"
 
+#include <crisp/device_features.hpp>
 #include <crisp/result.hpp>
 
 #include <vulkan/vulkan.h>
@@ -96,7 +97,18 @@ struct DeviceRef {
     VkPipelineCache pipeline_cache = VK_NULL_HANDLE;  // the caller's, or none
     // Where buffers take their memory (create_buffer); null: each buffer its own allocation.
     MemoryArena* arena = nullptr;
+    // Where pipelines made from this ref report the driver's statistics of their shaders (made with
+    // VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR); null: not captured. Set only where the device
+    // enabled pipelineExecutableInfo (DeviceFeatures::pipeline_executable_info).
+    std::vector<ShaderStatistic>* statistics = nullptr;
 };
+
+// The pipeline creation flags of `device`: capture statistics where it collects them.
+VkPipelineCreateFlags pipeline_create_flags(const DeviceRef& device);
+// Appends the statistics of every executable of `pipeline`, named `what`, to *device.statistics
+// (nothing where it is null). A driver that fails to report leaves them out: statistics are a
+// diagnostic, never a reason for a pipeline to fail.
+void collect_statistics(const DeviceRef& device, VkPipeline pipeline, std::string_view what);
 
 // A DeviceRef for `device`, calling through `fn` (which must outlive it): its memory properties
 // and the caller's pipeline cache.

@@ -155,6 +155,7 @@ struct DeviceCandidate {
     VkPhysicalDeviceVulkan12Properties vulkan12{};
     uint32_t queue_family = 0;
     vk::DeviceFeatures features;  // what its device is created with (unlinked)
+    bool pipeline_statistics = false;  // VK_KHR_pipeline_executable_properties and its feature offered
 };
 
 // Empty when `candidate` meets every requirement; otherwise what it lacks. Fills the candidate's
@@ -200,6 +201,15 @@ std::vector<std::string> check_device(const vk::Functions& fn, VkInstance instan
     extensions.resize(extension_count);
     for (const std::string& name : options.required_extensions) {
         if (!has_extension(extensions, name.c_str())) lacks.push_back("the device lacks extension " + name);
+    }
+    if (options.shader_statistics && has_extension(extensions, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME)) {
+        VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executable{};
+        executable.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR;
+        VkPhysicalDeviceFeatures2 features{};
+        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+        features.pNext = &executable;
+        fn.vkGetPhysicalDeviceFeatures2(candidate.handle, &features);
+        candidate.pipeline_statistics = executable.pipelineExecutableInfo == VK_TRUE;
     }
 
     candidate.features = required;
@@ -255,6 +265,8 @@ struct HeadlessContext::State {
     uint32_t driver_version = 0;
     uint32_t api_version = 0;
     vk::DeviceFeatures enabled;  // what the device was created with
+    // Linked after `enabled`'s structures where options.shader_statistics found it offered.
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executable_features{};
     VkPhysicalDeviceFeatures2* enabled_chain = nullptr;
     VkPhysicalDeviceProperties properties{};
     VkPhysicalDeviceMemoryProperties memory_properties{};
@@ -453,12 +465,24 @@ Status HeadlessContext::State::create_device(const DeviceCandidate& chosen, cons
     subgroup.supportedOperations = chosen.vulkan11.subgroupSupportedOperations;
     subgroup.quadOperationsInAllStages = chosen.vulkan11.subgroupQuadOperationsInAllStages;
     fn.vkGetPhysicalDeviceMemoryProperties(physical_device, &memory_properties);
-    for (const std::string& name : options.required_extensions) {
+    std::vector<std::string> wanted_extensions = options.required_extensions;
+    if (chosen.pipeline_statistics) wanted_extensions.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+    for (const std::string& name : wanted_extensions) {
         // Listing an extension twice is harmless to the caller but invalid for vkCreateDevice.
         if (std::find(enabled_extensions.begin(), enabled_extensions.end(), name) == enabled_extensions.end()) {
             enabled_extensions.push_back(name);
         }
     }
+    executable_features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR;
+    executable_features.pipelineExecutableInfo = chosen.pipeline_statistics ? VK_TRUE : VK_FALSE;
+    // Puts executable_features right after `chain`'s head where it is enabled.
+    const auto with_statistics = [&](VkPhysicalDeviceFeatures2* chain) {
+        if (chosen.pipeline_statistics) {
+            executable_features.pNext = chain->pNext;
+            chain->pNext = &executable_features;
+        }
+        return chain;
+    };
 
     const float priority = 1.0f;
     VkDeviceQueueCreateInfo queue_info{};
@@ -472,7 +496,7 @@ Status HeadlessContext::State::create_device(const DeviceCandidate& chosen, cons
     device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
     // Exactly what the caller required; the 1.3 structure only when it asks for something, since
     // a 1.2 device must not see it.
-    device_info.pNext = required.link(required.any_vulkan13());
+    device_info.pNext = with_statistics(required.link(required.any_vulkan13()));
     device_info.queueCreateInfoCount = 1;
     device_info.pQueueCreateInfos = &queue_info;
     device_info.enabledExtensionCount = static_cast<uint32_t>(device_extensions.size());
@@ -484,7 +508,7 @@ Status HeadlessContext::State::create_device(const DeviceCandidate& chosen, cons
         return s.error();
     }
     enabled = required;
-    enabled_chain = enabled.link(true);
+    enabled_chain = with_statistics(enabled.link(true));
     fn.vkGetDeviceQueue(device, queue_family, 0, &queue);
 
     return {};

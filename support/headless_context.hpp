@@ -149,6 +149,11 @@ struct HeadlessContextOptions {
     // the device offers it. With draw_path, api_version is raised to at least 1.3 (dynamic
     // rendering). nullopt: only what the fields above ask for.
     std::optional<CrispFeatureNeeds> crisp_needs;
+    // Where the chosen device offers VK_KHR_pipeline_executable_properties and its
+    // pipelineExecutableInfo feature, enable both (enabled_features() then chains the feature
+    // structure), so that renderers and compositors made from this context report their shaders'
+    // statistics (Renderer::shader_statistics()). Never a reason to pass a device over.
+    bool shader_statistics = false;
 };
 
 // What the validation layer has said so far (warnings and errors only; info and verbose messages

@@ -6,6 +6,7 @@
 #include "headless_context.hpp"
 #include "shared.h"
 #include "test_support.hpp"
+#include "vk_features.hpp"
 #include "vk_memory.hpp"
 #include "vk_resources.hpp"
 
@@ -841,6 +842,46 @@ TEST_F(VulkanTest, PipelinesGoThroughTheCallersCache) {
         EXPECT_GT(cache_reports(), after_renderer) << describe(context.validation_messages());
     }
     vkDestroyPipelineCache(other.device(), foreign, nullptr);
+}
+
+// Shader statistics come exactly where the device was created with pipelineExecutableInfo: the
+// enabled chain is read for it, and a context asked for statistics enables it where offered
+// (NVIDIA's driver does; lavapipe does not, and then nothing changes).
+TEST_F(VulkanTest, ShaderStatisticsFollowTheEnabledFeature) {
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executable{};
+    executable.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR;
+    VkPhysicalDeviceFeatures2 chain{};
+    chain.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    chain.pNext = &executable;
+    for (const VkBool32 on : {VK_FALSE, VK_TRUE}) {
+        executable.pipelineExecutableInfo = on;
+        Result<vk::DeviceFeatures> read = vk::read_enabled_features(&chain, "test");
+        ASSERT_TRUE(read) << read.error().message;
+        EXPECT_EQ(read->pipeline_executable_info, on == VK_TRUE);
+    }
+
+    HeadlessContextOptions options = validated_options();
+    options.crisp_needs = CrispFeatureNeeds{};
+    options.shader_statistics = true;
+    CRISP_CREATE_CONTEXT(context, options);
+    Result<vk::DeviceFeatures> enabled = vk::read_enabled_features(context.enabled_features(), "test");
+    ASSERT_TRUE(enabled) << enabled.error().message;
+    auto renderer = Renderer::create(renderer_create_info(context));
+    ASSERT_TRUE(renderer) << renderer.error().message;
+    auto compositor = Compositor::create(compositor_create_info(context));
+    ASSERT_TRUE(compositor) << compositor.error().message;
+    if (enabled->pipeline_executable_info) {
+        const auto& stats = renderer->shader_statistics();
+        ASSERT_FALSE(stats.empty());
+        EXPECT_TRUE(std::all_of(stats.begin(), stats.end(),
+                                [](const ShaderStatistic& s) { return s.shader == "raster.comp" && !s.name.empty(); }));
+        EXPECT_FALSE(compositor->shader_statistics().empty());
+    } else {
+        EXPECT_TRUE(renderer->shader_statistics().empty());
+        EXPECT_TRUE(compositor->shader_statistics().empty());
+    }
+    const ValidationMessages messages = context.validation_messages();
+    EXPECT_EQ(messages.errors + messages.warnings, 0u) << describe(messages);
 }
 
 TEST(VulkanErrors, DeviceLossIsItsOwnErrorCode) {

@@ -86,6 +86,7 @@ struct Args {
     std::string json_out;
     bool validate = false;
     bool validate_sync = false;
+    bool shader_stats = false;
 };
 
 // A comma-separated list of numbers, each within `range`, into `target`.
@@ -168,6 +169,10 @@ void declare_setup_options(crisp::cli::CommandLine& cli, Args& args) {
     cli.flag("--validate", "turn the validation layer on", args.validate);
     cli.flag("--validate-sync", "the validation layer with synchronization validation",
              [&args] { args.validate = args.validate_sync = true; });
+    cli.flag("--shader-stats",
+             "after the tables, the driver's statistics of the compositor's shaders (registers, spills, ...) "
+             "where the device offers VK_KHR_pipeline_executable_properties",
+             args.shader_stats);
     cli.flag("--json", "print JSON instead of Markdown", args.json);
     cli.text("--json-out", "FILE", "also write the JSON to FILE", args.json_out);
 }
@@ -558,6 +563,7 @@ struct Header {
     bool storage_without_format = false;
     std::string layout;
     std::vector<std::string> compositor_warnings;
+    std::vector<crisp::ShaderStatistic> shader_statistics;  // the first compositor's
 };
 
 double buffer_bytes_per_pixel(const Measurement& m, const Args& args) {
@@ -830,6 +836,7 @@ struct SceneRunner {
         info.reference_modes = false;
         auto rebinning = crisp::Compositor::create(info);
         if (!rebinning) fail(rebinning.error().message);
+        if (header.shader_statistics.empty()) header.shader_statistics = compositor->shader_statistics();
         for (const std::string& w : compositor->warnings()) {
             std::vector<std::string>& seen = header.compositor_warnings;
             if (std::find(seen.begin(), seen.end(), w) == seen.end()) seen.push_back(w);
@@ -915,6 +922,7 @@ int main(int argc, char** argv) {
     options.validation = args.validate;
     options.synchronization_validation = args.validate_sync;
     options.device_name_contains = args.device;
+    options.shader_statistics = args.shader_stats;
     bool storage_without_format = false;
     auto context = crisp::tools::create_context(options, storage_without_format);
     if (!context) fail(context.error().message);
@@ -964,6 +972,7 @@ int main(int argc, char** argv) {
         std::fputs(json.line().c_str(), stdout);
     } else {
         print_markdown(args, header, results, warnings);
+        if (args.shader_stats) crisp::tools::print_shader_statistics(header.shader_statistics);
     }
     if (!args.json_out.empty()) {
         if (crisp::Status s = json.write_file(args.json_out); !s) fail(s.error().message);

@@ -31,6 +31,7 @@ struct Args {
     bool no_shared_rows = false;
     crisp::SampleKind sample_kind = crisp::SampleKind::rows;
     bool validate = false;
+    bool shader_stats = false;
 };
 
 // Parses the command line; prints --help, or the help on stderr and exits 2 on a usage error.
@@ -69,6 +70,10 @@ Args parse(int argc, char** argv) {
         [](const crisp::SampleKind& kind) { return std::string(kind == crisp::SampleKind::rows ? "rows" : "points"); });
     cli.text("--device", "TEXT", "pick a device whose name contains TEXT", args.device);
     cli.flag("--validate", "turn the validation layer on", args.validate);
+    cli.flag("--shader-stats",
+             "print the driver's statistics of the rasterizer's shader (registers, spills, ...) where the "
+             "device offers VK_KHR_pipeline_executable_properties",
+             args.shader_stats);
     cli.parse(argc, argv);
     return args;
 }
@@ -192,6 +197,7 @@ int main(int argc, char** argv) {
     crisp::HeadlessContextOptions options;
     options.validation = args.validate;
     options.device_name_contains = args.device;
+    options.shader_statistics = args.shader_stats;
     bool storage_without_format = false;  // the rasterizer does not use it
     auto context = crisp::tools::create_context(options, storage_without_format);
     if (!context) fail(context.error().message);
@@ -207,6 +213,7 @@ int main(int argc, char** argv) {
         const std::vector<crisp::GlyphInstance> screen = screen_of_text(args, *font);
         const std::vector<Frame> frames = run_frames(*context, renderer, screen, args.max_frames);
         print_markdown(args, *context, renderer, layout->name, screen.size(), frames);
+        if (args.shader_stats) crisp::tools::print_shader_statistics(renderer.shader_statistics());
     }
     const auto messages = context->validation_messages();
     if (messages.errors + messages.warnings > 0) {

@@ -279,6 +279,9 @@ public:
     // The VkDeviceMemory objects the compositor holds now and their bytes (its buffers' blocks, as
     // the renderer's, and the reference modes' target image).
     DeviceMemoryUse device_memory() const;
+    // The driver's statistics of the compositor's compiled shaders, every pass of every path it
+    // made: see ShaderStatistic for when there are any; empty otherwise.
+    const std::vector<ShaderStatistic>& shader_statistics() const;
     // What the compositor chose that the caller may want to know ("exact mode:
     // maxStorageBufferRange holds N of the M list nodes asked for").
     const std::vector<std::string>& warnings() const;

@@ -45,6 +45,21 @@ CRISP_API Status add_crisp_features(VkInstance instance, VkPhysicalDevice physic
                                     VkPhysicalDeviceFeatures2& features, const CrispFeatureNeeds& needs = {},
                                     PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
 
+// One statistic of one of crisp's compiled shaders as the driver reports it through
+// VK_KHR_pipeline_executable_properties: registers, spills, shared memory, instruction counts,
+// whatever the driver names. Renderer::shader_statistics() and Compositor::shader_statistics()
+// return them when the device was created with that extension and its pipelineExecutableInfo
+// feature, and RendererCreateInfo::enabled_features / CompositorCreateInfo::enabled_features
+// chain the VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR that enabled it; otherwise
+// none (nothing else changes: the pipelines are the same).
+struct ShaderStatistic {
+    std::string shader;       // crisp's name for the pipeline, "raster.comp"
+    std::string executable;   // the driver's name for one compiled stage of it
+    std::string name;         // the driver's name for the statistic, "Register Count"
+    std::string description;  // the driver's description of it
+    double value = 0.0;       // booleans as 0 and 1, integers exactly up to 2^53
+};
+
 // "VK_ERROR_DEVICE_LOST", for messages; "VkResult -13" for a code this build does not know.
 CRISP_API std::string vk_result_name(VkResult result);
 

@@ -25,6 +25,7 @@
 #include <crisp/export.hpp>
 
 #include <crisp/atlas.hpp>
+#include <crisp/device_features.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 #include <crisp/result.hpp>
@@ -300,6 +301,9 @@ public:
     // The VkDeviceMemory objects the renderer holds now and their bytes: its buffers share a few
     // blocks (4 MiB, growing to 64 MiB as more are needed), and the atlas image has its own.
     DeviceMemoryUse device_memory() const;
+    // The driver's statistics of the rasterizer's compiled shader (registers, spills, ...): see
+    // ShaderStatistic for when there are any; empty otherwise.
+    const std::vector<ShaderStatistic>& shader_statistics() const;
     const GlyphAtlas& atlas() const;
     VkImage atlas_image() const;
     VkImageView atlas_view() const;
