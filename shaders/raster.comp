@@ -8,8 +8,10 @@
 // (continued across frames). The roots of each curve of the bands the subgroup touches on that
 // row (Lengyel's root classification, as for points) give the winding at the segment's start and
 // the crossings inside it, which are sorted and walked: the covered length under the nonzero rule
-// is exact, overlapping contours included. The covered fraction adds up to kRasterCoverageOne,
-// dithered to whole units by the R2 x offset of n.
+// is exact, overlapping contours included. Channels on one row (stripes, gray) share one sorted
+// list over the union of their segments, each covered stretch clipped to each channel's segment.
+// The covered fraction adds up to kRasterCoverageOne, dithered to whole units by the R2 x offset
+// of n.
 //
 // Point samples: one point per channel inside its rectangle (the R2 sequence), a ray towards +x,
 // and the nonzero winding number; a covered sample adds kRasterCoverageOne.
@@ -101,12 +103,14 @@ ivec3 winding_row(vec2 p0, vec2 p1, vec2 p2, float y, vec3 xs) {
 
 // ---- Row samples.
 
-// One channel's row segment of the sample being walked: [start, end] in em, the winding just right
-// of start (the crossings right of it), and the crossings inside (start, end) sorted by x, with
-// their directions as bits (set: -1, running up). At most kRasterRowCrossings are kept, the
-// leftmost; when one more comes, the rightmost is dropped and `more` says that the segment goes on
-// from the last crossing kept, in another pass. Every index into `x` is a compile-time constant
-// (the insertion and the walk are written out), so that the lists can live in registers.
+// The row segment being walked: [start, end] in em (the union of the segments of the channels that
+// share the row), the winding just right of start (the crossings right of it), and the crossings
+// inside (start, end) sorted by x, with their directions as bits (set: -1, running up). At most
+// kRasterRowCrossings are kept, the leftmost; when one more comes, the rightmost is dropped and
+// `more` says that the segment goes on from the last crossing kept, in another pass. Every index
+// into `x` is a compile-time constant (the insertion and the walk are written out), so that the
+// list can live in registers. One list serves every channel on the row: the walk clips each covered
+// stretch to each channel's own segment.
 struct RowList {
     float start;
     float end;
@@ -158,26 +162,16 @@ void row_crossing(inout RowList r, float x, int direction) {
     r.up = (r.up & below) | ((r.up << 1) & ~(below | (1u << p))) | (direction < 0 ? 1u << p : 0u);
 }
 
-// The roots of one curve as crossings of one segment.
-void row_roots(inout RowList r, uint code, float x1, float x2) {
-    if ((code & 1u) != 0u) row_crossing(r, x1, 1);
-    if (code > 1u) row_crossing(r, x2, -1);
-}
-
 // The crossings of one curve with the row at height y (absolute em): Lengyel's roots as in
-// winding(), as absolute x's, so one solve serves every channel on the row. False when there are
-// none to add.
-bool row_curve(vec2 p0, vec2 p1, vec2 p2, float y, out uint code, out float x1, out float x2) {
-    code = 0u;
-    x1 = 0.0;
-    x2 = 0.0;
+// winding(), as absolute x's, added to the list.
+void row_curve(inout RowList r, vec2 p0, vec2 p1, vec2 p2, float y) {
     p0.y -= y;
     p1.y -= y;
     p2.y -= y;
     uint shift = (floatBitsToUint(p0.y) >> 31) | ((floatBitsToUint(p1.y) >> 30) & 2u) |
                  ((floatBitsToUint(p2.y) >> 29) & 4u);
-    code = (0x2E74u >> shift) & 0x0101u;
-    if (code == 0u) return false;
+    uint code = (0x2E74u >> shift) & 0x0101u;
+    if (code == 0u) return;
     float ay = p0.y - 2.0 * p1.y + p2.y;
     float by = p0.y - p1.y;
     float d = sqrt(max(by * by - ay * p0.y, 0.0));
@@ -190,51 +184,53 @@ bool row_curve(vec2 p0, vec2 p1, vec2 p2, float y, out uint code, out float x1, 
     }
     float ax = p0.x - 2.0 * p1.x + p2.x;
     float bx = p0.x - p1.x;
-    x1 = (ax * t1 - 2.0 * bx) * t1 + p0.x;
-    x2 = (ax * t2 - 2.0 * bx) * t2 + p0.x;
+    float x1 = (ax * t1 - 2.0 * bx) * t1 + p0.x;
+    float x2 = (ax * t2 - 2.0 * bx) * t2 + p0.x;
     // Two roots that meet (a tangent, or a curve that misses the row) cancel exactly: skipping them
     // keeps the walk the same whichever band range the curves come from (the CPU reference reads
     // only the sample's band).
-    return !(code == 0x0101u && x1 == x2);
+    if (code == 0x0101u && x1 == x2) return;
+    if ((code & 1u) != 0u) row_crossing(r, x1, 1);
+    if (code > 1u) row_crossing(r, x2, -1);
+}
+
+// Adds the covered stretch [from, to] of the row, clipped to each channel's segment [lo, hi].
+// Inside a channel's segment the clip is exact (min and max pick an operand), so a channel sums
+// the same differences as a walk of its own segment would.
+void row_cover(inout vec3 covered, float from, float to, vec3 lo, vec3 hi) {
+    covered += max(min(vec3(to), hi) - max(vec3(from), lo), vec3(0.0));
 }
 
 // Step i of the walk.
-void row_walk_step(RowList r, uint i, inout int w, inout float at, inout float length) {
+void row_walk_step(RowList r, uint i, vec3 lo, vec3 hi, inout int w, inout float at, inout vec3 covered) {
     if (i >= r.count) return;
     float x = r.x[i];
-    if (w != 0) length += x - at;
+    if (w != 0) row_cover(covered, at, x, lo, hi);
     w -= (r.up & (1u << i)) != 0u ? -1 : 1;
     at = x;
 }
 
-// The covered length of the part of the segment this pass saw: up to its end, or up to its last
-// crossing kept when more follow (start then moves there for the next pass). Written out, as the
-// insertion, so that the list's indices are constants.
-float row_walk(inout RowList r) {
+// The covered length of each channel's segment [lo, hi] within the part of the row this pass saw:
+// up to its end, or up to its last crossing kept when more follow (start then moves there for the
+// next pass). Written out, as the insertion, so that the list's indices are constants.
+vec3 row_walk(inout RowList r, vec3 lo, vec3 hi) {
     int w = r.winding;
     float at = r.start;
-    float length = 0.0;
-    row_walk_step(r, 0u, w, at, length);
-    row_walk_step(r, 1u, w, at, length);
-    row_walk_step(r, 2u, w, at, length);
-    row_walk_step(r, 3u, w, at, length);
-    row_walk_step(r, 4u, w, at, length);
-    row_walk_step(r, 5u, w, at, length);
-    row_walk_step(r, 6u, w, at, length);
-    row_walk_step(r, 7u, w, at, length);
+    vec3 covered = vec3(0.0);
+    row_walk_step(r, 0u, lo, hi, w, at, covered);
+    row_walk_step(r, 1u, lo, hi, w, at, covered);
+    row_walk_step(r, 2u, lo, hi, w, at, covered);
+    row_walk_step(r, 3u, lo, hi, w, at, covered);
+    row_walk_step(r, 4u, lo, hi, w, at, covered);
+    row_walk_step(r, 5u, lo, hi, w, at, covered);
+    row_walk_step(r, 6u, lo, hi, w, at, covered);
+    row_walk_step(r, 7u, lo, hi, w, at, covered);
     if (r.more) {
         r.start = at;
     } else if (w != 0) {
-        length += r.end - at;
+        row_cover(covered, at, r.end, lo, hi);
     }
-    return length;
-}
-
-void row_begin_pass(inout RowList r) {
-    r.winding = 0;
-    r.count = 0u;
-    r.more = false;
-    r.up = 0u;
+    return covered;
 }
 
 // The covered fraction of a segment of `length` em in kRasterCoverageOne units, dithered: the
@@ -326,95 +322,66 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
 // fraction of the channel's segment in kRasterCoverageOne units.
 uvec3 row_samples(RasterItem item, uint tx, uint ty) {
     uint font = item.font;
+    // Each channel's segment in x (em), the same for every sample.
+    vec3 lo, hi;
+    for (int c = 0; c < 3; ++c) {
+        vec4 rect = pc.channel_rects[c];
+        lo[c] = item.offset_x + item.scale_x * (float(tx) + rect.x);
+        hi[c] = item.offset_x + item.scale_x * (float(tx) + rect.z);
+    }
+    // Channels that share their rows (stripes, gray) walk one list over the union of their
+    // segments; otherwise each channel is a row of its own, walked in turn.
+    uint rows = pc.shared_rows != 0u ? 1u : 3u;
     uvec3 sums = uvec3(0u);
     for (uint k = 0u; k < item.sample_count; ++k) {
         uint n = item.first_sample + k;
         float v = row_height(n);
         // The R2 x offset of n, free now that rows need no x: the dither of the quantization.
         float dither = fract(0.5 + float(n) * 0.7548776662466927);
-        // The channels written out, not a loop (as in row_crossing()), one list each.
-        RowList r0, r1, r2;
-        vec4 rect = pc.channel_rects[0];
-        float y0 = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
-        r0.start = item.offset_x + item.scale_x * (float(tx) + rect.x);
-        r0.end = item.offset_x + item.scale_x * (float(tx) + rect.z);
-        rect = pc.channel_rects[1];
-        float y1 = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
-        r1.start = item.offset_x + item.scale_x * (float(tx) + rect.x);
-        r1.end = item.offset_x + item.scale_x * (float(tx) + rect.z);
-        rect = pc.channel_rects[2];
-        float y2 = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
-        r2.start = item.offset_x + item.scale_x * (float(tx) + rect.x);
-        r2.end = item.offset_x + item.scale_x * (float(tx) + rect.z);
-        vec3 lengths = vec3(r0.end - r0.start, r1.end - r1.start, r2.end - r2.start);
-        // Uniform band range across the subgroup, so the curve loop and its loads are uniform.
-        uint lo_band = subgroupMin(min(band_of(item, y0), min(band_of(item, y1), band_of(item, y2))));
-        uint hi_band = subgroupMax(max(band_of(item, y0), max(band_of(item, y1), band_of(item, y2))));
-
-        // Channels whose segment is still being walked; a pass per kRasterRowCrossings crossings.
-        // The subgroup passes together (an invocation done adds nothing), so that the curve loop
-        // and its loads stay uniform.
         vec3 covered = vec3(0.0);
-        // Equal rects (gray) give three equal walks: the red one stands for all.
-        uint pending = pc.equal_channels != 0u ? 1u : 7u;
-        while (subgroupMax(pending) != 0u) {
-            row_begin_pass(r0);
-            row_begin_pass(r1);
-            row_begin_pass(r2);
-            for (uint word = 0u; word < item.band_words; ++word) {
-                uint bits = 0u;
-                for (uint band = lo_band; band <= hi_band; ++band) {
-                    bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
-                }
-                while (bits != 0u) {
-                    uint bit = findLSB(bits);
-                    bits &= bits - 1u;
-                    uint first = item.point_offset + 2u * (word * 32u + bit);
-                    vec2 p0 = fonts_points[font].points[first];
-                    vec2 p1 = fonts_points[font].points[first + 1u];
-                    vec2 p2 = fonts_points[font].points[first + 2u];
-                    uint code;
-                    float x1, x2;
-                    if (pc.shared_rows != 0u) {
-                        if (pending != 0u && row_curve(p0, p1, p2, y0, code, x1, x2)) {
-                            if ((pending & 1u) != 0u) row_roots(r0, code, x1, x2);
-                            if ((pending & 2u) != 0u) row_roots(r1, code, x1, x2);
-                            if ((pending & 4u) != 0u) row_roots(r2, code, x1, x2);
-                        }
-                    } else {
-                        if ((pending & 1u) != 0u && row_curve(p0, p1, p2, y0, code, x1, x2)) {
-                            row_roots(r0, code, x1, x2);
-                        }
-                        if ((pending & 2u) != 0u && row_curve(p0, p1, p2, y1, code, x1, x2)) {
-                            row_roots(r1, code, x1, x2);
-                        }
-                        if ((pending & 4u) != 0u && row_curve(p0, p1, p2, y2, code, x1, x2)) {
-                            row_roots(r2, code, x1, x2);
-                        }
+        for (uint row = 0u; row < rows; ++row) {
+            vec4 rect = pc.channel_rects[row];
+            float y = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
+            // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
+            vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
+            RowList r;
+            r.start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
+            r.end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
+            // Uniform band range across the subgroup, so the curve loop and its loads are uniform.
+            uint band = band_of(item, y);
+            uint lo_band = subgroupMin(band);
+            uint hi_band = subgroupMax(band);
+            // A pass per kRasterRowCrossings crossings. The subgroup passes together (an invocation
+            // done adds nothing), so that the curve loop and its loads stay uniform.
+            bool pending = true;
+            while (subgroupMax(uint(pending)) != 0u) {
+                r.winding = 0;
+                r.count = 0u;
+                r.more = false;
+                r.up = 0u;
+                for (uint word = 0u; word < item.band_words; ++word) {
+                    uint bits = 0u;
+                    for (uint b = lo_band; b <= hi_band; ++b) {
+                        bits |= fonts_bands[font].words[item.band_offset + b * item.band_words + word];
+                    }
+                    while (bits != 0u) {
+                        uint bit = findLSB(bits);
+                        bits &= bits - 1u;
+                        uint first = item.point_offset + 2u * (word * 32u + bit);
+                        vec2 p0 = fonts_points[font].points[first];
+                        vec2 p1 = fonts_points[font].points[first + 1u];
+                        vec2 p2 = fonts_points[font].points[first + 2u];
+                        if (pending) row_curve(r, p0, p1, p2, y);
                     }
                 }
+                if (pending) {
+                    covered += row_walk(r, lo, hi) * mine;
+                    pending = r.more;
+                }
             }
-            uint next = 0u;
-            if ((pending & 1u) != 0u) {
-                covered[0] += row_walk(r0);
-                if (r0.more) next |= 1u;
-            }
-            if ((pending & 2u) != 0u) {
-                covered[1] += row_walk(r1);
-                if (r1.more) next |= 2u;
-            }
-            if ((pending & 4u) != 0u) {
-                covered[2] += row_walk(r2);
-                if (r2.more) next |= 4u;
-            }
-            pending = next;
         }
-        if (pc.equal_channels != 0u) {
-            sums += uvec3(row_units(covered[0], lengths[0], dither));
-        } else {
-            sums += uvec3(row_units(covered[0], lengths[0], dither), row_units(covered[1], lengths[1], dither),
-                          row_units(covered[2], lengths[2], dither));
-        }
+        sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),
+                      row_units(covered.z, hi.z - lo.z, dither));
     }
     return sums;
 }

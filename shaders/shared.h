@@ -102,9 +102,8 @@ struct RasterPushConstants {
     vec4 channel_rects[3];  // subpixel layout: x0, y0, x1, y1 of red, green, blue, pixel units, y down
     uint item_count;
     uint workgroup_count;  // workgroups that have work (the dispatch may round up)
-    uint shared_rows;      // 1: the three rects share their rows, one set of roots serves all
+    uint shared_rows;      // 1: the three rects share their rows: one set of roots, one row list, serves all
     uint sample_kind;      // kRasterSampleRows or kRasterSamplePoints
-    uint equal_channels;   // 1: the three rects are one (gray): row samples walk the red one only
 };
 
 
@@ -284,7 +283,7 @@ static_assert(offsetof(CompositeQuad, color) == 48);
 static_assert(sizeof(CompositePushConstants) == 64);
 static_assert(offsetof(CompositePushConstants, width) == 16);
 static_assert(offsetof(RasterItem, first_workgroup) == 84);
-static_assert(sizeof(RasterPushConstants) == 68);
+static_assert(sizeof(RasterPushConstants) == 64);
 static_assert(offsetof(RasterPushConstants, item_count) == 48);
 static_assert(sizeof(SelftestPushConstants) == 8);
 static_assert(offsetof(SelftestPushConstants, seed) == 4);

@@ -1103,8 +1103,6 @@ void Renderer::State::record_raster_dispatch(VkCommandBuffer command_buffer, uin
     push.workgroup_count = workgroups;
     push.shared_rows = shared_row_roots && shares_sample_rows(layout) ? 1u : 0u;
     push.sample_kind = sample_kind == SampleKind::points ? gpu::kRasterSamplePoints : gpu::kRasterSampleRows;
-    const auto& rects = layout.channels;
-    push.equal_channels = rects[0] == rects[1] && rects[1] == rects[2] ? 1u : 0u;
     fn.vkCmdPushConstants(command_buffer, descriptors.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
                           &push);
     const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);

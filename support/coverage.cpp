@@ -255,7 +255,8 @@ float row_dither(uint32_t n) {
 
 namespace {
 
-// One channel's segment being walked: the shader's row_* arrays.
+// The row segment being walked (the union of the segments of the channels on the row): the
+// shader's RowList.
 template <class Real>
 struct RowSpan {
     Real start = 0, end = 0;
@@ -285,20 +286,29 @@ struct RowSpan {
         direction[n] = dir;
     }
 
-    Real walk() {
+    // Adds the covered stretch [from, to], clipped to each channel's segment [lo, hi], to `part`.
+    static void cover(std::span<Real, 3> part, Real from, Real to, std::span<const Real, 3> lo,
+                      std::span<const Real, 3> hi) {
+        for (size_t c = 0; c < 3; ++c) part[c] += std::max(std::min(to, hi[c]) - std::max(from, lo[c]), Real(0));
+    }
+
+    // The covered length of each channel's segment within the part of the row this pass saw
+    // (shaders/raster.comp's row_walk()).
+    std::array<Real, 3> walk(std::span<const Real, 3> lo, std::span<const Real, 3> hi) {
+        std::array<Real, 3> part{};
         int w = winding;
-        Real at = start, length = 0;
+        Real at = start;
         for (uint32_t i = 0; i < count; ++i) {
-            if (w != 0) length += x[i] - at;
+            if (w != 0) cover(part, at, x[i], lo, hi);
             w -= direction[i];
             at = x[i];
         }
         if (more) {
             start = at;
         } else if (w != 0) {
-            length += end - at;
+            cover(part, at, end, lo, hi);
         }
-        return length;
+        return part;
     }
 };
 
@@ -320,13 +330,16 @@ void row_curve(RowSpan<Real>& span, Real p0x, Real p0y, Real p1x, Real p1y, Real
     if (code > 1u) span.cross(x2, -1);
 }
 
-// Passes of `for_each_curve(visit)` (visit takes the six coordinates) until the segment is walked.
+// Passes of `for_each_curve(visit)` (visit takes the six coordinates) until the row at height y is
+// walked over [start, end]; adds the covered length within each channel's segment [lo, hi] to
+// covered[c] where mine[c] is 1 (0 adds nothing), as the shader does.
 template <class Real, class ForEachCurve>
-Real row_length(ForEachCurve&& for_each_curve, Real y, Real x0, Real x1, uint32_t* passes) {
+void row_lengths(ForEachCurve&& for_each_curve, Real y, Real start, Real end, std::span<const Real, 3> lo,
+                 std::span<const Real, 3> hi, std::span<const Real, 3> mine, std::span<Real, 3> covered,
+                 uint32_t* passes) {
     RowSpan<Real> span;
-    span.start = x0;
-    span.end = x1;
-    Real covered = 0;
+    span.start = start;
+    span.end = end;
     uint32_t pass_count = 0;
     do {
         span.winding = 0;
@@ -335,11 +348,39 @@ Real row_length(ForEachCurve&& for_each_curve, Real y, Real x0, Real x1, uint32_
         for_each_curve([&](Real p0x, Real p0y, Real p1x, Real p1y, Real p2x, Real p2y) {
             row_curve(span, p0x, p0y, p1x, p1y, p2x, p2y, y);
         });
-        covered += span.walk();
+        const std::array<Real, 3> part = span.walk(lo, hi);
+        for (size_t c = 0; c < 3; ++c) covered[c] += part[c] * mine[c];
         ++pass_count;
     } while (span.more);
     if (passes) *passes = pass_count;
-    return covered;
+}
+
+template <class Real, class ForEachCurve>
+Real row_length(ForEachCurve&& for_each_curve, Real y, Real x0, Real x1, uint32_t* passes) {
+    const std::array<Real, 3> lo{x0, x0, x0}, hi{x1, x1, x1}, mine{1, 0, 0};
+    std::array<Real, 3> covered{};
+    row_lengths<Real>(for_each_curve, y, x0, x1, std::span<const Real, 3>(lo), std::span<const Real, 3>(hi),
+                      std::span<const Real, 3>(mine), std::span<Real, 3>(covered), passes);
+    return covered[0];
+}
+
+// Calls visit(p0x, p0y, p1x, p1y, p2x, p2y) for each curve listed in the band of the glyph that
+// holds y (none for a glyph without bands).
+template <class Real>
+auto banded_curves(const FontAsset& asset, const GlyphRecord& glyph, Real y) {
+    return [&asset, &glyph, y](auto&& visit) {
+        if (glyph.band_count == 0 || glyph.band_words == 0) return;
+        const uint32_t band = FontAsset::band_of(glyph, static_cast<float>(y));
+        const uint32_t* words = &asset.band_words[glyph.band_offset + size_t{band} * glyph.band_words];
+        const Point* points = &asset.points[glyph.point_offset];
+        for (uint32_t word = 0; word < glyph.band_words; ++word) {
+            for (uint32_t bits = words[word]; bits != 0u; bits &= bits - 1u) {
+                const Point* p = points + 2 * size_t{word * 32u + static_cast<uint32_t>(std::countr_zero(bits))};
+                visit(static_cast<Real>(p[0].x), static_cast<Real>(p[0].y), static_cast<Real>(p[1].x),
+                      static_cast<Real>(p[1].y), static_cast<Real>(p[2].x), static_cast<Real>(p[2].y));
+            }
+        }
+    };
 }
 
 }  // namespace
@@ -358,23 +399,7 @@ Real row_covered_length(std::span<const Quad> curves, Real y, Real x0, Real x1, 
 template <class Real>
 Real row_covered_length_banded(const FontAsset& asset, const GlyphRecord& glyph, Real y, Real x0, Real x1,
                                uint32_t* passes) {
-    if (glyph.band_count == 0 || glyph.band_words == 0) {
-        if (passes) *passes = 1;
-        return 0;
-    }
-    const uint32_t band = FontAsset::band_of(glyph, static_cast<float>(y));
-    const uint32_t* words = &asset.band_words[glyph.band_offset + size_t{band} * glyph.band_words];
-    const Point* points = &asset.points[glyph.point_offset];
-    auto each = [&](auto&& visit) {
-        for (uint32_t word = 0; word < glyph.band_words; ++word) {
-            for (uint32_t bits = words[word]; bits != 0u; bits &= bits - 1u) {
-                const Point* p = points + 2 * size_t{word * 32u + static_cast<uint32_t>(std::countr_zero(bits))};
-                visit(static_cast<Real>(p[0].x), static_cast<Real>(p[0].y), static_cast<Real>(p[1].x),
-                      static_cast<Real>(p[1].y), static_cast<Real>(p[2].x), static_cast<Real>(p[2].y));
-            }
-        }
-    };
-    return row_length<Real>(each, y, x0, x1, passes);
+    return row_length<Real>(banded_curves<Real>(asset, glyph, y), y, x0, x1, passes);
 }
 
 template <class Real>
@@ -392,15 +417,44 @@ template double row_covered_length_banded<double>(const FontAsset&, const GlyphR
 template uint32_t row_units<float>(float, float, float, uint32_t);
 template uint32_t row_units<double>(double, double, double, uint32_t);
 
-uint32_t row_sample_units(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map,
-                          const SampleRect& rect, uint32_t tx, uint32_t ty, uint32_t n, uint32_t* passes) {
+std::array<uint32_t, 3> row_sample_units(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map,
+                                         const SubpixelLayout& layout, uint32_t tx, uint32_t ty, uint32_t n,
+                                         uint32_t* passes) {
     const auto v = static_cast<float>(row_height(n));
-    const float py = static_cast<float>(ty) + (rect.y0 + (rect.y1 - rect.y0) * v);
-    const float y = map.offset_y + map.scale_y * py;
-    const float start = map.offset_x + map.scale_x * (static_cast<float>(tx) + rect.x0);
-    const float end = map.offset_x + map.scale_x * (static_cast<float>(tx) + rect.x1);
-    const float covered = row_covered_length_banded<float>(asset, glyph, y, start, end, passes);
-    return row_units<float>(covered, end - start, row_dither(n), 64);
+    std::array<float, 3> lo{}, hi{};
+    for (size_t c = 0; c < 3; ++c) {
+        const SampleRect& rect = layout.channels[c];
+        lo[c] = map.offset_x + map.scale_x * (static_cast<float>(tx) + rect.x0);
+        hi[c] = map.offset_x + map.scale_x * (static_cast<float>(tx) + rect.x1);
+    }
+    // One row for channels that share their rows, else a row per channel (the shader's `rows`).
+    const size_t rows = shares_sample_rows(layout) ? 1 : 3;
+    std::array<float, 3> covered{};
+    uint32_t pass_count = 0;
+    for (size_t row = 0; row < rows; ++row) {
+        const SampleRect& rect = layout.channels[row];
+        const float y = map.offset_y + map.scale_y * (static_cast<float>(ty) + (rect.y0 + (rect.y1 - rect.y0) * v));
+        // Shared rows walk the union of the segments; a row of its own, its channel's segment.
+        std::array<float, 3> mine{1, 1, 1};
+        float start = std::min(lo[0], std::min(lo[1], lo[2]));
+        float end = std::max(hi[0], std::max(hi[1], hi[2]));
+        if (rows > 1) {
+            mine = {0, 0, 0};
+            mine[row] = 1;
+            start = lo[row];
+            end = hi[row];
+        }
+        uint32_t row_passes = 0;
+        row_lengths<float>(banded_curves<float>(asset, glyph, y), y, start, end, std::span<const float, 3>(lo),
+                           std::span<const float, 3>(hi), std::span<const float, 3>(mine), std::span<float, 3>(covered),
+                           &row_passes);
+        pass_count += row_passes;
+    }
+    if (passes) *passes = pass_count;
+    const float dither = row_dither(n);
+    return {row_units<float>(covered[0], hi[0] - lo[0], dither, 64),
+            row_units<float>(covered[1], hi[1] - lo[1], dither, 64),
+            row_units<float>(covered[2], hi[2] - lo[2], dither, 64)};
 }
 
 double coverage_rows(const FontAsset& asset, const GlyphRecord& glyph, double x0, double y0, double x1, double y1,

@@ -24,6 +24,7 @@
 #include <crisp/glyph.hpp>
 #include <crisp/subpixel.hpp>
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -118,12 +119,15 @@ Real row_covered_length_banded(const FontAsset& asset, const GlyphRecord& glyph,
 template <class Real>
 uint32_t row_units(Real covered, Real length, Real dither, uint32_t one);
 
-// What row sample n of texel (tx, ty) of a glyph rect (mapped to em by `map`) adds to the channel
-// whose sample rectangle is `rect` (pixel units, y down), in float as shaders/raster.comp computes
-// it: the segment across the rect at height row_height(n), its banded covered length, and
-// row_units(..., row_dither(n), 64). `passes` as in row_covered_length.
-uint32_t row_sample_units(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map,
-                          const SampleRect& rect, uint32_t tx, uint32_t ty, uint32_t n, uint32_t* passes = nullptr);
+// What row sample n of texel (tx, ty) of a glyph rect (mapped to em by `map`) adds to each channel
+// of `layout`, in float as shaders/raster.comp computes it with shared row roots (the renderer's
+// default): channels that share their rows (shares_sample_rows) walk one row across the union of
+// their segments, each covered stretch clipped to each channel's segment; otherwise each channel
+// walks its own row. Each channel then adds row_units(..., row_dither(n), 64). `passes`, when
+// given, receives the passes over the curves all rows took together.
+std::array<uint32_t, 3> row_sample_units(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map,
+                                         const SubpixelLayout& layout, uint32_t tx, uint32_t ty, uint32_t n,
+                                         uint32_t* passes = nullptr);
 
 // Mean over the row samples first_sample .. first_sample + sample_count - 1 of the covered fraction
 // of the segment [x0, x1] at height y0 + row_height(n) (y1 - y0), in double. `quantized`: each

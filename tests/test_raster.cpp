@@ -101,27 +101,32 @@ uint32_t point_hits(const FontAsset& asset, const GlyphRecord& glyph, const Texe
     return hits * kCoverageOne;
 }
 
-// A row-sample channel's expected sum: the CPU reference in float, the shader's arithmetic.
-// `ambiguous` is set when a sample's units differ in double precision (the GPU may round a last
-// bit differently, e.g. by fusing a multiply-add).
-uint32_t row_sum(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map, const SampleRect& rect,
-                 uint32_t tx, uint32_t ty, uint32_t samples, bool& ambiguous, uint64_t& extra_passes) {
-    uint32_t sum = 0;
+// A row-sample texel's expected sums: the CPU reference in float, the shader's arithmetic.
+// `ambiguous` is set when a sample's units in a channel differ in double precision (the GPU may
+// round a last bit differently, e.g. by fusing a multiply-add).
+std::array<uint32_t, 3> row_sums(const FontAsset& asset, const GlyphRecord& glyph, const TexelToEm& map,
+                                 const SubpixelLayout& layout, uint32_t tx, uint32_t ty, uint32_t samples,
+                                 bool& ambiguous, uint64_t& extra_passes) {
+    const uint32_t rows = shares_sample_rows(layout) ? 1 : 3;
+    std::array<uint32_t, 3> sums{};
     for (uint32_t n = 0; n < samples; ++n) {
-        uint32_t passes = 1;
-        const uint32_t units = row_sample_units(asset, glyph, map, rect, tx, ty, n, &passes);
-        sum += units;
-        extra_passes += passes - 1;
-        const double v = row_height(n), px = tx, py = ty;
-        const double ry0 = rect.y0, ry1 = rect.y1, rx0 = rect.x0, rx1 = rect.x1;
-        const double ox = map.offset_x, oy = map.offset_y, sx = map.scale_x, sy = map.scale_y;
-        const double y = oy + sy * (py + (ry0 + (ry1 - ry0) * v));
-        const double x0 = ox + sx * (px + rx0);
-        const double x1 = ox + sx * (px + rx1);
-        const double covered = row_covered_length_banded<double>(asset, glyph, y, x0, x1);
-        if (row_units<double>(covered, x1 - x0, row_dither(n), kCoverageOne) != units) ambiguous = true;
+        uint32_t passes = rows;
+        const std::array<uint32_t, 3> units = row_sample_units(asset, glyph, map, layout, tx, ty, n, &passes);
+        extra_passes += passes - rows;
+        for (size_t c = 0; c < 3; ++c) {
+            sums[c] += units[c];
+            const SampleRect& rect = layout.channels[c];
+            const double v = row_height(n), px = tx, py = ty;
+            const double ry0 = rect.y0, ry1 = rect.y1, rx0 = rect.x0, rx1 = rect.x1;
+            const double ox = map.offset_x, oy = map.offset_y, sx = map.scale_x, sy = map.scale_y;
+            const double y = oy + sy * (py + (ry0 + (ry1 - ry0) * v));
+            const double x0 = ox + sx * (px + rx0);
+            const double x1 = ox + sx * (px + rx1);
+            const double covered = row_covered_length_banded<double>(asset, glyph, y, x0, x1);
+            if (row_units<double>(covered, x1 - x0, row_dither(n), kCoverageOne) != units[c]) ambiguous = true;
+        }
     }
-    return sum;
+    return sums;
 }
 
 // Compares every texel of every drawn glyph with the CPU reference of the renderer's sample kind.
@@ -141,11 +146,16 @@ Comparison compare(const Renderer& renderer, const std::vector<Texel>& texels, u
                 EXPECT_EQ(t.count, samples);
                 const uint16_t got[3] = {t.r, t.g, t.b};
                 bool mismatch = false, explained = false;
+                const SubpixelLayout& layout = renderer.subpixel_layout();
+                std::array<uint32_t, 3> row_expected{};
+                if (rows) {
+                    row_expected = row_sums(asset, glyph, map, layout, tx + d.part_x, ty + d.part_y, samples, explained,
+                                            result.row_passes);
+                }
                 for (size_t c = 0; c < 3; ++c) {
-                    const SampleRect& rect = renderer.subpixel_layout().channels[c];
+                    const SampleRect& rect = layout.channels[c];
                     const uint32_t expected =
-                        rows ? row_sum(asset, glyph, map, rect, tx + d.part_x, ty + d.part_y, samples, explained,
-                                       result.row_passes)
+                        rows ? row_expected[c]
                              : point_hits(asset, glyph, map, rect, tx + d.part_x, ty + d.part_y, samples, explained);
                     if (got[c] != expected) mismatch = true;
                     if (got[c] > 0) ++result.covered;
