@@ -5,8 +5,8 @@
 //
 // Row samples (the default): sample n is, per colour channel, a horizontal segment across that
 // channel's subpixel rectangle at the height frac(radical_inverse_2(n) + kRasterRowOffset) of it
-// (continued across frames). The roots of each curve of the bands the subgroup touches on that
-// row (Lengyel's root classification, as for points) give the winding at the segment's start and
+// (continued across frames). The roots of each curve of the sample's band on that row (Lengyel's
+// root classification, as for points) give the winding at the segment's start and
 // the crossings inside it, which are sorted and walked: the covered length under the nonzero rule
 // is exact, overlapping contours included. Channels on one row (stripes, gray) share one sorted
 // list over the union of their segments, each covered stretch clipped to each channel's segment.
@@ -17,8 +17,6 @@
 // and the nonzero winding number; a covered sample adds kRasterCoverageOne.
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#extension GL_KHR_shader_subgroup_basic : require
-#extension GL_KHR_shader_subgroup_arithmetic : require
 
 #include "shared.h"
 
@@ -105,12 +103,13 @@ ivec3 winding_row(vec2 p0, vec2 p1, vec2 p2, float y, vec3 xs) {
 
 // The row segment being walked: [start, end] in em (the union of the segments of the channels that
 // share the row), the winding just right of start (the crossings right of it), and the crossings
-// inside (start, end) sorted by x, with their directions as bits (set: -1, running up). At most
-// kRasterRowCrossings are kept, the leftmost; when one more comes, the rightmost is dropped and
-// `more` says that the segment goes on from the last crossing kept, in another pass. Every index
-// into `x` is a compile-time constant (the insertion and the walk are written out), so that the
-// list can live in registers. One list serves every channel on the row: the walk clips each covered
-// stretch to each channel's own segment.
+// inside (start, end), kept in arrival order and sorted by x before the walk, with their
+// directions as bits (set: -1, running up); unused entries hold +infinity. At most
+// kRasterRowCrossings are kept, the leftmost; when one more comes, the largest kept gives way
+// to a smaller one, and `more` says that the segment goes on from the last crossing kept, in
+// another pass. Every index into `x` is a compile-time constant (the steps are written out), so
+// that the list can live in registers. One list serves every channel on the row: the walk clips
+// each covered stretch to each channel's own segment.
 struct RowList {
     float start;
     float end;
@@ -121,45 +120,109 @@ struct RowList {
     float x[kRasterRowCrossings];
 };
 
-// row_crossing() and row_walk() write out their steps for 8 registers: a shader of this size fails
-// to compile if kRasterRowCrossings changes without them.
+// row_crossing(), row_sort() and row_walk() write out their steps for 8 entries: a shader of this
+// size fails to compile if kRasterRowCrossings changes without them.
 const uint kRowStepsWritten[kRasterRowCrossings == 8u ? 1 : 0] = uint[1](8u);
 
-// Step j of an insertion of x at position p among the first n sorted entries (p <= n <
-// kRasterRowCrossings): entries from p on move up one, x goes to p.
-void row_insert_step(inout RowList r, uint j, uint n, uint p, float x) {
-    if (j > p && j <= n) r.x[j] = r.x[j - 1u];
-    else if (j == p) r.x[j] = x;
+void row_begin_pass(inout RowList r) {
+    r.winding = 0;
+    r.count = 0u;
+    r.more = false;
+    r.up = 0u;
+    const float inf = uintBitsToFloat(0x7F800000u);
+    r.x[0] = inf;
+    r.x[1] = inf;
+    r.x[2] = inf;
+    r.x[3] = inf;
+    r.x[4] = inf;
+    r.x[5] = inf;
+    r.x[6] = inf;
+    r.x[7] = inf;
 }
 
+// Crossing x of the row, running down (+1) or up (-1). Appending costs a dozen instructions where
+// a sorted insertion cost some fifty, and a subgroup pays for whichever lane adds one: most
+// crossings land in some lane's segment. Written out, not a loop: lavapipe ends every loop of an
+// invocation once their iterations together reach 65535, and this runs per crossing (see "Loops"
+// in docs/rasterizer.md).
 void row_crossing(inout RowList r, float x, int direction) {
     if (!(x > r.start)) return;
     r.winding += direction;
     if (!(x < r.end)) return;
-    uint n = r.count;
-    bool full = n == kRasterRowCrossings;
-    if (full) r.more = true;
-    // When full, the rightmost is dropped: every crossing dropped lies at or right of every one kept.
-    if (full && !(x < r.x[kRasterRowCrossings - 1u])) return;
-    if (full) n = kRasterRowCrossings - 1u;
-    r.count = n + 1u;
-    // x goes after the entries not greater than it (a sorted prefix). Written out, not a loop:
-    // lavapipe ends every loop of an invocation once their iterations together reach 65535, and
-    // this runs per crossing (see "Loops" in docs/rasterizer.md).
-    uint p = uint(n > 0u && !(r.x[0] > x)) + uint(n > 1u && !(r.x[1] > x)) +
-             uint(n > 2u && !(r.x[2] > x)) + uint(n > 3u && !(r.x[3] > x)) +
-             uint(n > 4u && !(r.x[4] > x)) + uint(n > 5u && !(r.x[5] > x)) +
-             uint(n > 6u && !(r.x[6] > x));
-    row_insert_step(r, 7u, n, p, x);
-    row_insert_step(r, 6u, n, p, x);
-    row_insert_step(r, 5u, n, p, x);
-    row_insert_step(r, 4u, n, p, x);
-    row_insert_step(r, 3u, n, p, x);
-    row_insert_step(r, 2u, n, p, x);
-    row_insert_step(r, 1u, n, p, x);
-    if (p == 0u) r.x[0] = x;
-    uint below = (1u << p) - 1u;
-    r.up = (r.up & below) | ((r.up << 1) & ~(below | (1u << p))) | (direction < 0 ? 1u << p : 0u);
+    uint at = r.count;
+    if (at == kRasterRowCrossings) {
+        // Full: keep the 8 leftmost. Which of equal largest gives way changes no covered length
+        // (crossings at one x bound stretches of no length).
+        r.more = true;
+        float largest = max(max(max(r.x[0], r.x[1]), max(r.x[2], r.x[3])), max(max(r.x[4], r.x[5]), max(r.x[6], r.x[7])));
+        if (!(x < largest)) return;
+        at = r.x[0] == largest   ? 0u
+             : r.x[1] == largest ? 1u
+             : r.x[2] == largest ? 2u
+             : r.x[3] == largest ? 3u
+             : r.x[4] == largest ? 4u
+             : r.x[5] == largest ? 5u
+             : r.x[6] == largest ? 6u
+                                 : 7u;
+    } else {
+        r.count = at + 1u;
+    }
+    r.x[0] = at == 0u ? x : r.x[0];
+    r.x[1] = at == 1u ? x : r.x[1];
+    r.x[2] = at == 2u ? x : r.x[2];
+    r.x[3] = at == 3u ? x : r.x[3];
+    r.x[4] = at == 4u ? x : r.x[4];
+    r.x[5] = at == 5u ? x : r.x[5];
+    r.x[6] = at == 6u ? x : r.x[6];
+    r.x[7] = at == 7u ? x : r.x[7];
+    r.up = (r.up & ~(1u << at)) | (direction < 0 ? 1u << at : 0u);
+}
+
+// Entries i < j in order, with their direction bits.
+void row_order(inout RowList r, uint i, uint j) {
+    float a = r.x[i];
+    float b = r.x[j];
+    if (b < a) {
+        r.x[i] = b;
+        r.x[j] = a;
+        uint differ = ((r.up >> i) ^ (r.up >> j)) & 1u;
+        r.up ^= differ * ((1u << i) | (1u << j));
+    }
+}
+
+// Sorts the entries by x: sorting networks of 1, 5 and 19 comparators for up to 2, 4 and 8
+// entries (the unused ones, +infinity, stay last). Entries of equal x may come in either order:
+// they bound stretches of no length, so the covered lengths are the same bits as a stable sort's.
+void row_sort(inout RowList r) {
+    if (r.count == 2u) {
+        row_order(r, 0u, 1u);
+    } else if (r.count > 2u && r.count <= 4u) {
+        row_order(r, 0u, 1u);
+        row_order(r, 2u, 3u);
+        row_order(r, 0u, 2u);
+        row_order(r, 1u, 3u);
+        row_order(r, 1u, 2u);
+    } else if (r.count > 4u) {
+        row_order(r, 0u, 2u);
+        row_order(r, 1u, 3u);
+        row_order(r, 4u, 6u);
+        row_order(r, 5u, 7u);
+        row_order(r, 0u, 4u);
+        row_order(r, 1u, 5u);
+        row_order(r, 2u, 6u);
+        row_order(r, 3u, 7u);
+        row_order(r, 0u, 1u);
+        row_order(r, 2u, 3u);
+        row_order(r, 4u, 5u);
+        row_order(r, 6u, 7u);
+        row_order(r, 2u, 4u);
+        row_order(r, 3u, 5u);
+        row_order(r, 1u, 4u);
+        row_order(r, 3u, 6u);
+        row_order(r, 1u, 2u);
+        row_order(r, 3u, 4u);
+        row_order(r, 5u, 6u);
+    }
 }
 
 // The crossings of one curve with the row at height y (absolute em): Lengyel's roots as in
@@ -212,8 +275,10 @@ void row_walk_step(RowList r, uint i, vec3 lo, vec3 hi, inout int w, inout float
 
 // The covered length of each channel's segment [lo, hi] within the part of the row this pass saw:
 // up to its end, or up to its last crossing kept when more follow (start then moves there for the
-// next pass). Written out, as the insertion, so that the list's indices are constants.
+// next pass). Sorts the list first. Written out, as the crossings, so that the list's indices are
+// constants.
 vec3 row_walk(inout RowList r, vec3 lo, vec3 hi) {
+    row_sort(r);
     int w = r.winding;
     float at = r.start;
     vec3 covered = vec3(0.0);
@@ -287,9 +352,8 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
             lo_band = min(lo_band, band);
             hi_band = max(hi_band, band);
         }
-        // Uniform band range across the subgroup, so the curve loop and its loads are uniform.
-        lo_band = subgroupMin(lo_band);
-        hi_band = subgroupMax(hi_band);
+        // The bands of this invocation's channels (one where they share a row): a subgroup takes as
+        // many steps as its fullest range has curves, not the curves of every range it holds.
 
         ivec3 w = ivec3(0);
         for (uint word = 0u; word < item.band_words; ++word) {
@@ -347,23 +411,17 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             RowList r;
             r.start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
             r.end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
-            // Uniform band range across the subgroup, so the curve loop and its loads are uniform.
-            uint band = band_of(item, y);
-            uint lo_band = subgroupMin(band);
-            uint hi_band = subgroupMax(band);
-            // A pass per kRasterRowCrossings crossings. The subgroup passes together (an invocation
-            // done adds nothing), so that the curve loop and its loads stay uniform.
+            // Each invocation walks the curves of its own band: a subgroup then takes as many steps
+            // as its fullest band has curves, where a band range shared by the subgroup took the
+            // curves of all its rows' bands (the loads differ between invocations on different
+            // rows, a few addresses a step).
+            uint words = item.band_offset + band_of(item, y) * item.band_words;
+            // A pass per kRasterRowCrossings crossings.
             bool pending = true;
-            while (subgroupMax(uint(pending)) != 0u) {
-                r.winding = 0;
-                r.count = 0u;
-                r.more = false;
-                r.up = 0u;
+            while (pending) {
+                row_begin_pass(r);
                 for (uint word = 0u; word < item.band_words; ++word) {
-                    uint bits = 0u;
-                    for (uint b = lo_band; b <= hi_band; ++b) {
-                        bits |= fonts_bands[font].words[item.band_offset + b * item.band_words + word];
-                    }
+                    uint bits = fonts_bands[font].words[words + word];
                     while (bits != 0u) {
                         uint bit = findLSB(bits);
                         bits &= bits - 1u;
@@ -371,13 +429,11 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                         vec2 p0 = fonts_points[font].points[first];
                         vec2 p1 = fonts_points[font].points[first + 1u];
                         vec2 p2 = fonts_points[font].points[first + 2u];
-                        if (pending) row_curve(r, p0, p1, p2, y);
+                        row_curve(r, p0, p1, p2, y);
                     }
                 }
-                if (pending) {
-                    covered += row_walk(r, lo, hi) * mine;
-                    pending = r.more;
-                }
+                covered += row_walk(r, lo, hi) * mine;
+                pending = r.more;
             }
         }
         sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),

@@ -609,9 +609,6 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
                      "renderer: the device was created without shaderStorageBufferArrayDynamicIndexing (enable it; "
                      "add_crisp_features() does)"};
     }
-    if (!vk::has_compute_subgroup_arithmetic(fn, info.physical_device)) {
-        return Error{ErrorCode::vulkan, "renderer: the device lacks subgroup arithmetic in compute shaders"};
-    }
     const uint32_t buffers_needed = 1 + 2 * kRendererFontPages;
     if (properties.limits.maxPerStageDescriptorStorageBuffers < buffers_needed) {
         return Error{ErrorCode::vulkan, "renderer: the device offers " +
