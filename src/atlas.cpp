@@ -497,6 +497,29 @@ uint64_t GlyphAtlas::schedule_split(uint32_t id, uint64_t allowance, bool force)
     return work.curve_tests;
 }
 
+GlyphAtlas::FirstFrame GlyphAtlas::fit_first_frame(size_t new_count) const {
+    FirstFrame fit;
+    uint64_t cost_sum = 0;  // of one sample of every new entry that is not split
+    uint32_t step = 0;
+    for (size_t i = 0; i < new_count; ++i) {
+        const Slot& slot = slots_[waiting_ids_[i]];
+        const uint64_t cost = slot.entry.curve_tests_per_sample;
+        if (cost > config_.frame_budget || slot.entry.split_texels_done > 0) continue;  // split: its own turns
+        cost_sum += cost;
+        step = std::max(step, share(slot));
+    }
+    fit.samples = step;
+    if (cost_sum == 0) return fit;
+    const uint64_t budget = config_.frame_budget;
+    if (cost_sum > budget / std::max<uint32_t>(step, 1)) {
+        // The largest power of two that fits for all; 1 when even one each does not (strict turns).
+        const uint64_t affordable = std::max<uint64_t>(budget / cost_sum, 1);
+        fit.samples = std::bit_floor(static_cast<uint32_t>(std::min<uint64_t>(affordable, step)));
+        fit.spare = budget - std::min(budget, cost_sum * fit.samples);
+    }
+    return fit;
+}
+
 std::span<const RasterWork> GlyphAtlas::schedule() {
     if (scheduled_) return work_;
     scheduled_ = true;
@@ -520,6 +543,7 @@ std::span<const RasterWork> GlyphAtlas::schedule() {
     uint64_t budget_left = config_.frame_budget;
     // Split entries share at most half the budget while others wait, and the rest of it after.
     uint64_t split_left = std::max<uint64_t>(config_.frame_budget / 2, 1);
+    FirstFrame first = fit_first_frame(new_count);
     split_ids_.clear();
     bool cursor_moved = false;
     for (size_t i = 0; i < waiting_ids_.size(); ++i) {
@@ -540,7 +564,16 @@ std::span<const RasterWork> GlyphAtlas::schedule() {
             }
             continue;
         }
-        const uint32_t wanted = share(slot);
+        uint32_t wanted = share(slot);
+        if (!is_old && wanted > first.samples) {
+            // Cut to the fitted power of two unless the whole step fits what the fit left over.
+            const uint64_t extra = cost * (wanted - first.samples);
+            if (extra <= first.spare) {
+                first.spare -= extra;
+            } else {
+                wanted = first.samples;
+            }
+        }
         uint64_t count = cost == 0 ? wanted : std::min<uint64_t>(wanted, budget_left / cost);
         if (count == 0) {
             // Strict turns: an entry that cannot be served ends the frame rather than let

@@ -667,13 +667,14 @@ TEST(AtlasSchedule, NewGlyphsFirstAndShortChangedOnesCatchUp) {
         EXPECT_LE(atlas.stats().frame.curve_tests, 10u);
         return counts;
     };
-    EXPECT_EQ(frame({'a', 'b'}), (std::vector<uint32_t>{8, 2}));
+    // 8 each does not fit: 4 each does (the largest power of two), and 2 to spare buy no more.
+    EXPECT_EQ(frame({'a', 'b'}), (std::vector<uint32_t>{4, 4}));
     // The new glyph goes first although acquired last; a is cut short and b waits.
     EXPECT_EQ(frame({'a', 'b', 'c'}), (std::vector<uint32_t>{2, 0, 8}));
-    // a wants 14 - 10; b, cut short in its first frame, wants 12 - 2 and gets what is left.
-    EXPECT_EQ(frame({'a', 'b', 'c'}), (std::vector<uint32_t>{4, 6, 0}));
-    // b's turn comes first now: it wants 14 - 8, then c its 4.
-    EXPECT_EQ(frame({'a', 'b', 'c'}), (std::vector<uint32_t>{0, 6, 4}));
+    // a wants 14 - 6; b, cut short in its first frame, wants 12 - 4 and gets what is left.
+    EXPECT_EQ(frame({'a', 'b', 'c'}), (std::vector<uint32_t>{8, 2, 0}));
+    // b's turn comes first now: it wants 14 - 6, then c its 12 - 8 and gets what is left.
+    EXPECT_EQ(frame({'a', 'b', 'c'}), (std::vector<uint32_t>{0, 8, 2}));
 }
 
 TEST(AtlasSchedule, ZeroCostGlyphsIgnoreTheBudget) {
@@ -682,8 +683,31 @@ TEST(AtlasSchedule, ZeroCostGlyphsIgnoreTheBudget) {
     const uint32_t paid = atlas.acquire(key_of('a'), 12, 14, 3).entry;
     const std::span<const RasterWork> work = atlas.schedule();
     EXPECT_EQ(samples_for(work, free_glyph), 8u);
-    EXPECT_EQ(samples_for(work, paid), 3u);  // 9 of 10 curve tests
-    EXPECT_EQ(atlas.stats().frame.curve_tests, 9u);
+    // 3 would fit (9 of 10 curve tests); a new glyph's first frame takes a power of two.
+    EXPECT_EQ(samples_for(work, paid), 2u);
+    EXPECT_EQ(atlas.stats().frame.curve_tests, 6u);
+}
+
+// New text whose first ramp step does not fit the budget shows whole: every new glyph gets the
+// largest power of two of samples that fits for all, and those first in acquire order whose full
+// step still fits the rest get it.
+TEST(AtlasSchedule, NewTextShowsWholeInItsFirstFrameWithAPowerOfTwoOfSamples) {
+    constexpr uint64_t kCost = 10;
+    for (const uint64_t budget : {uint64_t{800}, uint64_t{500}, uint64_t{270}, uint64_t{45}}) {
+        GlyphAtlas atlas = make_atlas(256, 256, budget);
+        std::vector<uint32_t> entries;
+        for (uint32_t g = 0; g < 10; ++g) entries.push_back(atlas.acquire(key_of('a' + g), 10, 12, kCost).entry);
+        const std::span<const RasterWork> work = atlas.schedule();
+        std::vector<uint32_t> got;
+        for (uint32_t e : entries) got.push_back(samples_for(work, e));
+        EXPECT_LE(atlas.stats().frame.curve_tests, budget);
+        const std::vector<uint32_t> expected =
+            budget == 800   ? std::vector<uint32_t>(10, 8)                          // the whole step fits
+            : budget == 500 ? std::vector<uint32_t>{8, 8, 4, 4, 4, 4, 4, 4, 4, 4}   // 4 each, 100 to spare
+            : budget == 270 ? std::vector<uint32_t>{8, 2, 2, 2, 2, 2, 2, 2, 2, 2}   // 2 each, 70 to spare
+                            : std::vector<uint32_t>{1, 1, 1, 1, 0, 0, 0, 0, 0, 0};  // not one each: strict turns
+        EXPECT_EQ(got, expected) << "budget " << budget;
+    }
 }
 
 TEST(AtlasSchedule, BudgetNeverExceededAndNoGlyphStarves) {

