@@ -32,6 +32,11 @@ layout(std430, set = 0, binding = kRasterBindItems) readonly buffer Items {
     RasterItem items[];
 };
 
+// The index into `items` of each workgroup of the dispatch.
+layout(std430, set = 0, binding = kRasterBindWorkgroupItems) readonly buffer WorkgroupItems {
+    uint workgroup_items[];
+};
+
 layout(std430, set = 0, binding = kRasterBindPoints) readonly buffer Points {
     vec2 points[];
 } fonts_points[kRasterFontPages];
@@ -322,17 +327,6 @@ uint band_of(RasterItem item, float y) {
     return min(uint(band), item.band_count - 1u);
 }
 
-uint find_item(uint workgroup) {
-    // The last item whose first workgroup is at or before this one.
-    uint lo = 0u, hi = pc.item_count - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi + 1u) >> 1;
-        if (items[mid].first_workgroup <= workgroup) lo = mid;
-        else hi = mid - 1u;
-    }
-    return lo;
-}
-
 // The item's point samples of texel (tx, ty) of the glyph rect: kRasterCoverageOne per covered
 // sample and channel.
 uvec3 point_samples(RasterItem item, uint tx, uint ty) {
@@ -445,7 +439,7 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
 void main() {
     uint workgroup = gl_WorkGroupID.y * kRasterDispatchWidth + gl_WorkGroupID.x;
     if (workgroup >= pc.workgroup_count) return;
-    RasterItem item = items[find_item(workgroup)];
+    RasterItem item = items[workgroup_items[workgroup]];
     uint local = (workgroup - item.first_workgroup) * kRasterWorkgroupSize + gl_LocalInvocationIndex;
     if (local >= item.texel_count) return;
     local += item.first_texel;

@@ -62,7 +62,7 @@ CRISP_CONSTANT(uint, kRasterRowCrossings, 8u);
 // centres and the first 8 within 9/1024 (docs/rasterizer.md, "Row samples", says why not 8 too).
 CRISP_CONSTANT(float, kRasterRowOffset, 0.0712890625f);
 // Storage buffers of curve points and of band bitsets, one each per font: with the work items
-// 17 storage buffers, within the 32 per stage that lavapipe and desktop drivers offer.
+// 18 storage buffers, within the 32 per stage that lavapipe and desktop drivers offer.
 CRISP_CONSTANT(uint, kRasterFontPages, 8u);  // font pages, each several fonts' points and bands
 // Workgroups per row of the 2D dispatch (maxComputeWorkGroupCount[0] is at least 65535).
 CRISP_CONSTANT(uint, kRasterDispatchWidth, 65535u);
@@ -71,6 +71,7 @@ CRISP_CONSTANT(uint, kRasterBindAtlas, 0u);   // the atlas, storage image
 CRISP_CONSTANT(uint, kRasterBindItems, 1u);   // RasterItem[]
 CRISP_CONSTANT(uint, kRasterBindPoints, 2u);  // kRasterFontPages buffers of curve points
 CRISP_CONSTANT(uint, kRasterBindBands, 3u);   // kRasterFontPages buffers of band words
+CRISP_CONSTANT(uint, kRasterBindWorkgroupItems, 4u);  // uint[]: the item of each workgroup
 
 // One glyph's work this frame, in a std430 storage buffer.
 struct RasterItem {
@@ -95,7 +96,7 @@ struct RasterItem {
     uint part_y;
     uint first_texel;      // the work's texels, row-major over width x height
     uint texel_count;
-    uint first_workgroup;  // this item's first workgroup; the items' ranges tile the dispatch
+    uint first_workgroup;  // this item's first workgroup; the items' ranges tile the dispatch, in order
 };
 
 struct RasterPushConstants {

@@ -124,11 +124,16 @@ struct CRISP_HIDDEN Renderer::State {
     };
     std::vector<RetiredImage> retired_images;  // smaller atlas images, until the GPU is done
 
-    GpuBuffer items;  // device-local, RasterItem[usable cells]
-    // Host-visible and mapped, one per frame in flight, as large as `items`: a frame's items are
-    // written here and copied into `items` by its command buffer.
+    // Device-local: RasterItem[item_capacity], then at table_offset the item of each workgroup,
+    // uint[workgroup_capacity].
+    GpuBuffer items;
+    // Host-visible and mapped, one per frame in flight, laid out as `items`: a frame's items and
+    // table are written here and copied into `items` by its command buffer.
     std::vector<GpuBuffer> item_staging;
     uint32_t item_capacity = 0;
+    uint32_t workgroup_capacity = 0;
+    VkDeviceSize table_offset = 0;
+    std::vector<uint32_t> workgroup_items;  // this frame's table
     GpuBuffer dummy;  // bound to the font slots no font uses
 
     std::vector<GpuFont> fonts;                      // index order; removed ones have no font
@@ -444,9 +449,10 @@ struct CRISP_HIDDEN Renderer::State {
     ~State();
     Status make_buffer(VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible, const char* what,
                        GpuBuffer& out);
-    // `items` and its staging buffers for `capacity` items; the ones they replace are retired at
-    // frame `retire_at`. On failure nothing changes.
-    Status make_item_buffers(uint32_t capacity, uint64_t retire_at);
+    // `items` and its staging buffers for `capacity` items and the workgroups of an atlas of
+    // `atlas_texels`; the ones they replace are retired at frame `retire_at`. On failure nothing
+    // changes.
+    Status make_item_buffers(uint32_t capacity, uint64_t atlas_texels, uint64_t retire_at);
     void free_buffer(GpuBuffer& buffer);
     Status create_objects();
     void write_descriptors(VkDescriptorSet set);
@@ -480,8 +486,14 @@ void Renderer::State::free_buffer(GpuBuffer& buffer) {
     buffer.reset();
 }
 
-Status Renderer::State::make_item_buffers(uint32_t capacity, uint64_t retire_at) {
-    const VkDeviceSize bytes = VkDeviceSize{capacity} * sizeof(gpu::RasterItem);
+Status Renderer::State::make_item_buffers(uint32_t capacity, uint64_t atlas_texels, uint64_t retire_at) {
+    // Items cover disjoint parts of the atlas, so a dispatch has at most a workgroup per 64 atlas
+    // texels plus one partial workgroup per item.
+    const uint64_t workgroups = atlas_texels / gpu::kRasterWorkgroupSize + capacity;
+    if (workgroups > UINT32_MAX) return Error{ErrorCode::invalid_argument, "renderer: the atlas is too large"};
+    // The table starts at an offset every device accepts for a storage buffer (at most 256).
+    const VkDeviceSize offset = (VkDeviceSize{capacity} * sizeof(gpu::RasterItem) + 255) / 256 * 256;
+    const VkDeviceSize bytes = offset + workgroups * sizeof(uint32_t);
     GpuBuffer device_items;
     if (Status s = make_buffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false,
                                "work items", device_items);
@@ -499,6 +511,8 @@ Status Renderer::State::make_item_buffers(uint32_t capacity, uint64_t retire_at)
     items = std::move(device_items);
     item_staging = std::move(staging);
     item_capacity = capacity;
+    workgroup_capacity = static_cast<uint32_t>(workgroups);
+    table_offset = offset;
     return {};
 }
 
@@ -510,7 +524,9 @@ Status Renderer::State::create_objects() {
     image_height = config.height;
 
     // Work items: an entry takes at least one cell, so a frame never has more items than cells.
-    if (Status s = make_item_buffers(atlas.stats().usable_cells, 0); !s) return s;
+    if (Status s = make_item_buffers(atlas.stats().usable_cells, uint64_t{config.width} * config.height, 0); !s) {
+        return s;
+    }
     if (Status s = make_buffer(16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "empty font slot", dummy); !s) return s;
 
     // The pipeline.
@@ -524,6 +540,7 @@ Status Renderer::State::create_objects() {
          nullptr},
         {gpu::kRasterBindBands, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT,
          nullptr},
+        {gpu::kRasterBindWorkgroupItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
     };
     // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
     if (Status s =
@@ -541,14 +558,15 @@ Status Renderer::State::create_objects() {
 
 void Renderer::State::write_descriptors(VkDescriptorSet set) {
     VkDescriptorImageInfo image{VK_NULL_HANDLE, atlas_image.view, VK_IMAGE_LAYOUT_GENERAL};
-    VkDescriptorBufferInfo item_info{items.buffer, 0, VK_WHOLE_SIZE};
+    VkDescriptorBufferInfo item_info{items.buffer, 0, table_offset};
+    VkDescriptorBufferInfo table_info{items.buffer, table_offset, VK_WHOLE_SIZE};
     std::array<VkDescriptorBufferInfo, kRendererFontPages> point_infos{}, band_infos{};
     for (uint32_t page = 0; page < kRendererFontPages; ++page) {
         const bool used = page < pages.size();
         point_infos[page] = {used ? pages[page].points.buffer : dummy.buffer, 0, VK_WHOLE_SIZE};
         band_infos[page] = {used ? pages[page].bands.buffer : dummy.buffer, 0, VK_WHOLE_SIZE};
     }
-    VkWriteDescriptorSet writes[4]{};
+    VkWriteDescriptorSet writes[5]{};
     for (VkWriteDescriptorSet& write : writes) {
         write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
         write.dstSet = set;
@@ -566,7 +584,9 @@ void Renderer::State::write_descriptors(VkDescriptorSet set) {
     writes[3].dstBinding = gpu::kRasterBindBands;
     writes[3].descriptorCount = kRendererFontPages;
     writes[3].pBufferInfo = band_infos.data();
-    fn.vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
+    writes[4].dstBinding = gpu::kRasterBindWorkgroupItems;
+    writes[4].pBufferInfo = &table_info;
+    fn.vkUpdateDescriptorSets(device, 5, writes, 0, nullptr);
 }
 
 Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
@@ -609,7 +629,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
                      "renderer: the device was created without shaderStorageBufferArrayDynamicIndexing (enable it; "
                      "add_crisp_features() does)"};
     }
-    const uint32_t buffers_needed = 1 + 2 * kRendererFontPages;
+    const uint32_t buffers_needed = 2 + 2 * kRendererFontPages;
     if (properties.limits.maxPerStageDescriptorStorageBuffers < buffers_needed) {
         return Error{ErrorCode::vulkan, "renderer: the device offers " +
                                             std::to_string(properties.limits.maxPerStageDescriptorStorageBuffers) +
@@ -656,8 +676,9 @@ Status Renderer::State::grow_image(VkCommandBuffer command_buffer, uint64_t this
     vk::DeviceImage grown;
     if (Status s = make_atlas_image(config, grown); !s) return s;
     const uint32_t cells = atlas.stats().usable_cells;
-    if (cells > item_capacity) {
-        if (Status s = make_item_buffers(cells, this_frame); !s) {
+    const uint64_t texels = uint64_t{config.width} * config.height;
+    if (cells > item_capacity || texels / gpu::kRasterWorkgroupSize + cells > workgroup_capacity) {
+        if (Status s = make_item_buffers(cells, texels, this_frame); !s) {
             grown.reset();
             return s;
         }
@@ -1029,6 +1050,7 @@ Status Renderer::State::prepare_atlas_image(VkCommandBuffer command_buffer, uint
 // The rasterizer's work items for `work` into item_data; returns the workgroups they take.
 uint32_t Renderer::State::build_work_items(std::span<const RasterWork> work) {
     item_data.clear();
+    workgroup_items.clear();
     uint32_t workgroups = 0;
     for (const RasterWork& w : work) {
         const auto slot = font_slot.find(w.key.font);
@@ -1060,7 +1082,9 @@ uint32_t Renderer::State::build_work_items(std::span<const RasterWork> work) {
         item.first_texel = w.first_texel;
         item.texel_count = w.texel_count;
         item.first_workgroup = workgroups;
-        workgroups += (w.texel_count + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
+        const uint32_t own = (w.texel_count + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
+        workgroups += own;
+        workgroup_items.insert(workgroup_items.end(), own, static_cast<uint32_t>(item_data.size()));
         item_data.push_back(item);
     }
     stats.work_items = static_cast<uint32_t>(item_data.size());
@@ -1082,11 +1106,14 @@ void Renderer::State::record_item_upload(VkCommandBuffer command_buffer, uint64_
                            VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                            VK_ACCESS_TRANSFER_WRITE_BIT);
         const GpuBuffer& staging = item_staging[this_frame % frames_in_flight];
-        const VkDeviceSize total = item_data.size() * sizeof(gpu::RasterItem);
-        std::memcpy(staging.mapped, item_data.data(), total);
-        const VkBufferCopy copy{0, 0, total};
-        fn.vkCmdCopyBuffer(command_buffer, staging.buffer, items.buffer, 1, &copy);
-        stats.upload_bytes += total;
+        const VkDeviceSize item_bytes = item_data.size() * sizeof(gpu::RasterItem);
+        const VkDeviceSize table_bytes = workgroup_items.size() * sizeof(uint32_t);
+        auto* bytes = static_cast<std::byte*>(staging.mapped);
+        std::memcpy(bytes, item_data.data(), item_bytes);
+        std::memcpy(bytes + table_offset, workgroup_items.data(), table_bytes);
+        const VkBufferCopy copies[2] = {{0, 0, item_bytes}, {table_offset, table_offset, table_bytes}};
+        fn.vkCmdCopyBuffer(command_buffer, staging.buffer, items.buffer, 2, copies);
+        stats.upload_bytes += item_bytes + table_bytes;
     }
     if (fonts_uploaded || !item_data.empty()) {
         vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,

@@ -204,7 +204,7 @@ public:
     // Creates the atlas image, buffers and the compute pipeline. Fails with ErrorCode::vulkan when
     // the device is below Vulkan 1.2 or lacks what the rasterizer needs (named in the message:
     // shaderStorageBufferArrayDynamicIndexing, storage images of R16G16B16A16_UINT,
-    // 1 + 2 * kRendererFontPages storage buffers per stage), and with
+    // 2 + 2 * kRendererFontPages storage buffers per stage), and with
     // ErrorCode::invalid_argument for a bad atlas config (see GlyphAtlas::create), max_samples above
     // kMaxRendererSamples, frames_in_flight outside 1..8, an invalid layout, or a sample_kind
     // that is neither rows nor points.
