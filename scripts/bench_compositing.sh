@@ -4,18 +4,19 @@
 #   scripts/bench_compositing.sh BIN_DIR OUT_DIR gpu       # a GPU: 3840x2160, and 32 layers at 1920x1080
 #   scripts/bench_compositing.sh BIN_DIR OUT_DIR lavapipe  # the CPU driver: 512x256
 #
-# BIN_DIR holds crisp-bench-composite (a Release build); it runs from the repository root (the
-# font path). Each run writes OUT_DIR/<name>.md and .json; progress goes to OUT_DIR/<name>.log.
+# BIN_DIR holds crisp-bench (a Release build), whose compositing suite runs; it runs from the
+# repository root (the font path). Each run writes OUT_DIR/<name>.md and .json; progress goes to
+# OUT_DIR/<name>.log.
 set -euo pipefail
 [ $# -eq 3 ] || { echo "usage: $0 BIN_DIR OUT_DIR gpu|lavapipe" >&2; exit 64; }
-bin=$1/crisp-bench-composite
+bin=$1/crisp-bench
 out=$2
 mkdir -p "$out"
 run() {
   local name=$1
   shift
   echo "== $name: $*" >&2
-  "$bin" "$@" --json-out "$out/$name.json" > "$out/$name.md" 2> "$out/$name.log"
+  "$bin" --suite compositing --no-files "$@" --json-out "$out/$name.json" > "$out/$name.md" 2> "$out/$name.log"
 }
 case $3 in
   gpu)

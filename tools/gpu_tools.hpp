@@ -41,25 +41,26 @@ inline void begin_rendering_over(VkCommandBuffer command_buffer, VkImageView vie
     vkCmdBeginRendering(command_buffer, &rendering);
 }
 
-// Prints the driver's statistics of compiled shaders (Renderer::shader_statistics()) as a Markdown
-// table: one row per shader and executable, one column per statistic; a line saying there are none
-// where the device reports none.
-inline void print_shader_statistics(const std::vector<ShaderStatistic>& statistics) {
+// Prints the driver's statistics of compiled shaders (Renderer::shader_statistics()) to `out` as a
+// Markdown table: one row per shader and executable, one column per statistic; a line saying there
+// are none where the device reports none.
+inline void print_shader_statistics(std::FILE* out, const std::vector<ShaderStatistic>& statistics) {
     if (statistics.empty()) {
-        std::printf("\nShader statistics: none (the device does not offer VK_KHR_pipeline_executable_properties).\n");
+        std::fprintf(out,
+                     "\nShader statistics: none (the device does not offer VK_KHR_pipeline_executable_properties).\n");
         return;
     }
     std::vector<std::string> names;
     for (const ShaderStatistic& s : statistics) {
         if (std::find(names.begin(), names.end(), s.name) == names.end()) names.push_back(s.name);
     }
-    std::printf("\nShader statistics (VK_KHR_pipeline_executable_properties):\n\n| shader | executable |");
-    for (const std::string& name : names) std::printf(" %s |", name.c_str());
-    std::printf("\n|---|---|");
-    for (size_t i = 0; i < names.size(); ++i) std::printf("---:|");
+    std::fprintf(out, "\nShader statistics (VK_KHR_pipeline_executable_properties):\n\n| shader | executable |");
+    for (const std::string& name : names) std::fprintf(out, " %s |", name.c_str());
+    std::fprintf(out, "\n|---|---|");
+    for (size_t i = 0; i < names.size(); ++i) std::fprintf(out, "---:|");
     for (size_t i = 0; i < statistics.size();) {
         const ShaderStatistic& first = statistics[i];
-        std::printf("\n| %s | %s |", first.shader.c_str(), first.executable.c_str());
+        std::fprintf(out, "\n| %s | %s |", first.shader.c_str(), first.executable.c_str());
         size_t end = i;
         while (end < statistics.size() && statistics[end].shader == first.shader &&
                statistics[end].executable == first.executable) {
@@ -70,13 +71,13 @@ inline void print_shader_statistics(const std::vector<ShaderStatistic>& statisti
                                       statistics.begin() + static_cast<std::ptrdiff_t>(end),
                                       [&](const ShaderStatistic& s) { return s.name == name; });
             if (found == statistics.begin() + static_cast<std::ptrdiff_t>(end))
-                std::printf("  |");
+                std::fprintf(out, "  |");
             else
-                std::printf(" %.6g |", found->value);
+                std::fprintf(out, " %.6g |", found->value);
         }
         i = end;
     }
-    std::printf("\n");
+    std::fprintf(out, "\n");
 }
 
 // The GPU time between two points of a command buffer, from a pool of two timestamp queries.

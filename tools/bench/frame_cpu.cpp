@@ -1,10 +1,10 @@
-// crisp-bench-frame: the CPU time one frame of a game's UI text costs on the calling thread. Eight
-// labels (health, ammo, a name, coordinates, an FPS counter, ...) are laid out once; every frame
+// crisp-bench --suite frame-cpu (formerly crisp-bench-frame): the CPU time one frame of a game's UI text costs on the
+// calling thread. Eight labels (health, ammo, a name, coordinates, an FPS counter, ...) are laid out once; every frame
 // three of them get a new string and are laid out again with a Layouter, all eight are drawn with
 // DrawOptions, and the renderer's and the compositor's (tile path) record() fill the frame's command
 // buffer, with 2 frames in flight. Timed with a steady clock, per phase, and with the thread's CPU
-// clock: begin_frame() through the end of compositor.record(). Prints Markdown
-// (docs/benchmarks-cpu.md); --json-out writes JSON too.
+// clock: begin_frame() through the end of compositor.record(). docs/benchmarks-cpu.md.
+#include "bench.hpp"
 #include "cli.hpp"
 #include "gpu_tools.hpp"
 #include "json_writer.hpp"
@@ -26,7 +26,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
-#include <fstream>
 #include <optional>
 #include <span>
 #include <string>
@@ -52,62 +51,20 @@ double thread_cpu_us() {
 constexpr VkFormat kTargetFormat = VK_FORMAT_R8G8B8A8_UNORM;
 
 [[noreturn]] void fail(const std::string& message) {
-    std::fprintf(stderr, "crisp-bench-frame: %s\n", message.c_str());
-    std::exit(1);
+    crisp::bench::fail("frame-cpu", message);
 }
 
 // ---- Options
 
 struct Args {
     std::string font = "fonts/DejaVuSans.ttf";
-    std::string device;
     uint32_t width = 1920, height = 1080;
     float size = 16.0f;
     uint32_t warmup = 100;
     uint32_t frames = 1000;
     std::vector<std::string> variants = {"static", "changed", "moving"};
-    std::string json_out;
     bool validate = false;
 };
-
-crisp::Status parse_canvas(Args& args, std::string_view text) {
-    const std::vector<std::string_view> sides = crisp::cli::split(text, 'x');
-    if (sides.size() != 2) {
-        return crisp::Error{crisp::ErrorCode::invalid_argument,
-                            "--canvas: '" + crisp::cli::printable(text) + "' is not WxH"};
-    }
-    const crisp::cli::Range<uint32_t> range{64, 16384};
-    for (auto [side, target] : {std::pair{sides[0], &args.width}, std::pair{sides[1], &args.height}}) {
-        crisp::Result<uint32_t> value = crisp::cli::CommandLine::checked_number<uint32_t>("--canvas", side, range);
-        if (!value) return value.error();
-        *target = *value;
-    }
-    return {};
-}
-
-void declare_options(crisp::cli::CommandLine& cli, Args& args) {
-    cli.on_usage_error(2, " (--help lists the options)");
-    cli.text("--font", "PATH", "a font file, baked at start (default fonts/DejaVuSans.ttf, from the repository root)",
-             args.font);
-    cli.number<float>("--size", "PX", "pixels per em of every label (default 16)", args.size, {4.0f, 256.0f});
-    cli.option("--canvas", "WxH", "the RGBA8 storage image composited into (default 1920x1080)",
-               [&args](std::string_view text) { return parse_canvas(args, text); });
-    cli.number<uint32_t>("--warmup", "N", "untimed frames per variant first (default 100)", args.warmup, {0, 1000000});
-    cli.number<uint32_t>("--frames", "N", "timed frames per variant (default 1000)", args.frames, {1, 1000000});
-    cli.option("--variants", "LIST",
-               "comma-separated, from static (nothing changes), changed (3 strings laid out\n"
-               "again every frame) and moving (as changed, and every label moves every frame)\n"
-               "(default static,changed,moving)",
-               [&args](std::string_view text) {
-                   const std::vector<std::string_view> names = crisp::cli::split(text, ',');
-                   args.variants.assign(names.begin(), names.end());
-                   return crisp::Status{};
-               });
-    cli.text("--device", "TEXT", "pick a device whose name contains TEXT", args.device);
-    cli.text("--json-out", "FILE", "also write the results as JSON to FILE", args.json_out);
-    cli.flag("--validate", "turn the validation layer on (to check the tool; the times then mean little)",
-             args.validate);
-}
 
 // ---- The scene
 
@@ -511,38 +468,6 @@ double thread_cpu_clock_cost_us() {
     return sink > 0.0 ? us / kReads : 0.0;
 }
 
-// The first "model name" of /proc/cpuinfo; "unknown" where there is none.
-std::string cpu_model() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line)) {
-        if (line.rfind("model name", 0) != 0) continue;
-        const size_t colon = line.find(':');
-        if (colon != std::string::npos) return line.substr(std::min(colon + 2, line.size()));
-    }
-    return "unknown";
-}
-
-std::string build_description() {
-    std::string build = CRISP_BENCH_BUILD_TYPE[0] ? CRISP_BENCH_BUILD_TYPE : "no CMAKE_BUILD_TYPE";
-#ifdef __OPTIMIZE__
-    build += ", optimized";
-#else
-    build += ", NOT optimized";
-#endif
-#ifdef NDEBUG
-    build += ", assertions off";
-#else
-    build += ", assertions on";
-#endif
-#if defined(__clang__)
-    build += ", Clang " __clang_version__;
-#elif defined(__GNUC__)
-    build += ", GCC " __VERSION__;
-#endif
-    return build;
-}
-
 double per_frame(uint64_t sum, uint32_t frames) {
     return static_cast<double>(sum) / static_cast<double>(frames);
 }
@@ -555,21 +480,23 @@ std::string median_cell(const std::vector<double>& values) {
     return cell;
 }
 
-void print_summary_cells(const Summary& s) {
-    std::printf("%.1f | %.1f | %.1f | %.1f | %.1f |", s.median, s.p90, s.p99, s.max, s.mean);
+void print_summary_cells(std::FILE* out, const Summary& s) {
+    std::fprintf(out, "%.1f | %.1f | %.1f | %.1f | %.1f |", s.median, s.p90, s.p99, s.max, s.mean);
 }
 
-void print_markdown(const Args& args, const Header& header, const std::vector<VariantResult>& results) {
-    std::printf("Device: %s, driver %s; Vulkan %s. CPU: %s, %u hardware threads. Build: %s.\n\n", header.device.c_str(),
-                header.driver.c_str(), header.api.c_str(), header.cpu.c_str(), std::thread::hardware_concurrency(),
-                header.build.c_str());
-    std::printf(
+void print_markdown(std::FILE* out, const Args& args, const Header& header, const std::vector<VariantResult>& results) {
+    std::fprintf(out, "Device: %s, driver %s; Vulkan %s. CPU: %s, %u hardware threads. Build: %s.\n\n",
+                 header.device.c_str(), header.driver.c_str(), header.api.c_str(), header.cpu.c_str(),
+                 std::thread::hardware_concurrency(), header.build.c_str());
+    std::fprintf(
+        out,
         "Scene: 8 labels of %s at %g px (%zu glyphs), each laid out once; drawn with DrawOptions (offset, a colour, "
         "a depth, the target as the visible rect, an id per label) into a %ux%u R8G8B8A8_UNORM storage image by the "
         "tile path; %u frames in flight. Changing labels: coordinates, an FPS counter and a clock.\n",
         args.font.c_str(), static_cast<double>(args.size), results.empty() ? size_t{0} : results[0].label_glyphs,
         args.width, args.height, kFramesInFlight);
-    std::printf(
+    std::fprintf(
+        out,
         "Timed on the calling thread with std::chrono::steady_clock: begin_frame() through the end of "
         "compositor.record(); not timed: writing the strings, vkBeginCommandBuffer, vkEndCommandBuffer, barriers, "
         "vkQueueSubmit and fence waits. CPU time: the thread's CPU time over the same region "
@@ -579,38 +506,39 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Va
         header.cpu_clock_read_us, args.warmup, args.frames,
         args.validate ? " The validation layer was on: these times are not the library's." : "");
 
-    std::printf(
+    std::fprintf(
+        out,
         "\n| variant | median µs | p90 µs | p99 µs | max µs | mean µs | CPU time: median µs | p99 µs | max µs |\n"
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const VariantResult& r : results) {
-        std::printf("| %s: %s | ", r.variant->name, r.variant->description);
-        print_summary_cells(summarize(r.total_us));
+        std::fprintf(out, "| %s: %s | ", r.variant->name, r.variant->description);
+        print_summary_cells(out, summarize(r.total_us));
         const Summary cpu = summarize(r.thread_cpu_us);
-        std::printf(" %.1f | %.1f | %.1f |\n", cpu.median, cpu.p99, cpu.max);
+        std::fprintf(out, " %.1f | %.1f | %.1f |\n", cpu.median, cpu.p99, cpu.max);
     }
 
-    std::printf(
-        "\nWhere the time goes:\n\n| variant | phase | median µs | p90 µs | p99 µs | max µs | mean µs |\n"
-        "|---|---|---:|---:|---:|---:|---:|\n");
+    std::fprintf(out,
+                 "\nWhere the time goes:\n\n| variant | phase | median µs | p90 µs | p99 µs | max µs | mean µs |\n"
+                 "|---|---|---:|---:|---:|---:|---:|\n");
     for (const VariantResult& r : results) {
         for (size_t p = 0; p < kPhaseCount; ++p) {
-            std::printf("| %s | %s | ", r.variant->name, kPhaseNames[p]);
-            print_summary_cells(summarize(r.phase_us[p]));
-            std::printf("\n");
+            std::fprintf(out, "| %s | %s | ", r.variant->name, kPhaseNames[p]);
+            print_summary_cells(out, summarize(r.phase_us[p]));
+            std::fprintf(out, "\n");
         }
     }
 
-    std::printf(
-        "\nWhat the renderer and the compositor did, per timed frame:\n\n"
-        "| variant | glyphs drawn | moving glyphs | frames with raster work | raster work items | "
-        "frames with bins reused | quads | median µs, frames with raster work | median µs, frames without |\n"
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::fprintf(out,
+                 "\nWhat the renderer and the compositor did, per timed frame:\n\n"
+                 "| variant | glyphs drawn | moving glyphs | frames with raster work | raster work items | "
+                 "frames with bins reused | quads | median µs, frames with raster work | median µs, frames without |\n"
+                 "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const VariantResult& r : results) {
-        std::printf("| %s | %.1f | %.1f | %u of %u | %.2f | %u of %u | %.1f | %s | %s |\n", r.variant->name,
-                    per_frame(r.drawn_glyphs, args.frames), per_frame(r.moving_glyphs, args.frames), r.frames_with_work,
-                    args.frames, per_frame(r.work_items, args.frames), r.frames_bins_reused, args.frames,
-                    per_frame(r.quads, args.frames), median_cell(r.total_us_with_work).c_str(),
-                    median_cell(r.total_us_without_work).c_str());
+        std::fprintf(out, "| %s | %.1f | %.1f | %u of %u | %.2f | %u of %u | %.1f | %s | %s |\n", r.variant->name,
+                     per_frame(r.drawn_glyphs, args.frames), per_frame(r.moving_glyphs, args.frames),
+                     r.frames_with_work, args.frames, per_frame(r.work_items, args.frames), r.frames_bins_reused,
+                     args.frames, per_frame(r.quads, args.frames), median_cell(r.total_us_with_work).c_str(),
+                     median_cell(r.total_us_without_work).c_str());
     }
 }
 
@@ -646,10 +574,9 @@ void write_variant(crisp::JsonWriter& json, const Args& args, const VariantResul
     json.end_array().end_object();
 }
 
-crisp::JsonWriter to_json(const Args& args, const Header& header, const std::vector<VariantResult>& results) {
-    crisp::JsonWriter json;
+void to_json(crisp::JsonWriter& json, const Args& args, const Header& header,
+             const std::vector<VariantResult>& results) {
     json.begin_object()
-        .field("tool", "crisp-bench-frame")
         .field("device", header.device)
         .field("driver", header.driver)
         .field("api_version", header.api)
@@ -667,54 +594,45 @@ crisp::JsonWriter to_json(const Args& args, const Header& header, const std::vec
     json.key("variants").begin_array();
     for (const VariantResult& r : results) write_variant(json, args, r);
     json.end_array().end_object();
-    return json;
 }
 
-// Parses the command line and the variants it names; exits on --help or a usage error (2).
-Args parse(int argc, char** argv, std::vector<const Variant*>& variants) {
+// The suite's arguments: the options given, else its defaults (smaller with --quick or on a
+// CPU device).
+Args args_from(const crisp::bench::Session& session) {
+    const crisp::bench::Options& o = session.options;
     Args args;
-    crisp::cli::CommandLine cli(
-        "crisp-bench-frame",
-        "usage: crisp-bench-frame [options]\n"
-        "Measures the CPU time of one frame of UI text on the calling thread: 8 labels laid out once,\n"
-        "3 of them laid out again every frame, all 8 drawn with DrawOptions, then Renderer::record and\n"
-        "Compositor::record (the tile path) into per-frame command buffers, 2 frames in flight. Timed:\n"
-        "begin_frame() through the end of compositor.record(); not timed: vkBegin/EndCommandBuffer,\n"
-        "submits and fence waits. Prints Markdown tables (median, p90, p99, max per phase).\n\n");
-    declare_options(cli, args);
-    cli.parse(argc, argv);
-    for (const std::string& name : args.variants) {
-        const auto* found =
-            std::find_if(std::begin(kVariants), std::end(kVariants), [&](const Variant& v) { return name == v.name; });
-        if (found == std::end(kVariants)) cli.fail("--variants: unknown variant '" + crisp::cli::printable(name) + "'");
-        variants.push_back(found);
-    }
+    if (!o.fonts.empty()) args.font = o.fonts.front();
+    args.size = o.size.value_or(args.size);
+    args.width = o.width.value_or(o.quick ? 256 : session.cpu_device ? 640 : args.width);
+    args.height = o.height.value_or(o.quick ? 128 : session.cpu_device ? 360 : args.height);
+    args.warmup = o.warmup.value_or(o.quick ? 2 : args.warmup);
+    args.frames = o.frames.value_or(o.quick ? 20 : args.frames);
+    args.variants = o.variants;
+    args.validate = o.validate;
     return args;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
+void crisp::bench::run_frame_cpu(Session& session) {
+    const Args args = args_from(session);
     std::vector<const Variant*> variants;
-    const Args args = parse(argc, argv, variants);
-
-    crisp::HeadlessContextOptions context_options;
-    context_options.validation = args.validate;
-    context_options.device_name_contains = args.device;
-    bool storage_without_format = false;  // the RGBA8 target needs no format-less storage
-    auto context = crisp::tools::create_context(context_options, storage_without_format);
-    if (!context) fail(context.error().message);
-
+    for (const std::string& name : args.variants) {
+        const auto* found =
+            std::find_if(std::begin(kVariants), std::end(kVariants), [&](const Variant& v) { return name == v.name; });
+        variants.push_back(found);  // parse_options checked the names
+    }
+    crisp::HeadlessContext* context = session.context;
     crisp::BakeOptions bake;  // the labels are ASCII
     bake.all_glyphs = false;
     for (uint32_t c = 0x20; c < 0x7F; ++c) bake.codepoints.push_back(c);
     auto baked = crisp::bake_font_file(args.font, bake);
     if (!baked) {
         const std::string& why = baked.error().message;  // an unreadable file's names it
-        fail(why.find(args.font) != std::string::npos ? why : crisp::cli::printable(args.font) + ": " + why);
+        ::fail(why.find(args.font) != std::string::npos ? why : crisp::cli::printable(args.font) + ": " + why);
     }
     auto font = crisp::Font::create(std::move(baked->asset), 1);
-    if (!font) fail(crisp::cli::printable(args.font) + ": " + font.error().message);
+    if (!font) ::fail(crisp::cli::printable(args.font) + ": " + font.error().message);
 
     crisp::ImageDesc target_desc;
     target_desc.format = kTargetFormat;
@@ -722,36 +640,31 @@ int main(int argc, char** argv) {
     target_desc.height = args.height;
     target_desc.usage = VK_IMAGE_USAGE_STORAGE_BIT;
     auto target = context->create_image(target_desc);
-    if (!target) fail(target.error().message);
+    if (!target) ::fail(target.error().message);
     const crisp::Status to_general = context->submit_and_wait([&](VkCommandBuffer cb) {
         crisp::vk::image_barrier(context->functions(), cb, target->handle(), VK_IMAGE_LAYOUT_UNDEFINED,
                                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0,
                                  VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, crisp::vk::kShaderAccess);
     });
-    if (!to_general) fail(to_general.error().message);
+    if (!to_general) ::fail(to_general.error().message);
     auto slots = FrameSlots::create(*context);
-    if (!slots) fail(slots.error().message);
+    if (!slots) ::fail(slots.error().message);
 
     Bench bench{args, *context, *font, *slots, *target};
     std::vector<VariantResult> results;
-    for (const Variant* variant : variants) results.push_back(bench.run(*variant));
+    for (const Variant* variant : variants) {
+        crisp::bench::progress("frame-cpu", std::string(variant->name) + ": " + std::to_string(args.warmup) + " + " +
+                                                std::to_string(args.frames) + " frames");
+        results.push_back(bench.run(*variant));
+    }
 
     Header header;
     header.device = context->device_name();
     header.driver = context->driver_name() + " (" + context->driver_info() + ")";
     header.api = crisp::vk::version_string(context->api_version());
-    header.cpu = cpu_model();
-    header.build = build_description();
+    header.cpu = crisp::bench::cpu_model();
+    header.build = crisp::bench::build_description();
     header.cpu_clock_read_us = thread_cpu_clock_cost_us();
-    print_markdown(args, header, results);
-    if (!args.json_out.empty()) {
-        if (crisp::Status s = to_json(args, header, results).write_file(args.json_out); !s) fail(s.error().message);
-    }
-    const crisp::ValidationMessages messages = context->validation_messages();
-    if (messages.errors + messages.warnings > 0) {
-        std::fprintf(stderr, "validation: %u errors, %u warnings\n", messages.errors, messages.warnings);
-        for (const std::string& m : messages.recent) std::fprintf(stderr, "%s\n", m.c_str());
-        return 1;
-    }
-    return 0;
+    print_markdown(session.md, args, header, results);
+    to_json(session.json, args, header, results);
 }

@@ -1,11 +1,11 @@
-// crisp-bench-composite: what each compositing mode costs and how far it is from exact, for scenes
-// of N overlapping layers of text at high and low alpha. Per mode (the tile path into RGBA32F and
-// RGBA8 images, the whole frame of converged text with it, the draw path, and the reference modes:
-// exact, unsorted, wboit): the GPU time of its record call on
-// converged static text (Vulkan timestamp queries), the error of its image against the exact CPU
-// reference (src/oit_reference) in 8-bit sRGB codes, and its bytes per pixel. Prints Markdown (or
-// JSON with --json); docs/benchmarks-compositing.md.
-#include "cli.hpp"
+// crisp-bench --suite compositing (formerly crisp-bench-composite): what each compositing mode
+// costs and how far it is from exact, for scenes of N overlapping layers of text at high and low
+// alpha. Per mode (the tile path into RGBA32F and RGBA8 images, the whole frame of converged text
+// with it, the draw path, and the reference modes: exact, unsorted, wboit): the GPU time of its
+// record call on converged static text (Vulkan timestamp queries), the error of its image against
+// the exact CPU reference (src/oit_reference) in 8-bit sRGB codes, and its bytes per pixel.
+// docs/benchmarks-compositing.md.
+#include "bench.hpp"
 #include "gpu_tools.hpp"
 #include "vk_barriers.hpp"
 #include "vk_resources.hpp"
@@ -66,7 +66,6 @@ constexpr uint32_t kMaxConvergeFrames = 4096;
 
 struct Args {
     std::string font = "fonts/DejaVuSans.ttf";
-    std::string device;
     std::string layout = "rgb";
     float size = 18.0f;
     uint32_t width = 512, height = 256;
@@ -82,106 +81,11 @@ struct Args {
     std::vector<std::string> modes = {"tiled", "tiled-rebin", "tiled-rgba8", "frame",
                                       "draw",  "exact",       "unsorted",    "wboit"};
     bool cpu_check = true;
-    bool json = false;
-    std::string json_out;
-    bool validate = false;
-    bool validate_sync = false;
-    bool shader_stats = false;
 };
 
-// A comma-separated list of numbers, each within `range`, into `target`.
-template <class T>
-crisp::cli::CommandLine::Apply number_list(std::vector<T>& target, const char* option, crisp::cli::Range<T> range) {
-    return [&target, option, range](std::string_view text) -> crisp::Status {
-        target.clear();
-        for (const std::string_view item : crisp::cli::split(text, ',')) {
-            crisp::Result<T> value = crisp::cli::CommandLine::checked_number<T>(option, item, range);
-            if (!value) return value.error();
-            target.push_back(*value);
-        }
-        return {};
-    };
-}
-
-// --canvas W,H or WxH, each side 16..16384.
-crisp::Status parse_canvas(Args& args, std::string_view text) {
-    auto size =
-        crisp::cli::parse_number_list<uint32_t>("--canvas", text, text.find('x') != std::string_view::npos ? 'x' : ',');
-    if (!size) return size.error();
-    if (size->size() != 2 || (*size)[0] < 16 || (*size)[1] < 16 || (*size)[0] > 16384 || (*size)[1] > 16384) {
-        return crisp::Error{crisp::ErrorCode::invalid_argument, "--canvas: W,H each in 16..16384"};
-    }
-    args.width = (*size)[0];
-    args.height = (*size)[1];
-    return {};
-}
-
-// What is measured: the modes, the scenes and the frames.
-void declare_measure_options(crisp::cli::CommandLine& cli, Args& args) {
-    cli.option("--modes", "LIST",
-               "modes, comma-separated, from tiled (the tile path into RGBA32F; static\n"
-               "text: the bins are reused), tiled-rebin (binned every frame),\n"
-               "tiled-rgba8 (into R8G8B8A8_UNORM), frame (the renderer's converged\n"
-               "frame and the tile path together), draw (the draw path, RGBA32F),\n"
-               "exact, unsorted and wboit (default: all of them)",
-               [&args](std::string_view text) {
-                   const std::vector<std::string_view> modes = crisp::cli::split(text, ',');
-                   args.modes.assign(modes.begin(), modes.end());
-                   return crisp::Status{};
-               });
-    cli.option("--layers", "LIST", "layer counts, comma-separated (default 1,2,4,8,16,32)",
-               number_list<uint32_t>(args.layers, "--layers", {1, 1024}));
-    cli.option("--alphas", "LIST", "text alphas, comma-separated, in (0, 1] (default 0.9,0.3)",
-               number_list<float>(args.alphas, "--alphas", {0.0f, 1.0f, true}));
-    cli.option("--canvas", "W,H", "target size, also WxH (default 512,256)",
-               [&args](std::string_view text) { return parse_canvas(args, text); });
-    cli.number<uint32_t>("--frames", "N", "timed frames per mode (default 10)", args.frames, {1, 1000000});
-    cli.number<uint32_t>("--warmup", "N",
-                         "untimed frames per mode before them, at least " + std::to_string(kFramesInFlight) +
-                             " (default " + std::to_string(kDefaultWarmupFrames) + ")",
-                         args.warmup, {kFramesInFlight, 1000000});
-    cli.number<double>(
-        "--warmup-ms", "T",
-        "... and more until T ms have passed (default " + std::to_string(static_cast<int>(kDefaultWarmupMs)) + ")",
-        args.warmup_ms, {0.0, 600000.0});
-    cli.number<uint32_t>("--clock-load", "N",
-                         "untimed clears of the RGBA32F target before each frame's timed\n"
-                         "commands, so that the GPU keeps its clocks between frames (default " +
-                             std::to_string(kDefaultClockLoad) + ")",
-                         args.clock_load, {0, 1000});
-}
-
-// The text, the device and the output.
-void declare_setup_options(crisp::cli::CommandLine& cli, Args& args) {
-    cli.text("--font", "PATH", "a font file, baked at start (default fonts/DejaVuSans.ttf)", args.font);
-    cli.number<float>("--size", "PX", "pixels per em (default 18)", args.size, {4.0f, 256.0f});
-    cli.number<uint32_t>("--samples", "N", "samples per glyph the text converges to (default 512)", args.samples);
-    cli.number<uint32_t>("--subpixel-steps", "N", "subpixel positions per pixel in glyph keys (default 4)",
-                         args.subpixel_steps);
-    cli.text("--layout", "NAME", "subpixel layout preset or file (default rgb)", args.layout);
-    cli.choice<crisp::QuadPath>("--path", "NAME",
-                                "quad passes of wboit and exact: raster or compute\n"
-                                "(default raster; unsorted is always rasterized)",
-                                args.path, {crisp::QuadPath::raster, crisp::QuadPath::compute},
-                                [](const crisp::QuadPath& path) { return std::string(crisp::quad_path_name(path)); });
-    cli.flag("--no-cpu-check", "skip checking the exact mode against the CPU reference", args.cpu_check, false);
-    cli.text("--device", "TEXT", "pick a device whose name contains TEXT", args.device);
-    cli.flag("--validate", "turn the validation layer on", args.validate);
-    cli.flag("--validate-sync", "the validation layer with synchronization validation",
-             [&args] { args.validate = args.validate_sync = true; });
-    cli.flag("--shader-stats",
-             "the driver's statistics of the compositor's shaders\n(registers, ...), where the device offers them",
-             args.shader_stats);
-    cli.flag("--json", "print JSON instead of Markdown", args.json);
-    cli.text("--json-out", "FILE", "also write the JSON to FILE", args.json_out);
-}
-
 [[noreturn]] void fail(const std::string& message) {
-    std::fprintf(stderr, "crisp-bench-composite: %s\n", message.c_str());
-    std::exit(1);
+    crisp::bench::fail("compositing", message);
 }
-
-// ---- Device
 
 // ---- Scenes
 
@@ -611,9 +515,8 @@ void write_scene(crisp::JsonWriter& json, const Args& args, const SceneResult& r
     json.end_array().end_object();
 }
 
-crisp::JsonWriter to_json(const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
-                          const std::vector<std::string>& warnings) {
-    crisp::JsonWriter json;
+void to_json(crisp::JsonWriter& json, const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
+             const std::vector<std::string>& warnings) {
     json.begin_object()
         .field("device", header.device)
         .field("driver_name", header.driver_name)
@@ -637,32 +540,33 @@ crisp::JsonWriter to_json(const Args& args, const Header& header, const std::vec
     json.key("scenes").begin_array();
     for (const SceneResult& r : scenes) write_scene(json, args, r);
     json.end_array().field("warnings", warnings).end_object();
-    return json;
 }
 
-void print_markdown(const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
+void print_markdown(std::FILE* out, const Args& args, const Header& header, const std::vector<SceneResult>& scenes,
                     const std::vector<std::string>& warnings) {
-    std::printf("Device: %s, driver %s (%s); Vulkan %s in use.\n", header.device.c_str(), header.driver_name.c_str(),
-                header.driver_info.c_str(), header.api.c_str());
-    std::printf(
-        "Reference quad passes: %s. Canvas %ux%u; %s at %g px, layout %s, %u "
-        "subpixel steps, %u samples per glyph; background sRGB %g grey.\n",
-        crisp::quad_path_name(args.path), args.width, args.height, args.font.c_str(), static_cast<double>(args.size),
-        header.layout.c_str(), args.subpixel_steps, args.samples, static_cast<double>(kBackgroundSrgb));
-    for (const std::string& w : header.compositor_warnings) std::printf("Compositor: %s.\n", w.c_str());
-    std::printf(
-        "GPU ms: median of %u frames after at least %u warm-up frames and %g ms, timestamps around the "
-        "mode's record call alone (frame: the renderer's record() of the converged text too), each frame "
-        "after %u untimed clears of the target that keep the GPU's clocks up. "
-        "RMSE and max: 8-bit sRGB codes against %s, over all pixels and channels. B/px: the buffers the "
-        "mode uses (CompositorStats::buffer_bytes / pixels: the tile and draw paths' quads and bins, the "
-        "reference modes' per-pixel buffers); the target image adds %u B/px (RGBA32F) or 4 (rgba8).\n",
-        args.frames, args.warmup, args.warmup_ms, args.clock_load,
-        args.cpu_check ? "the exact CPU reference (double precision, every fragment)" : "the exact mode",
-        kTargetBytesPerPixel);
+    std::fprintf(out, "Device: %s, driver %s (%s); Vulkan %s in use.\n", header.device.c_str(),
+                 header.driver_name.c_str(), header.driver_info.c_str(), header.api.c_str());
+    std::fprintf(out,
+                 "Reference quad passes: %s. Canvas %ux%u; %s at %g px, layout %s, %u "
+                 "subpixel steps, %u samples per glyph; background sRGB %g grey.\n",
+                 crisp::quad_path_name(args.path), args.width, args.height, args.font.c_str(),
+                 static_cast<double>(args.size), header.layout.c_str(), args.subpixel_steps, args.samples,
+                 static_cast<double>(kBackgroundSrgb));
+    for (const std::string& w : header.compositor_warnings) std::fprintf(out, "Compositor: %s.\n", w.c_str());
+    std::fprintf(out,
+                 "GPU ms: median of %u frames after at least %u warm-up frames and %g ms, timestamps around the "
+                 "mode's record call alone (frame: the renderer's record() of the converged text too), each frame "
+                 "after %u untimed clears of the target that keep the GPU's clocks up. "
+                 "RMSE and max: 8-bit sRGB codes against %s, over all pixels and channels. B/px: the buffers the "
+                 "mode uses (CompositorStats::buffer_bytes / pixels: the tile and draw paths' quads and bins, the "
+                 "reference modes' per-pixel buffers); the target image adds %u B/px (RGBA32F) or 4 (rgba8).\n",
+                 args.frames, args.warmup, args.warmup_ms, args.clock_load,
+                 args.cpu_check ? "the exact CPU reference (double precision, every fragment)" : "the exact mode",
+                 kTargetBytesPerPixel);
     for (const float alpha : args.alphas) {
-        std::printf("\n### alpha %g\n\n", static_cast<double>(alpha));
-        std::printf(
+        std::fprintf(out, "\n### alpha %g\n\n", static_cast<double>(alpha));
+        std::fprintf(
+            out,
             "| layers | mode | GPU ms | RMSE | max | B/px | max overlap | tail pixels | tiles: exact / layered |\n"
             "|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
         for (const SceneResult& r : scenes) {
@@ -682,65 +586,41 @@ void print_markdown(const Args& args, const Header& header, const std::vector<Sc
                 if (tiled && m.stats.measured) {
                     std::snprintf(tiles, sizeof tiles, "%u / %u", m.stats.exact_tiles, m.stats.layered_tiles);
                 }
-                std::printf("| %u | %s | %.4g | %s%s | %.2f | %s | %s | %s |\n", r.layers, mode_label(m.run).c_str(),
-                            m.median_ms, error, exact && !args.cpu_check ? " | " : "", buffer_bytes_per_pixel(m, args),
-                            overlap, tail, tiles);
+                std::fprintf(out, "| %u | %s | %.4g | %s%s | %.2f | %s | %s | %s |\n", r.layers,
+                             mode_label(m.run).c_str(), m.median_ms, error, exact && !args.cpu_check ? " | " : "",
+                             buffer_bytes_per_pixel(m, args), overlap, tail, tiles);
             }
         }
     }
-    std::printf(
-        "\n### Scenes and the exact mode\n\n"
-        "| layers | alpha | glyphs | frames to converge | fragments / px | max overlap | exact nodes / px | "
-        "lost nodes | dropped | exact vs CPU: RMSE | max |\n"
-        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::fprintf(out,
+                 "\n### Scenes and the exact mode\n\n"
+                 "| layers | alpha | glyphs | frames to converge | fragments / px | max overlap | exact nodes / px | "
+                 "lost nodes | dropped | exact vs CPU: RMSE | max |\n"
+                 "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const SceneResult& r : scenes) {
         const Measurement* exact = nullptr;
         for (const Measurement& m : r.modes) {
             if (m.run.mode == crisp::CompositeMode::exact) exact = &m;
         }
         const double pixels = static_cast<double>(args.width) * args.height;
-        std::printf("| %u | %g | %zu | %u | ", r.layers, static_cast<double>(r.alpha), r.drawn, r.converge_frames);
+        std::fprintf(out, "| %u | %g | %zu | %u | ", r.layers, static_cast<double>(r.alpha), r.drawn,
+                     r.converge_frames);
         if (r.cpu)
-            std::printf("%.2f | %u | ", static_cast<double>(r.cpu->fragments) / pixels, r.cpu->max_overlap);
+            std::fprintf(out, "%.2f | %u | ", static_cast<double>(r.cpu->fragments) / pixels, r.cpu->max_overlap);
         else
-            std::printf(" | %u | ", exact ? exact->stats.max_overlap : 0u);
-        std::printf("%u | %llu | %llu | ", r.exact_nodes_per_pixel,
-                    static_cast<unsigned long long>(exact ? exact->stats.exact_lost_nodes : 0),
-                    static_cast<unsigned long long>(exact ? exact->stats.exact_dropped : 0));
+            std::fprintf(out, " | %u | ", exact ? exact->stats.max_overlap : 0u);
+        std::fprintf(out, "%u | %llu | %llu | ", r.exact_nodes_per_pixel,
+                     static_cast<unsigned long long>(exact ? exact->stats.exact_lost_nodes : 0),
+                     static_cast<unsigned long long>(exact ? exact->stats.exact_dropped : 0));
         if (r.cpu)
-            std::printf("%.3f | %d |\n", r.exact_vs_cpu.rmse, r.exact_vs_cpu.max);
+            std::fprintf(out, "%.3f | %d |\n", r.exact_vs_cpu.rmse, r.exact_vs_cpu.max);
         else
-            std::printf("not checked | |\n");
+            std::fprintf(out, "not checked | |\n");
     }
     if (!warnings.empty()) {
-        std::printf("\nWarnings:\n\n");
-        for (const std::string& w : warnings) std::printf("- %s\n", w.c_str());
+        std::fprintf(out, "\nWarnings:\n\n");
+        for (const std::string& w : warnings) std::fprintf(out, "- %s\n", w.c_str());
     }
-}
-
-// Parses the command line and the modes it names; exits on --help or a usage error (2).
-Args parse(int argc, char** argv, std::vector<ModeRun>& runs) {
-    Args args;
-    crisp::cli::CommandLine cli(
-        "crisp-bench-composite",
-        "usage: crisp-bench-composite [options]\n"
-        "For scenes of N overlapping layers of text, measures each compositing mode's GPU time\n"
-        "(timestamp queries around its record call), its error against the exact CPU reference (or,\n"
-        "with --no-cpu-check, the exact mode) in 8-bit sRGB codes, and its bytes per pixel.\n"
-        "Progress goes to stderr.\n\n");
-    cli.on_usage_error(2, "", true);
-    declare_measure_options(cli, args);
-    declare_setup_options(cli, args);
-    cli.parse(argc, argv);
-    for (const std::string& name : args.modes) {
-        const std::optional<ModeRun> run = parse_mode_run(name);
-        if (!run) cli.fail("--modes: unknown mode '" + crisp::cli::printable(name) + "'");
-        runs.push_back(*run);
-    }
-    const bool exact =
-        std::any_of(runs.begin(), runs.end(), [](const ModeRun& r) { return r.mode == crisp::CompositeMode::exact; });
-    if (!args.cpu_check && !exact) cli.fail("--no-cpu-check needs the exact mode as the reference");
-    return args;
 }
 
 crisp::Renderer make_renderer(const crisp::HeadlessContext& context, const Args& args,
@@ -911,42 +791,64 @@ struct SceneRunner {
     }
 };
 
+// The suite's arguments: the options given, else its defaults (smaller with --quick).
+Args args_from(const crisp::bench::Session& session) {
+    const crisp::bench::Options& o = session.options;
+    Args args;
+    if (!o.fonts.empty()) args.font = o.fonts.front();
+    if (o.layout) args.layout = *o.layout;
+    args.size = o.size.value_or(args.size);
+    args.width = o.width.value_or(o.quick ? 128 : args.width);
+    args.height = o.height.value_or(o.quick ? 64 : args.height);
+    args.layers = o.layers;
+    args.alphas = o.alphas;
+    args.modes = o.modes;
+    // --quick, and a CPU device (the sweep scripts/bench_compositing.sh ran on lavapipe), take
+    // fewer scenes where the options do not name them.
+    if ((o.quick || session.cpu_device) && !o.scenes_given) {
+        args.layers = o.quick ? std::vector<uint32_t>{1, 4} : std::vector<uint32_t>{1, 4, 32};
+        args.alphas = {0.9f};
+    }
+    args.frames = o.frames.value_or(o.quick ? 2 : args.frames);
+    args.warmup = o.warmup.value_or(args.warmup);
+    args.warmup_ms = o.warmup_ms.value_or(o.quick ? 0.0 : args.warmup_ms);
+    args.clock_load = o.clock_load.value_or(o.quick ? 1 : args.clock_load);
+    args.samples = o.samples.value_or(o.quick ? 16 : args.samples);
+    args.subpixel_steps = o.subpixel_steps;
+    args.path = o.quad_path;
+    args.cpu_check = o.cpu_check;
+    return args;
+}
+
 }  // namespace
 
-int main(int argc, char** argv) {
+void crisp::bench::run_compositing(Session& session) {
+    const Args args = args_from(session);
     std::vector<ModeRun> runs;
-    const Args args = parse(argc, argv, runs);
-
-    crisp::HeadlessContextOptions options;
-    options.validation = args.validate;
-    options.synchronization_validation = args.validate_sync;
-    options.device_name_contains = args.device;
-    options.shader_statistics = args.shader_stats;
-    bool storage_without_format = false;
-    auto context = crisp::tools::create_context(options, storage_without_format);
-    if (!context) fail(context.error().message);
+    for (const std::string& name : args.modes) runs.push_back(*parse_mode_run(name));  // checked by parse_options
+    crisp::HeadlessContext* context = session.context;
 
     auto baked = crisp::bake_font_file(args.font, crisp::BakeOptions{});
-    if (!baked) fail(baked.error().message);
+    if (!baked) ::fail(baked.error().message);
     auto font = crisp::Font::create(std::move(baked->asset), 1);
-    if (!font) fail(font.error().message);
+    if (!font) ::fail(font.error().message);
     auto layout = crisp::resolve_subpixel_layout(args.layout);
-    if (!layout) fail(layout.error().message);
+    if (!layout) ::fail(layout.error().message);
     crisp::Renderer renderer = make_renderer(*context, args, *layout, *font);
     const std::string text = prose_for(args);
 
     auto timer = crisp::tools::GpuTimer::create(*context);
-    if (!timer) fail(timer.error().message);
+    if (!timer) ::fail(timer.error().message);
     const size_t pixels = size_t{args.width} * args.height;
     auto target_readback = context->create_buffer(pixels * 4 * sizeof(float), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                                   crisp::MemoryUsage::readback);
-    if (!target_readback) fail(target_readback.error().message);
+    if (!target_readback) ::fail(target_readback.error().message);
     std::optional<crisp::Buffer> atlas_readback;
     if (args.cpu_check) {
         const crisp::AtlasConfig& atlas_config = renderer.atlas().config();
         auto buffer = context->create_buffer(size_t{atlas_config.width} * atlas_config.height * 4 * sizeof(uint16_t),
                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
-        if (!buffer) fail(buffer.error().message);
+        if (!buffer) ::fail(buffer.error().message);
         atlas_readback = std::move(*buffer);
     }
     Targets targets;
@@ -954,7 +856,7 @@ int main(int argc, char** argv) {
 
     std::vector<std::string> warnings;
     Bench bench{args, *context, renderer, *timer, *target_readback, targets, warnings};
-    Header header = make_header(*context, storage_without_format, layout->name);
+    Header header = make_header(*context, session.storage_without_format, layout->name);
     const uint64_t range = context->properties().limits.maxStorageBufferRange;
     const uint64_t pool_cap =
         std::min<uint64_t>(crisp::kMaxExactFragmentsPerPixel, range / (uint64_t{kExactNodeBytes} * pixels));
@@ -966,21 +868,8 @@ int main(int argc, char** argv) {
         for (const float alpha : args.alphas) results.push_back(scenes.run(layers, alpha));
     }
 
-    const crisp::JsonWriter json = to_json(args, header, results, warnings);
-    if (args.json) {
-        std::fputs(json.line().c_str(), stdout);
-    } else {
-        print_markdown(args, header, results, warnings);
-        if (args.shader_stats) crisp::tools::print_shader_statistics(header.shader_statistics);
-    }
-    if (!args.json_out.empty()) {
-        if (crisp::Status s = json.write_file(args.json_out); !s) fail(s.error().message);
-    }
-    const auto messages = context->validation_messages();
-    if (messages.errors + messages.warnings > 0) {
-        std::fprintf(stderr, "validation: %u errors, %u warnings\n", messages.errors, messages.warnings);
-        for (const auto& m : messages.recent) std::fprintf(stderr, "%s\n", m.c_str());
-        return 1;
-    }
-    return 0;
+    to_json(session.json, args, header, results, warnings);
+    print_markdown(session.md, args, header, results, warnings);
+    if (session.options.shader_stats) crisp::tools::print_shader_statistics(session.md, header.shader_statistics);
+    for (const std::string& w : warnings) session.warnings.push_back("compositing: " + w);
 }

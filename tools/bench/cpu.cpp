@@ -1,4 +1,5 @@
-// crisp-bench-cpu: measures the CPU half of crisp's run time (no GPU) and prints Markdown tables.
+// crisp-bench --suite cpu (formerly crisp-bench-cpu): measures the CPU half of crisp's run time (no GPU) and prints
+// Markdown tables.
 //
 // Layout: a UI-like frame of about 10,000 glyphs in many short strings (labels, buttons, numbers,
 // a wrapped paragraph), with one font and with a fallback chain; and one million characters as
@@ -6,7 +7,7 @@
 // in a warm atlas, allocation and eviction throughput, and how many atlas entries a page of text
 // needs at each subpixel quantization. Each timed case is warmed up, then timed N times; the
 // tables show the median and the fastest run.
-#include "cli.hpp"
+#include "bench.hpp"
 
 #include <crisp/atlas.hpp>
 #include <crisp/bake.hpp>
@@ -21,7 +22,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <string>
@@ -43,43 +43,18 @@ struct Args {
     std::string only;  // run only the cases whose name contains this
 };
 
-// Parses the command line; prints --help, or the help on stderr and exits 2 on a usage error.
-Args parse(int argc, char** argv) {
-    Args args;
-    crisp::cli::CommandLine cli(
-        "crisp-bench-cpu",
-        "usage: crisp-bench-cpu [options]\n"
-        "Measures crisp's CPU run time: text layout (HarfBuzz shaping, bidi, fallback, line breaking,\n"
-        "glyph keys) and the glyph atlas (look-up, allocation, eviction, reuse), and prints Markdown\n"
-        "tables of median and fastest times.\n\n");
-    cli.on_usage_error(2, "", true);
-    cli.text("--dejavu", "PATH", "DejaVu Sans (default fonts/DejaVuSans.ttf, run from the repository root)",
-             args.dejavu);
-    cli.text("--inter", "PATH", "Inter Regular, first font of the fallback chain (default fonts/Inter-Regular.otf)",
-             args.inter);
-    cli.text("--cjk", "PATH",
-             "Noto Sans CJK collection, third font of the chain\n"
-             "(default /usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc)",
-             args.cjk);
-    cli.number<int>("--runs", "N", "timed runs per case (default 21)", args.runs, {1, 1000000});
-    cli.number<int>("--warmup", "N", "untimed runs first (default 3)", args.warmup, {0, 1000000});
-    cli.text("--only", "TEXT", "run only the cases whose name contains TEXT", args.only);
-    cli.parse(argc, argv);
-    return args;
-}
-
 std::unique_ptr<crisp::Font> load(const std::string& path, crisp::FontId id, std::vector<uint32_t> codepoints) {
     crisp::BakeOptions options;
     options.all_glyphs = codepoints.empty();
     options.codepoints = std::move(codepoints);
     auto baked = crisp::bake_font_file(path, options);
     if (!baked) {
-        std::fprintf(stderr, "crisp-bench-cpu: %s: %s\n", path.c_str(), baked.error().message.c_str());
+        std::fprintf(stderr, "crisp-bench: cpu: %s: %s\n", path.c_str(), baked.error().message.c_str());
         return nullptr;
     }
     auto font = crisp::Font::create(std::move(baked.value().asset), id);
     if (!font) {
-        std::fprintf(stderr, "crisp-bench-cpu: %s: %s\n", path.c_str(), font.error().message.c_str());
+        std::fprintf(stderr, "crisp-bench: cpu: %s: %s\n", path.c_str(), font.error().message.c_str());
         return nullptr;
     }
     return std::make_unique<crisp::Font>(std::move(font).value());
@@ -178,40 +153,26 @@ Measurement measure(int warmup, int runs, const std::function<void()>& body) {
     return {ms[ms.size() / 2], ms.front()};
 }
 
-std::string cpu_model() {
-    std::ifstream cpuinfo("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(cpuinfo, line)) {
-        if (line.rfind("model name", 0) == 0) {
-            const size_t colon = line.find(':');
-            return colon == std::string::npos ? line : line.substr(colon + 2);
-        }
-    }
-    return "unknown CPU";
+void print_row(std::FILE* out, const std::string& name, size_t strings, size_t glyphs, Measurement m) {
+    std::fprintf(out, "| %s | %zu | %zu | %.3f | %.3f | %.1f |\n", name.c_str(), strings, glyphs, m.median_ms,
+                 m.fastest_ms, m.median_ms * 1e6 / static_cast<double>(std::max<size_t>(glyphs, 1)));
 }
 
-void print_row(const std::string& name, size_t strings, size_t glyphs, Measurement m) {
-    std::printf("| %s | %zu | %zu | %.3f | %.3f | %.1f |\n", name.c_str(), strings, glyphs, m.median_ms, m.fastest_ms,
-                m.median_ms * 1e6 / static_cast<double>(std::max<size_t>(glyphs, 1)));
-    std::fflush(stdout);
-}
-
-void print_atlas_row(const std::string& name, size_t glyphs, Measurement m) {
-    std::printf("| %s | %zu | %.3f | %.3f | %.1f |\n", name.c_str(), glyphs, m.median_ms, m.fastest_ms,
-                m.median_ms * 1e6 / static_cast<double>(std::max<size_t>(glyphs, 1)));
-    std::fflush(stdout);
+void print_atlas_row(std::FILE* out, const std::string& name, size_t glyphs, Measurement m) {
+    std::fprintf(out, "| %s | %zu | %.3f | %.3f | %.1f |\n", name.c_str(), glyphs, m.median_ms, m.fastest_ms,
+                 m.median_ms * 1e6 / static_cast<double>(std::max<size_t>(glyphs, 1)));
 }
 
 // The baked fonts and the scratch state the cases share; each group of cases prints its table.
 class Bench {
 public:
-    Bench(const Args& args, const crisp::Font& dejavu, const crisp::Font& inter, const crisp::Font& cjk)
-        : args_(args), all_fonts_{&dejavu, &inter, &cjk}, one_{&dejavu}, chain_{&inter, &dejavu, &cjk} {}
+    Bench(std::FILE* out, const Args& args, const crisp::Font& dejavu, const crisp::Font& inter, const crisp::Font& cjk)
+        : out_(out), args_(args), all_fonts_{&dejavu, &inter, &cjk}, one_{&dejavu}, chain_{&inter, &dejavu, &cjk} {}
 
     // Layout: the UI frame with one font and with the fallback chain, against bare hb_shape.
     void layout_cases() {
-        std::printf("| case | strings | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
-        std::printf("|---|---:|---:|---:|---:|---:|\n");
+        std::fprintf(out_, "| case | strings | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
+        std::fprintf(out_, "|---|---:|---:|---:|---:|---:|\n");
         const crisp::Font& dejavu = *all_fonts_[0];
         const crisp::Font& inter = *all_fonts_[1];
         latin_ = ui_frame(false, 10'000, one_);
@@ -229,12 +190,12 @@ public:
 
     // The atlas: the UI frame looked up in a warm atlas, and allocation and eviction throughput.
     void atlas_cases() {
-        std::printf("\n| atlas case | glyphs | median ms | fastest ms | ns per glyph (median) |\n");
-        std::printf("|---|---:|---:|---:|---:|\n");
+        std::fprintf(out_, "\n| atlas case | glyphs | median ms | fastest ms | ns per glyph (median) |\n");
+        std::fprintf(out_, "|---|---:|---:|---:|---:|\n");
         std::string warm_note;
         if (selected("UI frame + warm atlas")) warm_note = warm_atlas_case();
         if (selected("allocation and eviction")) eviction_case();
-        if (!warm_note.empty()) std::printf("\n%s\n", warm_note.c_str());
+        if (!warm_note.empty()) std::fprintf(out_, "\n%s\n", warm_note.c_str());
     }
 
     // Reuse against subpixel quantization: a page of real text at 16 px, wrapped at 900 px, and
@@ -251,9 +212,9 @@ public:
             "of comparison only.\n";
         std::string page;
         for (int i = 0; i < 6; ++i) page += page_text;
-        std::printf(
-            "\n| subpixel steps per pixel | glyphs on the page | distinct atlas entries | glyphs per entry | "
-            "atlas cells used |\n|---:|---:|---:|---:|---:|\n");
+        std::fprintf(out_,
+                     "\n| subpixel steps per pixel | glyphs on the page | distinct atlas entries | glyphs per entry | "
+                     "atlas cells used |\n|---:|---:|---:|---:|---:|\n");
         for (const uint32_t steps : {256u, 64u, 16u, 8u, 4u, 2u, 1u}) {
             crisp::LayoutOptions options;
             options.origin_x = 10.25f;
@@ -266,17 +227,18 @@ public:
             atlas->begin_frame();
             acquire_all(*atlas, layout_.glyphs);
             const crisp::AtlasStats& stats = atlas->stats();
-            std::printf("| %u | %zu | %u | %.2f | %u |\n", steps, layout_.glyphs.size(), stats.resident_glyphs,
-                        static_cast<double>(layout_.glyphs.size()) / std::max(1u, stats.resident_glyphs),
-                        stats.used_cells);
+            std::fprintf(out_, "| %u | %zu | %u | %.2f | %u |\n", steps, layout_.glyphs.size(), stats.resident_glyphs,
+                         static_cast<double>(layout_.glyphs.size()) / std::max(1u, stats.resident_glyphs),
+                         stats.used_cells);
         }
-        std::printf("\n");
+        std::fprintf(out_, "\n");
     }
 
     // A million characters: one paragraph, 80-column lines, one line, and mixed scripts.
     void large_text_cases() {
-        std::printf("\n| large text | strings | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
-        std::printf("|---|---:|---:|---:|---:|---:|\n");
+        std::fprintf(out_,
+                     "\n| large text | strings | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
+        std::fprintf(out_, "|---|---:|---:|---:|---:|---:|\n");
         std::string million;
         million.reserve(1'000'100);
         const std::string words = "Lorem ipsum dolor sit amet, consectetur adipiscing elit, sed do eiusmod tempor. ";
@@ -296,7 +258,38 @@ public:
                  1000.0f);
     }
 
+    // Every case measured, for the JSON.
+    void write_json(crisp::JsonWriter& json) const {
+        json.key("cases").begin_array();
+        for (const Case& c : cases_) {
+            json.begin_object()
+                .field("name", c.name)
+                .field("strings", c.strings)
+                .field("glyphs", c.glyphs)
+                .field("median_ms", c.m.median_ms)
+                .field("fastest_ms", c.m.fastest_ms)
+                .end_object();
+        }
+        json.end_array();
+    }
+
 private:
+    struct Case {
+        std::string name;
+        size_t strings = 0;
+        size_t glyphs = 0;
+        Measurement m;
+    };
+
+    void print_row(const std::string& name, size_t strings, size_t glyphs, Measurement m) {
+        ::print_row(out_, name, strings, glyphs, m);
+        cases_.push_back({name, strings, glyphs, m});
+    }
+    void print_atlas_row(const std::string& name, size_t glyphs, Measurement m) {
+        ::print_atlas_row(out_, name, glyphs, m);
+        cases_.push_back({name, 0, glyphs, m});
+    }
+
     bool selected(const std::string& name) const { return name.find(args_.only) != std::string::npos; }
 
     // Lays out every label into frame_, as an engine would before uploading it.
@@ -430,6 +423,7 @@ private:
         print_atlas_row(name, 10 * per_frame, m);
     }
 
+    std::FILE* out_;
     const Args& args_;
     std::vector<const crisp::Font*> all_fonts_;  // by FontId - 1
     std::vector<const crisp::Font*> one_;        // DejaVu Sans alone
@@ -438,28 +432,43 @@ private:
     crisp::Layouter layouter_;
     crisp::TextLayout layout_;
     std::vector<crisp::GlyphInstance> frame_;  // what an engine would upload
+    std::vector<Case> cases_;
 };
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    const Args args = parse(argc, argv);
+void crisp::bench::run_cpu(Session& session) {
+    const Options& o = session.options;
+    Args args;
+    args.dejavu = o.dejavu;
+    args.inter = o.inter;
+    args.cjk = o.cjk;
+    args.runs = o.runs.value_or(o.quick ? 1 : args.runs);
+    args.warmup = static_cast<int>(o.warmup.value_or(o.quick ? 0 : static_cast<uint32_t>(args.warmup)));
+    args.only = o.only;
 
     const auto bake_start = Clock::now();
     auto dejavu = load(args.dejavu, 1, {});
     auto inter = load(args.inter, 2, {});
     // A subset: the CJK characters the frame uses, like an asset pipeline would bake.
     auto cjk = load(args.cjk, 3, {0x8A2D, 0x5B9A, 0x4FDD, 0x5B58, 0x6F22, 0x5B57});
-    if (!dejavu || !inter || !cjk) return 1;
+    if (!dejavu || !inter || !cjk) fail("cpu", "a font did not load (the message is above)");
     const double bake_ms = std::chrono::duration<double, std::milli>(Clock::now() - bake_start).count();
 
-    std::printf("Machine: %s, %u hardware threads (one used). Compiler: %s. Fonts baked in %.0f ms.\n\n",
-                cpu_model().c_str(), std::max(1u, static_cast<unsigned>(std::thread::hardware_concurrency())),
-                __VERSION__, bake_ms);
-    Bench bench(args, *dejavu, *inter, *cjk);
+    std::fprintf(session.md,
+                 "Machine: %s, %u hardware threads (one used). Compiler: %s. Fonts baked in %.0f ms. %d timed runs per "
+                 "case after %d untimed (the large-text cases a quarter as many).\n\n",
+                 bench::cpu_model().c_str(), std::max(1u, static_cast<unsigned>(std::thread::hardware_concurrency())),
+                 __VERSION__, bake_ms, args.runs, args.warmup);
+    Bench bench(session.md, args, *dejavu, *inter, *cjk);
+    progress("cpu", "layout cases");
     bench.layout_cases();
+    progress("cpu", "atlas cases");
     bench.atlas_cases();
     bench.quantization_case();
+    progress("cpu", "large text cases");
     bench.large_text_cases();
-    return 0;
+    session.json.begin_object().field("runs", args.runs).field("warmup", args.warmup);
+    bench.write_json(session.json);
+    session.json.end_object();
 }

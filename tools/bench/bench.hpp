@@ -1,0 +1,124 @@
+// crisp-bench: one benchmark tool with suites (docs/benchmarks.md). What the suites share: the
+// option table (options.cpp), the device and the report they write into.
+#pragma once
+
+#include "headless_context.hpp"
+#include "json_writer.hpp"
+
+#include <crisp/compositor.hpp>
+#include <crisp/renderer.hpp>
+
+#include <cstdint>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace crisp::bench {
+
+// The command line. Options several suites read are optional: each suite has its own default,
+// which it uses where the option was not given (the --help text lists them).
+struct Options {
+    std::vector<std::string> suites;  // in the order they run
+    bool quick = false;
+    std::string out_dir = "docs/results";
+    std::string name;  // file name stem; empty: the device's slug
+    bool write_files = true;
+    bool json = false;  // JSON on stdout instead of Markdown
+    std::string json_out;
+    std::string device;
+    bool validate = false;
+    bool validate_sync = false;
+    bool shader_stats = false;  // frames, compositing: the driver's statistics of their shaders
+    std::string command;        // the command line, as the result file records it
+
+    // Shared by several suites.
+    std::vector<std::string> fonts;  // --font: the text's font
+    std::optional<float> size;
+    std::optional<uint32_t> width, height;  // --canvas
+    std::optional<std::string> layout;
+    std::optional<uint32_t> samples;
+    std::optional<uint32_t> frames;
+    std::optional<uint32_t> warmup;
+
+    // frames
+    uint32_t atlas_budget_mib = 0;
+    bool no_shared_rows = false;
+    std::optional<SampleKind> sample_kind;  // none: both
+
+    // compositing
+    std::vector<std::string> modes = {"tiled", "tiled-rebin", "tiled-rgba8", "frame",
+                                      "draw",  "exact",       "unsorted",    "wboit"};
+    std::vector<uint32_t> layers = {1, 2, 4, 8, 16, 32};
+    std::vector<float> alphas = {0.9f, 0.3f};
+    bool scenes_given = false;  // --layers or --alphas
+    std::optional<double> warmup_ms;
+    std::optional<uint32_t> clock_load;
+    uint32_t subpixel_steps = 4;
+    QuadPath quad_path = QuadPath::raster;
+    bool cpu_check = true;
+
+    // frame-cpu
+    std::vector<std::string> variants = {"static", "changed", "moving"};
+
+    // cpu
+    std::string dejavu = "fonts/DejaVuSans.ttf";
+    std::string inter = "fonts/Inter-Regular.otf";
+    std::string cjk = "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc";
+    std::optional<int> runs;
+    std::string only;
+
+    bool given_canvas() const { return width.has_value(); }
+};
+
+// Every suite, in the order `all` runs them.
+struct SuiteInfo {
+    const char* name;
+    const char* summary;
+    bool needs_device;
+};
+inline constexpr SuiteInfo kSuites[] = {
+    {"frames", "GPU ms per frame, new text to converged (was crisp-bench-gpu)", true},
+    {"compositing", "each compositing mode's GPU ms, error and memory (was crisp-bench-composite)", true},
+    {"frame-cpu", "CPU time of a frame of UI text (was crisp-bench-frame)", true},
+    {"cpu", "layout and atlas CPU time (was crisp-bench-cpu)", false},
+};
+
+// Parses argv; prints --help, or exits 2 on a usage error.
+Options parse_options(int argc, char** argv);
+
+// A suite's error that ends the run: "crisp-bench: SUITE: MESSAGE" on stderr, exit 1.
+[[noreturn]] void fail(std::string_view suite, const std::string& message);
+// One line of progress on stderr.
+void progress(std::string_view suite, const std::string& message);
+// The first "model name" of /proc/cpuinfo, and the build type, optimization, assertions and compiler.
+std::string cpu_model();
+std::string build_description();
+
+// One run of the tool: the device (none for the CPU-only suites alone) and the report the suites
+// write into.
+struct Session {
+    explicit Session(const Options& run_options) : options(run_options) {}
+
+    const Options& options;
+    HeadlessContext* context = nullptr;
+    bool storage_without_format = false;
+    bool cpu_device = false;  // lavapipe and the like: the suites pick smaller defaults
+    std::FILE* md = nullptr;  // the Markdown report
+    JsonWriter json;          // inside the "suites" object: each suite writes key(name) and its value
+    std::vector<std::string> warnings;
+
+    void warn(std::string_view suite, const std::string& text);
+    // A heading in the Markdown report.
+    void heading(const std::string& text);
+};
+
+const char* sample_kind_name(SampleKind kind);
+
+void run_frames(Session& session);
+void run_compositing(Session& session);
+void run_frame_cpu(Session& session);
+void run_cpu(Session& session);
+
+}  // namespace crisp::bench

@@ -1,0 +1,219 @@
+// crisp-bench: crisp's benchmarks as suites of one tool. main: the options, the device, each suite
+// in turn, then the report: Markdown on stdout and, unless --no-files, DIR/NAME.md and
+// DIR/NAME.json.
+#include "bench.hpp"
+#include "cli.hpp"
+#include "gpu_tools.hpp"
+#include "vk_resources.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+namespace crisp::bench {
+
+void fail(std::string_view suite, const std::string& message) {
+    std::fprintf(stderr, "crisp-bench: %.*s: %s\n", static_cast<int>(suite.size()), suite.data(), message.c_str());
+    std::exit(1);
+}
+
+void progress(std::string_view suite, const std::string& message) {
+    std::fprintf(stderr, "[%.*s] %s\n", static_cast<int>(suite.size()), suite.data(), message.c_str());
+}
+
+void Session::warn(std::string_view suite, const std::string& text) {
+    std::fprintf(stderr, "crisp-bench: %.*s: warning: %s\n", static_cast<int>(suite.size()), suite.data(),
+                 text.c_str());
+    warnings.push_back(std::string(suite) + ": " + text);
+}
+
+void Session::heading(const std::string& text) {
+    std::fprintf(md, "\n### %s\n\n", text.c_str());
+}
+
+const char* sample_kind_name(SampleKind kind) {
+    return kind == SampleKind::rows ? "rows" : "points";
+}
+
+std::string cpu_model() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("model name", 0) != 0) continue;
+        const size_t colon = line.find(':');
+        if (colon != std::string::npos) return line.substr(std::min(colon + 2, line.size()));
+    }
+    return "unknown CPU";
+}
+
+std::string build_description() {
+    std::string build = CRISP_BENCH_BUILD_TYPE[0] ? CRISP_BENCH_BUILD_TYPE : "no CMAKE_BUILD_TYPE";
+#ifdef __OPTIMIZE__
+    build += ", optimized";
+#else
+    build += ", NOT optimized";
+#endif
+#ifdef NDEBUG
+    build += ", assertions off";
+#else
+    build += ", assertions on";
+#endif
+#if defined(__clang__)
+    build += ", Clang " __clang_version__;
+#elif defined(__GNUC__)
+    build += ", GCC " __VERSION__;
+#endif
+    return build;
+}
+
+namespace {
+
+// The device's name as a file name: lavapipe for Mesa's llvmpipe, else lower case with runs of
+// anything but letters and digits as one '-' ("NVIDIA H200" -> nvidia-h200).
+std::string device_slug(const HeadlessContext* context) {
+    if (!context) return "cpu";
+    if (context->driver_name() == "llvmpipe") return "lavapipe";
+    std::string slug;
+    for (const char c : context->device_name()) {
+        if (std::isalnum(static_cast<unsigned char>(c))) {
+            slug += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        } else if (!slug.empty() && slug.back() != '-') {
+            slug += '-';
+        }
+    }
+    while (!slug.empty() && slug.back() == '-') slug.pop_back();
+    return slug.empty() ? "device" : slug;
+}
+
+std::string utc_now() {
+    const std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    char text[32];
+    std::strftime(text, sizeof text, "%Y-%m-%d %H:%M UTC", &tm);
+    return text;
+}
+
+void run_suite(Session& session, const std::string& name) {
+    if (name == "frames") return run_frames(session);
+    if (name == "compositing") return run_compositing(session);
+    if (name == "frame-cpu") return run_frame_cpu(session);
+    if (name == "cpu") return run_cpu(session);
+}
+
+}  // namespace
+}  // namespace crisp::bench
+
+int main(int argc, char** argv) {
+    using namespace crisp::bench;
+    const Options options = parse_options(argc, argv);
+
+    const bool needs_device = std::any_of(options.suites.begin(), options.suites.end(), [](const std::string& name) {
+        return std::any_of(std::begin(kSuites), std::end(kSuites),
+                           [&](const SuiteInfo& s) { return name == s.name && s.needs_device; });
+    });
+    std::optional<crisp::HeadlessContext> context;
+    Session session(options);
+    if (needs_device) {
+        crisp::HeadlessContextOptions context_options;
+        context_options.validation = options.validate;
+        context_options.synchronization_validation = options.validate_sync;
+        context_options.device_name_contains = options.device;
+        context_options.shader_statistics = options.shader_stats;
+        auto made = crisp::tools::create_context(context_options, session.storage_without_format);
+        if (!made) fail("device", made.error().message);
+        context = std::move(*made);
+        session.context = &*context;
+        session.cpu_device = context->properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    }
+
+    char* body = nullptr;
+    size_t body_size = 0;
+    session.md = open_memstream(&body, &body_size);
+    if (!session.md) fail("report", "open_memstream failed");
+    session.json.begin_object().key("suites").begin_object();
+    for (const std::string& suite : options.suites) {
+        const auto start = std::chrono::steady_clock::now();
+        progress(suite, "start");
+        const auto info =
+            std::find_if(std::begin(kSuites), std::end(kSuites), [&](const SuiteInfo& s) { return suite == s.name; });
+        std::fprintf(session.md, "\n## %s: %s\n\n", suite.c_str(), info->summary);
+        session.json.key(suite);
+        run_suite(session, suite);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        progress(suite, "done in " + std::to_string(static_cast<int>(seconds + 0.5)) + " s");
+        std::fprintf(session.md, "\n(%s suite: %.0f s of wall time.)\n", suite.c_str(), seconds);
+    }
+    std::fclose(session.md);
+    const std::string tables(body, body_size);
+    std::free(body);
+
+    const std::string device = context ? context->device_name() : "none (CPU suites only)";
+    const std::string driver = context ? context->driver_name() + " (" + context->driver_info() + ")" : "";
+    std::string header = "# crisp-bench: " + device + "\n\nMade by (from the repository root, a " +
+                         "RelWithDebInfo or Release build):\n\n    " + options.command + "\n\n";
+    header += "Device: " + device + (driver.empty() ? "" : ", driver " + driver) +
+              (context ? ", Vulkan " + crisp::vk::version_string(context->api_version()) : "") +
+              ". CPU: " + cpu_model() + ", " + std::to_string(std::thread::hardware_concurrency()) +
+              " hardware threads. Build: " + build_description() + ". Run " + utc_now() +
+              (options.quick ? "; --quick: the numbers mean little" : "") +
+              (options.validate ? "; validation layer on: the times are not the library's" : "") + ".\n";
+
+    session.json.end_object()
+        .field("tool", "crisp-bench")
+        .field("command", options.command)
+        .field("device", device)
+        .field("driver", driver)
+        .field("cpu_device", session.cpu_device)
+        .field("cpu", cpu_model())
+        .field("hardware_threads", std::thread::hardware_concurrency())
+        .field("build", build_description())
+        .field("date", utc_now())
+        .field("quick", options.quick)
+        .field("validation", options.validate)
+        .field("warnings", session.warnings)
+        .end_object();
+
+    if (options.write_files) {
+        const std::string name =
+            !options.name.empty() ? options.name : device_slug(session.context) + (options.quick ? "-quick" : "");
+        std::error_code ec;
+        std::filesystem::create_directories(options.out_dir, ec);
+        const std::filesystem::path json_path = std::filesystem::path(options.out_dir) / (name + ".json");
+        if (crisp::Status s = session.json.write_file(json_path); !s) fail("report", s.error().message);
+        const std::filesystem::path md_path = std::filesystem::path(options.out_dir) / (name + ".md");
+        std::ofstream md(md_path, std::ios::binary);
+        md << header;
+        if (!session.warnings.empty()) {
+            md << "\nWarnings:\n\n";
+            for (const std::string& w : session.warnings) md << "- " << w << "\n";
+        }
+        md << tables;
+        if (!md.good()) fail("report", "could not write " + md_path.string());
+        progress("report", "wrote " + md_path.string() + " and " + json_path.string());
+    }
+    if (options.json) {
+        std::fputs(session.json.line().c_str(), stdout);
+    } else {
+        std::fputs((header + tables).c_str(), stdout);
+    }
+    if (!options.json_out.empty()) {
+        if (crisp::Status s = session.json.write_file(options.json_out); !s) fail("report", s.error().message);
+    }
+    if (context) {
+        const auto messages = context->validation_messages();
+        if (messages.errors + messages.warnings > 0) {
+            std::fprintf(stderr, "validation: %u errors, %u warnings\n", messages.errors, messages.warnings);
+            for (const auto& m : messages.recent) std::fprintf(stderr, "%s\n", m.c_str());
+            return 1;
+        }
+    }
+    return 0;
+}
