@@ -1,5 +1,7 @@
 // crisp-bench: one benchmark tool with suites (docs/benchmarks.md). What the suites share: the
-// option table (options.cpp), the device and the report they write into.
+// option table (options.cpp), the device, the report they write into, and what one suite leaves
+// for another (the frames suite's GPU time per sample count, which the coverage suite's errors
+// are plotted against).
 #pragma once
 
 #include "headless_context.hpp"
@@ -10,6 +12,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -34,7 +37,7 @@ struct Options {
     std::string command;        // the command line, as the result file records it
 
     // Shared by several suites.
-    std::vector<std::string> fonts;  // --font: the text's font
+    std::vector<std::string> fonts;  // --font: the text's font; coverage: fonts added to its set
     std::optional<float> size;
     std::optional<uint32_t> width, height;  // --canvas
     std::optional<std::string> layout;
@@ -69,7 +72,9 @@ struct Options {
     std::optional<int> runs;
     std::string only;
 
-    bool given_canvas() const { return width.has_value(); }
+    // coverage
+    uint32_t cells_gray = 16;
+    uint32_t cells_rgb = 64;
 };
 
 // Every suite, in the order `all` runs them.
@@ -80,6 +85,7 @@ struct SuiteInfo {
 };
 inline constexpr SuiteInfo kSuites[] = {
     {"frames", "GPU ms per frame, new text to converged (was crisp-bench-gpu)", true},
+    {"coverage", "atlas error against FreeType's exact area coverage per sample count; FreeType as a peer", true},
     {"compositing", "each compositing mode's GPU ms, error and memory (was crisp-bench-composite)", true},
     {"frame-cpu", "CPU time of a frame of UI text (was crisp-bench-frame)", true},
     {"cpu", "layout and atlas CPU time (was crisp-bench-cpu)", false},
@@ -96,8 +102,22 @@ void progress(std::string_view suite, const std::string& message);
 std::string cpu_model();
 std::string build_description();
 
-// One run of the tool: the device (none for the CPU-only suites alone) and the report the suites
-// write into.
+// What the frames suite measured, per layout and sample kind: the samples each glyph holds after
+// each frame, and the GPU ms summed through that frame.
+struct TimeCurve {
+    std::vector<uint32_t> samples;
+    std::vector<double> cumulative_ms;
+};
+// What the coverage suite measured, per layout and sample kind: the errors at each sample count.
+struct ErrorPoint {
+    uint32_t samples = 0;
+    double mean = 0.0;   // mean absolute error per texel channel, averaged over the glyphs
+    double worst = 0.0;  // the worst single texel channel over the glyphs
+};
+using CurveKey = std::pair<std::string, std::string>;  // layout, sample kind ("rows", "points")
+
+// One run of the tool: the device (none for the CPU-only suites alone), the report the suites
+// write into, and what they leave for each other.
 struct Session {
     explicit Session(const Options& run_options) : options(run_options) {}
 
@@ -109,6 +129,12 @@ struct Session {
     JsonWriter json;          // inside the "suites" object: each suite writes key(name) and its value
     std::vector<std::string> warnings;
 
+    std::map<CurveKey, TimeCurve> frame_time;
+    std::map<std::string, double> freetype_screen_ms;  // peer mode ("gray", "lcd") -> CPU ms, the frames' screen
+    size_t frames_screen_entries = 0;
+    std::map<CurveKey, std::vector<ErrorPoint>> coverage_error;
+    std::map<std::string, ErrorPoint> freetype_error;  // peer mode -> error (samples 0)
+
     void warn(std::string_view suite, const std::string& text);
     // A heading in the Markdown report.
     void heading(const std::string& text);
@@ -117,6 +143,7 @@ struct Session {
 const char* sample_kind_name(SampleKind kind);
 
 void run_frames(Session& session);
+void run_coverage(Session& session);
 void run_compositing(Session& session);
 void run_frame_cpu(Session& session);
 void run_cpu(Session& session);

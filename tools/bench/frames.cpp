@@ -1,9 +1,11 @@
 // crisp-bench --suite frames (formerly crisp-bench-gpu): GPU time of the rasterizer for a screen of
 // text, from its first frame (new glyphs, 8 samples each) through the converging frames to
 // converged static text, per subpixel layout and sample kind. Measures with Vulkan timestamp
-// queries around the recorded work.
+// queries around the recorded work. Also FreeType's CPU time for the same new glyphs (the peer of
+// the coverage suite), so that error can be set against time.
 #include "bench.hpp"
 #include "frame_loop.hpp"
+#include "freetype_reference.hpp"
 #include "gpu_tools.hpp"
 #include "headless_context.hpp"
 
@@ -14,7 +16,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <set>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace crisp::bench {
@@ -128,6 +133,26 @@ void print_markdown(std::FILE* out, const FrameArgs& args, const crisp::Renderer
                  renderer.converged() ? "yes" : "no");
 }
 
+// FreeType's CPU time to render the screen's atlas entries once each (the median of 3 renders of
+// each), in `mode`: what the peer spends on the same new glyphs.
+double freetype_screen_ms(const std::string& font_path, const Font& font, const Renderer& renderer,
+                          freetype::PeerMode mode) {
+    auto face = freetype::Face::open_file(font_path);
+    if (!face) fail(font_path + ": " + face.error().message);
+    std::set<std::tuple<uint32_t, uint32_t, uint32_t, uint8_t, uint8_t>> seen;
+    double seconds = 0.0;
+    for (const DrawnGlyph& d : renderer.drawn()) {
+        const GlyphKey& key = d.instance.key;
+        if (!seen.emplace(key.glyph, key.size_x, key.size_y, key.subpixel_x, key.subpixel_y).second) continue;
+        const GlyphRect rect = glyph_rect(font.asset().glyphs[key.glyph], key);
+        if (rect.width == 0) continue;
+        auto peer = freetype::render_peer(*face, key, rect, mode, 3);
+        if (!peer) fail("FreeType: " + peer.error().message);
+        seconds += peer->seconds_per_glyph;
+    }
+    return seconds * 1e3;
+}
+
 void write_run_json(JsonWriter& json, const FrameArgs& args, const Renderer& renderer, size_t screen_glyphs,
                     const std::vector<Frame>& frames) {
     json.begin_object()
@@ -202,9 +227,37 @@ void run_frames(Session& session) {
             print_markdown(session.md, args, renderer, layout->name, screen.size(), frames);
             if (o.shader_stats) tools::print_shader_statistics(session.md, renderer.shader_statistics());
             write_run_json(session.json, args, renderer, screen.size(), frames);
+
+            TimeCurve& curve = session.frame_time[{layout->name, sample_kind_name(kind)}];
+            double samples = 0.0, ms = 0.0;
+            for (const Frame& f : frames) {
+                if (f.items == 0) break;
+                samples += static_cast<double>(f.samples) / f.items;
+                ms += f.gpu_ms;
+                curve.samples.push_back(static_cast<uint32_t>(samples + 0.5));
+                curve.cumulative_ms.push_back(ms);
+            }
+            // FreeType, the coverage suite's peer, on the same new glyphs: gray beside gray, LCD beside rgb.
+            std::vector<std::pair<freetype::PeerMode, const char*>> peers;
+            if (layout->name == "gray") peers = {{freetype::PeerMode::gray, "gray"}};
+            if (layout->name == "rgb") {
+                peers = {{freetype::PeerMode::lcd, "lcd"}, {freetype::PeerMode::lcd_unfiltered, "lcd-unfiltered"}};
+            }
+            for (const auto& [peer, peer_name] : peers) {
+                if (session.freetype_screen_ms.count(peer_name)) continue;
+                session.freetype_screen_ms[peer_name] = freetype_screen_ms(args.font, *font, renderer, peer);
+                session.frames_screen_entries = renderer.atlas().stats().resident_glyphs;
+                std::fprintf(
+                    session.md,
+                    "\nFreeType %s (the coverage suite's peer) renders the same %u atlas entries in %.3f ms of "
+                    "CPU time on one thread.\n",
+                    peer_name, renderer.atlas().stats().resident_glyphs, session.freetype_screen_ms[peer_name]);
+            }
         }
     }
-    session.json.end_array().end_object();
+    session.json.end_array().key("freetype_screen_ms").begin_object();
+    for (const auto& [mode, ms] : session.freetype_screen_ms) session.json.field(mode, ms);
+    session.json.end_object().field("screen_atlas_entries", session.frames_screen_entries).end_object();
 }
 
 }  // namespace crisp::bench

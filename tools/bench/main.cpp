@@ -103,9 +103,42 @@ std::string utc_now() {
 
 void run_suite(Session& session, const std::string& name) {
     if (name == "frames") return run_frames(session);
+    if (name == "coverage") return run_coverage(session);
     if (name == "compositing") return run_compositing(session);
     if (name == "frame-cpu") return run_frame_cpu(session);
     if (name == "cpu") return run_cpu(session);
+}
+
+// The error at each sample count against the GPU ms the frames suite spent reaching that count:
+// where both suites ran, per layout and sample kind.
+void print_error_against_time(Session& session) {
+    if (session.frame_time.empty() || session.coverage_error.empty()) return;
+    std::fprintf(session.md, "\n## Error against cumulative GPU time (frames and coverage together)\n\n");
+    std::fprintf(session.md,
+                 "The coverage suite's error at N samples, against the GPU ms the frames suite's screen took to give "
+                 "every glyph N samples (the frames summed from new text on; N only where a frame ends on it). "
+                 "FreeType: its error, against the CPU ms (one thread) it takes to render the screen's %zu atlas "
+                 "entries.\n\n",
+                 session.frames_screen_entries);
+    std::fprintf(session.md,
+                 "| layout | samples | cumulative GPU ms | mean | worst texel |\n|---|---|---:|---:|---:|\n");
+    for (const auto& [key, curve] : session.frame_time) {
+        const auto errors = session.coverage_error.find(key);
+        if (errors == session.coverage_error.end()) continue;
+        for (const ErrorPoint& e : errors->second) {
+            for (size_t f = 0; f < curve.samples.size(); ++f) {
+                if (curve.samples[f] != e.samples) continue;
+                std::fprintf(session.md, "| %s | %u %s | %.1f | %.4f | %.4f |\n", key.first.c_str(), e.samples,
+                             key.second.c_str(), curve.cumulative_ms[f], e.mean, e.worst);
+            }
+        }
+    }
+    for (const auto& [mode, ms] : session.freetype_screen_ms) {
+        const auto error = session.freetype_error.find(mode);
+        if (error == session.freetype_error.end()) continue;
+        std::fprintf(session.md, "| %s | FreeType %s (CPU ms) | %.2f | %.4f | %.4f |\n",
+                     mode == "gray" ? "gray" : "rgb", mode.c_str(), ms, error->second.mean, error->second.worst);
+    }
 }
 
 }  // namespace
@@ -151,6 +184,7 @@ int main(int argc, char** argv) {
         progress(suite, "done in " + std::to_string(static_cast<int>(seconds + 0.5)) + " s");
         std::fprintf(session.md, "\n(%s suite: %.0f s of wall time.)\n", suite.c_str(), seconds);
     }
+    print_error_against_time(session);
     std::fclose(session.md);
     const std::string tables(body, body_size);
     std::free(body);

@@ -102,18 +102,23 @@ void declare_run_options(cli::CommandLine& cli, Options& o) {
 
 void declare_shared_options(cli::CommandLine& cli, Options& o) {
     cli.section("options several suites read (each suite's default in brackets):");
-    cli.option("--font", "PATH", "the text's font, baked at start [fonts/DejaVuSans.ttf]", [&o](std::string_view text) {
-        o.fonts.emplace_back(text);
-        return Status{};
-    });
+    cli.option("--font", "PATH",
+               "the text's font, baked at start [fonts/DejaVuSans.ttf];\n"
+               "coverage: a font added to its glyph set (repeatable)",
+               [&o](std::string_view text) {
+                   o.fonts.emplace_back(text);
+                   return Status{};
+               });
     cli.number<float>("--size", "PX", "pixels per em [frames, frame-cpu 16; compositing 18]", o.size, {4.0f, 256.0f});
     cli.option("--canvas", "WxH",
                "the target, also W,H [frames, frame-cpu 1920x1080, on a CPU device\n"
                "640x360; compositing 512x256]",
                [&o](std::string_view text) { return parse_canvas(o, text); });
     cli.text("--layout", "NAME", "subpixel layout preset or file [frames: gray and rgb; compositing rgb]", o.layout);
-    cli.number<uint32_t>("--samples", "N", "samples per glyph to converge to [512; frames: 16 with --quick]", o.samples,
-                         {1, 65536});
+    cli.number<uint32_t>("--samples", "N",
+                         "samples per glyph to converge to [512; frames, coverage: 16 with --quick];\n"
+                         "coverage: its largest sample count",
+                         o.samples, {1, 65536});
     cli.number<uint32_t>("--frames", "N",
                          "frames: stop after N frames even if not converged [1000];\n"
                          "compositing: timed frames per mode [10]; frame-cpu: per variant [1000]",
@@ -130,9 +135,14 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
                          "let the 2048x2048 atlas grow to MIB mebibytes (default 0: it does not)", o.atlas_budget_mib);
     cli.flag("--no-shared-rows", "solve roots per channel even where channels share rows", o.no_shared_rows);
     cli.choice<std::optional<SampleKind>>(
-        "--sample-kind", "KIND", "rows (exact in x) or points (default: both)", o.sample_kind,
+        "--sample-kind", "KIND", "rows (exact in x) or points (default: both; coverage too)", o.sample_kind,
         {SampleKind::rows, SampleKind::points},
         [](const std::optional<SampleKind>& kind) { return std::string(kind ? sample_kind_name(*kind) : ""); });
+
+    cli.section("coverage:");
+    cli.number<uint32_t>("--cells-gray", "S", "reference cells per texel side for gray (default 16)", o.cells_gray,
+                         {1, 256});
+    cli.number<uint32_t>("--cells-rgb", "S", "... for rgb thirds (default 64)", o.cells_rgb, {1, 256});
 
     cli.section("compositing:");
     cli.option("--modes", "LIST",

@@ -1,0 +1,456 @@
+// crisp-bench --suite coverage: how far crisp's atlas is from exact area coverage after N samples
+// (N = 1, 2, 4, ..., --samples), per sample kind (rows, points) and layout (gray, rgb thirds), on a
+// varied set of glyphs, with FreeType's CPU rasterizer as a peer on the same texels. The reference
+// is not crisp's own sampler: FreeType's area coverage of the original outline on a grid of S x S
+// cells per texel (support/freetype_reference.hpp, docs/coverage.md).
+#include "bench.hpp"
+#include "freetype_reference.hpp"
+#include "harness.hpp"
+#include "utf8.hpp"
+
+#include <crisp/bake.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/renderer.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace crisp::bench {
+namespace {
+
+constexpr std::string_view kSuite = "coverage";
+
+// One entry of the glyph set: the glyphs of `text` in a font at a size.
+struct GlyphSpec {
+    std::string path;
+    uint32_t face = 0;
+    std::vector<Variation> variations;
+    std::string text;
+    float size = 16.0f;
+    std::string what;
+};
+
+constexpr uint32_t tag(const char (&name)[5]) {
+    return uint32_t(uint8_t(name[0])) << 24 | uint32_t(uint8_t(name[1])) << 16 | uint32_t(uint8_t(name[2])) << 8 |
+           uint32_t(uint8_t(name[3]));
+}
+
+const char* const kNotoCjk = "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc";
+const char* const kDejaVuSerifItalic = "/usr/share/fonts/truetype/dejavu/DejaVuSerif-Italic.ttf";
+
+// The glyph set: TrueType and CFF, a hairline (Inter at weight 100), a variable font's overlapping
+// contours (Inter's default instance keeps them), italic, CJK, and 4 to 240 px. The system fonts
+// (scripts/setup.sh installs them) are left out, with a warning, where they are missing.
+std::vector<GlyphSpec> glyph_set(const Options& options) {
+    std::vector<GlyphSpec> set;
+    if (options.quick) {
+        set = {{"fonts/DejaVuSans.ttf", 0, {}, "g", 13.0f, "TrueType"},
+               {"fonts/Inter-Regular.otf", 0, {}, "S", 9.0f, "CFF"},
+               {"fonts/Inter-roman.var.ttf", 0, {{tag("wght"), 100.0f}}, "k", 12.0f, "variable, wght 100 (hairline)"}};
+    } else {
+        set = {
+            {"fonts/DejaVuSans.ttf", 0, {}, "g@", 13.0f, "TrueType"},
+            {"fonts/DejaVuSans.ttf", 0, {}, "e&", 4.0f, "TrueType, 4 px"},
+            {"fonts/DejaVuSans.ttf", 0, {}, "a", 48.0f, "TrueType"},
+            {"fonts/DejaVuSans.ttf", 0, {}, "e", 240.0f, "TrueType, 240 px"},
+            {"fonts/Inter-Regular.otf", 0, {}, "Sa", 9.0f, "CFF"},
+            {"fonts/Inter-Regular.otf", 0, {}, "R", 16.0f, "CFF"},
+            {"fonts/Inter-roman.var.ttf", 0, {{tag("wght"), 100.0f}}, "kM", 16.0f, "variable, wght 100 (hairline)"},
+            {"fonts/Inter-roman.var.ttf", 0, {}, "Ak$", 20.0f, "variable, overlapping contours"},
+            {kDejaVuSerifItalic, 0, {}, "fy", 18.0f, "italic"},
+            {kNotoCjk, 0, {}, "\u6c38", 13.0f, "CJK, CFF"},
+            {kNotoCjk, 0, {}, "\u9f98", 24.0f, "CJK, hundreds of curves"},
+        };
+    }
+    for (const std::string& path : options.fonts) set.push_back({path, 0, {}, "Ag&", 16.0f, "--font"});
+    return set;
+}
+
+// A font of the set, baked with the text it draws, its FreeType face, and its FontId (index + 1).
+struct LoadedFont {
+    std::string path;
+    std::vector<Variation> variations;
+    std::unique_ptr<Font> font;
+    std::unique_ptr<freetype::Face> face;
+};
+
+// One glyph instance of the set, where it is drawn, and what it is.
+struct SetGlyph {
+    GlyphInstance instance;
+    const GlyphSpec* spec = nullptr;
+    uint32_t codepoint = 0;
+};
+
+std::string describe_variations(const std::vector<Variation>& variations) {
+    std::string text;
+    for (const Variation& v : variations) {
+        const char name[5] = {char(v.tag >> 24), char(v.tag >> 16), char(v.tag >> 8), char(v.tag), 0};
+        text += std::string(text.empty() ? "" : ",") + name + "=" + std::to_string(static_cast<int>(v.value));
+    }
+    return text;
+}
+
+class Coverage {
+public:
+    Coverage(Session& session) : session_(session), options_(session.options) {}
+
+    void load(Session& session) {
+        uint32_t line = 0;
+        for (const GlyphSpec& spec : specs_) {
+            if (!std::filesystem::exists(spec.path)) {
+                session.warn(kSuite, spec.path + " is missing (scripts/setup.sh installs it): its glyphs are left out");
+                continue;
+            }
+            LoadedFont& font = font_for(spec);
+            const Font* fonts[] = {font.font.get()};
+            TextStyle style;
+            style.size = spec.size;
+            LayoutOptions layout_options;
+            layout_options.origin_x = 3.37f;
+            layout_options.origin_y = 0.61f + static_cast<float>(++line) * 300.0f;
+            auto laid = layout_text(fonts, spec.text, style, layout_options);
+            if (!laid) fail(kSuite, spec.path + ": " + laid.error().message);
+            const std::vector<uint32_t> codepoints = decode_utf8(spec.text);
+            for (size_t i = 0; i < laid->glyphs.size(); ++i) {
+                if (laid->glyphs[i].width == 0) continue;
+                glyphs_.push_back({laid->glyphs[i], &spec, i < codepoints.size() ? codepoints[i] : 0});
+            }
+        }
+        if (glyphs_.empty()) fail(kSuite, "no glyph of the set could be loaded");
+    }
+
+    void run() {
+        const uint32_t max_samples = options_.samples.value_or(options_.quick ? 16 : 512);
+        std::vector<SampleKind> kinds = {SampleKind::rows, SampleKind::points};
+        if (options_.sample_kind) kinds = {*options_.sample_kind};
+        print_glyph_set();
+        session_.json.begin_object();
+        write_glyph_set_json(max_samples);
+        session_.json.key("runs").begin_array();
+        for (const char* layout_name : {"gray", "rgb"}) {
+            const SubpixelLayout layout = *subpixel_preset(layout_name);
+            const uint32_t cells = std::string(layout_name) == "gray" ? options_.cells_gray : options_.cells_rgb;
+            progress(kSuite, std::string(layout_name) + ": reference coverage, " + std::to_string(cells) + "x" +
+                                 std::to_string(cells) + " cells per texel, " + std::to_string(glyphs_.size()) +
+                                 " glyphs");
+            const std::vector<freetype::CoverageImage> references = reference_images(layout, cells);
+            session_.heading(std::string("coverage: ") + layout_name);
+            std::map<std::string, std::vector<ErrorPoint>> by_kind;
+            for (const SampleKind kind : kinds) {
+                by_kind[sample_kind_name(kind)] = measure_crisp(layout, layout_name, kind, max_samples, references);
+            }
+            print_table(layout_name, kinds, by_kind);
+            peers(layout_name, references);
+        }
+        session_.json.end_array();
+        write_peers_json();
+        session_.json.end_object();
+    }
+
+private:
+    LoadedFont& font_for(const GlyphSpec& spec) {
+        for (LoadedFont& f : fonts_) {
+            if (f.path == spec.path && describe_variations(f.variations) == describe_variations(spec.variations)) {
+                return f;
+            }
+        }
+        std::string text;
+        for (const GlyphSpec& s : specs_) {
+            if (s.path == spec.path && describe_variations(s.variations) == describe_variations(spec.variations)) {
+                text += s.text;
+            }
+        }
+        BakeOptions bake;
+        bake.all_glyphs = false;
+        bake.codepoints = decode_utf8(text);
+        bake.face_index = spec.face;
+        bake.variations = spec.variations;
+        auto baked = bake_font_file(spec.path, bake);
+        if (!baked) fail(kSuite, spec.path + ": " + baked.error().message);
+        auto font = Font::create(std::move(baked->asset), static_cast<FontId>(fonts_.size() + 1));
+        if (!font) fail(kSuite, spec.path + ": " + font.error().message);
+        auto face = freetype::Face::open_file(spec.path, spec.face, spec.variations);
+        if (!face) fail(kSuite, spec.path + ": FreeType: " + face.error().message);
+        fonts_.push_back({spec.path, spec.variations, std::make_unique<Font>(std::move(*font)),
+                          std::make_unique<freetype::Face>(std::move(*face))});
+        return fonts_.back();
+    }
+
+    LoadedFont& font_of(const GlyphInstance& g) { return fonts_[g.key.font - 1]; }
+    GlyphRect rect_of(const GlyphInstance& g) {
+        return glyph_rect(font_of(g).font->asset().glyphs[g.key.glyph], g.key);
+    }
+
+    std::vector<freetype::CoverageImage> reference_images(const SubpixelLayout& layout, uint32_t cells) {
+        std::vector<freetype::CoverageImage> images;
+        for (const SetGlyph& g : glyphs_) {
+            auto image = freetype::reference_coverage(*font_of(g.instance).face, g.instance.key, rect_of(g.instance),
+                                                      layout, cells);
+            if (!image) fail(kSuite, g.spec->path + ": reference: " + image.error().message);
+            images.push_back(std::move(*image));
+        }
+        return images;
+    }
+
+    // The atlas after every power-of-two sample count: a renderer whose ramp adds 1, 1, 2, 4, ...
+    // samples, so that frame k ends on 2^(k-1) samples, with an unbounded frame budget.
+    std::vector<ErrorPoint> measure_crisp(const SubpixelLayout& layout, const char* layout_name, SampleKind kind,
+                                          uint32_t max_samples,
+                                          const std::vector<freetype::CoverageImage>& references) {
+        HeadlessContext& context = *session_.context;
+        RendererCreateInfo info = renderer_create_info(context);
+        info.layout = layout;
+        info.sample_kind = kind;
+        info.atlas.width = info.atlas.height = 1024;
+        info.atlas.max_samples = max_samples;
+        info.atlas.frame_budget = uint64_t{1} << 50;
+        info.atlas.ramp = {1};
+        for (uint32_t n = 1; 2 * n <= max_samples; n *= 2) info.atlas.ramp.push_back(n);
+        info.atlas.steady = 1;
+        auto renderer = Renderer::create(info);
+        if (!renderer) fail(kSuite, renderer.error().message);
+        for (const LoadedFont& f : fonts_) {
+            if (Status s = renderer->add_font(*f.font); !s) fail(kSuite, s.error().message);
+        }
+        std::vector<GlyphInstance> instances;
+        for (const SetGlyph& g : glyphs_) instances.push_back(g.instance);
+
+        std::vector<ErrorPoint> points;
+        session_.json.begin_object()
+            .field("layout", layout_name)
+            .field("sample_kind", sample_kind_name(kind))
+            .key("points")
+            .begin_array();
+        uint32_t expected = 0;
+        for (size_t frame = 0; frame < info.atlas.ramp.size() || expected < max_samples; ++frame) {
+            expected += frame < info.atlas.ramp.size() ? info.atlas.ramp[frame] : info.atlas.steady;
+            expected = std::min(expected, max_samples);
+            const Result<uint32_t> rendered =
+                harness::render_until_converged(context, *renderer, 1, [&] { renderer->draw(instances); });
+            if (!rendered) fail(kSuite, rendered.error().message);
+            if ((expected & (expected - 1)) != 0 && expected != max_samples) continue;
+            progress(kSuite, std::string(layout_name) + ", " + sample_kind_name(kind) + ": " +
+                                 std::to_string(expected) + " samples");
+            points.push_back(errors_at(*renderer, expected, references));
+            if (expected == max_samples) break;
+        }
+        session_.json.end_array().end_object();
+        session_.coverage_error[{layout_name, sample_kind_name(kind)}] = points;
+        return points;
+    }
+
+    // The atlas read back, each glyph's texels against its reference.
+    ErrorPoint errors_at(const Renderer& renderer, uint32_t samples,
+                         const std::vector<freetype::CoverageImage>& references) {
+        Result<std::vector<harness::Texel>> atlas = harness::read_atlas(*session_.context, renderer);
+        if (!atlas) fail(kSuite, atlas.error().message);
+        const uint32_t atlas_width = renderer.atlas().config().width;
+        std::vector<freetype::CoverageImage> images(glyphs_.size());
+        for (size_t i = 0; i < glyphs_.size(); ++i) {
+            const GlyphRect rect = rect_of(glyphs_[i].instance);
+            images[i].width = rect.width;
+            images[i].height = rect.height;
+            images[i].values.assign(size_t{rect.width} * rect.height * 3, 0.0f);
+        }
+        uint64_t wrong_counts = 0;
+        for (const DrawnGlyph& d : renderer.drawn()) {
+            size_t i = 0;
+            while (i < glyphs_.size() && !(glyphs_[i].instance.key == d.instance.key)) ++i;
+            if (i == glyphs_.size()) continue;
+            freetype::CoverageImage& image = images[i];
+            for (uint32_t ty = 0; ty < d.instance.height; ++ty) {
+                for (uint32_t tx = 0; tx < d.instance.width; ++tx) {
+                    const harness::Texel& t = (*atlas)[size_t{d.atlas_y + ty} * atlas_width + d.atlas_x + tx];
+                    if (t.count != samples) ++wrong_counts;
+                    const float scale =
+                        static_cast<float>(kCoverageOne) * static_cast<float>(std::max<uint16_t>(t.count, 1));
+                    const uint16_t sums[3] = {t.r, t.g, t.b};
+                    const size_t column = tx + d.part_x, row = ty + d.part_y;
+                    if (column >= image.width || row >= image.height) continue;
+                    for (size_t c = 0; c < 3; ++c) {
+                        image.values[(row * image.width + column) * 3 + c] = static_cast<float>(sums[c]) / scale;
+                    }
+                }
+            }
+        }
+        if (wrong_counts > 0) {
+            session_.warn(kSuite, std::to_string(wrong_counts) + " texels did not hold " + std::to_string(samples) +
+                                      " samples when read");
+        }
+        ErrorPoint point;
+        point.samples = samples;
+        std::vector<double> means, worsts;
+        for (size_t i = 0; i < glyphs_.size(); ++i) {
+            auto error = freetype::compare_coverage(images[i], references[i]);
+            if (!error) fail(kSuite, error.error().message);
+            means.push_back(error->mean);
+            worsts.push_back(error->worst);
+            point.mean += error->mean / static_cast<double>(glyphs_.size());
+            point.worst = std::max(point.worst, error->worst);
+        }
+        session_.json.begin_object()
+            .field("samples", samples)
+            .field("mean", point.mean)
+            .field("worst", point.worst)
+            .field("glyph_mean", means)
+            .field("glyph_worst", worsts)
+            .end_object();
+        return point;
+    }
+
+    // FreeType as an application renders: gray against the gray reference; LCD, with and without
+    // its default filter, against the rgb one.
+    void peers(const std::string& layout_name, const std::vector<freetype::CoverageImage>& references) {
+        struct Peer {
+            freetype::PeerMode mode;
+            const char* name;
+        };
+        const std::vector<Peer> modes = layout_name == "gray"
+                                            ? std::vector<Peer>{{freetype::PeerMode::gray, "gray"}}
+                                            : std::vector<Peer>{{freetype::PeerMode::lcd, "lcd"},
+                                                                {freetype::PeerMode::lcd_unfiltered, "lcd-unfiltered"}};
+        for (const Peer& peer : modes) {
+            ErrorPoint point;
+            double seconds = 0.0;
+            std::vector<double> means, worsts, times;
+            for (size_t i = 0; i < glyphs_.size(); ++i) {
+                const GlyphInstance& g = glyphs_[i].instance;
+                auto render = freetype::render_peer(*font_of(g).face, g.key, rect_of(g), peer.mode);
+                if (!render) fail(kSuite, "FreeType " + std::string(peer.name) + ": " + render.error().message);
+                auto error = freetype::compare_coverage(render->image, references[i]);
+                if (!error) fail(kSuite, error.error().message);
+                means.push_back(error->mean);
+                worsts.push_back(error->worst);
+                times.push_back(render->seconds_per_glyph * 1e6);
+                point.mean += error->mean / static_cast<double>(glyphs_.size());
+                point.worst = std::max(point.worst, error->worst);
+                seconds += render->seconds_per_glyph / static_cast<double>(glyphs_.size());
+            }
+            session_.freetype_error[peer.name] = point;
+            std::fprintf(session_.md, "| FreeType %s (CPU, %.3g µs a glyph) | %.4f | %.4f |\n", peer.name,
+                         seconds * 1e6, point.mean, point.worst);
+            freetype_json_.push_back({peer.name, layout_name, point, seconds * 1e6, means, worsts, times});
+        }
+    }
+
+    void print_glyph_set() {
+        std::fprintf(session_.md,
+                     "crisp's atlas texels after N samples (read back from the GPU; the renderer's ramp set to 1, 1, "
+                     "2, 4, ... so that a frame ends on every power of two; rows and points are the two "
+                     "RendererCreateInfo::sample_kind) against FreeType's area coverage of the original outline, cut "
+                     "into %ux%u cells per texel for gray and %ux%u for rgb thirds (support/freetype_reference.hpp). "
+                     "Error: mean absolute error per texel channel over the texels either image touches, averaged "
+                     "over the glyphs; worst: the largest single texel channel of any glyph. FreeType as a peer: "
+                     "unhinted, as an application renders, its time per glyph the median of 9 "
+                     "FT_Load_Glyph + FT_Render_Glyph, averaged over the glyphs.\n\n"
+                     "| glyphs | font | px | what | texels |\n|---|---|---:|---|---:|\n",
+                     options_.cells_gray, options_.cells_gray, options_.cells_rgb, options_.cells_rgb);
+        for (const GlyphSpec& spec : specs_) {
+            uint64_t texels = 0;
+            bool present = false;
+            for (const SetGlyph& g : glyphs_) {
+                if (g.spec != &spec) continue;
+                present = true;
+                texels += uint64_t{g.instance.width} * g.instance.height;
+            }
+            if (!present) continue;
+            const std::string variations = describe_variations(spec.variations);
+            std::fprintf(session_.md, "| %s | %s%s | %g | %s | %llu |\n", spec.text.c_str(),
+                         std::filesystem::path(spec.path).filename().c_str(),
+                         variations.empty() ? "" : (" " + variations).c_str(), static_cast<double>(spec.size),
+                         spec.what.c_str(), static_cast<unsigned long long>(texels));
+        }
+    }
+
+    void print_table(const char* layout_name, const std::vector<SampleKind>& kinds,
+                     const std::map<std::string, std::vector<ErrorPoint>>& by_kind) {
+        std::fprintf(session_.md, "%s layout, %zu glyphs.\n\n| samples |", layout_name, glyphs_.size());
+        for (const SampleKind kind : kinds) std::fprintf(session_.md, " %s: mean | worst |", sample_kind_name(kind));
+        std::fprintf(session_.md, "\n|---|");
+        for (size_t k = 0; k < kinds.size(); ++k) std::fprintf(session_.md, "---:|---:|");
+        std::fprintf(session_.md, "\n");
+        const std::vector<ErrorPoint>& first = by_kind.at(sample_kind_name(kinds.front()));
+        for (size_t p = 0; p < first.size(); ++p) {
+            std::fprintf(session_.md, "| %u |", first[p].samples);
+            for (const SampleKind kind : kinds) {
+                const ErrorPoint& e = by_kind.at(sample_kind_name(kind))[p];
+                std::fprintf(session_.md, " %.4f | %.4f |", e.mean, e.worst);
+            }
+            std::fprintf(session_.md, "\n");
+        }
+        std::fprintf(session_.md, "\n| peer | mean | worst |\n|---|---:|---:|\n");
+    }
+
+    void write_glyph_set_json(uint32_t max_samples) {
+        session_.json.field("max_samples", max_samples)
+            .field("cells_gray", options_.cells_gray)
+            .field("cells_rgb", options_.cells_rgb)
+            .key("glyphs")
+            .begin_array();
+        for (const SetGlyph& g : glyphs_) {
+            session_.json.begin_object()
+                .field("font", g.spec->path)
+                .field("variations", describe_variations(g.spec->variations))
+                .field("codepoint", g.codepoint)
+                .field("glyph", g.instance.key.glyph)
+                .field("size", g.spec->size)
+                .field("what", g.spec->what)
+                .field("subpixel_x", g.instance.key.subpixel_x)
+                .field("subpixel_y", g.instance.key.subpixel_y)
+                .field("width", g.instance.width)
+                .field("height", g.instance.height)
+                .end_object();
+        }
+        session_.json.end_array();
+    }
+
+public:
+    void write_peers_json() {
+        session_.json.key("freetype").begin_array();
+        for (const PeerJson& p : freetype_json_) {
+            session_.json.begin_object()
+                .field("mode", p.mode)
+                .field("layout", p.layout)
+                .field("mean", p.error.mean)
+                .field("worst", p.error.worst)
+                .field("us_per_glyph", p.us_per_glyph)
+                .field("glyph_mean", p.means)
+                .field("glyph_worst", p.worsts)
+                .field("glyph_us", p.times)
+                .end_object();
+        }
+        session_.json.end_array();
+    }
+
+    std::vector<GlyphSpec> specs_;
+
+private:
+    struct PeerJson {
+        std::string mode, layout;
+        ErrorPoint error;
+        double us_per_glyph;
+        std::vector<double> means, worsts, times;
+    };
+    Session& session_;
+    const Options& options_;
+    std::vector<LoadedFont> fonts_;
+    std::vector<SetGlyph> glyphs_;
+    std::vector<PeerJson> freetype_json_;
+};
+
+}  // namespace
+
+void run_coverage(Session& session) {
+    Coverage coverage(session);
+    coverage.specs_ = glyph_set(session.options);
+    coverage.load(session);
+    coverage.run();
+}
+
+}  // namespace crisp::bench
