@@ -1,12 +1,12 @@
-// crisp-bench --suite cpu (formerly crisp-bench-cpu): measures the CPU half of crisp's run time (no GPU) and prints
-// Markdown tables.
+// crisp-bench --suite cpu (formerly crisp-bench-cpu): measures the CPU half of crisp's run time
+// (no GPU) and prints Markdown tables.
 //
 // Layout: a UI-like frame of about 10,000 glyphs in many short strings (labels, buttons, numbers,
 // a wrapped paragraph), with one font and with a fallback chain; and one million characters as
 // one wrapped paragraph and as 80-column lines. Atlas: the same UI frame laid out and looked up
-// in a warm atlas, allocation and eviction throughput, and how many atlas entries a page of text
-// needs at each subpixel quantization. Each timed case is warmed up, then timed N times; the
-// tables show the median and the fastest run.
+// in a warm atlas, and allocation and eviction throughput (how many atlas entries a page of text
+// needs at each subpixel quantization is the atlas suite's). Each timed case is warmed up, then
+// timed N times; the tables show the median and the fastest run.
 #include "bench.hpp"
 
 #include <crisp/atlas.hpp>
@@ -196,42 +196,6 @@ public:
         if (selected("UI frame + warm atlas")) warm_note = warm_atlas_case();
         if (selected("allocation and eviction")) eviction_case();
         if (!warm_note.empty()) std::fprintf(out_, "\n%s\n", warm_note.c_str());
-    }
-
-    // Reuse against subpixel quantization: a page of real text at 16 px, wrapped at 900 px, and
-    // how many distinct atlas entries (and cells) it needs at each quantization.
-    void quantization_case() {
-        if (!selected("subpixel quantization")) return;
-        const char* page_text =
-            "It was the best of times, it was the worst of times, it was the age of wisdom, it was the age of "
-            "foolishness, it was the epoch of belief, it was the epoch of incredulity, it was the season of Light, "
-            "it was the season of Darkness, it was the spring of hope, it was the winter of despair, we had "
-            "everything before us, we had nothing before us, we were all going direct to Heaven, we were all going "
-            "direct the other way - in short, the period was so far like the present period, that some of its "
-            "noisiest authorities insisted on its being received, for good or for evil, in the superlative degree "
-            "of comparison only.\n";
-        std::string page;
-        for (int i = 0; i < 6; ++i) page += page_text;
-        std::fprintf(out_,
-                     "\n| subpixel steps per pixel | glyphs on the page | distinct atlas entries | glyphs per entry | "
-                     "atlas cells used |\n|---:|---:|---:|---:|---:|\n");
-        for (const uint32_t steps : {256u, 64u, 16u, 8u, 4u, 2u, 1u}) {
-            crisp::LayoutOptions options;
-            options.origin_x = 10.25f;
-            options.origin_y = 20.0f;
-            options.wrap_width = 900.0f;
-            options.subpixel_steps = steps;
-            if (!layouter_.layout(one_, page, {.size = 16.0f}, options, layout_)) std::abort();
-            auto atlas = crisp::GlyphAtlas::create();
-            if (!atlas) std::abort();
-            atlas->begin_frame();
-            acquire_all(*atlas, layout_.glyphs);
-            const crisp::AtlasStats& stats = atlas->stats();
-            std::fprintf(out_, "| %u | %zu | %u | %.2f | %u |\n", steps, layout_.glyphs.size(), stats.resident_glyphs,
-                         static_cast<double>(layout_.glyphs.size()) / std::max(1u, stats.resident_glyphs),
-                         stats.used_cells);
-        }
-        std::fprintf(out_, "\n");
     }
 
     // A million characters: one paragraph, 80-column lines, one line, and mixed scripts.
@@ -465,7 +429,6 @@ void crisp::bench::run_cpu(Session& session) {
     bench.layout_cases();
     progress("cpu", "atlas cases");
     bench.atlas_cases();
-    bench.quantization_case();
     progress("cpu", "large text cases");
     bench.large_text_cases();
     session.json.begin_object().field("runs", args.runs).field("warmup", args.warmup);

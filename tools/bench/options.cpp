@@ -109,7 +109,8 @@ void declare_shared_options(cli::CommandLine& cli, Options& o) {
                    o.fonts.emplace_back(text);
                    return Status{};
                });
-    cli.number<float>("--size", "PX", "pixels per em [frames, frame-cpu 16; compositing 18]", o.size, {4.0f, 256.0f});
+    cli.number<float>("--size", "PX", "pixels per em [frames, atlas, frame-cpu 16; compositing 18]", o.size,
+                      {4.0f, 256.0f});
     cli.option("--canvas", "WxH",
                "the target, also W,H [frames, frame-cpu 1920x1080, on a CPU device\n"
                "640x360; compositing 512x256]",
@@ -173,6 +174,10 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
                          [](const QuadPath& path) { return std::string(quad_path_name(path)); });
     cli.flag("--no-cpu-check", "skip checking the exact mode against the CPU reference", o.cpu_check, false);
 
+    cli.section("atlas:");
+    cli.option("--steps", "LIST", "subpixel steps per pixel, comma-separated (default 256,64,16,8,4,2,1)",
+               number_list<uint32_t>(o.steps, "--steps", {1, 256}));
+
     cli.section("frame-cpu:");
     cli.option("--variants", "LIST",
                "comma-separated, from static (nothing changes), changed (3 strings laid out\n"
@@ -204,6 +209,7 @@ Options parse_options(int argc, char** argv) {
     cli.epilogue("\nexit status: 0 measured, 1 a failure while measuring (or validation messages), 2 usage.\n");
     cli.parse(argc, argv);
     o.scenes_given = cli.given("--layers") || cli.given("--alphas");
+    o.steps_given = cli.given("--steps");
     if (o.suites.empty()) {
         for (const SuiteInfo& suite : kSuites) o.suites.emplace_back(suite.name);
     }
@@ -228,6 +234,9 @@ Options parse_options(int argc, char** argv) {
         if (v != "static" && v != "changed" && v != "moving") {
             cli.fail("--variants: unknown variant '" + cli::printable(v) + "'");
         }
+    }
+    for (uint32_t s : o.steps) {
+        if ((s & (s - 1)) != 0) cli.fail("--steps: " + std::to_string(s) + " is not a power of two");
     }
     for (int i = 0; i < argc; ++i) {
         std::string arg = i == 0 ? "crisp-bench" : cli::printable(argv[i]);
