@@ -91,6 +91,7 @@ inline constexpr SuiteInfo kSuites[] = {
     {"frames", "GPU ms per frame, new text to converged (was crisp-bench-gpu)", true},
     {"coverage", "atlas error against FreeType's exact area coverage per sample count; FreeType as a peer", true},
     {"compositing", "each compositing mode's GPU ms, error and memory (was crisp-bench-composite)", true},
+    {"scaling", "frame cost against the text on screen and against the screen", true},
     {"atlas", "atlas entries of a page at each subpixel quantization, and the error it costs", false},
     {"frame-cpu", "CPU time of a frame of UI text (was crisp-bench-frame)", true},
     {"cpu", "layout and atlas CPU time (was crisp-bench-cpu)", false},
@@ -150,6 +151,7 @@ const char* sample_kind_name(SampleKind kind);
 void run_frames(Session& session);
 void run_coverage(Session& session);
 void run_compositing(Session& session);
+void run_scaling(Session& session);
 void run_atlas(Session& session);
 void run_frame_cpu(Session& session);
 void run_cpu(Session& session);

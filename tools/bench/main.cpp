@@ -105,6 +105,7 @@ void run_suite(Session& session, const std::string& name) {
     if (name == "frames") return run_frames(session);
     if (name == "coverage") return run_coverage(session);
     if (name == "compositing") return run_compositing(session);
+    if (name == "scaling") return run_scaling(session);
     if (name == "atlas") return run_atlas(session);
     if (name == "frame-cpu") return run_frame_cpu(session);
     if (name == "cpu") return run_cpu(session);

@@ -109,11 +109,11 @@ void declare_shared_options(cli::CommandLine& cli, Options& o) {
                    o.fonts.emplace_back(text);
                    return Status{};
                });
-    cli.number<float>("--size", "PX", "pixels per em [frames, atlas, frame-cpu 16; compositing 18]", o.size,
+    cli.number<float>("--size", "PX", "pixels per em [frames, scaling, atlas, frame-cpu 16; compositing 18]", o.size,
                       {4.0f, 256.0f});
     cli.option("--canvas", "WxH",
                "the target, also W,H [frames, frame-cpu 1920x1080, on a CPU device\n"
-               "640x360; compositing 512x256]",
+               "640x360; compositing 512x256; scaling: its text-amount series' canvas]",
                [&o](std::string_view text) { return parse_canvas(o, text); });
     cli.text("--layout", "NAME", "subpixel layout preset or file [frames: gray and rgb; compositing rgb]", o.layout);
     cli.number<uint32_t>("--samples", "N",
