@@ -17,6 +17,7 @@ packages=(
   libgtest-dev                           # GoogleTest
   clang libclang-rt-14-dev               # libFuzzer for the fuzz targets
   python3                                # the CLI tests check --json output with it
+  python3-matplotlib                     # crisp-bench's plots (scripts/plot_bench.py)
   python3-fonttools                      # tests derive a 16384 units-per-em font from DejaVu Sans
   fonts-noto-cjk                         # tests: a CJK collection (.ttc, CFF, 1000 units per em)
   fonts-cantarell                        # tests: a CFF face with 1000 units per em

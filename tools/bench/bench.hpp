@@ -28,6 +28,7 @@ struct Options {
     std::string out_dir = "docs/results";
     std::string name;  // file name stem; empty: the device's slug
     bool write_files = true;
+    bool plots = true;
     bool json = false;  // JSON on stdout instead of Markdown
     std::string json_out;
     std::string device;

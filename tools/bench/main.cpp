@@ -1,6 +1,6 @@
-// crisp-bench: crisp's benchmarks as suites of one tool. main: the options, the device, each suite
-// in turn, then the report: Markdown on stdout and, unless --no-files, DIR/NAME.md and
-// DIR/NAME.json.
+// crisp-bench: crisp's benchmarks as suites of one tool (docs/benchmarks.md). main: the options,
+// the device, each suite in turn, then the report: Markdown on stdout and, unless --no-files,
+// DIR/NAME.md, DIR/NAME.json and the plots scripts/plot_bench.py makes from the JSON.
 #include "bench.hpp"
 #include "cli.hpp"
 #include "gpu_tools.hpp"
@@ -143,6 +143,42 @@ void print_error_against_time(Session& session) {
     }
 }
 
+// Runs scripts/plot_bench.py on the JSON with the first python3 that has matplotlib (the one on
+// PATH, else Debian's); returns the PNGs it wrote, or says how to make them.
+std::vector<std::string> make_plots(const std::filesystem::path& json_path, std::string& note) {
+    const std::string script = std::string(CRISP_SOURCE_DIR) + "/scripts/plot_bench.py";
+    const std::string how = "python3 scripts/plot_bench.py " + json_path.string();
+    std::string python;
+    for (const char* candidate : {"python3", "/usr/bin/python3"}) {
+        if (std::system((std::string(candidate) + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) == 0) {
+            python = candidate;
+            break;
+        }
+    }
+    if (python.empty()) {
+        note =
+            "No plots: python3 with matplotlib was not found (Debian: python3-matplotlib, which "
+            "scripts/setup.sh installs). Make them with `" +
+            how + "`.";
+        return {};
+    }
+    const std::string command = python + " '" + script + "' '" + json_path.string() + "'";
+    std::vector<std::string> pngs;
+    std::FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) {
+        note = "No plots: could not run " + script + ". Make them with `" + how + "`.";
+        return {};
+    }
+    char line[4096];
+    while (std::fgets(line, sizeof line, pipe)) {
+        std::string name = line;
+        while (!name.empty() && (name.back() == '\n' || name.back() == '\r')) name.pop_back();
+        if (!name.empty()) pngs.push_back(std::filesystem::path(name).filename().string());
+    }
+    if (pclose(pipe) != 0) note = "scripts/plot_bench.py failed (its message is above); `" + how + "` retries.";
+    return pngs;
+}
+
 }  // namespace
 }  // namespace crisp::bench
 
@@ -217,6 +253,7 @@ int main(int argc, char** argv) {
         .field("warnings", session.warnings)
         .end_object();
 
+    std::string plots;
     if (options.write_files) {
         const std::string name =
             !options.name.empty() ? options.name : device_slug(session.context) + (options.quick ? "-quick" : "");
@@ -224,6 +261,14 @@ int main(int argc, char** argv) {
         std::filesystem::create_directories(options.out_dir, ec);
         const std::filesystem::path json_path = std::filesystem::path(options.out_dir) / (name + ".json");
         if (crisp::Status s = session.json.write_file(json_path); !s) fail("report", s.error().message);
+        std::string note;
+        std::vector<std::string> pngs;
+        if (options.plots) pngs = make_plots(json_path, note);
+        plots = "\n## Plots\n\nFrom " + json_path.filename().string() + " by scripts/plot_bench.py.\n\n";
+        for (const std::string& png : pngs) plots += "![" + png + "](" + png + ")\n\n";
+        if (!note.empty()) plots += note + "\n";
+        if (!options.plots)
+            plots += "Not made (--no-plots): `python3 scripts/plot_bench.py " + json_path.string() + "`.\n";
         const std::filesystem::path md_path = std::filesystem::path(options.out_dir) / (name + ".md");
         std::ofstream md(md_path, std::ios::binary);
         md << header;
@@ -231,9 +276,10 @@ int main(int argc, char** argv) {
             md << "\nWarnings:\n\n";
             for (const std::string& w : session.warnings) md << "- " << w << "\n";
         }
-        md << tables;
+        md << tables << plots;
         if (!md.good()) fail("report", "could not write " + md_path.string());
-        progress("report", "wrote " + md_path.string() + " and " + json_path.string());
+        progress("report", "wrote " + md_path.string() + ", " + json_path.string() + " and " +
+                               std::to_string(pngs.size()) + " plots");
     }
     if (options.json) {
         std::fputs(session.json.line().c_str(), stdout);

@@ -49,7 +49,8 @@ std::string synopsis() {
     std::string text =
         "usage: crisp-bench [--suite NAME]... [--quick] [options]\n"
         "Measures crisp on one Vulkan device and writes DIR/<device>.md (the tables and the command\n"
-        "that made them) and DIR/<device>.json. The Markdown also goes to stdout; progress to stderr.\n"
+        "that made them), DIR/<device>.json and PNG plots beside them (scripts/plot_bench.py, where\n"
+        "python3 and matplotlib are installed). The Markdown also goes to stdout; progress to stderr.\n"
         "On a CPU device (lavapipe) the suites pick smaller canvases. docs/benchmarks.md.\n\n"
         "suites (--suite, repeatable, or all; default all):\n";
     for (const SuiteInfo& suite : kSuites) {
@@ -87,6 +88,7 @@ void declare_run_options(cli::CommandLine& cli, Options& o) {
              "with --quick, that and -quick)",
              o.name);
     cli.flag("--no-files", "write no files: Markdown on stdout only", o.write_files, false);
+    cli.flag("--no-plots", "do not run scripts/plot_bench.py", o.plots, false);
     cli.flag("--json", "print JSON instead of Markdown on stdout", o.json);
     cli.text("--json-out", "FILE", "also write the JSON to FILE", o.json_out);
     cli.text("--device", "TEXT", "pick a device whose name contains TEXT", o.device);
