@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# bench_cli_test.sh CRISP_BENCH SOURCE_DIR WORK_DIR: crisp-bench works. Its usage errors exit 2;
+# --quick runs every suite on whatever Vulkan device there is (lavapipe in CI) with the validation
+# layer on, and writes well-formed Markdown, JSON and (where matplotlib is installed) PNG plots.
+# It checks the shape of what is written, never the numbers: a benchmark measures, a test checks.
+set -uo pipefail
+bench=$1 source=$2 work=$3
+rm -rf "$work" && mkdir -p "$work"
+cd "$source" || exit 1  # the suites' default fonts are relative to the repository root
+failures=0
+fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+expect_exit() {  # expect_exit CODE DESCRIPTION -- COMMAND...
+  local want=$1 what=$2; shift 3
+  "$@" >"$work/out" 2>"$work/err"
+  local got=$?
+  [ "$got" -eq "$want" ] || fail "$what: exit $got, want $want; stderr: $(head -c 400 "$work/err")"
+}
+expect_stderr() {  # expect_stderr TEXT DESCRIPTION: the last command's stderr holds TEXT
+  grep -qF -- "$1" "$work/err" || fail "$2: stderr lacks '$1': $(head -c 400 "$work/err")"
+}
+suites=(frames coverage compositing scaling atlas frame-cpu cpu)
+
+# ---- --help and usage errors: exit 2, nothing measured.
+expect_exit 0 "--help" -- "$bench" --help
+for suite in "${suites[@]}"; do
+  grep -q "^  $suite " "$work/out" || fail "--help does not list the suite $suite"
+done
+for option in --quick --suite --out --canvas --samples --sample-kind --clock-load --modes --variants --steps; do
+  grep -qF -- "$option" "$work/out" || fail "--help does not list $option"
+done
+expect_exit 2 "unknown suite" -- "$bench" --suite nonesuch
+expect_stderr "unknown suite 'nonesuch'" "unknown suite"
+expect_exit 2 "unknown option" -- "$bench" --frobnicate
+expect_exit 2 "option without its value" -- "$bench" --suite
+expect_exit 2 "--samples 0" -- "$bench" --samples 0
+expect_exit 2 "--canvas not WxH" -- "$bench" --canvas 640
+expect_exit 2 "unknown compositing mode" -- "$bench" --modes tiled,bogus
+expect_stderr "unknown mode 'bogus'" "unknown compositing mode"
+expect_exit 2 "unknown sample kind" -- "$bench" --sample-kind lines
+expect_exit 2 "--steps not a power of two" -- "$bench" --steps 3
+expect_exit 2 "compositing warm-up below its frames in flight" -- "$bench" --suite compositing --warmup 1
+
+# ---- --quick, every suite, validation layer on.
+validate=()
+if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.json' 2>/dev/null)" ]; then
+  validate=(--validate)
+fi
+start=$(date +%s)
+expect_exit 0 "--quick --suite all" -- "$bench" --quick --suite all "${validate[@]}" --out "$work/results" --name quick
+echo "crisp-bench --quick took $(( $(date +%s) - start )) s" >&2
+md=$work/results/quick.md json=$work/results/quick.json
+[ -s "$md" ] || fail "no $md"
+[ -s "$json" ] || fail "no $json"
+cmp -s "$work/out" /dev/null && fail "nothing on stdout"
+grep -qF -- "crisp-bench --quick --suite all" "$md" || fail "the Markdown does not name the command that made it"
+for suite in "${suites[@]}"; do
+  grep -q "^## $suite: " "$md" || fail "the Markdown has no section for $suite"
+  grep -qF "[$suite] done" "$work/err" || fail "no progress line for $suite on stderr"
+done
+grep -q "^## Error against cumulative GPU time" "$md" || fail "the Markdown has no error-against-time table"
+python3 - "$json" <<'EOF' || fail "the JSON is not what the suites write"
+import json, math, sys
+data = json.load(open(sys.argv[1]))
+suites = data["suites"]
+for name in ["frames", "coverage", "compositing", "scaling", "atlas", "frame-cpu", "cpu"]:
+    assert name in suites, name
+assert data["tool"] == "crisp-bench" and data["quick"] is True and data["command"].startswith("crisp-bench")
+def unit(x):
+    return isinstance(x, (int, float)) and math.isfinite(x) and 0.0 <= x <= 1.0
+runs = suites["coverage"]["runs"]
+assert {(r["layout"], r["sample_kind"]) for r in runs} == {(l, k) for l in ("gray", "rgb") for k in ("rows", "points")}
+for r in runs:
+    assert [p["samples"] for p in r["points"]] == [1, 2, 4, 8, 16], r["points"]
+    for p in r["points"]:
+        assert unit(p["mean"]) and unit(p["worst"]) and p["mean"] <= p["worst"], p
+        assert len(p["glyph_mean"]) == len(suites["coverage"]["glyphs"])
+assert {p["mode"] for p in suites["coverage"]["freetype"]} == {"gray", "lcd", "lcd-unfiltered"}
+for p in suites["coverage"]["freetype"]:
+    assert unit(p["mean"]) and unit(p["worst"]) and p["us_per_glyph"] > 0, p
+assert len(suites["frames"]["runs"]) == 4
+for r in suites["frames"]["runs"]:
+    assert r["converged"] and r["frames"], r
+    assert all(f["gpu_ms"] >= 0 for f in r["frames"])
+    assert sum(f["samples"] for f in r["frames"]) == 16 * r["atlas_entries"], r["frames"]
+assert set(suites["frames"]["freetype_screen_ms"]) == {"gray", "lcd", "lcd-unfiltered"}
+assert [p["series"] for p in suites["scaling"]["points"]] == ["same text"] * 2 + ["more text"] * 2
+assert [r["steps"] for r in suites["atlas"]["rows"]] == [256, 4, 1]
+assert suites["atlas"]["rows"][0]["gray_mean"] == 0 and suites["atlas"]["rows"][0]["entries"] > 0
+assert [v["name"] for v in suites["frame-cpu"]["variants"]] == ["static", "changed", "moving"]
+assert suites["compositing"]["scenes"] and not suites["compositing"]["warnings"], suites["compositing"]["warnings"]
+EOF
+# Plots where some python3 has matplotlib, else the Markdown says how to make them.
+if python3 -c 'import matplotlib' 2>/dev/null || /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then
+  for plot in error-vs-samples error-vs-time scaling atlas; do
+    png=$work/results/quick-$plot.png
+    [ "$(head -c 4 "$png" 2>/dev/null | od -An -c | tr -d ' ')" = "211PNG" ] || fail "$png is not a PNG"
+    grep -qF "](quick-$plot.png)" "$md" || fail "the Markdown does not show quick-$plot.png"
+  done
+else
+  grep -qF "python3-matplotlib" "$md" || fail "no plots, and the Markdown does not say how to make them"
+fi
+
+# One suite alone, JSON on stdout, no files.
+expect_exit 0 "--suite atlas --quick --json --no-files" -- "$bench" --suite atlas --quick --json --no-files
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert list(d["suites"]) == ["atlas"], d' "$work/out" \
+  || fail "--json does not print the one suite's JSON"
+
+[ "$failures" -eq 0 ] || { echo "$failures failures" >&2; exit 1; }
+echo "crisp-bench: all checks passed"
