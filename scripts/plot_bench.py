@@ -71,6 +71,8 @@ def plot_error_vs_samples(data, stem, written):
                 ax.axhline(max(peer[metric], 1e-6), linestyle="--", color=PEER_STYLE.get(peer["mode"], "gray"),
                            label=f"FreeType {peer['mode']} ({peer['us_per_glyph']:.2g} µs/glyph, CPU)")
             log_axes(ax, "samples per texel", label, f"{layout}: {label}", x_base=2)
+            counts = sorted({p["samples"] for run in coverage["runs"] for p in run["points"]})
+            ax.set_xticks(counts, [str(n) for n in counts])
     fig.suptitle(f"crisp coverage error against samples, {glyphs} glyphs, vs. FreeType area coverage — "
                  f"{title_of(data)}")
     save(fig, stem, "error-vs-samples", written)

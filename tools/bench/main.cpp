@@ -179,6 +179,104 @@ std::vector<std::string> make_plots(const std::filesystem::path& json_path, std:
     return pngs;
 }
 
+// Every suite in turn, each under its heading and key: opens the JSON document and its "suites"
+// object (finish_json closes them); returns the Markdown the suites wrote.
+std::string run_suites(Session& session) {
+    char* body = nullptr;
+    size_t body_size = 0;
+    session.md = open_memstream(&body, &body_size);
+    if (!session.md) fail("report", "open_memstream failed");
+    session.json.begin_object().key("suites").begin_object();
+    for (const std::string& suite : session.options.suites) {
+        const auto start = std::chrono::steady_clock::now();
+        progress(suite, "start");
+        const auto info =
+            std::find_if(std::begin(kSuites), std::end(kSuites), [&](const SuiteInfo& s) { return suite == s.name; });
+        std::fprintf(session.md, "\n## %s: %s\n\n", suite.c_str(), info->summary);
+        session.json.key(suite);
+        run_suite(session, suite);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        progress(suite, "done in " + std::to_string(static_cast<int>(seconds + 0.5)) + " s");
+        std::fprintf(session.md, "\n(%s suite: %.0f s of wall time.)\n", suite.c_str(), seconds);
+    }
+    print_error_against_time(session);
+    std::fclose(session.md);
+    const std::string tables(body, body_size);
+    std::free(body);
+    return tables;
+}
+
+std::string device_name(const HeadlessContext* context) {
+    return context ? context->device_name() : "none (CPU suites only)";
+}
+
+std::string driver_name(const HeadlessContext* context) {
+    return context->driver_name() + " (" + context->driver_info() + ")";
+}
+
+// The report's first lines: what made it (the command), on what device, CPU and build, and when.
+std::string report_header(const Session& session) {
+    const Options& options = session.options;
+    const HeadlessContext* context = session.context;
+    std::string header = "# crisp-bench: " + device_name(context) + "\n\nMade by, from the repository root:\n\n    " +
+                         options.command + "\n\n";
+    header += "Device: " + device_name(context) + (context ? ", driver " + driver_name(context) : "") +
+              (context ? ", Vulkan " + vk::version_string(context->api_version()) : "") + ". CPU: " + cpu_model() +
+              ", " + std::to_string(std::thread::hardware_concurrency()) +
+              " hardware threads. Build: " + build_description() + ". Run " + utc_now() +
+              (options.quick ? "; --quick: the numbers mean little" : "") +
+              (options.validate ? "; validation layer on: the times are not the library's" : "") + ".\n";
+    return header;
+}
+
+// Closes the "suites" object, adds what the run was (as the header says it) and closes the document.
+void finish_json(Session& session) {
+    const Options& options = session.options;
+    session.json.end_object()
+        .field("tool", "crisp-bench")
+        .field("command", options.command)
+        .field("device", device_name(session.context))
+        .field("driver", session.context ? driver_name(session.context) : "")
+        .field("cpu_device", session.cpu_device)
+        .field("cpu", cpu_model())
+        .field("hardware_threads", std::thread::hardware_concurrency())
+        .field("build", build_description())
+        .field("date", utc_now())
+        .field("quick", options.quick)
+        .field("validation", options.validate)
+        .field("warnings", session.warnings)
+        .end_object();
+}
+
+// DIR/NAME.json, the plots made from it, and DIR/NAME.md: the header, warnings, tables and plots.
+void write_result_files(Session& session, const std::string& header, const std::string& tables) {
+    const Options& options = session.options;
+    const std::string name =
+        !options.name.empty() ? options.name : device_slug(session.context) + (options.quick ? "-quick" : "");
+    std::error_code ec;
+    std::filesystem::create_directories(options.out_dir, ec);
+    const std::filesystem::path json_path = std::filesystem::path(options.out_dir) / (name + ".json");
+    if (Status s = session.json.write_file(json_path); !s) fail("report", s.error().message);
+    std::string note;
+    std::vector<std::string> pngs;
+    if (options.plots) pngs = make_plots(json_path, note);
+    std::string plots = "\n## Plots\n\nFrom " + json_path.filename().string() + " by scripts/plot_bench.py.\n\n";
+    for (const std::string& png : pngs) plots += "![" + png + "](" + png + ")\n\n";
+    if (!note.empty()) plots += note + "\n";
+    if (!options.plots) plots += "Not made (--no-plots): `python3 scripts/plot_bench.py " + json_path.string() + "`.\n";
+    const std::filesystem::path md_path = std::filesystem::path(options.out_dir) / (name + ".md");
+    std::ofstream md(md_path, std::ios::binary);
+    md << header;
+    if (!session.warnings.empty()) {
+        md << "\nWarnings:\n\n";
+        for (const std::string& w : session.warnings) md << "- " << w << "\n";
+    }
+    md << tables << plots;
+    if (!md.good()) fail("report", "could not write " + md_path.string());
+    progress("report", "wrote " + md_path.string() + ", " + json_path.string() + " and " + std::to_string(pngs.size()) +
+                           " plots");
+}
+
 }  // namespace
 }  // namespace crisp::bench
 
@@ -205,82 +303,11 @@ int main(int argc, char** argv) {
         session.cpu_device = context->properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     }
 
-    char* body = nullptr;
-    size_t body_size = 0;
-    session.md = open_memstream(&body, &body_size);
-    if (!session.md) fail("report", "open_memstream failed");
-    session.json.begin_object().key("suites").begin_object();
-    for (const std::string& suite : options.suites) {
-        const auto start = std::chrono::steady_clock::now();
-        progress(suite, "start");
-        const auto info =
-            std::find_if(std::begin(kSuites), std::end(kSuites), [&](const SuiteInfo& s) { return suite == s.name; });
-        std::fprintf(session.md, "\n## %s: %s\n\n", suite.c_str(), info->summary);
-        session.json.key(suite);
-        run_suite(session, suite);
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        progress(suite, "done in " + std::to_string(static_cast<int>(seconds + 0.5)) + " s");
-        std::fprintf(session.md, "\n(%s suite: %.0f s of wall time.)\n", suite.c_str(), seconds);
-    }
-    print_error_against_time(session);
-    std::fclose(session.md);
-    const std::string tables(body, body_size);
-    std::free(body);
+    const std::string tables = run_suites(session);
 
-    const std::string device = context ? context->device_name() : "none (CPU suites only)";
-    const std::string driver = context ? context->driver_name() + " (" + context->driver_info() + ")" : "";
-    std::string header = "# crisp-bench: " + device + "\n\nMade by (from the repository root, a " +
-                         "RelWithDebInfo or Release build):\n\n    " + options.command + "\n\n";
-    header += "Device: " + device + (driver.empty() ? "" : ", driver " + driver) +
-              (context ? ", Vulkan " + crisp::vk::version_string(context->api_version()) : "") +
-              ". CPU: " + cpu_model() + ", " + std::to_string(std::thread::hardware_concurrency()) +
-              " hardware threads. Build: " + build_description() + ". Run " + utc_now() +
-              (options.quick ? "; --quick: the numbers mean little" : "") +
-              (options.validate ? "; validation layer on: the times are not the library's" : "") + ".\n";
-
-    session.json.end_object()
-        .field("tool", "crisp-bench")
-        .field("command", options.command)
-        .field("device", device)
-        .field("driver", driver)
-        .field("cpu_device", session.cpu_device)
-        .field("cpu", cpu_model())
-        .field("hardware_threads", std::thread::hardware_concurrency())
-        .field("build", build_description())
-        .field("date", utc_now())
-        .field("quick", options.quick)
-        .field("validation", options.validate)
-        .field("warnings", session.warnings)
-        .end_object();
-
-    std::string plots;
-    if (options.write_files) {
-        const std::string name =
-            !options.name.empty() ? options.name : device_slug(session.context) + (options.quick ? "-quick" : "");
-        std::error_code ec;
-        std::filesystem::create_directories(options.out_dir, ec);
-        const std::filesystem::path json_path = std::filesystem::path(options.out_dir) / (name + ".json");
-        if (crisp::Status s = session.json.write_file(json_path); !s) fail("report", s.error().message);
-        std::string note;
-        std::vector<std::string> pngs;
-        if (options.plots) pngs = make_plots(json_path, note);
-        plots = "\n## Plots\n\nFrom " + json_path.filename().string() + " by scripts/plot_bench.py.\n\n";
-        for (const std::string& png : pngs) plots += "![" + png + "](" + png + ")\n\n";
-        if (!note.empty()) plots += note + "\n";
-        if (!options.plots)
-            plots += "Not made (--no-plots): `python3 scripts/plot_bench.py " + json_path.string() + "`.\n";
-        const std::filesystem::path md_path = std::filesystem::path(options.out_dir) / (name + ".md");
-        std::ofstream md(md_path, std::ios::binary);
-        md << header;
-        if (!session.warnings.empty()) {
-            md << "\nWarnings:\n\n";
-            for (const std::string& w : session.warnings) md << "- " << w << "\n";
-        }
-        md << tables << plots;
-        if (!md.good()) fail("report", "could not write " + md_path.string());
-        progress("report", "wrote " + md_path.string() + ", " + json_path.string() + " and " +
-                               std::to_string(pngs.size()) + " plots");
-    }
+    const std::string header = report_header(session);
+    finish_json(session);
+    if (options.write_files) write_result_files(session, header, tables);
     if (options.json) {
         std::fputs(session.json.line().c_str(), stdout);
     } else {
