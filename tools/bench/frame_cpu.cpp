@@ -1,9 +1,10 @@
-// crisp-bench --suite frame-cpu (formerly crisp-bench-frame): the CPU time one frame of a game's UI text costs on the
-// calling thread. Eight labels (health, ammo, a name, coordinates, an FPS counter, ...) are laid out once; every frame
-// three of them get a new string and are laid out again with a Layouter, all eight are drawn with
-// DrawOptions, and the renderer's and the compositor's (tile path) record() fill the frame's command
-// buffer, with 2 frames in flight. Timed with a steady clock, per phase, and with the thread's CPU
-// clock: begin_frame() through the end of compositor.record(). docs/benchmarks-cpu.md.
+// crisp-bench --suite frame-cpu (formerly crisp-bench-frame): the CPU time one frame of a game's
+// UI text costs on the calling thread. Eight labels (health, ammo, a name, coordinates, an FPS
+// counter, ...) are laid out once; every frame three of them get a new string and are laid out
+// again with a Layouter, all eight are drawn with DrawOptions, and the renderer's and the
+// compositor's (tile path) record() fill the frame's command buffer, with 2 frames in flight.
+// Timed with a steady clock, per phase, and with the thread's CPU clock: begin_frame() through the
+// end of compositor.record(). docs/benchmarks-cpu.md.
 #include "bench.hpp"
 #include "cli.hpp"
 #include "gpu_tools.hpp"
