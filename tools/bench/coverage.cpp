@@ -19,6 +19,8 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace crisp::bench {
@@ -98,13 +100,16 @@ std::string describe_variations(const std::vector<Variation>& variations) {
 
 class Coverage {
 public:
-    Coverage(Session& session) : session_(session), options_(session.options) {}
+    Coverage(Session& session, std::vector<GlyphSpec> specs)
+        : session_(session), options_(session.options), specs_(std::move(specs)) {}
 
-    void load(Session& session) {
+    // Bakes the fonts and lays out the set; a missing font file is left out with a warning.
+    void load() {
         uint32_t line = 0;
         for (const GlyphSpec& spec : specs_) {
             if (!std::filesystem::exists(spec.path)) {
-                session.warn(kSuite, spec.path + " is missing (scripts/setup.sh installs it): its glyphs are left out");
+                session_.warn(kSuite,
+                              spec.path + " is missing (scripts/setup.sh installs it): its glyphs are left out");
                 continue;
             }
             LoadedFont& font = font_for(spec);
@@ -116,15 +121,16 @@ public:
             layout_options.origin_y = 0.61f + static_cast<float>(++line) * 300.0f;
             auto laid = layout_text(fonts, spec.text, style, layout_options);
             if (!laid) fail(kSuite, spec.path + ": " + laid.error().message);
-            const std::vector<uint32_t> codepoints = decode_utf8(spec.text);
-            for (size_t i = 0; i < laid->glyphs.size(); ++i) {
-                if (laid->glyphs[i].width == 0) continue;
-                glyphs_.push_back({laid->glyphs[i], &spec, i < codepoints.size() ? codepoints[i] : 0});
+            for (const GlyphInstance& g : laid->glyphs) {
+                if (g.width == 0) continue;
+                const std::vector<uint32_t> from_cluster = decode_utf8(std::string_view(spec.text).substr(g.cluster));
+                glyphs_.push_back({g, &spec, from_cluster.empty() ? 0 : from_cluster.front()});
             }
         }
         if (glyphs_.empty()) fail(kSuite, "no glyph of the set could be loaded");
     }
 
+    // Every layout and sample kind measured, the report's tables and the JSON written.
     void run() {
         const uint32_t max_samples = options_.samples.value_or(options_.quick ? 16 : 512);
         std::vector<SampleKind> kinds = {SampleKind::rows, SampleKind::points};
@@ -410,7 +416,6 @@ private:
         session_.json.end_array();
     }
 
-public:
     void write_peers_json() {
         session_.json.key("freetype").begin_array();
         for (const PeerJson& p : freetype_json_) {
@@ -428,17 +433,15 @@ public:
         session_.json.end_array();
     }
 
-    std::vector<GlyphSpec> specs_;
-
-private:
     struct PeerJson {
         std::string mode, layout;
         ErrorPoint error;
-        double us_per_glyph;
+        double us_per_glyph = 0.0;
         std::vector<double> means, worsts, times;
     };
     Session& session_;
     const Options& options_;
+    std::vector<GlyphSpec> specs_;  // glyphs_ point into it
     std::vector<LoadedFont> fonts_;
     std::vector<SetGlyph> glyphs_;
     std::vector<PeerJson> freetype_json_;
@@ -447,9 +450,8 @@ private:
 }  // namespace
 
 void run_coverage(Session& session) {
-    Coverage coverage(session);
-    coverage.specs_ = glyph_set(session.options);
-    coverage.load(session);
+    Coverage coverage(session, glyph_set(session.options));
+    coverage.load();
     coverage.run();
 }
 

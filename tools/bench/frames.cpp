@@ -31,7 +31,6 @@ constexpr std::string_view kSuite = "frames";
     bench::fail(kSuite, message);
 }
 
-// A screen of prose: lines of text at the given size until the canvas is full.
 }  // namespace
 
 std::vector<crisp::GlyphInstance> screen_of_text(const FrameArgs& args, const crisp::Font& font) {
