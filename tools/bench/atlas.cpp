@@ -31,12 +31,19 @@ const char* const kPageText =
     "noisiest authorities insisted on its being received, for good or for evil, in the superlative degree "
     "of comparison only.\n";
 
+// The coverage error of one quantization over the glyphs measured.
+struct QuantizationError {
+    double mean = 0.0;   // mean absolute error per texel channel, averaged over the glyphs
+    double worst = 0.0;  // the worst texel channel
+    uint32_t glyphs = 0;
+};
+
 struct Row {
     uint32_t steps = 0;
     size_t glyphs = 0;
     uint32_t entries = 0;
     uint32_t cells = 0;
-    ErrorPoint gray, rgb;
+    QuantizationError gray, rgb;
 };
 
 std::vector<GlyphInstance> lay_out_page(const Font& font, float size, uint32_t steps, const std::string& page) {
@@ -75,10 +82,10 @@ void count_entries(const Font& font, const std::vector<GlyphInstance>& glyphs, R
 // per glyph, both references on the same target pixels (the finest glyph's rect widened by a
 // texel on each side), mean absolute error per texel channel averaged over the glyphs, and the
 // worst channel.
-ErrorPoint quantization_error(freetype::Face& face, const Font& font, const std::vector<GlyphInstance>& finest,
-                              const std::vector<GlyphInstance>& quantized, size_t count, const SubpixelLayout& layout,
-                              uint32_t cells) {
-    ErrorPoint point;
+QuantizationError quantization_error(freetype::Face& face, const Font& font, const std::vector<GlyphInstance>& finest,
+                                     const std::vector<GlyphInstance>& quantized, size_t count,
+                                     const SubpixelLayout& layout, uint32_t cells) {
+    QuantizationError point;
     size_t measured = 0;
     for (size_t i = 0; i < finest.size() && i < quantized.size() && measured < count; ++i) {
         const GlyphInstance& a = finest[i];
@@ -101,7 +108,7 @@ ErrorPoint quantization_error(freetype::Face& face, const Font& font, const std:
         ++measured;
     }
     if (measured > 0) point.mean /= static_cast<double>(measured);
-    point.samples = static_cast<uint32_t>(measured);
+    point.glyphs = static_cast<uint32_t>(measured);
     return point;
 }
 
@@ -148,12 +155,12 @@ void run_atlas(Session& session) {
                  "| subpixel steps per pixel | distinct atlas entries | glyphs per entry | atlas cells used | gray: "
                  "mean | worst | rgb: mean | worst |\n|---:|---:|---:|---:|---:|---:|---:|---:|\n",
                  font_path.c_str(), static_cast<double>(size), finest.size(),
-                 rows.empty() ? 0u : rows.front().gray.samples, o.cells_gray, o.cells_gray);
+                 rows.empty() ? 0u : rows.front().gray.glyphs, o.cells_gray, o.cells_gray);
     session.json.begin_object()
         .field("font", font_path)
         .field("size", size)
         .field("page_glyphs", finest.size())
-        .field("error_glyphs", rows.empty() ? 0u : rows.front().gray.samples)
+        .field("error_glyphs", rows.empty() ? 0u : rows.front().gray.glyphs)
         .field("cells", o.cells_gray)
         .key("rows")
         .begin_array();
