@@ -167,8 +167,9 @@ def plot_atlas(data, stem, written):
     axes[0][1].set_ylabel("coverage error of the quantization")
     axes[0][1].set_title(f"exact coverage, {atlas['error_glyphs']} glyphs, against 1/256 px")
     axes[0][1].legend(fontsize=8)
-    for ax in axes[0]:
+    for ax, ticks in zip(axes[0], (steps, [n for n in steps if n < 256])):
         ax.set_xscale("log", base=2)
+        ax.set_xticks(ticks, [str(n) for n in ticks])
         ax.set_xlabel("subpixel steps per pixel")
         ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(f"atlas reuse against subpixel quantization — {title_of(data)}")
