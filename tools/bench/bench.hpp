@@ -48,6 +48,7 @@ struct Options {
 
     // frames
     uint32_t atlas_budget_mib = 0;
+    uint64_t frame_budget = uint64_t{1} << 50;  // unbounded
     bool no_shared_rows = false;
     std::optional<SampleKind> sample_kind;  // none: both
 

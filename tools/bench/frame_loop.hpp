@@ -22,7 +22,8 @@ struct FrameArgs {
     uint32_t width = 1920, height = 1080;
     uint32_t samples = 512;
     uint32_t max_frames = 1000;
-    uint32_t atlas_budget_mib = 0;  // 0: the atlas keeps its 2048x2048
+    uint32_t atlas_budget_mib = 0;              // 0: the atlas keeps its 2048x2048
+    uint64_t frame_budget = uint64_t{1} << 50;  // curve tests per frame; default: unbounded (raw throughput)
     bool no_shared_rows = false;
     SampleKind sample_kind = SampleKind::rows;
 };
@@ -38,8 +39,8 @@ struct Frame {
 // A screen of prose: lines of text at args.size, wrapped at the canvas, until the canvas is full.
 std::vector<GlyphInstance> screen_of_text(const FrameArgs& args, const Font& font);
 
-// A renderer for the benchmark: an unbounded frame budget (raw throughput), args' samples,
-// layout, atlas budget, shared rows and sample kind, with `font` added.
+// A renderer for the benchmark: args' samples, frame budget, layout, atlas budget, shared rows and
+// sample kind, with `font` added.
 Renderer make_renderer(const HeadlessContext& context, const FrameArgs& args, const SubpixelLayout& layout,
                        const Font& font);
 

@@ -5,6 +5,7 @@
 #include "cli.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <string>
 
 namespace crisp::bench {
@@ -136,6 +137,9 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
     cli.section("frames:");
     cli.number<uint32_t>("--atlas-budget", "MIB",
                          "let the 2048x2048 atlas grow to MIB mebibytes (default 0: it does not)", o.atlas_budget_mib);
+    cli.number<uint64_t>("--frame-budget", "TESTS",
+                         "curve tests per frame (default 2^50, unbounded;\nthe library's default is 2^26)",
+                         o.frame_budget, {1, std::numeric_limits<uint64_t>::max()});
     cli.flag("--no-shared-rows", "solve roots per channel even where channels share rows", o.no_shared_rows);
     cli.choice<std::optional<SampleKind>>(
         "--sample-kind", "KIND", "rows (exact in x) or points (default: both; coverage too)", o.sample_kind,
