@@ -7,17 +7,7 @@ set -uo pipefail
 bench=$1 source=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 cd "$source" || exit 1  # the suites' default fonts are relative to the repository root
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
-expect_exit() {  # expect_exit CODE DESCRIPTION -- COMMAND...
-  local want=$1 what=$2; shift 3
-  "$@" >"$work/out" 2>"$work/err"
-  local got=$?
-  [ "$got" -eq "$want" ] || fail "$what: exit $got, want $want; stderr: $(head -c 400 "$work/err")"
-}
-expect_stderr() {  # expect_stderr TEXT DESCRIPTION: the last command's stderr holds TEXT
-  grep -qF -- "$1" "$work/err" || fail "$2: stderr lacks '$1': $(head -c 400 "$work/err")"
-}
+. "$(dirname "${BASH_SOURCE[0]}")/cli_common.sh"
 suites=(frames coverage compositing scaling atlas frame-cpu cpu)
 
 # ---- --help and usage errors: exit 2, nothing measured.

@@ -4,14 +4,7 @@
 set -uo pipefail
 bake=$1 source=$2 work=$3
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
-expect_exit() {  # expect_exit CODE DESCRIPTION -- COMMAND...
-  local want=$1 what=$2; shift 3
-  "$@" >"$work/out" 2>"$work/err"
-  local got=$?
-  [ "$got" -eq "$want" ] || fail "$what: exit $got, want $want; stderr: $(head -c 400 "$work/err")"
-}
+. "$(dirname "${BASH_SOURCE[0]}")/cli_common.sh"
 font=$source/fonts/DejaVuSans.ttf
 
 expect_exit 0 "--help" -- "$bake" --help

@@ -5,17 +5,7 @@
 set -uo pipefail
 render=$1 bake=$2 source=$3 work=$4
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
-expect_exit() {  # expect_exit CODE DESCRIPTION -- COMMAND...
-  local want=$1 what=$2; shift 3
-  "$@" >"$work/out" 2>"$work/err"
-  local got=$?
-  [ "$got" -eq "$want" ] || fail "$what: exit $got, want $want; stderr: $(head -c 400 "$work/err")"
-}
-expect_stderr() {  # expect_stderr TEXT DESCRIPTION: the last command's stderr holds TEXT
-  grep -qF -- "$1" "$work/err" || fail "$2: stderr lacks '$1': $(head -c 400 "$work/err")"
-}
+. "$(dirname "${BASH_SOURCE[0]}")/cli_common.sh"
 
 "$bake" "$source/fonts/DejaVuSans.ttf" --text "Hi" -o "$work/dejavu.crisp" -q || { echo "crisp-bake failed" >&2; exit 1; }
 font=$work/dejavu.crisp
