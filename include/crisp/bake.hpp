@@ -31,7 +31,7 @@ namespace crisp {
 inline constexpr float kDefaultToleranceEm = 1.0f / 4096.0f;
 
 // Bands are added until the fullest band holds at most this many curves, or until kMaxBands.
-inline constexpr uint32_t kTargetCurvesPerBand = 8;
+inline constexpr uint32_t kTargetCurvesPerBand = 4;
 inline constexpr uint32_t kMaxBands = 32;
 // Each band reaches this fraction of its height past both of its edges, so a curve whose y-extent
 // ends exactly on an edge (or within float rounding of it) is listed in both bands.
