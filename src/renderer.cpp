@@ -7,6 +7,7 @@
 #include <crisp/renderer.hpp>
 
 #include <algorithm>
+#include <cassert>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -1105,6 +1106,8 @@ void Renderer::State::record_item_upload(VkCommandBuffer command_buffer, uint64_
         vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                            VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                            VK_ACCESS_TRANSFER_WRITE_BIT);
+        // Items are parts of disjoint atlas entries: make_item_buffers() sized both for every atlas texel.
+        assert(item_data.size() <= item_capacity && workgroup_items.size() <= workgroup_capacity);
         const GpuBuffer& staging = item_staging[this_frame % frames_in_flight];
         const VkDeviceSize item_bytes = item_data.size() * sizeof(gpu::RasterItem);
         const VkDeviceSize table_bytes = workgroup_items.size() * sizeof(uint32_t);
