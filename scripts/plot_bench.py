@@ -28,7 +28,15 @@ LAYOUTS = ["gray", "rgb"]
 METRICS = [("mean", "mean abs. error per texel channel"), ("worst", "worst texel channel")]
 
 
-def save(fig, stem, name, written):
+def panels(rows):
+    """A figure of `rows` x 2 panels, the size and layout every plot here shares."""
+    return plt.subplots(rows, 2, figsize=(11, 4 * rows + 0.5), squeeze=False, layout="constrained")
+
+
+def finish(fig, data, title, stem, name, written):
+    """Titles the figure after what it shows and the device, writes stem-name.png, closes it."""
+    device = f"{data.get('device', '?')}{' (--quick)' if data.get('quick') else ''}"
+    fig.suptitle(f"{title} — {device}")
     path = f"{stem}-{name}.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -46,36 +54,35 @@ def log_axes(ax, xlabel, ylabel, title, x_base=10):
     ax.legend(fontsize=8)
 
 
-def title_of(data):
-    return f"{data.get('device', '?')}{' (--quick)' if data.get('quick') else ''}"
+def error_panels(axes, coverage):
+    """The 2 x 2 error grid (rows: layouts, columns: metrics): per panel its axes, layout, metric,
+    the metric's label, and the coverage suite's runs and FreeType peers of that layout."""
+    for row, layout in enumerate(LAYOUTS):
+        for col, (metric, label) in enumerate(METRICS):
+            runs = [run for run in coverage["runs"] if run["layout"] == layout]
+            peers = [peer for peer in coverage.get("freetype", []) if peer["layout"] == layout]
+            yield axes[row][col], layout, metric, label, runs, peers
 
 
 def plot_error_vs_samples(data, stem, written):
     coverage = data["suites"].get("coverage")
     if not coverage:
         return
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5), squeeze=False, layout="constrained")
+    fig, axes = panels(2)
     glyphs = len(coverage.get("glyphs", []))
-    for row, layout in enumerate(LAYOUTS):
-        for col, (metric, label) in enumerate(METRICS):
-            ax = axes[row][col]
-            for run in coverage["runs"]:
-                if run["layout"] != layout:
-                    continue
-                xs = [p["samples"] for p in run["points"]]
-                ys = [max(p[metric], 1e-6) for p in run["points"]]
-                ax.plot(xs, ys, label=f"crisp, {run['sample_kind']}", **KIND_STYLE.get(run["sample_kind"], {}))
-            for peer in coverage.get("freetype", []):
-                if peer["layout"] != layout:
-                    continue
-                ax.axhline(max(peer[metric], 1e-6), linestyle="--", color=PEER_STYLE.get(peer["mode"], "gray"),
-                           label=f"FreeType {peer['mode']} ({peer['us_per_glyph']:.2g} µs/glyph, CPU)")
-            log_axes(ax, "samples per texel", label, f"{layout}: {label}", x_base=2)
-            counts = sorted({p["samples"] for run in coverage["runs"] for p in run["points"]})
-            ax.set_xticks(counts, [str(n) for n in counts])
-    fig.suptitle(f"crisp coverage error against samples, {glyphs} glyphs, vs. FreeType area coverage — "
-                 f"{title_of(data)}")
-    save(fig, stem, "error-vs-samples", written)
+    counts = sorted({p["samples"] for run in coverage["runs"] for p in run["points"]})
+    for ax, layout, metric, label, runs, peers in error_panels(axes, coverage):
+        for run in runs:
+            xs = [p["samples"] for p in run["points"]]
+            ys = [max(p[metric], 1e-6) for p in run["points"]]
+            ax.plot(xs, ys, label=f"crisp, {run['sample_kind']}", **KIND_STYLE.get(run["sample_kind"], {}))
+        for peer in peers:
+            ax.axhline(max(peer[metric], 1e-6), linestyle="--", color=PEER_STYLE.get(peer["mode"], "gray"),
+                       label=f"FreeType {peer['mode']} ({peer['us_per_glyph']:.2g} µs/glyph, CPU)")
+        log_axes(ax, "samples per texel", label, f"{layout}: {label}", x_base=2)
+        ax.set_xticks(counts, [str(n) for n in counts])
+    finish(fig, data, f"crisp coverage error against samples, {glyphs} glyphs, vs. FreeType area coverage", stem,
+           "error-vs-samples", written)
 
 
 def plot_error_vs_time(data, stem, written):
@@ -85,55 +92,50 @@ def plot_error_vs_time(data, stem, written):
         return
     screen_ms = frames.get("freetype_screen_ms", {})
     entries = frames.get("screen_atlas_entries", 0)
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5), squeeze=False, layout="constrained")
+    fig, axes = panels(2)
     plotted = False
-    for row, layout in enumerate(LAYOUTS):
-        for col, (metric, label) in enumerate(METRICS):
-            ax = axes[row][col]
-            for run in coverage["runs"]:
-                if run["layout"] != layout:
-                    continue
-                timing = next((f for f in frames["runs"]
-                               if f["layout"] == layout and f["sample_kind"] == run["sample_kind"]), None)
-                if timing is None or timing.get("frame_budget", 2**50) != 2**50:
-                    continue  # a bounded budget gives glyphs different samples in a frame
-                cumulative, samples, total = {}, 0.0, 0.0
-                for f in timing["frames"]:
-                    if f["glyphs_refined"] == 0:
-                        break
-                    samples += f["samples"] / f["glyphs_refined"]
-                    total += f["gpu_ms"]
-                    cumulative[int(round(samples))] = total
-                pts = [(cumulative[p["samples"]], max(p[metric], 1e-6), p["samples"]) for p in run["points"]
-                       if p["samples"] in cumulative]
-                if not pts:
-                    continue
-                plotted = True
-                ax.plot([p[0] for p in pts], [p[1] for p in pts], label=f"crisp, {run['sample_kind']} (GPU)",
-                        **KIND_STYLE.get(run["sample_kind"], {}))
-                for x, y, n in pts:
-                    ax.annotate(str(n), (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7,
-                                color=KIND_STYLE.get(run["sample_kind"], {}).get("color", "black"))
-            for peer in coverage.get("freetype", []):
-                if peer["layout"] != layout or peer["mode"] not in screen_ms:
-                    continue
-                ax.scatter([screen_ms[peer["mode"]]], [max(peer[metric], 1e-6)], marker="*", s=140,
-                           color=PEER_STYLE.get(peer["mode"], "gray"), label=f"FreeType {peer['mode']} (CPU, 1 thread)",
-                           zorder=3)
-            log_axes(ax, f"cumulative ms, frames suite's screen ({entries} atlas entries)", label,
-                     f"{layout}: {label}")
+    for ax, layout, metric, label, runs, peers in error_panels(axes, coverage):
+        for run in runs:
+            timing = next((f for f in frames["runs"]
+                           if f["layout"] == layout and f["sample_kind"] == run["sample_kind"]), None)
+            if timing is None or timing.get("frame_budget", 2**50) != 2**50:
+                continue  # a bounded budget gives glyphs different samples in a frame
+            cumulative, samples, total = {}, 0.0, 0.0
+            for f in timing["frames"]:
+                if f["glyphs_refined"] == 0:
+                    break
+                samples += f["samples"] / f["glyphs_refined"]
+                total += f["gpu_ms"]
+                cumulative[int(round(samples))] = total
+            pts = [(cumulative[p["samples"]], max(p[metric], 1e-6), p["samples"]) for p in run["points"]
+                   if p["samples"] in cumulative]
+            if not pts:
+                continue
+            plotted = True
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], label=f"crisp, {run['sample_kind']} (GPU)",
+                    **KIND_STYLE.get(run["sample_kind"], {}))
+            for x, y, n in pts:
+                ax.annotate(str(n), (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7,
+                            color=KIND_STYLE.get(run["sample_kind"], {}).get("color", "black"))
+        for peer in peers:
+            if peer["mode"] not in screen_ms:
+                continue
+            ax.scatter([screen_ms[peer["mode"]]], [max(peer[metric], 1e-6)], marker="*", s=140,
+                       color=PEER_STYLE.get(peer["mode"], "gray"), label=f"FreeType {peer['mode']} (CPU, 1 thread)",
+                       zorder=3)
+        log_axes(ax, f"cumulative ms, frames suite's screen ({entries} atlas entries)", label,
+                 f"{layout}: {label}")
     if not plotted:
         plt.close(fig)
         return
-    fig.suptitle(f"error against cumulative time (labels: samples per texel) — {title_of(data)}")
-    save(fig, stem, "error-vs-time", written)
+    finish(fig, data, "error against cumulative time (labels: samples per texel)", stem, "error-vs-time", written)
 
 
 def plot_scaling(data, stem, written):
     scaling = data["suites"].get("scaling")
     if not scaling or not scaling.get("points"):
         return
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), squeeze=False, layout="constrained")
+    fig, axes = panels(1)
     series = [("same text", lambda p: p["width"] * p["height"] / 1e6, "canvas megapixels (same glyphs)"),
               ("more text", lambda p: p["glyphs"], "glyphs on screen (same canvas)")]
     lines = [("first_renderer_ms", "frame 1, renderer"), ("first_compositor_ms", "frame 1, compositor"),
@@ -144,8 +146,7 @@ def plot_scaling(data, stem, written):
         for key, label in lines:
             ax.plot([x_of(p) for p in pts], [max(p[key], 1e-4) for p in pts], marker="o", label=label)
         log_axes(ax, xlabel, "GPU ms", name)
-    fig.suptitle(f"frame cost against screen and text — {title_of(data)}")
-    save(fig, stem, "scaling", written)
+    finish(fig, data, "frame cost against screen and text", stem, "scaling", written)
 
 
 def plot_atlas(data, stem, written):
@@ -153,7 +154,7 @@ def plot_atlas(data, stem, written):
     if not atlas or not atlas.get("rows"):
         return
     rows = sorted(atlas["rows"], key=lambda r: r["steps"])
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), squeeze=False, layout="constrained")
+    fig, axes = panels(1)
     steps = [r["steps"] for r in rows]
     axes[0][0].plot(steps, [r["entries"] for r in rows], marker="o")
     axes[0][0].set_ylabel("distinct atlas entries")
@@ -172,8 +173,7 @@ def plot_atlas(data, stem, written):
         ax.set_xticks(ticks, [str(n) for n in ticks])
         ax.set_xlabel("subpixel steps per pixel")
         ax.grid(True, which="both", alpha=0.3)
-    fig.suptitle(f"atlas reuse against subpixel quantization — {title_of(data)}")
-    save(fig, stem, "atlas", written)
+    finish(fig, data, "atlas reuse against subpixel quantization", stem, "atlas", written)
 
 
 def main():
