@@ -220,7 +220,7 @@ CRISP_CONSTANT(float, kTileOpaque, 1.0f / 65536.0f);
 CRISP_CONSTANT(uint, kTileBindAtlas, 0u);    // the atlas, storage image
 CRISP_CONSTANT(uint, kTileBindQuads, 1u);    // CompositeQuad[], front to back
 CRISP_CONSTANT(uint, kTileBindTiles, 2u);    // per tile: count, start, cursor (plane-major); block sums
-CRISP_CONSTANT(uint, kTileBindBins, 3u);     // quad indices, each tile's at its start
+CRISP_CONSTANT(uint, kTileBindBins, 3u);     // TileBinEntry[], each tile's at its start
 CRISP_CONSTANT(uint, kTileBindHeader, 4u);   // TileHeader, then the non-empty tiles' indices
 CRISP_CONSTANT(uint, kTileBindTarget, 5u);   // the caller's image, storage image
 CRISP_CONSTANT(uint, kTileBindingCount, 6u);
@@ -259,6 +259,16 @@ CRISP_CONSTANT(uint, kTileBusyIndexBits, 20u);
 CRISP_CONSTANT(uint, kTileBusyCountMax, 4095u);
 CRISP_CONSTANT(uint, kTileLayeredDispatchOffset, 40u);  // bytes
 
+// An entry of a tile's list in the bins, written by the scatter: what the tile pass's walk needs of
+// the quad, so that the pass reads no quad between its list and the atlas.
+struct TileBinEntry {
+    uint quad;    // the quad's index: its key
+    uint rect;    // its rect in the tile's pixels, clamped to the tile: x0, y0, x1, y1, a byte each
+    int texel_x;  // its atlas texel minus its position
+    int texel_y;
+    vec4 color;
+};
+
 struct TilePushConstants {
     int origin_x;  // the caller's rect: its top-left pixel in the image, and its size
     int origin_y;
@@ -267,12 +277,13 @@ struct TilePushConstants {
     uint tiles_x;  // tiles across and down the rect
     uint tiles_y;
     uint quad_count;
-    uint bin_capacity;  // quad indices the bins buffer holds
+    uint bin_capacity;  // entries the bins buffer holds
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(RasterItem) == 88);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
+static_assert(sizeof(TileBinEntry) == 32);
 static_assert(offsetof(TileHeader, layered_dispatch_x) == kTileLayeredDispatchOffset);
 static_assert(kTileScanBlock == kTileScanInvocations * kTileScanPerInvocation);
 static_assert(kTileScanBlock * kTileScanBlock <= 1u << kTileBusyIndexBits);

@@ -15,7 +15,7 @@ layout(std430, set = 0, binding = kTileBindTiles) buffer Tiles {
     uint tile_words[];
 };
 layout(std430, set = 0, binding = kTileBindBins) buffer Bins {
-    uint bins[];
+    TileBinEntry bins[];
 };
 // TileHeader's words, then the non-empty tiles' entries (kTileBusyEntryWords each), then the
 // indices of the tiles the exact pass hands to the layered pass.
@@ -50,4 +50,13 @@ bool quad_tile_range(CompositeQuad q, out uvec2 first, out uvec2 last) {
     first = uvec2(low) / kTileSide;
     last = uvec2(high - 1) / kTileSide;
     return true;
+}
+
+// Quad `index`'s entry in the list of the tile whose top-left pixel is `corner`.
+TileBinEntry tile_bin_entry(uint index, CompositeQuad q, ivec2 corner) {
+    const ivec2 low = clamp(ivec2(q.x, q.y) - corner, ivec2(0), ivec2(kTileSide));
+    const ivec2 high = clamp(ivec2(q.x, q.y) + ivec2(q.width, q.height) - corner, ivec2(0), ivec2(kTileSide));
+    const uint rect = uint(low.x) | (uint(low.y) << 8) | (uint(high.x) << 16) | (uint(high.y) << 24);
+    const ivec2 texel = ivec2(q.atlas_x, q.atlas_y) - ivec2(q.x, q.y);
+    return TileBinEntry(index, rect, texel.x, texel.y, q.color);
 }

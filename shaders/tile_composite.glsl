@@ -41,8 +41,8 @@ layout(set = 0, binding = kTileBindTarget) uniform image2D target;
 
 #include "glyph_texel.glsl"
 
-shared uint unsorted[kCapacity];  // the tile's list as the scatter left it
-shared uint list[kCapacity];      // ... sorted
+shared uint unsorted[kCapacity];  // the keys of the tile's list as the scatter left it
+shared uint list[kCapacity];      // ... sorted, as positions in that list
 // A chunk of the sorted list, staged for the walk: per quad its rect in tile pixels (x0, y0, x1, y1
 // in bytes, clamped to the tile), its atlas texel minus its position, and its colour.
 shared uint chunk_rect[kTileChunk];
@@ -60,29 +60,43 @@ vec3 linear_to_srgb(vec3 c) {
     return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
 }
 
-// Stages quad `index` at `slot` of the chunk for the walk: its rect relative to the tile's corner
-// (clamped to the tile, a byte per edge), its atlas texel minus its position, and its colour.
-void stage_quad(uint slot, uint index, ivec2 corner) {
-    const CompositeQuad q = quads[index];
-    const ivec2 low = clamp(ivec2(q.x, q.y) - corner, ivec2(0), ivec2(kTileSide));
-    const ivec2 high = clamp(ivec2(q.x, q.y) + ivec2(q.width, q.height) - corner, ivec2(0), ivec2(kTileSide));
-    chunk_rect[slot] = uint(low.x) | (uint(low.y) << 8) | (uint(high.x) << 16) | (uint(high.y) << 24);
-    chunk_texel[slot] = ivec2(q.atlas_x, q.atlas_y) - ivec2(q.x, q.y);
-    chunk_colour[slot] = q.color;
+// Stages a list entry at `slot` of the chunk for the walk.
+void stage_entry(uint slot, TileBinEntry e) {
+    chunk_rect[slot] = e.rect;
+    chunk_texel[slot] = ivec2(e.texel_x, e.texel_y);
+    chunk_colour[slot] = e.color;
 }
 
-// The tile's list from the bins into `list`, sorted ascending: each entry's place is the number
-// of entries smaller than it (a quad is in a tile's list once, so entries are distinct). One
-// barrier; count^2 / kTileInvocations reads of workgroup memory per invocation.
-void sort_list(uint start, uint count, ivec2 corner) {
-    for (uint i = gl_LocalInvocationIndex; i < count; i += kTileInvocations) unsorted[i] = bins[start + i];
+// Entry i's place in the sorted list: the number of keys smaller than its own (a quad is in a
+// tile's list once, so keys are distinct). count / kTileInvocations reads of workgroup memory.
+uint sorted_place(uint i, uint count) {
+    const uint key = unsorted[i];
+    uint place = 0u;
+    for (uint j = 0u; j < count; ++j) place += unsorted[j] < key ? 1u : 0u;
+    return place;
+}
+
+// The tile's list sorted by key into `list` (positions in the bins' list), the first chunk staged.
+// Each invocation's first entry is read whole before the barrier, so that staging it waits on no
+// second load; with a capacity above kTileInvocations the further entries are read again.
+void sort_list(uint start, uint count) {
+    const uint mine = gl_LocalInvocationIndex;
+    TileBinEntry entry;
+    if (mine < count) {
+        entry = bins[start + mine];
+        unsorted[mine] = entry.quad;
+    }
+    for (uint i = mine + kTileInvocations; i < count; i += kTileInvocations) unsorted[i] = bins[start + i].quad;
     barrier();
-    for (uint i = gl_LocalInvocationIndex; i < count; i += kTileInvocations) {
-        const uint key = unsorted[i];
-        uint place = 0u;
-        for (uint j = 0u; j < count; ++j) place += unsorted[j] < key ? 1u : 0u;
-        list[place] = key;
-        if (place < kTileChunk) stage_quad(place, key, corner);  // the first chunk, staged at once
+    if (mine < count) {
+        const uint place = sorted_place(mine, count);
+        list[place] = mine;
+        if (place < kTileChunk) stage_entry(place, entry);  // the first chunk, staged at once
+    }
+    for (uint i = mine + kTileInvocations; i < count; i += kTileInvocations) {
+        const uint place = sorted_place(i, count);
+        list[place] = i;
+        if (place < kTileChunk) stage_entry(place, bins[start + i]);
     }
     barrier();
 }
@@ -118,7 +132,7 @@ void blend_over(inout Blend b, vec3 opacity, vec3 colour) {
 // so that the texel loads of successive quads do not wait on each other.
 Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) {
     if (gl_LocalInvocationIndex == 0u) tile_busy_pixels = 0u;
-    sort_list(start, count, corner);  // its barriers also order tile_busy_pixels' reset before the adds
+    sort_list(start, count);  // its barriers also order tile_busy_pixels' reset before the adds
     Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
     bool walking = inside;
     const uint walkers = subgroupAdd(walking ? 1u : 0u);
@@ -129,7 +143,7 @@ Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) 
         if (base > 0u) {
             // The barrier that ended the last chunk's walk lets its staged quads be replaced.
             const uint i = base + gl_LocalInvocationIndex;
-            if (gl_LocalInvocationIndex < kTileChunk && i < count) stage_quad(gl_LocalInvocationIndex, list[i], corner);
+            if (gl_LocalInvocationIndex < kTileChunk && i < count) stage_entry(gl_LocalInvocationIndex, bins[start + list[i]]);
             barrier();
         }
         const uint staged = min(kTileChunk, count - base);
@@ -176,7 +190,7 @@ Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, out bool tai
     bvec3 opaque = bvec3(false);
     float tail_coverage = 1.0;
     for (uint i = 0u; i < count; ++i) {
-        uint candidate = bins[start + i];
+        uint candidate = bins[start + i].quad;
         vec3 opacity, colour;
         if (!quad_opacity(candidate, pixel, opacity, colour)) continue;
         ++b.fragments;

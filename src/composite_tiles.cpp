@@ -51,6 +51,9 @@ TileCompositor::~TileCompositor() = default;
 Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& config) {
     ref_ = device;
     config_ = config;
+    VkPhysicalDeviceProperties device_properties{};
+    ref_.fn->vkGetPhysicalDeviceProperties(config.physical_device, &device_properties);
+    max_buffer_range_ = device_properties.limits.maxStorageBufferRange;
     // The tile pass reduces its statistics per subgroup.
     if (!vk::has_compute_subgroup_arithmetic(*ref_.fn, config.physical_device)) {
         return Error{ErrorCode::vulkan, "compositor: the device has no subgroup arithmetic in compute shaders"};
@@ -122,10 +125,12 @@ bool TileCompositor::supports(VkFormat format, VkFormat view_format) const {
 Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
                             const char* what) {
     if (buffer.buffer && buffer.size >= bytes) return {};
-    // The slot's last use is done (the frames-in-flight contract), so its buffer can go.
+    // The slot's last use is done (the frames-in-flight contract), so its buffer can go. Doubled
+    // sizes, so that growing text reallocates rarely, but never past what a descriptor can reach
+    // (record() refuses more than that).
     buffer.reset();
-    return vk::create_buffer(ref_, std::max<VkDeviceSize>(256, std::bit_ceil(bytes)), usage, host_visible, what,
-                             buffer);
+    const VkDeviceSize size = std::max(bytes, std::min(std::bit_ceil(bytes), max_buffer_range_));
+    return vk::create_buffer(ref_, std::max<VkDeviceSize>(256, size), usage, host_visible, what, buffer);
 }
 
 Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles,
@@ -135,7 +140,7 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
     const VkDeviceSize quad_bytes = quads.size_bytes();
     if (Status s = grow(slot.quads, quad_bytes, storage, true, "tile quads"); !s) return s;
     if (Status s = grow(slot.tiles, tile_words(tiles) * kWord, storage | transfer, false, "tile counts"); !s) return s;
-    if (Status s = grow(slot.bins, pairs * kWord, storage, false, "tile bins"); !s) return s;
+    if (Status s = grow(slot.bins, pairs * sizeof(gpu::TileBinEntry), storage, false, "tile bins"); !s) return s;
     // Host-visible, so that the host reads the frame's counts straight from it once the frame is done.
     if (Status s = grow(slot.header, header_words(tiles) * kWord,
                         storage | transfer | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true, "tile header");
@@ -204,31 +209,43 @@ void TileCompositor::record_binning(VkCommandBuffer cb, const gpu::TilePushConst
                        shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
 }
 
+// The frame's counters start again, written through the header's mapping: the slot's last frame
+// is done (the frames-in-flight contract), and submitting the command buffer makes host writes
+// before it visible to the GPU. So static text's frame carries no clear and no transfer barrier.
+// Binning anew, the whole TileHeader starts at zero (the scan writes the dispatches); with the
+// bins reused, the busy list and the exact pass's dispatch stand, and the tile passes' counts and
+// the layered dispatch start again.
+void TileCompositor::reset_header(const Slot& slot, bool reuse_bins) {
+    if (reuse_bins) {
+        constexpr uint32_t reset[] = {0, 0, 0, 0, 0, 1, 1};  // layered tiles .. layered dispatch z
+        static_assert(offsetof(gpu::TileHeader, layered_dispatch_z) - offsetof(gpu::TileHeader, layered_tiles) ==
+                      sizeof(reset) - kWord);
+        std::memcpy(static_cast<char*>(slot.header.mapped) + offsetof(gpu::TileHeader, layered_tiles), reset,
+                    sizeof(reset));
+    } else {
+        const gpu::TileHeader zero{};
+        std::memcpy(slot.header.mapped, &zero, sizeof(zero));
+    }
+}
+
 void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
                                    const gpu::TilePushConstants& push, bool reuse_bins) {
     constexpr VkPipelineStageFlags compute = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
     constexpr VkPipelineStageFlags transfer = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    constexpr VkPipelineStageFlags indirect = VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT;
     constexpr VkAccessFlags shader = vk::kShaderAccess;
     const uint32_t tiles = push.tiles_x * push.tiles_y;
     // This slot's buffers were last used by a frame the caller has waited for; the barrier orders
     // them for the validation layer and for callers who recycle command buffers early.
-    vk::memory_barrier(*ref_.fn, cb, compute | transfer | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
-                       shader | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT, transfer,
-                       VK_ACCESS_TRANSFER_WRITE_BIT);
-    if (reuse_bins) {
-        // The bins, the busy list and the exact pass's dispatch stand; the tile passes' counts
-        // and the layered dispatch start again.
-        constexpr uint32_t reset[] = {0, 0, 0, 0, 0, 1, 1};  // layered tiles .. layered dispatch z
-        static_assert(offsetof(gpu::TileHeader, layered_dispatch_z) - offsetof(gpu::TileHeader, layered_tiles) ==
-                      sizeof(reset) - kWord);
-        ref_.fn->vkCmdUpdateBuffer(cb, slot.header.buffer, offsetof(gpu::TileHeader, layered_tiles), sizeof(reset),
-                                   reset);
-    } else {
+    vk::memory_barrier(*ref_.fn, cb, compute | transfer | indirect,
+                       shader | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT,
+                       compute | transfer | indirect,
+                       shader | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+    reset_header(slot, reuse_bins);
+    if (!reuse_bins) {
         ref_.fn->vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
-        ref_.fn->vkCmdFillBuffer(cb, slot.header.buffer, 0, sizeof(gpu::TileHeader), 0);
+        vk::memory_barrier(*ref_.fn, cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, compute, shader);
     }
-    vk::memory_barrier(*ref_.fn, cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT,
-                       compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
 
     ref_.fn->vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set,
                                      0, nullptr);
@@ -278,9 +295,12 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     push.tiles_y = (push.height + gpu::kTileSide - 1) / gpu::kTileSide;
     push.quad_count = static_cast<uint32_t>(quads.size());
     const uint64_t pairs = count_tile_pairs(quads, push.width, push.height);
-    if (pairs > 0xFFFFFFFFu / kWord) {
-        return Error{ErrorCode::invalid_argument, "compositor: " + std::to_string(pairs) +
-                                                      " (glyph, tile) pairs in one frame, more than a buffer holds"};
+    if (pairs * sizeof(gpu::TileBinEntry) > max_buffer_range_ || quads.size_bytes() > max_buffer_range_) {
+        return Error{ErrorCode::invalid_argument, "compositor: " + std::to_string(quads.size()) + " glyphs in " +
+                                                      std::to_string(pairs) + " (glyph, tile) pairs need " +
+                                                      std::to_string(pairs * sizeof(gpu::TileBinEntry)) +
+                                                      " bytes of bins, more than the device's maxStorageBufferRange (" +
+                                                      std::to_string(max_buffer_range_) + ") lets a shader reach"};
     }
     push.bin_capacity = static_cast<uint32_t>(pairs);
     const uint32_t tiles = push.tiles_x * push.tiles_y;
@@ -304,7 +324,8 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     slot.frame = frame_;
     recorded_ = true;
     last_binned_ = !reused;
-    return quads.size_bytes() + tile_words(tiles) * kWord + pairs * kWord + header_words(tiles) * kWord;
+    return quads.size_bytes() + tile_words(tiles) * kWord + pairs * sizeof(gpu::TileBinEntry) +
+           header_words(tiles) * kWord;
 }
 
 }  // namespace crisp::composite

@@ -93,7 +93,7 @@ private:
     struct Slot {
         vk::DeviceBuffer quads;   // host-visible CompositeQuad[]
         vk::DeviceBuffer tiles;   // three planes of tile words
-        vk::DeviceBuffer bins;    // quad indices
+        vk::DeviceBuffer bins;    // TileBinEntry lists
         vk::DeviceBuffer header;  // host-visible: TileHeader, then the busy tiles' entries
         VkDescriptorSet set = VK_NULL_HANDLE;
         bool pending = false;
@@ -109,11 +109,13 @@ private:
     Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
     void write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view);
     void record_binning(VkCommandBuffer command_buffer, const gpu::TilePushConstants& push);
+    void reset_header(const Slot& slot, bool reuse_bins);
     void record_passes(VkCommandBuffer command_buffer, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
                        const gpu::TilePushConstants& push, bool reuse_bins);
 
     vk::DeviceRef ref_;
     TileConfig config_;
+    VkDeviceSize max_buffer_range_ = 0;  // maxStorageBufferRange: the largest buffer a descriptor reaches
     vk::DescriptorSets descriptors_;
     vk::DeviceObjects objects_;  // shader modules and pipelines
     VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;

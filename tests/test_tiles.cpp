@@ -5,6 +5,7 @@
 #include "composite_fixture.hpp"
 #include "gpu_tools.hpp"
 #include "headless_context.hpp"
+#include "shared.h"
 
 #include <crisp/compositor.hpp>
 #include <crisp/layout.hpp>
@@ -800,6 +801,44 @@ TEST(TileCompositor, RefusesWhatItCannotDraw) {
     }));
     // Untouched: every refusal recorded nothing.
     EXPECT_EQ(read_target(t), t.initial);
+    expect_no_validation_messages();
+}
+
+// The bins hold a 32-byte entry per (glyph, tile) pair; a frame whose bins a shader could not reach
+// whole (past maxStorageBufferRange: 128 MiB on lavapipe) is refused before anything is recorded,
+// with the numbers in the message. Glyph rects covering the whole target make the pairs cheaply.
+TEST(TileCompositor, RefusesBinsPastTheStorageBufferRange) {
+    const VkDeviceSize range = fixture().context->properties().limits.maxStorageBufferRange;
+    const uint64_t tiles =
+        uint64_t{(kWidth + gpu::kTileSide - 1) / gpu::kTileSide} * ((kHeight + gpu::kTileSide - 1) / gpu::kTileSide);
+    const uint64_t glyphs = range / (sizeof(gpu::TileBinEntry) * tiles) + 1;
+    if (glyphs > (uint64_t{1} << 20)) GTEST_SKIP() << "a range of " << range << " bytes takes too many glyphs";
+    const Scene scene = render_scene({{"H", 2.0f, 20.0f, {0.1f, 0.1f, 0.1f, 1.0f}, 0.5f}});
+    ASSERT_FALSE(scene.drawn.empty());
+    DrawnGlyph whole = scene.drawn[0];
+    whole.instance.x = whole.instance.y = 0;
+    whole.instance.width = kWidth;
+    whole.instance.height = kHeight;
+    const std::vector<DrawnGlyph> many(glyphs, whole);
+    auto compositor = Compositor::create(tile_info());
+    ASSERT_TRUE(compositor);
+    Target t = make_target(VK_FORMAT_R8G8B8A8_UNORM, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+    const CompositeTarget target{t.image.view(), t.format, VK_FORMAT_UNDEFINED, {kWidth, kHeight}, {}};
+    EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
+        const Status too_many = compositor->record(cb, {many, scene.renderer->atlas_view()}, target);
+        ASSERT_FALSE(too_many);
+        EXPECT_EQ(too_many.error().code, ErrorCode::invalid_argument);
+        EXPECT_NE(too_many.error().message.find("maxStorageBufferRange"), std::string::npos);
+    }));
+    EXPECT_EQ(read_target(t), t.initial);
+    // One glyph fewer fits: recorded (not run: every pixel would walk them all) and dropped.
+    test::UnsubmittedCommandBuffer dropped(*fixture().context);
+    ASSERT_TRUE(dropped.ok());
+    const std::span<const DrawnGlyph> fitting(many.data(), glyphs - 1);
+    EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) {
+        EXPECT_TRUE(compositor->record(cb, {fitting, scene.renderer->atlas_view()}, target));
+    }));
+    compositor->abandon_frame();
     expect_no_validation_messages();
 }
 

@@ -227,8 +227,10 @@ public:
     // buffer must be recording, outside a render pass.
     // Errors: invalid_argument for a frame without an atlas view, a null target view, a format
     // this compositor cannot store to (the
-    // message says why), or a rect outside the image or with a side above 16384; vulkan for a
-    // failed allocation; either leaves no commands recorded. Non-finite colours or depths are
+    // message says why), a rect outside the image or with a side above 16384, or a frame whose
+    // bins (32 bytes a (glyph, 16 x 16 tile) pair) or glyph list (64 bytes a glyph) pass the
+    // device's maxStorageBufferRange; vulkan for a failed allocation; either leaves no commands
+    // recorded. Non-finite colours or depths are
     // clamped into range; a glyph whose rect does not lie in the atlas draws nothing where it
     // misses it; rects over 65535 texels a side draw nothing.
     Status record(VkCommandBuffer command_buffer, const DrawnFrame& frame, const CompositeTarget& target);
