@@ -76,12 +76,15 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     slots_.resize(config.frames_in_flight);
     for (uint32_t i = 0; i < config.frames_in_flight; ++i) slots_[i].set = descriptors_.sets[i];
 
-    auto pipeline = [&](const char* shader, const VkSpecializationInfo* specialization, VkPipeline& out) -> Status {
+    // `label` names the pipeline in errors and shader statistics: the shader, and which of its
+    // specializations where it has several.
+    auto pipeline = [&](const char* shader, const VkSpecializationInfo* specialization, const std::string& label,
+                        VkPipeline& out) -> Status {
         Result<VkShaderModule> module = vk::create_embedded_shader(ref_, shader);
         if (!module) return module.error();
         objects_.keep(ref_, *module);
         Result<VkPipeline> made =
-            vk::create_compute_pipeline(ref_, *module, descriptors_.pipeline_layout, specialization, shader);
+            vk::create_compute_pipeline(ref_, *module, descriptors_.pipeline_layout, specialization, label.c_str());
         if (!made) return made.error();
         out = objects_.keep(ref_, *made);
         return {};
@@ -89,12 +92,16 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     const uint32_t scatter = 1;
     const VkSpecializationMapEntry scatter_entry{0, 0, 4};
     const VkSpecializationInfo scatter_info{1, &scatter_entry, 4, &scatter};
-    if (Status s = pipeline("tile_bin.comp", nullptr, count_); !s) return s;
-    if (Status s = pipeline("tile_bin.comp", &scatter_info, scatter_); !s) return s;
+    if (Status s = pipeline("tile_bin.comp", nullptr, "tile_bin.comp (count)", count_); !s) return s;
+    if (Status s = pipeline("tile_bin.comp", &scatter_info, "tile_bin.comp (scatter)", scatter_); !s) return s;
     for (uint32_t phase = 0; phase < scan_.size(); ++phase) {
         const VkSpecializationMapEntry phase_entry{0, 0, 4};
         const VkSpecializationInfo phase_info{1, &phase_entry, 4, &phase};
-        if (Status s = pipeline("tile_scan.comp", &phase_info, scan_[phase]); !s) return s;
+        constexpr const char* kPhases[] = {"reduce", "blocks", "down"};
+        if (Status s = pipeline("tile_scan.comp", &phase_info, std::string("tile_scan.comp (") + kPhases[phase] + ")",
+                                scan_[phase]);
+            !s)
+            return s;
     }
 
     for (size_t i = 0; i < kTileVariants.size(); ++i) {
@@ -111,7 +118,9 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
                 config.capacity, variant.image != variant.view ? 1u : 0u, pass};
             const VkSpecializationMapEntry entries[5] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {4, 16, 4}};
             const VkSpecializationInfo specialization{5, entries, sizeof(constants), constants};
-            if (Status s = pipeline(variant.shader, &specialization, tile_pipelines_[i][pass]); !s) return s;
+            const std::string label = std::string(variant.shader) + (pass == 0 ? " (exact pass)" : " (layered pass)") +
+                                      (variant.image != variant.view ? ", red and blue swapped" : "");
+            if (Status s = pipeline(variant.shader, &specialization, label, tile_pipelines_[i][pass]); !s) return s;
         }
     }
     return {};

@@ -46,13 +46,17 @@ static_assert(kDefaultWarmupFrames >= kFramesInFlight);
 // scene) runs its first frames at low clocks: on an H200 the first modes of a scene measured up
 // to 5x slower with 2 warm-up frames alone.
 constexpr double kDefaultWarmupMs = 500.0;
-// Untimed clears of the RGBA32F target recorded before each frame's timed commands. Between two
-// frames the GPU idles while the CPU works (the compositor sorts the quads, the bench checks), and
-// with short frames an H200's clock governor then held the SM clock at 345-900 MHz, lower the
+// Untimed clears of a 3840x2160 RGBA32F image recorded before each frame's timed commands. Between
+// two frames the GPU idles while the CPU works (the compositor sorts the quads, the bench checks),
+// and with short frames an H200's clock governor then held the SM clock at 345-900 MHz, lower the
 // longer the run: the tile path's 4-layer time rose from 0.66 to 1.13 ms within 100 frames and
 // depended on the modes that ran before. With 8 clears at 3840x2160 the clock stayed at 1980 MHz
-// (2 were too few); docs/results/h200-composite-tiles-clocks.md.
+// (2 were too few); docs/results/h200-composite-tiles-clocks.md. The load image has that size
+// whatever the canvas: 8 clears of a 1920x1080 target did not hold the clock (32 layers: 1.43 ms
+// against 0.556 with 32 clears; docs/results/h200-composite-tiles-staged-bins.md). A CPU device
+// has no clock governor, and there the clears would only slow the sweep: none by default.
 constexpr uint32_t kDefaultClockLoad = 8;
+constexpr uint32_t kClockLoadWidth = 3840, kClockLoadHeight = 2160;
 // Layer i is shifted by (i * kShiftStepX mod kShiftRangeX, i * kShiftStepY mod kShiftRangeY)
 // pixels: fractional steps, so that the layers' glyphs overlap partially and at many phases.
 constexpr float kShiftStepX = 1.37f, kShiftRangeX = 5.0f;
@@ -305,6 +309,7 @@ double median(std::vector<double> values) {
 struct Targets {
     crisp::Image rgba32f;  // storage, colour attachment
     crisp::Image rgba8;    // storage
+    crisp::Image load;     // kClockLoadWidth x kClockLoadHeight RGBA32F, cleared for the clock load
     const crisp::Image& of(VkFormat format) const { return format == VK_FORMAT_R8G8B8A8_UNORM ? rgba8 : rgba32f; }
 };
 
@@ -350,7 +355,10 @@ struct Bench {
 
     // Clears the target image of `format` to the background.
     void clear_target(VkCommandBuffer cb, VkFormat format, const crisp::CompositeParams& params) {
-        const VkImage image = targets.of(format).handle();
+        clear_image(cb, targets.of(format).handle(), format, params);
+    }
+
+    void clear_image(VkCommandBuffer cb, VkImage image, VkFormat format, const crisp::CompositeParams& params) {
         const crisp::vk::Functions& fn = context.functions();
         crisp::vk::image_barrier(fn, cb, image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL, kAnyStage, kAnyAccess,
                                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
@@ -429,7 +437,9 @@ struct Bench {
                 renderer.draw(scene.glyphs, scene.visible);
             }
             const crisp::Status status = context.submit_and_wait([&](VkCommandBuffer cb) {
-                for (uint32_t k = 0; k < args.clock_load; ++k) clear_target(cb, VK_FORMAT_R32G32B32A32_SFLOAT, params);
+                for (uint32_t k = 0; k < args.clock_load; ++k) {
+                    clear_image(cb, targets.load.handle(), VK_FORMAT_R32G32B32A32_SFLOAT, params);
+                }
                 if (!is_reference(run)) clear_target(cb, run.format, params);  // the tile and draw paths' image
                 // The clears are not the mode's cost.
                 timer.begin(cb, !is_reference(run) || args.clock_load > 0);
@@ -553,14 +563,18 @@ void print_markdown(std::FILE* out, const Args& args, const Header& header, cons
                  static_cast<double>(args.size), header.layout.c_str(), args.subpixel_steps, args.samples,
                  static_cast<double>(kBackgroundSrgb));
     for (const std::string& w : header.compositor_warnings) std::fprintf(out, "Compositor: %s.\n", w.c_str());
+    const std::string load = args.clock_load == 0
+                                 ? "no clock load"
+                                 : "each frame after " + std::to_string(args.clock_load) + " untimed clears of a " +
+                                       std::to_string(kClockLoadWidth) + "x" + std::to_string(kClockLoadHeight) +
+                                       " RGBA32F image that keep the GPU's clocks up";
     std::fprintf(out,
                  "GPU ms: median of %u frames after at least %u warm-up frames and %g ms, timestamps around the "
-                 "mode's record call alone (frame: the renderer's record() of the converged text too), each frame "
-                 "after %u untimed clears of the target that keep the GPU's clocks up. "
+                 "mode's record call alone (frame: the renderer's record() of the converged text too), %s. "
                  "RMSE and max: 8-bit sRGB codes against %s, over all pixels and channels. B/px: the buffers the "
                  "mode uses (CompositorStats::buffer_bytes / pixels: the tile and draw paths' quads and bins, the "
                  "reference modes' per-pixel buffers); the target image adds %u B/px (RGBA32F) or 4 (rgba8).\n",
-                 args.frames, args.warmup, args.warmup_ms, args.clock_load,
+                 args.frames, args.warmup, args.warmup_ms, load.c_str(),
                  args.cpu_check ? "the exact CPU reference (double precision, every fragment)" : "the exact mode",
                  kTargetBytesPerPixel);
     for (const float alpha : args.alphas) {
@@ -648,28 +662,33 @@ std::string prose_for(const Args& args) {
     return text;
 }
 
-// The tile and draw paths' target images, zeroed and in GENERAL, where the frames keep them.
+// The tile and draw paths' target images, and the clock load's image where there is a load, zeroed
+// and in GENERAL, where the frames keep them.
 void make_targets(crisp::HeadlessContext& context, const Args& args, Targets& targets) {
     struct TargetDesc {
         crisp::Image* image;
         VkFormat format;
         VkImageUsageFlags usage;
+        uint32_t width, height;
     };
-    const TargetDesc target_descs[] = {
+    std::vector<TargetDesc> target_descs = {
         {&targets.rgba32f, VK_FORMAT_R32G32B32A32_SFLOAT,
-         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT},
-        {&targets.rgba8, VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_STORAGE_BIT},
+         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, args.width, args.height},
+        {&targets.rgba8, VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_STORAGE_BIT, args.width, args.height},
     };
+    if (args.clock_load > 0) {
+        target_descs.push_back({&targets.load, VK_FORMAT_R32G32B32A32_SFLOAT, 0, kClockLoadWidth, kClockLoadHeight});
+    }
     for (const TargetDesc& d : target_descs) {
         crisp::ImageDesc desc;
         desc.format = d.format;
-        desc.width = args.width;
-        desc.height = args.height;
+        desc.width = d.width;
+        desc.height = d.height;
         desc.usage = d.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
         auto made = context.create_image(desc);
         if (!made) fail(made.error().message);
         *d.image = std::move(*made);
-        const std::vector<std::byte> zeros(size_t{args.width} * args.height * crisp::format_texel_size(d.format));
+        const std::vector<std::byte> zeros(size_t{d.width} * d.height * crisp::format_texel_size(d.format));
         if (crisp::Status st = context.upload(*d.image, zeros, VK_IMAGE_LAYOUT_GENERAL); !st) fail(st.error().message);
     }
 }
@@ -812,7 +831,7 @@ Args args_from(const crisp::bench::Session& session) {
     args.frames = o.frames.value_or(o.quick ? 2 : args.frames);
     args.warmup = o.warmup.value_or(args.warmup);
     args.warmup_ms = o.warmup_ms.value_or(o.quick ? 0.0 : args.warmup_ms);
-    args.clock_load = o.clock_load.value_or(o.quick ? 1 : args.clock_load);
+    args.clock_load = o.clock_load.value_or(session.cpu_device ? 0 : o.quick ? 1 : args.clock_load);
     args.samples = o.samples.value_or(o.quick ? 16 : args.samples);
     args.subpixel_steps = o.subpixel_steps;
     args.path = o.quad_path;
