@@ -1,7 +1,7 @@
 # GLSL -> SPIR-V at build time, embedded in C++.
 #
 #   crisp_add_shaders(TARGET crisp
-#                     SOURCES shaders/raster.comp shaders/composite.vert ...
+#                     SOURCES shaders/raster/raster.comp shaders/composite/quad_pipeline.vert ...
 #                     INCLUDE_DIRS shaders
 #                     [NAMESPACE crisp::shaders])
 #

@@ -1,6 +1,6 @@
 // Fuzzes the asset loader. The checksum would reject almost every mutation before the structure
 // is looked at, so the target re-seals it: what is fuzzed is every check behind it.
-#include "crc32c.hpp"
+#include "asset/crc32c.hpp"
 
 #include <crisp/asset.hpp>
 

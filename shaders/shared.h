@@ -108,7 +108,7 @@ struct RasterPushConstants {
 };
 
 
-// ---- The compositor (composite.vert and the *.frag / *_resolve.comp of each mode).
+// ---- The compositor (quad_pipeline.vert and the *.frag / *_resolve.comp of each mode).
 
 // The descriptor set every quad pass shares (the draw path binds the first two).
 CRISP_CONSTANT(uint, kCompositeBindAtlas, 0u);         // the atlas, storage image
@@ -187,7 +187,7 @@ struct CompositePushConstants {
 };
 
 
-// ---- The tile compositor (tile_bin.comp, tile_scan.comp, tile_composite*.comp): the frame's quads,
+// ---- The tile compositor (tiles_bin.comp, tiles_scan.comp, tiles_pass_*.comp): the frame's quads,
 // sorted front to back on the CPU (so a quad's index is its key), binned into screen tiles on the
 // GPU and composited per tile into the caller's image (docs/compositing.md).
 
@@ -216,7 +216,7 @@ CRISP_CONSTANT(uint, kTileNoQuad, 0xFFFFFFFFu);
 // 16-bit code): a pixel's walk stops there.
 CRISP_CONSTANT(float, kTileOpaque, 1.0f / 65536.0f);
 
-// Bindings of the tile compositor's descriptor set (tile_common.glsl declares the same).
+// Bindings of the tile compositor's descriptor set (tiles_common.glsl declares the same).
 CRISP_CONSTANT(uint, kTileBindAtlas, 0u);    // the atlas, storage image
 CRISP_CONSTANT(uint, kTileBindQuads, 1u);    // CompositeQuad[], front to back
 CRISP_CONSTANT(uint, kTileBindTiles, 2u);    // per tile: count, start, cursor (plane-major); block sums

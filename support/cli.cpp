@@ -1,6 +1,6 @@
 #include "cli.hpp"
 
-#include "utf8.hpp"
+#include "text/utf8.hpp"
 
 #include <algorithm>
 #include <cstdio>

@@ -234,7 +234,7 @@ double coverage_points(const FontAsset& asset, const GlyphRecord& glyph, double 
     return static_cast<double>(hits) / static_cast<double>(sample_count);
 }
 
-// Row samples: shaders/raster.comp's row_crossing(), row_curve() and row_walk(), operation for
+// Row samples: shaders/raster/raster.comp's row_crossing(), row_curve() and row_walk(), operation for
 // operation (Real = float).
 
 double radical_inverse_2(uint32_t n) {
@@ -293,7 +293,7 @@ struct RowSpan {
     }
 
     // The covered length of each channel's segment within the part of the row this pass saw
-    // (shaders/raster.comp's row_walk()).
+    // (shaders/raster/raster.comp's row_walk()).
     std::array<Real, 3> walk(std::span<const Real, 3> lo, std::span<const Real, 3> hi) {
         std::array<Real, 3> part{};
         int w = winding;

@@ -18,7 +18,7 @@
 // index its points and band words without further checks.
 #pragma once
 
-#include "curves.hpp"
+#include "bake/curves.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/glyph.hpp>
@@ -83,7 +83,7 @@ std::vector<Quad> listed_quads(const FontAsset& asset, const GlyphRecord& glyph)
 // Offset of R2 sample n within a unit square, in [0, 1)^2, computed in double.
 Vec2 r2_offset(uint32_t n);
 
-// ---- Row samples (shaders/raster.comp's row_samples(); docs/coverage.md, "Row samples").
+// ---- Row samples (shaders/raster/raster.comp's row_samples(); docs/coverage.md, "Row samples").
 
 // Crossings inside one segment kept at once (gpu::kRasterRowCrossings): a segment with more is
 // finished by further passes over the curves, each from the last crossing kept. Exact either way.
@@ -120,7 +120,7 @@ template <class Real>
 uint32_t row_units(Real covered, Real length, Real dither, uint32_t one);
 
 // What row sample n of texel (tx, ty) of a glyph rect (mapped to em by `map`) adds to each channel
-// of `layout`, in float as shaders/raster.comp computes it with shared row roots (the renderer's
+// of `layout`, in float as shaders/raster/raster.comp computes it with shared row roots (the renderer's
 // default): channels that share their rows (shares_sample_rows) walk one row across the union of
 // their segments, each covered stretch clipped to each channel's segment; otherwise each channel
 // walks its own row. Each channel then adds row_units(..., row_dither(n), 64). `passes`, when

@@ -1,7 +1,7 @@
 #include "freetype_reference.hpp"
 
-#include "file_io.hpp"
-#include "limits.hpp"
+#include "core/file_io.hpp"
+#include "core/limits.hpp"
 
 #include <ft2build.h>
 #include FT_FREETYPE_H

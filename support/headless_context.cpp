@@ -3,8 +3,8 @@
 // headless_resources.cpp.
 #include "headless_context.hpp"
 
-#include "vk_features.hpp"
-#include "vk_resources.hpp"
+#include "vk/features.hpp"
+#include "vk/resources.hpp"
 
 #include <algorithm>
 #include <cassert>

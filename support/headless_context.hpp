@@ -198,7 +198,7 @@ public:
     // RendererCreateInfo::get_instance_proc_addr and CompositorCreateInfo::get_instance_proc_addr.
     PFN_vkGetInstanceProcAddr get_instance_proc_addr() const;
     // The functions the context calls through, for crisp's own tools and tests (the type is in
-    // the private src/vk_functions.hpp).
+    // the private src/vk/functions.hpp).
     const vk::Functions& functions() const;
     // crisp uses the driver's allocator: always nullptr, passed wherever Vulkan takes one.
     const VkAllocationCallbacks* allocation_callbacks() const { return nullptr; }

@@ -2,8 +2,8 @@
 // move bytes between them and the host.
 #include "headless_context.hpp"
 
-#include "vk_barriers.hpp"
-#include "vk_resources.hpp"
+#include "vk/barriers.hpp"
+#include "vk/resources.hpp"
 
 #include <cassert>
 #include <cstring>

@@ -1,7 +1,7 @@
 #include "image_io.hpp"
 
-#include "file_io.hpp"
-#include "limits.hpp"
+#include "core/file_io.hpp"
+#include "core/limits.hpp"
 
 #include <png.h>
 

@@ -1,7 +1,7 @@
 #include "json_writer.hpp"
 
-#include "file_io.hpp"
-#include "json.hpp"
+#include "core/file_io.hpp"
+#include "core/json.hpp"
 
 #include <cassert>
 #include <charconv>

@@ -1,6 +1,6 @@
 #include "output_files.hpp"
 
-#include "file_io.hpp"
+#include "core/file_io.hpp"
 
 #include <cassert>
 

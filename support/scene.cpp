@@ -1,8 +1,8 @@
 #include "scene.hpp"
 
-#include "file_io.hpp"
-#include "limits.hpp"
-#include "json.hpp"
+#include "core/file_io.hpp"
+#include "core/limits.hpp"
+#include "core/json.hpp"
 
 #include <crisp/renderer.hpp>
 

@@ -1,11 +1,11 @@
 // The GPU rasterizer's accuracy against exact area coverage, and the hard cases of DESIGN.md, on
 // lavapipe with validation on. Each texel channel's coverage (hits / samples) is compared with the
 // exact area fraction of that channel's sample rectangle covered by the glyph (nonzero rule).
-#include "bands.hpp"
+#include "bake/bands.hpp"
 #include "coverage.hpp"
 #include "headless_context.hpp"
 #include "test_support.hpp"
-#include "utf8.hpp"
+#include "text/utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>

@@ -3,8 +3,8 @@
 // atomic file write and FontAsset::band_of.
 #include <crisp/asset.hpp>
 
-#include "crc32c.hpp"
-#include "file_io.hpp"
+#include "asset/crc32c.hpp"
+#include "core/file_io.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>

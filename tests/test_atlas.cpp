@@ -1,4 +1,4 @@
-#include "morton.hpp"
+#include "atlas/morton.hpp"
 
 #include <crisp/atlas.hpp>
 

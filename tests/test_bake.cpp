@@ -1,5 +1,5 @@
 #include "test_support.hpp"
-#include "utf8.hpp"
+#include "text/utf8.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>

@@ -1,5 +1,5 @@
-#include "bands.hpp"
-#include "outline.hpp"
+#include "bake/bands.hpp"
+#include "bake/outline.hpp"
 #include "test_support.hpp"
 
 #include <crisp/bake.hpp>

@@ -1,11 +1,11 @@
 // The two coverage references: the Slug sample function (double, float, banded, unbanded) and the
 // exact area coverage, held to analytic truths, to each other, and to independent crossing tests.
 // docs/coverage.md explains what each test shows and records the numbers measured here.
-#include "bands.hpp"
+#include "bake/bands.hpp"
 #include "coverage.hpp"
-#include "outline.hpp"
+#include "bake/outline.hpp"
 #include "test_support.hpp"
-#include "utf8.hpp"
+#include "text/utf8.hpp"
 
 #include <crisp/bake.hpp>
 

@@ -1,4 +1,4 @@
-#include "curves.hpp"
+#include "bake/curves.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 namespace crisp {
 namespace {
 
-// Evaluated here independently of curves.cpp, in the power basis.
+// Evaluated here independently of bake/curves.cpp, in the power basis.
 Vec2 cubic_at(const Cubic& c, double t) {
     const Vec2 a = c.p3 - 3.0 * c.p2 + 3.0 * c.p1 - c.p0;
     const Vec2 b = 3.0 * (c.p2 - 2.0 * c.p1 + c.p0);

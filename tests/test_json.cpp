@@ -1,4 +1,4 @@
-#include "json.hpp"
+#include "core/json.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // Bounded inputs and safe outputs (docs/limits.md): reads only of regular files within a limit,
 // writes that refuse to replace what is not a regular file or is an input, and font containers
 // the baker refuses up front with what to do instead.
-#include "file_io.hpp"
-#include "limits.hpp"
+#include "core/file_io.hpp"
+#include "core/limits.hpp"
 #include "scene.hpp"
 #include "test_support.hpp"
 

@@ -2,7 +2,7 @@
 #include "coverage.hpp"
 #include "headless_context.hpp"
 #include "test_support.hpp"
-#include "utf8.hpp"
+#include "text/utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>

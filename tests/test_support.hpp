@@ -3,7 +3,7 @@
 
 #include "harness.hpp"
 #include "headless_context.hpp"
-#include "utf8.hpp"
+#include "text/utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>

@@ -6,9 +6,9 @@
 #include "headless_context.hpp"
 #include "shared.h"
 #include "test_support.hpp"
-#include "vk_features.hpp"
-#include "vk_memory.hpp"
-#include "vk_resources.hpp"
+#include "vk/features.hpp"
+#include "vk/memory.hpp"
+#include "vk/resources.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/renderer.hpp>
@@ -110,7 +110,7 @@ uint32_t lowbias32(uint32_t x) {
 }
 
 // The objects of one compute pipeline with one storage buffer at binding 0 and push constants,
-// made with the library's own helpers (vk_resources.hpp), destroyed in reverse order of creation.
+// made with the library's own helpers (vk/resources.hpp), destroyed in reverse order of creation.
 struct ComputeKernel {
     vk::DeviceRef device;
     VkShaderModule module = VK_NULL_HANDLE;

@@ -7,8 +7,8 @@
 // docs/benchmarks-compositing.md.
 #include "bench.hpp"
 #include "gpu_tools.hpp"
-#include "vk_barriers.hpp"
-#include "vk_resources.hpp"
+#include "vk/barriers.hpp"
+#include "vk/resources.hpp"
 #include "image_io.hpp"
 #include "json_writer.hpp"
 #include "oit_reference.hpp"

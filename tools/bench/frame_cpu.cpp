@@ -9,8 +9,8 @@
 #include "cli.hpp"
 #include "gpu_tools.hpp"
 #include "json_writer.hpp"
-#include "vk_barriers.hpp"
-#include "vk_resources.hpp"
+#include "vk/barriers.hpp"
+#include "vk/resources.hpp"
 #include "headless_context.hpp"
 
 #include <crisp/bake.hpp>

@@ -4,7 +4,7 @@
 #include "bench.hpp"
 #include "cli.hpp"
 #include "gpu_tools.hpp"
-#include "vk_resources.hpp"
+#include "vk/resources.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -6,8 +6,8 @@
 #include "bench.hpp"
 #include "frame_loop.hpp"
 #include "gpu_tools.hpp"
-#include "vk_barriers.hpp"
-#include "vk_resources.hpp"
+#include "vk/barriers.hpp"
+#include "vk/resources.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>

@@ -1,7 +1,7 @@
 #include "gpu_frame.hpp"
 #include "headless_context.hpp"
 
-#include "vk_barriers.hpp"
+#include "vk/barriers.hpp"
 
 #include <utility>
 

@@ -7,7 +7,7 @@
 
 #include "vulkan_window.hpp"
 
-#include "vk_resources.hpp"
+#include "vk/resources.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/renderer.hpp>

@@ -1,7 +1,7 @@
 #include "vulkan_window.hpp"
 #include "headless_context.hpp"
 
-#include "vk_resources.hpp"
+#include "vk/resources.hpp"
 
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>

@@ -1,0 +1,5 @@
+// exact, the quad pass as a compute dispatch over the frame's tiles (reference_exact.glsl).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define CRISP_COMPUTE 1
+#include "reference_exact.glsl"

@@ -1,0 +1,37 @@
+// The tile compositor's binning, one invocation per quad (docs/compositing.md). Specialization
+// constant 0 picks the pass:
+//   0, count: add 1 to the count of every tile the quad reaches;
+//   1, scatter: write the quad's entry (TileBinEntry) into each such tile's list, at the tile's cursor.
+// The scatter order inside a list depends on arrival; the tile pass sorts each list.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "tiles_common.glsl"
+
+layout(local_size_x = kTileBinInvocations) in;
+layout(constant_id = 0) const uint kScatter = 0u;
+
+void main() {
+    const uint quad = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * kTileBinInvocations +
+                      gl_LocalInvocationIndex;
+    if (quad >= pc.quad_count) return;
+    const CompositeQuad q = quads[quad];
+    uvec2 first, last;
+    if (!quad_tile_range(q, first, last)) return;
+    const uint tiles = tile_total();
+    for (uint y = first.y; y <= last.y; ++y) {
+        for (uint x = first.x; x <= last.x; ++x) {
+            const uint tile = y * pc.tiles_x + x;
+            if (kScatter == 0u) {
+                atomicAdd(tile_words[tile], 1u);
+            } else {
+                const uint at = atomicAdd(tile_words[2u * tiles + tile], 1u);
+                if (at < pc.bin_capacity) {
+                    bins[at] = tile_bin_entry(quad, q, ivec2(x, y) * int(kTileSide));
+                } else {
+                    atomicAdd(header[kHeaderLostPairs], 1u);
+                }
+            }
+        }
+    }
+}

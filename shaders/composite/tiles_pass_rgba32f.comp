@@ -1,0 +1,5 @@
+// The tile pass into a rgba32f storage image (tiles_pass.glsl).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define CRISP_TARGET_FORMAT rgba32f
+#include "tiles_pass.glsl"

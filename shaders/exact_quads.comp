@@ -1,5 +1,0 @@
-// exact, the quad pass as a compute dispatch over the frame's tiles (exact.glsl).
-#version 460
-#extension GL_GOOGLE_include_directive : require
-#define CRISP_COMPUTE 1
-#include "exact.glsl"

@@ -1,5 +1,0 @@
-// The tile pass into a rgba32f storage image (tile_composite.glsl).
-#version 460
-#extension GL_GOOGLE_include_directive : require
-#define CRISP_TARGET_FORMAT rgba32f
-#include "tile_composite.glsl"

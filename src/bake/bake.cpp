@@ -1,0 +1,444 @@
+#include "bake/bands.hpp"
+#include "core/file_io.hpp"
+#include "core/limits.hpp"
+#include "bake/outline.hpp"
+
+#include <crisp/bake.hpp>
+
+#include <ft2build.h>
+#include FT_FREETYPE_H
+#include FT_MULTIPLE_MASTERS_H
+#include FT_OUTLINE_H
+#include <hb-ot.h>
+#include <hb.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+namespace crisp {
+
+namespace {
+
+// Coordinates past this many em are refused (the loader refuses them too): no real glyph reaches
+// it, and it keeps every em-space computation far from float overflow.
+constexpr float kMaxEmCoordinate = 64.0f;
+constexpr size_t kReportedFailures = 16;
+
+struct LibraryDeleter {
+    void operator()(FT_Library library) const { FT_Done_FreeType(library); }
+};
+struct FaceDeleter {
+    void operator()(FT_Face face) const { FT_Done_Face(face); }
+};
+using LibraryHandle = std::unique_ptr<FT_LibraryRec_, LibraryDeleter>;
+using FaceHandle = std::unique_ptr<FT_FaceRec_, FaceDeleter>;
+
+std::string freetype_error(FT_Error error) {
+    const char* text = FT_Error_String(error);
+    return "FreeType error " + std::to_string(error) + (text ? std::string(" (") + text + ")" : std::string());
+}
+
+double fixed_to_double(FT_Fixed value) {
+    return static_cast<double>(value) / 65536.0;
+}
+
+// The glyphs to bake: every glyph the code points map to, every glyph GSUB can substitute for
+// them (ligatures, alternates, contextual forms), and .notdef.
+std::vector<uint8_t> requested_glyphs(std::span<const std::byte> font_bytes, uint32_t face_index,
+                                      const std::vector<uint32_t>& codepoints, uint32_t glyph_count) {
+    std::vector<uint8_t> wanted(glyph_count, 0);
+    hb_blob_t* blob =
+        hb_blob_create(reinterpret_cast<const char*>(font_bytes.data()), static_cast<unsigned>(font_bytes.size()),
+                       HB_MEMORY_MODE_READONLY, nullptr, nullptr);
+    hb_face_t* face = hb_face_create(blob, face_index);
+    hb_font_t* font = hb_font_create(face);
+    hb_set_t* glyphs = hb_set_create();
+    hb_set_add(glyphs, 0);
+    for (uint32_t cp : codepoints) {
+        hb_codepoint_t glyph = 0;
+        if (hb_font_get_nominal_glyph(font, cp, &glyph)) hb_set_add(glyphs, glyph);
+    }
+    hb_set_t* lookups = hb_set_create();
+    hb_ot_layout_collect_lookups(face, make_tag("GSUB"), nullptr, nullptr, nullptr, lookups);
+    hb_ot_layout_lookups_substitute_closure(face, lookups, glyphs);
+    hb_codepoint_t glyph = UINT32_MAX;  // HB_SET_VALUE_INVALID: start of the walk
+    while (hb_set_next(glyphs, &glyph)) {
+        if (glyph < glyph_count) wanted[glyph] = 1;
+    }
+    hb_set_destroy(lookups);
+    hb_set_destroy(glyphs);
+    hb_font_destroy(font);
+    hb_face_destroy(face);
+    hb_blob_destroy(blob);
+    return wanted;
+}
+
+Status apply_variations(FT_Library library, FT_Face face, const BakeOptions& options, FontInfo& info) {
+    if (!FT_HAS_MULTIPLE_MASTERS(face)) {
+        if (!options.variations.empty()) {
+            return Error{ErrorCode::font_unsupported,
+                         "--var given but the face has no variation axes (it is not a variable font)"};
+        }
+        return {};
+    }
+    FT_MM_Var* mm = nullptr;
+    if (const FT_Error error = FT_Get_MM_Var(face, &mm); error != 0) {
+        return Error{ErrorCode::font_unsupported, "cannot read the variation axes: " + freetype_error(error)};
+    }
+    std::vector<FT_Fixed> coords(mm->num_axis);
+    std::string axis_names;
+    for (FT_UInt i = 0; i < mm->num_axis; ++i) {
+        const FT_Var_Axis& axis = mm->axis[i];
+        coords[i] = axis.def;
+        axis_names += (i ? ", " : "") + tag_to_string(static_cast<uint32_t>(axis.tag));
+    }
+    Status status;
+    for (const Variation& variation : options.variations) {
+        FT_UInt i = 0;
+        while (i < mm->num_axis && static_cast<uint32_t>(mm->axis[i].tag) != variation.tag) ++i;
+        if (i == mm->num_axis) {
+            status = Error{ErrorCode::font_unsupported,
+                           "the face has no axis '" + tag_to_string(variation.tag) + "'; its axes are " + axis_names};
+            break;
+        }
+        const FT_Var_Axis& axis = mm->axis[i];
+        const double minimum = fixed_to_double(axis.minimum), maximum = fixed_to_double(axis.maximum);
+        const auto value = static_cast<double>(variation.value);
+        if (!std::isfinite(value) || value < minimum || value > maximum) {
+            status = Error{ErrorCode::invalid_argument,
+                           "axis '" + tag_to_string(variation.tag) + "' value " + std::to_string(variation.value) +
+                               " is outside [" + std::to_string(minimum) + ", " + std::to_string(maximum) + "]"};
+            break;
+        }
+        coords[i] = static_cast<FT_Fixed>(std::lround(value * 65536.0));
+    }
+    if (status.ok()) {
+        if (const FT_Error error = FT_Set_Var_Design_Coordinates(face, mm->num_axis, coords.data()); error != 0) {
+            status = Error{ErrorCode::font_unsupported, "cannot set the variation: " + freetype_error(error)};
+        }
+    }
+    if (status.ok()) {
+        info.flags |= kFontVariable;
+        for (FT_UInt i = 0; i < mm->num_axis; ++i) {
+            const FT_Var_Axis& axis = mm->axis[i];
+            info.axes.push_back({static_cast<uint32_t>(axis.tag), static_cast<float>(fixed_to_double(coords[i])),
+                                 static_cast<float>(fixed_to_double(axis.minimum)),
+                                 static_cast<float>(fixed_to_double(axis.def)),
+                                 static_cast<float>(fixed_to_double(axis.maximum))});
+        }
+    }
+    FT_Done_MM_Var(library, mm);
+    return status;
+}
+
+struct GlyphOutcome {
+    bool failed = false;
+    std::string reason;
+};
+
+// Converts one glyph and appends it to the asset.
+GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em, const BakeOptions& options,
+                        OutlineCounters& counters, FontAsset& asset, BakeReport& report) {
+    GlyphRecord& record = asset.glyphs[glyph_index];
+    const FT_Error error = FT_Load_Glyph(face, glyph_index, FT_LOAD_NO_HINTING | FT_LOAD_NO_BITMAP);
+    if (error != 0) return {true, freetype_error(error)};
+    const FT_GlyphSlot slot = face->glyph;
+    if (slot->format != FT_GLYPH_FORMAT_OUTLINE) {
+        return {true, "not an outline glyph (FreeType glyph format 0x" + [&] {
+                    char buffer[16];
+                    std::snprintf(buffer, sizeof buffer, "%08lx", static_cast<unsigned long>(slot->format));
+                    return std::string(buffer);
+                }() + ")"};
+    }
+    // The char size is set so that one pixel is one font unit: 26.6 values are font units * 64,
+    // and linearHoriAdvance (16.16) is font units * 65536, both unhinted.
+    const double to_em_26_6 = 1.0 / (64.0 * units_per_em);
+    record.advance = static_cast<float>(static_cast<double>(slot->linearHoriAdvance) / (65536.0 * units_per_em));
+    record.bearing_x = static_cast<float>(static_cast<double>(slot->metrics.horiBearingX) * to_em_26_6);
+    record.bearing_y = static_cast<float>(static_cast<double>(slot->metrics.horiBearingY) * to_em_26_6);
+
+    OutlineOptions outline_options;
+    outline_options.scale = to_em_26_6;
+    outline_options.tolerance = static_cast<double>(options.tolerance_em);
+    outline_options.split_y_extrema = options.split_y_extrema;
+    OutlineCounters glyph_counters;
+    OutlineBuilder builder(outline_options, glyph_counters);
+    std::string reason;
+    if (!decompose_outline(slot->outline, builder, reason)) return {true, reason};
+    const PackedGlyph packed = pack_contours(builder.finish());
+    if (packed.real_curves > options.max_curves_per_glyph) {
+        return {true, std::to_string(packed.real_curves) + " curves, more than the limit of " +
+                          std::to_string(options.max_curves_per_glyph)};
+    }
+    if (packed.curve_count > 0 && (std::max({std::fabs(packed.min_x), std::fabs(packed.max_x), std::fabs(packed.min_y),
+                                             std::fabs(packed.max_y)}) > kMaxEmCoordinate ||
+                                   !std::isfinite(record.advance) || std::fabs(record.advance) > kMaxEmCoordinate)) {
+        return {true, "coordinates beyond +-64 em"};
+    }
+
+    counters.lines += glyph_counters.lines;
+    counters.quadratics += glyph_counters.quadratics;
+    counters.cubics += glyph_counters.cubics;
+    counters.cubic_pieces += glyph_counters.cubic_pieces;
+    counters.dropped_zero_length += glyph_counters.dropped_zero_length;
+    counters.closed_contours += glyph_counters.closed_contours;
+    counters.y_splits += glyph_counters.y_splits;
+    counters.max_deviation = std::max(counters.max_deviation, glyph_counters.max_deviation);
+    counters.seed_max_deviation = std::max(counters.seed_max_deviation, glyph_counters.seed_max_deviation);
+
+    record.flags = kGlyphBaked;
+    if (packed.curve_count == 0) {
+        ++report.empty_glyphs;
+        return {};
+    }
+    const GlyphBands bands = build_bands(packed, kTargetCurvesPerBand, kMaxBands, kBandOverlap);
+    record.bbox_min_x = packed.min_x;
+    record.bbox_min_y = packed.min_y;
+    record.bbox_max_x = packed.max_x;
+    record.bbox_max_y = packed.max_y;
+    record.point_offset = static_cast<uint32_t>(asset.points.size());
+    record.curve_count = packed.curve_count;
+    record.band_offset = static_cast<uint32_t>(asset.band_words.size());
+    record.band_count = bands.band_count;
+    record.band_words = bands.band_words;
+    asset.points.insert(asset.points.end(), packed.points.begin(), packed.points.end());
+    asset.band_words.insert(asset.band_words.end(), bands.words.begin(), bands.words.end());
+
+    report.curve_count += packed.real_curves;
+    report.max_curves_per_glyph = std::max(report.max_curves_per_glyph, packed.real_curves);
+    report.band_count += bands.band_count;
+    report.max_bands_per_glyph = std::max<uint32_t>(report.max_bands_per_glyph, bands.band_count);
+    report.max_curves_per_band = std::max(report.max_curves_per_band, bands.max_curves_in_band);
+    report.mean_curves_per_band += static_cast<double>(bands.entries);  // summed; divided at the end
+    report.mean_curve_tests_per_ray += bands.mean_tests_per_ray;        // summed; divided at the end
+    return {};
+}
+
+}  // namespace
+
+namespace {
+
+bool starts_with(std::span<const std::byte> bytes, std::string_view prefix) {
+    if (bytes.size() < prefix.size()) return false;
+    for (size_t i = 0; i < prefix.size(); ++i) {
+        if (bytes[i] != static_cast<std::byte>(prefix[i])) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+Status check_font_container(std::span<const std::byte> font_bytes) {
+    // FreeType opens these, but HarfBuzz (shaping, from the asset's font bytes) does not, and the
+    // asset must hold bytes it can shape: refused up front, saying what to do instead.
+    if (starts_with(font_bytes, "wOFF")) {
+        return Error{ErrorCode::font_unsupported,
+                     "a WOFF font: crisp bakes TrueType and OpenType; decompress it first (fontTools: "
+                     "python3 -c \"from fontTools.ttLib import TTFont; f = TTFont('in.woff'); f.flavor = None; "
+                     "f.save('out.otf')\")"};
+    }
+    if (starts_with(font_bytes, "wOF2")) {
+        return Error{ErrorCode::font_unsupported,
+                     "a WOFF2 font: crisp bakes TrueType and OpenType; decompress it first (woff2_decompress from "
+                     "the woff2 package, or fontTools with brotli)"};
+    }
+    if ((font_bytes.size() >= 2 && font_bytes[0] == std::byte{0x80} && font_bytes[1] == std::byte{0x01}) ||
+        starts_with(font_bytes, "%!PS-AdobeFont") || starts_with(font_bytes, "%!FontType1")) {
+        return Error{ErrorCode::font_unsupported,
+                     "a PostScript Type 1 font: crisp bakes TrueType and OpenType; convert it to OpenType CFF first "
+                     "(FontForge, for one)"};
+    }
+    return {};
+}
+
+namespace {
+
+// Refuses options out of range, and font bytes too large or in a container crisp does not bake.
+Status check_options(std::span<const std::byte> font_bytes, const BakeOptions& options) {
+    if (!(options.tolerance_em > 0.0f && options.tolerance_em <= 0.1f)) {
+        return Error{ErrorCode::invalid_argument, "tolerance must be in (0, 0.1] em"};
+    }
+    if (options.max_curves_per_glyph == 0 || options.max_curves_per_glyph > kMaxCurvesPerGlyph) {
+        return Error{ErrorCode::invalid_argument,
+                     "the curve limit per glyph must be 1 to " + std::to_string(kMaxCurvesPerGlyph)};
+    }
+    if (font_bytes.size() > 0x7FFFFFFF) {
+        return Error{ErrorCode::font_unreadable, "the font is larger than 2 GiB"};
+    }
+    return check_font_container(font_bytes);
+}
+
+// A FreeType library and the face opened in it; the face, declared last, is closed first.
+struct OpenedFace {
+    LibraryHandle library;
+    FaceHandle face;
+};
+
+// Starts FreeType and opens the requested face, refusing a face index past the font's face count.
+Result<OpenedFace> open_face(std::span<const std::byte> font_bytes, const BakeOptions& options) {
+    FT_Library raw_library = nullptr;
+    if (const FT_Error error = FT_Init_FreeType(&raw_library); error != 0) {
+        return Error{ErrorCode::font_unreadable, "cannot start FreeType: " + freetype_error(error)};
+    }
+    LibraryHandle library(raw_library);
+    const auto* data = reinterpret_cast<const FT_Byte*>(font_bytes.data());
+    const auto size = static_cast<FT_Long>(font_bytes.size());
+
+    FT_Face raw_face = nullptr;
+    if (const FT_Error error = FT_New_Memory_Face(library.get(), data, size, -1, &raw_face); error != 0) {
+        return Error{ErrorCode::font_unreadable, "not a font FreeType can read: " + freetype_error(error)};
+    }
+    const FT_Long face_count = raw_face->num_faces;
+    FT_Done_Face(raw_face);
+    if (static_cast<FT_Long>(options.face_index) >= face_count) {
+        return Error{ErrorCode::font_unreadable, "face " + std::to_string(options.face_index) +
+                                                     " requested, but the font holds " + std::to_string(face_count) +
+                                                     (face_count == 1 ? " face" : " faces")};
+    }
+    raw_face = nullptr;
+    if (const FT_Error error =
+            FT_New_Memory_Face(library.get(), data, size, static_cast<FT_Long>(options.face_index), &raw_face);
+        error != 0) {
+        return Error{ErrorCode::font_unreadable,
+                     "cannot open face " + std::to_string(options.face_index) + ": " + freetype_error(error)};
+    }
+    FaceHandle face(raw_face);
+    return OpenedFace{std::move(library), std::move(face)};
+}
+
+// Refuses a face without outlines, or with units per em or a glyph count outside what OpenType allows.
+Status check_face(FT_Face face) {
+    if (!FT_IS_SCALABLE(face)) {
+        return Error{ErrorCode::font_unsupported, "the face has no scalable outlines (bitmap-only font)"};
+    }
+    const uint32_t units_per_em = face->units_per_EM;
+    if (units_per_em < 16 || units_per_em > 16384) {
+        return Error{ErrorCode::font_unsupported,
+                     "units per em is " + std::to_string(units_per_em) + ", outside the 16 to 16384 OpenType allows"};
+    }
+    const auto glyph_count = static_cast<uint32_t>(face->num_glyphs);
+    if (glyph_count == 0 || glyph_count > 65536) {
+        return Error{ErrorCode::font_unsupported, "the face holds " + std::to_string(glyph_count) + " glyphs"};
+    }
+    return {};
+}
+
+// Fills info from the face (names, variation, metrics) and scales the face to one pixel per font unit.
+Status read_font_info(FT_Library library, FT_Face face, const BakeOptions& options, FontInfo& info) {
+    info.family = face->family_name ? face->family_name : "";
+    info.style = face->style_name ? face->style_name : "";
+    info.units_per_em = face->units_per_EM;
+    info.face_index = options.face_index;
+    info.tolerance_em = options.tolerance_em;
+    if (Status status = apply_variations(library, face, options, info); !status) return status;
+    // After the variation: FreeType applies MVAR to these.
+    info.ascender = face->ascender;
+    info.descender = face->descender;
+    info.line_gap = std::max(0, face->height - (face->ascender - face->descender));
+
+    // One pixel per font unit; see bake_glyph.
+    if (const FT_Error error = FT_Set_Char_Size(face, 0, static_cast<FT_F26Dot6>(info.units_per_em) * 64, 72, 72);
+        error != 0) {
+        return Error{ErrorCode::font_unsupported, "cannot scale the face: " + freetype_error(error)};
+    }
+    return {};
+}
+
+// Bakes every requested glyph into the asset, a failed one as an empty record flagged failed, and
+// reports progress; returns how many glyphs were requested.
+uint32_t bake_glyphs(std::span<const std::byte> font_bytes, FT_Face face, const BakeOptions& options,
+                     OutlineCounters& counters, FontAsset& asset, BakeReport& report) {
+    const auto glyph_count = static_cast<uint32_t>(face->num_glyphs);
+    const uint32_t units_per_em = face->units_per_EM;
+    std::vector<uint8_t> wanted;
+    if (!options.all_glyphs) wanted = requested_glyphs(font_bytes, options.face_index, options.codepoints, glyph_count);
+    const uint32_t to_do =
+        options.all_glyphs ? glyph_count : static_cast<uint32_t>(std::count(wanted.begin(), wanted.end(), 1));
+
+    asset.glyphs.assign(glyph_count, GlyphRecord{});
+    report.glyph_count = glyph_count;
+    uint32_t done = 0;
+    for (uint32_t glyph = 0; glyph < glyph_count; ++glyph) {
+        if (!options.all_glyphs && !wanted[glyph]) continue;
+        const GlyphOutcome outcome = bake_glyph(face, glyph, units_per_em, options, counters, asset, report);
+        if (outcome.failed) {
+            asset.glyphs[glyph] = GlyphRecord{};
+            asset.glyphs[glyph].flags = kGlyphBaked | kGlyphFailed;
+            if (report.failed_glyphs == 0)
+                report.first_failure = "glyph " + std::to_string(glyph) + ": " + outcome.reason;
+            if (report.failed_glyph_ids.size() < kReportedFailures) report.failed_glyph_ids.push_back(glyph);
+            ++report.failed_glyphs;
+        } else {
+            ++report.baked_glyphs;
+        }
+        ++done;
+        if (options.progress && (done % 256 == 0 || done == to_do)) options.progress(done, to_do);
+    }
+    return to_do;
+}
+
+// Copies the outline counters into the report, and divides its summed means by what they average over.
+void finish_report(const OutlineCounters& counters, BakeReport& report) {
+    report.line_count = counters.lines;
+    report.quadratic_count = counters.quadratics;
+    report.cubic_count = counters.cubics;
+    report.cubic_pieces = counters.cubic_pieces;
+    report.dropped_zero_length = counters.dropped_zero_length;
+    report.closed_contours = counters.closed_contours;
+    report.y_splits = counters.y_splits;
+    report.max_deviation_em = counters.max_deviation;
+    report.seed_max_deviation_em = counters.seed_max_deviation;
+    report.seed_cubic_pieces = 2 * counters.cubics;
+    const uint32_t outlined = report.baked_glyphs - report.empty_glyphs;
+    if (outlined > 0) {
+        report.mean_curves_per_glyph = static_cast<double>(report.curve_count) / outlined;
+        report.mean_curve_tests_per_ray /= outlined;
+    }
+    report.mean_curves_per_band =
+        report.band_count > 0 ? report.mean_curves_per_band / static_cast<double>(report.band_count) : 0.0;
+}
+
+}  // namespace
+
+Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options) {
+    const auto started = std::chrono::steady_clock::now();
+    if (Status status = check_options(font_bytes, options); !status) return status.error();
+    Result<OpenedFace> opened = open_face(font_bytes, options);
+    if (!opened) return opened.error();
+    const FT_Face face = opened->face.get();
+    if (Status status = check_face(face); !status) return status.error();
+
+    BakeResult result;
+    FontAsset& asset = result.asset;
+    BakeReport& report = result.report;
+    FontInfo& info = asset.info;
+    if (Status status = read_font_info(opened->library.get(), face, options, info); !status) return status.error();
+
+    OutlineCounters counters;
+    const uint32_t to_do = bake_glyphs(font_bytes, face, options, counters, asset, report);
+    if (counters.cubics > 0) info.flags |= kFontCubic;
+    info.max_deviation_em = static_cast<float>(counters.max_deviation);
+    asset.font_bytes.assign(font_bytes.begin(), font_bytes.end());
+    finish_report(counters, report);
+
+    if (report.failed_glyphs > 0 && !options.allow_failed) {
+        return Error{ErrorCode::glyph_failed, std::to_string(report.failed_glyphs) + " of " + std::to_string(to_do) +
+                                                  " glyphs failed; first: " + report.first_failure};
+    }
+    if (Status status = validate_asset(asset); !status) {
+        return Error{ErrorCode::asset_invalid,
+                     "the baked asset does not validate (a crisp bug): " + status.error().message};
+    }
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return result;
+}
+
+Result<BakeResult> bake_font_file(const std::filesystem::path& path, const BakeOptions& options) {
+    Result<std::vector<std::byte>> bytes = read_file(path, limits::kFontFileBytes);
+    if (!bytes) return bytes.error();
+    return bake_font(*bytes, options);
+}
+
+}  // namespace crisp

@@ -1,0 +1,340 @@
+// The tile compositor: binning on the GPU, then one workgroup per non-empty tile.
+#include "composite/tiles.hpp"
+
+#include "composite/quads.hpp"
+#include "vk/barriers.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <string>
+#include <string_view>
+
+namespace crisp::composite {
+
+namespace {
+
+constexpr VkDeviceSize kWord = 4;
+size_t variant_index(VkFormat format, VkFormat view_format) {
+    const auto found = std::find_if(kTileVariants.begin(), kTileVariants.end(),
+                                    [&](const TileVariant& v) { return v.image == format && v.view == view_format; });
+    return static_cast<size_t>(found - kTileVariants.begin());
+}
+
+bool is_srgb_encoded(VkFormat format) {
+    return format == VK_FORMAT_R8G8B8A8_UNORM || format == VK_FORMAT_B8G8R8A8_UNORM;
+}
+
+// Words of the header buffer: TileHeader, the busy tiles' entries, the tiles handed to the layered
+// pass.
+VkDeviceSize header_words(uint32_t tiles) {
+    return gpu::kTileHeaderWords + (gpu::kTileBusyEntryWords + 1) * VkDeviceSize{tiles};
+}
+
+// Words of the tiles buffer: count, start and cursor per tile, and two words per scan block.
+VkDeviceSize tile_words(uint32_t tiles) {
+    return VkDeviceSize{tiles} * 3 + 2 * VkDeviceSize{(tiles + gpu::kTileScanBlock - 1) / gpu::kTileScanBlock};
+}
+
+// Workgroups for `count` invocations in groups of `size`, as a 2D grid of rows of
+// kRasterDispatchWidth (the shaders index gl_WorkGroupID.y * gl_NumWorkGroups.x + x).
+VkExtent2D grid(uint32_t count, uint32_t size) {
+    const uint32_t groups = (count + size - 1) / size;
+    const uint32_t width = std::min(groups, gpu::kRasterDispatchWidth);
+    return {width, width == 0 ? 0 : (groups + width - 1) / width};
+}
+
+}  // namespace
+
+TileCompositor::~TileCompositor() = default;
+
+Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& config) {
+    ref_ = device;
+    config_ = config;
+    VkPhysicalDeviceProperties device_properties{};
+    ref_.fn->vkGetPhysicalDeviceProperties(config.physical_device, &device_properties);
+    max_buffer_range_ = device_properties.limits.maxStorageBufferRange;
+    // The tile pass reduces its statistics per subgroup.
+    if (!vk::has_compute_subgroup_arithmetic(*ref_.fn, config.physical_device)) {
+        return Error{ErrorCode::vulkan, "compositor: the device has no subgroup arithmetic in compute shaders"};
+    }
+    constexpr VkShaderStageFlags stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    const VkDescriptorSetLayoutBinding bindings[] = {
+        {gpu::kTileBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stage, nullptr},
+        {gpu::kTileBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
+        {gpu::kTileBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
+        {gpu::kTileBindBins, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
+        {gpu::kTileBindHeader, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
+        {gpu::kTileBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stage, nullptr},
+    };
+    static_assert(std::size(bindings) == gpu::kTileBindingCount);
+    if (Status s = vk::create_descriptor_sets(ref_, bindings, stage, sizeof(gpu::TilePushConstants),
+                                              config.frames_in_flight, "tile compositor", descriptors_);
+        !s) {
+        return s;
+    }
+    slots_.resize(config.frames_in_flight);
+    for (uint32_t i = 0; i < config.frames_in_flight; ++i) slots_[i].set = descriptors_.sets[i];
+
+    // `label` names the pipeline in errors and shader statistics: the shader, and which of its
+    // specializations where it has several.
+    auto pipeline = [&](const char* shader, const VkSpecializationInfo* specialization, const std::string& label,
+                        VkPipeline& out) -> Status {
+        Result<VkShaderModule> module = vk::create_embedded_shader(ref_, shader);
+        if (!module) return module.error();
+        objects_.keep(ref_, *module);
+        Result<VkPipeline> made =
+            vk::create_compute_pipeline(ref_, *module, descriptors_.pipeline_layout, specialization, label.c_str());
+        if (!made) return made.error();
+        out = objects_.keep(ref_, *made);
+        return {};
+    };
+    const uint32_t scatter = 1;
+    const VkSpecializationMapEntry scatter_entry{0, 0, 4};
+    const VkSpecializationInfo scatter_info{1, &scatter_entry, 4, &scatter};
+    if (Status s = pipeline("tiles_bin.comp", nullptr, "tiles_bin.comp (count)", count_); !s) return s;
+    if (Status s = pipeline("tiles_bin.comp", &scatter_info, "tiles_bin.comp (scatter)", scatter_); !s) return s;
+    for (uint32_t phase = 0; phase < scan_.size(); ++phase) {
+        const VkSpecializationMapEntry phase_entry{0, 0, 4};
+        const VkSpecializationInfo phase_info{1, &phase_entry, 4, &phase};
+        constexpr const char* kPhases[] = {"reduce", "blocks", "down"};
+        if (Status s = pipeline("tiles_scan.comp", &phase_info, std::string("tiles_scan.comp (") + kPhases[phase] + ")",
+                                scan_[phase]);
+            !s)
+            return s;
+    }
+
+    for (size_t i = 0; i < kTileVariants.size(); ++i) {
+        const TileVariant& variant = kTileVariants[i];
+        VkFormatProperties properties{};
+        ref_.fn->vkGetPhysicalDeviceFormatProperties(config.physical_device, variant.view, &properties);
+        if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT) == 0) continue;
+        if (std::string_view(variant.shader) == "tiles_pass_any.comp" && !config.storage_without_format) continue;
+        // constant_id 0: K; 1: the target's encoding; 2: the list capacity; 3: red and blue swap;
+        // 4: the pass (exact, layered).
+        for (uint32_t pass = 0; pass < 2; ++pass) {
+            const uint32_t constants[5] = {
+                config.layers, is_srgb_encoded(variant.image) ? gpu::kTileEncodeSrgb : gpu::kTileEncodeLinear,
+                config.capacity, variant.image != variant.view ? 1u : 0u, pass};
+            const VkSpecializationMapEntry entries[5] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {4, 16, 4}};
+            const VkSpecializationInfo specialization{5, entries, sizeof(constants), constants};
+            const std::string label = std::string(variant.shader) + (pass == 0 ? " (exact pass)" : " (layered pass)") +
+                                      (variant.image != variant.view ? ", red and blue swapped" : "");
+            if (Status s = pipeline(variant.shader, &specialization, label, tile_pipelines_[i][pass]); !s) return s;
+        }
+    }
+    return {};
+}
+
+bool TileCompositor::supports(VkFormat format, VkFormat view_format) const {
+    const size_t i = variant_index(format, view_format);
+    return i < kTileVariants.size() && tile_pipelines_[i][0] != VK_NULL_HANDLE;
+}
+
+Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
+                            const char* what) {
+    if (buffer.buffer && buffer.size >= bytes) return {};
+    // The slot's last use is done (the frames-in-flight contract), so its buffer can go. Doubled
+    // sizes, so that growing text reallocates rarely, but never past what a descriptor can reach
+    // (record() refuses more than that).
+    buffer.reset();
+    const VkDeviceSize size = std::max(bytes, std::min(std::bit_ceil(bytes), max_buffer_range_));
+    return vk::create_buffer(ref_, std::max<VkDeviceSize>(256, size), usage, host_visible, what, buffer);
+}
+
+Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles,
+                                    uint64_t pairs) {
+    constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    constexpr VkBufferUsageFlags transfer = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    const VkDeviceSize quad_bytes = quads.size_bytes();
+    if (Status s = grow(slot.quads, quad_bytes, storage, true, "tile quads"); !s) return s;
+    if (Status s = grow(slot.tiles, tile_words(tiles) * kWord, storage | transfer, false, "tile counts"); !s) return s;
+    if (Status s = grow(slot.bins, pairs * sizeof(gpu::TileBinEntry), storage, false, "tile bins"); !s) return s;
+    // Host-visible, so that the host reads the frame's counts straight from it once the frame is done.
+    if (Status s = grow(slot.header, header_words(tiles) * kWord,
+                        storage | transfer | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true, "tile header");
+        !s) {
+        return s;
+    }
+    if (quad_bytes > 0) std::memcpy(slot.quads.mapped, quads.data(), quad_bytes);
+    return {};
+}
+
+void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view) {
+    const VkDescriptorImageInfo atlas{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
+    const VkDescriptorImageInfo target{VK_NULL_HANDLE, target_view, VK_IMAGE_LAYOUT_GENERAL};
+    const VkDescriptorBufferInfo buffers[] = {
+        {slot.quads.buffer, 0, VK_WHOLE_SIZE},
+        {slot.tiles.buffer, 0, VK_WHOLE_SIZE},
+        {slot.bins.buffer, 0, VK_WHOLE_SIZE},
+        {slot.header.buffer, 0, VK_WHOLE_SIZE},
+    };
+    VkWriteDescriptorSet writes[gpu::kTileBindingCount]{};
+    for (uint32_t i = 0; i < gpu::kTileBindingCount; ++i) {
+        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[i].dstSet = slot.set;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    }
+    writes[gpu::kTileBindAtlas].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    writes[gpu::kTileBindAtlas].pImageInfo = &atlas;
+    writes[gpu::kTileBindTarget].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    writes[gpu::kTileBindTarget].pImageInfo = &target;
+    writes[gpu::kTileBindQuads].pBufferInfo = &buffers[0];
+    writes[gpu::kTileBindTiles].pBufferInfo = &buffers[1];
+    writes[gpu::kTileBindBins].pBufferInfo = &buffers[2];
+    writes[gpu::kTileBindHeader].pBufferInfo = &buffers[3];
+    ref_.fn->vkUpdateDescriptorSets(ref_.device, gpu::kTileBindingCount, writes, 0, nullptr);
+}
+
+// Count, prefix sum, scatter: the frame's quads into the slot's bins. The descriptor set and push
+// constants are bound.
+void TileCompositor::record_binning(VkCommandBuffer cb, const gpu::TilePushConstants& push) {
+    constexpr VkPipelineStageFlags compute = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    constexpr VkAccessFlags shader = vk::kShaderAccess;
+    const uint32_t tiles = push.tiles_x * push.tiles_y;
+    const VkExtent2D quad_groups = grid(push.quad_count, gpu::kTileBinInvocations);
+    auto bin = [&](VkPipeline pipeline) {
+        if (quad_groups.width == 0) return;
+        ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+        ref_.fn->vkCmdDispatch(cb, quad_groups.width, quad_groups.height, 1);
+    };
+    bin(count_);
+    // The prefix sum: block sums, their scan in one workgroup, the blocks' own scans.
+    const VkExtent2D blocks = grid(tiles, gpu::kTileScanBlock);
+    for (uint32_t phase = 0; phase < scan_.size(); ++phase) {
+        vk::memory_barrier(*ref_.fn, cb, compute, shader, compute, shader);
+        ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, scan_[phase]);
+        if (phase == 1) {
+            ref_.fn->vkCmdDispatch(cb, 1, 1, 1);
+        } else {
+            ref_.fn->vkCmdDispatch(cb, blocks.width, blocks.height, 1);
+        }
+    }
+    vk::memory_barrier(*ref_.fn, cb, compute, shader, compute, shader);
+    bin(scatter_);
+    vk::memory_barrier(*ref_.fn, cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+}
+
+// The frame's counters start again, written through the header's mapping: the slot's last frame
+// is done (the frames-in-flight contract), and submitting the command buffer makes host writes
+// before it visible to the GPU. So static text's frame carries no clear and no transfer barrier.
+// Binning anew, the whole TileHeader starts at zero (the scan writes the dispatches); with the
+// bins reused, the busy list and the exact pass's dispatch stand, and the tile passes' counts and
+// the layered dispatch start again.
+void TileCompositor::reset_header(const Slot& slot, bool reuse_bins) {
+    if (reuse_bins) {
+        constexpr uint32_t reset[] = {0, 0, 0, 0, 0, 1, 1};  // layered tiles .. layered dispatch z
+        static_assert(offsetof(gpu::TileHeader, layered_dispatch_z) - offsetof(gpu::TileHeader, layered_tiles) ==
+                      sizeof(reset) - kWord);
+        std::memcpy(static_cast<char*>(slot.header.mapped) + offsetof(gpu::TileHeader, layered_tiles), reset,
+                    sizeof(reset));
+    } else {
+        const gpu::TileHeader zero{};
+        std::memcpy(slot.header.mapped, &zero, sizeof(zero));
+    }
+}
+
+void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
+                                   const gpu::TilePushConstants& push, bool reuse_bins) {
+    constexpr VkPipelineStageFlags compute = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    constexpr VkPipelineStageFlags transfer = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    constexpr VkPipelineStageFlags indirect = VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT;
+    constexpr VkAccessFlags shader = vk::kShaderAccess;
+    const uint32_t tiles = push.tiles_x * push.tiles_y;
+    // This slot's buffers were last used by a frame the caller has waited for; the barrier orders
+    // them for the validation layer and for callers who recycle command buffers early.
+    vk::memory_barrier(*ref_.fn, cb, compute | transfer | indirect,
+                       shader | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT,
+                       compute | transfer | indirect,
+                       shader | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+    reset_header(slot, reuse_bins);
+    if (!reuse_bins) {
+        ref_.fn->vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
+        vk::memory_barrier(*ref_.fn, cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, compute, shader);
+    }
+
+    ref_.fn->vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set,
+                                     0, nullptr);
+    ref_.fn->vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    if (!reuse_bins) record_binning(cb, push);
+    ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[0]);
+    ref_.fn->vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
+    // The tiles the exact pass handed on; usually none, and then an empty dispatch.
+    vk::memory_barrier(*ref_.fn, cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+    ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[1]);
+    ref_.fn->vkCmdDispatchIndirect(cb, slot.header.buffer, gpu::kTileLayeredDispatchOffset);
+    // The frame's counts for the host.
+    vk::memory_barrier(*ref_.fn, cb, compute, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                       VK_ACCESS_HOST_READ_BIT);
+}
+
+void TileCompositor::abandon_frame() {
+    if (!recorded_) return;
+    recorded_ = false;
+    --frame_;
+    Slot& slot = slots_[frame_ % slots_.size()];
+    slot.pending = false;
+    if (last_binned_) slot.bins_valid = false;
+}
+
+Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
+                                        VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
+                                        uint64_t& measured_frame, bool& reused) {
+    Slot& slot = slots_[frame_ % slots_.size()];
+    if (slot.pending) {
+        gpu::TileHeader header{};
+        std::memcpy(&header, slot.header.mapped, sizeof(header));
+        measured = {header.busy_tiles,    header.busy_tiles - header.layered_tiles,
+                    header.layered_tiles, header.max_overlap,
+                    header.tail_pixels,   header.pairs,
+                    header.lost_pairs};
+        measured_frame = slot.frame;
+        slot.pending = false;
+    }
+    gpu::TilePushConstants push{};
+    push.origin_x = target.origin.x;
+    push.origin_y = target.origin.y;
+    push.width = target.size.width;
+    push.height = target.size.height;
+    push.tiles_x = (push.width + gpu::kTileSide - 1) / gpu::kTileSide;
+    push.tiles_y = (push.height + gpu::kTileSide - 1) / gpu::kTileSide;
+    push.quad_count = static_cast<uint32_t>(quads.size());
+    const uint64_t pairs = count_tile_pairs(quads, push.width, push.height);
+    if (pairs * sizeof(gpu::TileBinEntry) > max_buffer_range_ || quads.size_bytes() > max_buffer_range_) {
+        return Error{ErrorCode::invalid_argument, "compositor: " + std::to_string(quads.size()) + " glyphs in " +
+                                                      std::to_string(pairs) + " (glyph, tile) pairs need " +
+                                                      std::to_string(pairs * sizeof(gpu::TileBinEntry)) +
+                                                      " bytes of bins, more than the device's maxStorageBufferRange (" +
+                                                      std::to_string(max_buffer_range_) + ") lets a shader reach"};
+    }
+    push.bin_capacity = static_cast<uint32_t>(pairs);
+    const uint32_t tiles = push.tiles_x * push.tiles_y;
+    // Static text: the slot's bins already hold these very quads for a rect of this size.
+    reused = config_.reuse_static_bins && slot.bins_valid && slot.binned_width == push.width &&
+             slot.binned_height == push.height && slot.binned.size() == quads.size() &&
+             (quads.empty() || std::memcmp(slot.binned.data(), quads.data(), quads.size_bytes()) == 0);
+    if (!reused) {
+        slot.bins_valid = false;
+        if (Status s = prepare_slot(slot, quads, tiles, pairs); !s) return s.error();
+        slot.binned.assign(quads.begin(), quads.end());
+        slot.binned_width = push.width;
+        slot.binned_height = push.height;
+        slot.bins_valid = true;
+    }
+    write_descriptors(slot, atlas_view, target.view);
+    record_passes(command_buffer, slot, tile_pipelines_[variant_index(target.format, target.view_format)], push,
+                  reused);
+    ++frame_;
+    slot.pending = true;
+    slot.frame = frame_;
+    recorded_ = true;
+    last_binned_ = !reused;
+    return quads.size_bytes() + tile_words(tiles) * kWord + pairs * sizeof(gpu::TileBinEntry) +
+           header_words(tiles) * kWord;
+}
+
+}  // namespace crisp::composite

@@ -1,0 +1,130 @@
+// Private: the tile compositor (docs/compositing.md). The frame's quads, sorted front to back on
+// the CPU, are binned into 16 x 16 screen tiles on the GPU (count, prefix sum, scatter), and one
+// workgroup per non-empty tile composites its pixels into the caller's storage image: exactly
+// where the tile's list fits in workgroup memory, with the K nearest layers per pixel where not.
+// Nothing per pixel lives in global memory.
+#pragma once
+
+#include "shared.h"
+#include "vk/resources.hpp"
+
+#include <crisp/result.hpp>
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace crisp::composite {
+
+// The tile pass's pipelines: an image format seen through a view format.
+struct TileVariant {
+    VkFormat image;
+    VkFormat view;
+    const char* shader;
+};
+inline constexpr std::array<TileVariant, 5> kTileVariants = {{
+    {VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM, "tiles_pass_rgba8.comp"},
+    {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM, "tiles_pass_rgba8.comp"},  // red and blue swap
+    {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_B8G8R8A8_UNORM, "tiles_pass_any.comp"},    // storage_without_format
+    {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R16G16B16A16_SFLOAT, "tiles_pass_rgba16f.comp"},
+    {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT, "tiles_pass_rgba32f.comp"},
+}};
+
+struct TileConfig {
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    uint32_t frames_in_flight = 2;
+    uint32_t layers = gpu::kCompositeMaxLayers;     // K of tiles whose list overflows
+    uint32_t capacity = gpu::kTileDefaultCapacity;  // quads a tile's list holds in workgroup memory
+    bool storage_without_format = false;            // B8G8R8A8 targets allowed
+    bool reuse_static_bins = true;                  // skip binning when the quads did not change
+};
+
+// Where the tile pass draws: glyph pixel (0, 0) is `origin` in the image; `size` pixels from there.
+struct TileTarget {
+    VkImageView view = VK_NULL_HANDLE;
+    VkFormat format = VK_FORMAT_UNDEFINED;       // the image's
+    VkFormat view_format = VK_FORMAT_UNDEFINED;  // the view's
+    VkOffset2D origin{};
+    VkExtent2D size{};
+};
+
+// What the GPU counted in one frame (TileHeader).
+struct TileCounts {
+    uint32_t busy_tiles = 0;
+    uint32_t exact_tiles = 0;
+    uint32_t layered_tiles = 0;
+    uint32_t max_overlap = 0;
+    uint32_t tail_pixels = 0;
+    uint32_t pairs = 0;
+    uint32_t lost_pairs = 0;
+};
+
+class TileCompositor {
+public:
+    TileCompositor() = default;
+    TileCompositor(const TileCompositor&) = delete;
+    TileCompositor& operator=(const TileCompositor&) = delete;
+    ~TileCompositor();
+
+    // Pipelines for every format of kTileFormats the device can store to (B8G8R8A8 only with
+    // storage_without_format), and one descriptor set per frame in flight. Errors: vulkan.
+    Status create(const vk::DeviceRef& device, const TileConfig& config);
+
+    // True when an image of `format` seen through a view of `view_format` can be a target.
+    bool supports(VkFormat format, VkFormat view_format) const;
+
+    // Records the frame: `quads` sorted front to back (sort_front_to_back for target.size).
+    // Returns the buffer bytes the frame used; `measured` gets the counts of the frame that last
+    // used this frame slot, if it has not been read yet (`measured_frame` says which). `reused`
+    // says whether the slot's bins already held these quads (static text), so that the frame
+    // skipped the upload and the binning passes.
+    Result<uint64_t> record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
+                            VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
+                            uint64_t& measured_frame, bool& reused);
+    // Takes back the last record() (its command buffer will not be submitted): the slot's bins,
+    // if that record() binned, no longer count as holding its quads, its counts are not read,
+    // and the frame does not count towards frames in flight.
+    void abandon_frame();
+
+private:
+    struct Slot {
+        vk::DeviceBuffer quads;   // host-visible CompositeQuad[]
+        vk::DeviceBuffer tiles;   // three planes of tile words
+        vk::DeviceBuffer bins;    // TileBinEntry lists
+        vk::DeviceBuffer header;  // host-visible: TileHeader, then the busy tiles' entries
+        VkDescriptorSet set = VK_NULL_HANDLE;
+        bool pending = false;
+        uint64_t frame = 0;
+        // What the bins hold: the quads and the rect size they were binned for.
+        std::vector<gpu::CompositeQuad> binned;
+        uint32_t binned_width = 0, binned_height = 0;
+        bool bins_valid = false;
+    };
+
+    Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
+                const char* what);
+    Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
+    void write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view);
+    void record_binning(VkCommandBuffer command_buffer, const gpu::TilePushConstants& push);
+    void reset_header(const Slot& slot, bool reuse_bins);
+    void record_passes(VkCommandBuffer command_buffer, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
+                       const gpu::TilePushConstants& push, bool reuse_bins);
+
+    vk::DeviceRef ref_;
+    TileConfig config_;
+    VkDeviceSize max_buffer_range_ = 0;  // maxStorageBufferRange: the largest buffer a descriptor reaches
+    vk::DescriptorSets descriptors_;
+    vk::DeviceObjects objects_;  // shader modules and pipelines
+    VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
+    std::array<VkPipeline, 3> scan_{};                                              // reduce, blocks, down
+    std::array<std::array<VkPipeline, 2>, kTileVariants.size()> tile_pipelines_{};  // exact, layered pass
+    std::vector<Slot> slots_;
+    uint64_t frame_ = 0;
+    bool recorded_ = false;     // record() since the last abandon_frame()
+    bool last_binned_ = false;  // the last record() binned anew
+};
+
+}  // namespace crisp::composite

@@ -1,0 +1,144 @@
+#include "vk/memory.hpp"
+
+#include "vk/resources.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <string>
+
+namespace crisp::vk {
+
+namespace {
+
+VkDeviceSize align_up(VkDeviceSize value, VkDeviceSize alignment) {
+    return alignment <= 1 ? value : (value + alignment - 1) / alignment * alignment;
+}
+
+}  // namespace
+
+MemoryArena::MemoryArena(const Functions& fn, VkDevice device, const VkAllocationCallbacks* allocator,
+                         const VkPhysicalDeviceMemoryProperties& properties)
+    : fn_(fn), device_(device), allocator_(allocator), properties_(properties) {}
+
+MemoryArena::~MemoryArena() {
+    for (const Block& block : blocks_) {
+        assert(block.ranges == 0 && "a buffer outlived the arena its memory came from");
+        fn_.vkFreeMemory(device_, block.memory, allocator_);  // also unmaps
+    }
+}
+
+VkDeviceSize MemoryArena::block_bytes() const {
+    VkDeviceSize bytes = 0;
+    for (const Block& block : blocks_) bytes += block.size;
+    return bytes;
+}
+
+// First fit: the lowest free run that holds the aligned request.
+bool MemoryArena::take(Block& block, const VkMemoryRequirements& requirements, VkDeviceSize& offset) {
+    for (auto it = block.free.begin(); it != block.free.end(); ++it) {
+        const VkDeviceSize start = align_up(it->first, requirements.alignment);
+        const VkDeviceSize end = it->first + it->second;
+        if (start > end || end - start < requirements.size) continue;
+        const VkDeviceSize run_start = it->first;
+        block.free.erase(it);
+        if (start > run_start) block.free.emplace(run_start, start - run_start);
+        if (end > start + requirements.size)
+            block.free.emplace(start + requirements.size, end - start - requirements.size);
+        offset = start;
+        ++block.ranges;
+        return true;
+    }
+    return false;
+}
+
+Result<MemoryArena::Block*> MemoryArena::add_block(VkDeviceSize least, uint32_t type, const char* what) {
+    const auto same_type =
+        std::count_if(blocks_.begin(), blocks_.end(), [&](const Block& b) { return b.type == type; });
+    const VkDeviceSize growing = std::min(kLargestMemoryBlock, kFirstMemoryBlock << std::min<long>(same_type, 8));
+    Block block;
+    block.type = type;
+    // At least the request; one larger than half the largest block gets a block of its own, sized
+    // to it, rather than one that would mostly stay empty.
+    block.size = least > kLargestMemoryBlock / 2 ? least : std::max(growing, least);
+    VkMemoryAllocateInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    info.allocationSize = block.size;
+    info.memoryTypeIndex = type;
+    if (VkResult r = fn_.vkAllocateMemory(device_, &info, allocator_, &block.memory); r != VK_SUCCESS) {
+        return vulkan_error(std::string("vkAllocateMemory (a memory block of ") + std::to_string(block.size) +
+                                " bytes for the " + what + ")",
+                            r);
+    }
+    if (properties_.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) {
+        void* mapped = nullptr;
+        if (VkResult r = fn_.vkMapMemory(device_, block.memory, 0, VK_WHOLE_SIZE, 0, &mapped); r != VK_SUCCESS) {
+            fn_.vkFreeMemory(device_, block.memory, allocator_);
+            return vulkan_error(std::string("vkMapMemory (a memory block for the ") + what + ")", r);
+        }
+        block.mapped = static_cast<std::byte*>(mapped);
+    }
+    block.free.emplace(0, block.size);
+    blocks_.push_back(std::move(block));
+    return &blocks_.back();
+}
+
+Result<MemoryArena::Range> MemoryArena::allocate(const VkMemoryRequirements& requirements, uint32_t type,
+                                                 const char* what) {
+    VkDeviceSize offset = 0;
+    Block* chosen = nullptr;
+    for (Block& block : blocks_) {
+        if (block.type == type && take(block, requirements, offset)) {
+            chosen = &block;
+            break;
+        }
+    }
+    if (chosen == nullptr) {
+        Result<Block*> added = add_block(requirements.size, type, what);
+        if (!added) return added.error();
+        chosen = *added;
+        if (!take(*chosen, requirements, offset)) {  // a new block starts at offset 0: it always fits
+            return Error{ErrorCode::vulkan, std::string("memory arena: a new block does not hold the ") + what};
+        }
+    }
+    Range range;
+    range.memory = chosen->memory;
+    range.offset = offset;
+    range.size = requirements.size;
+    range.mapped = chosen->mapped != nullptr ? chosen->mapped + offset : nullptr;
+    return range;
+}
+
+void MemoryArena::free(const Range& range) {
+    if (range.memory == VK_NULL_HANDLE) return;
+    auto block = std::find_if(blocks_.begin(), blocks_.end(), [&](const Block& b) { return b.memory == range.memory; });
+    assert(block != blocks_.end() && "a range from another arena");
+    if (block == blocks_.end()) return;
+    // Back into the free list, merged with the runs on either side.
+    VkDeviceSize start = range.offset;
+    VkDeviceSize size = range.size;
+    auto next = block->free.lower_bound(start);
+    if (next != block->free.end() && next->first == start + size) {
+        size += next->second;
+        next = block->free.erase(next);
+    }
+    if (next != block->free.begin()) {
+        auto previous = std::prev(next);
+        if (previous->first + previous->second == start) {
+            start = previous->first;
+            size += previous->second;
+            block->free.erase(previous);
+        }
+    }
+    block->free.emplace(start, size);
+    --block->ranges;
+    // An empty block goes back to the driver, unless it is the last of its type (the next buffer of
+    // that type, a frame later, would only allocate it again).
+    const uint32_t type = block->type;
+    if (block->ranges == 0 &&
+        std::count_if(blocks_.begin(), blocks_.end(), [&](const Block& b) { return b.type == type; }) > 1) {
+        fn_.vkFreeMemory(device_, block->memory, allocator_);
+        blocks_.erase(block);
+    }
+}
+
+}  // namespace crisp::vk
