@@ -2,6 +2,7 @@
 #include "composite/draw.hpp"
 
 #include "composite/quad_pipeline.hpp"
+#include "vk/bindings.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -12,6 +13,12 @@ namespace crisp::composite {
 namespace {
 
 constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+// The bindings quad_pipeline.glsl declares for a rasterized quad: the atlas and the quads.
+constexpr vk::Binding kBindings[] = {
+    {gpu::kCompositeBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+    {gpu::kCompositeBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+};
+constexpr vk::BindingTable kTable{kBindings, kStages};
 
 }  // namespace
 
@@ -34,13 +41,8 @@ Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice phys
                                                 ") cannot be a depth attachment on this device"};
         }
     }
-    // The bindings quad_pipeline.glsl declares for a rasterized quad: the atlas and the quads.
-    const VkDescriptorSetLayoutBinding bindings[] = {
-        {gpu::kCompositeBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kStages, nullptr},
-        {gpu::kCompositeBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kStages, nullptr},
-    };
-    if (Status s = vk::create_descriptor_sets(ref_, bindings, kStages, sizeof(gpu::CompositePushConstants),
-                                              frames_in_flight, "compositor draw path", descriptors_);
+    if (Status s = vk::create_descriptor_sets(ref_, kTable, sizeof(gpu::CompositePushConstants), frames_in_flight,
+                                              "compositor draw path", descriptors_);
         !s) {
         return s;
     }
@@ -81,21 +83,10 @@ Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::spa
         }
     }
     if (bytes > 0) std::memcpy(slot.quads.mapped, quads.data(), bytes);
-    const VkDescriptorImageInfo atlas{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
-    const VkDescriptorBufferInfo quad_info{slot.quads.buffer, 0, VK_WHOLE_SIZE};
-    VkWriteDescriptorSet writes[2]{};
-    for (VkWriteDescriptorSet& write : writes) {
-        write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        write.dstSet = slot.set;
-        write.descriptorCount = 1;
-    }
-    writes[0].dstBinding = gpu::kCompositeBindAtlas;
-    writes[1].dstBinding = gpu::kCompositeBindQuads;
-    writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    writes[0].pImageInfo = &atlas;
-    writes[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[1].pBufferInfo = &quad_info;
-    ref_.fn->vkUpdateDescriptorSets(ref_.device, 2, writes, 0, nullptr);
+    vk::DescriptorWrites(kTable, slot.set)
+        .storage_image(gpu::kCompositeBindAtlas, atlas_view)
+        .storage_buffer(gpu::kCompositeBindQuads, slot.quads.buffer)
+        .update(ref_);
     ++frame_;
     recorded_ = true;
     if (quads.empty()) return uint64_t{0};

@@ -7,6 +7,7 @@
 #include "composite/quad_pipeline.hpp"
 #include "composite/quads.hpp"
 #include "vk/barriers.hpp"
+#include "vk/bindings.hpp"
 
 #include <algorithm>
 #include <array>
@@ -30,21 +31,19 @@ constexpr VkDeviceSize kWord = 4;
 static_assert(kMaxCompositeLayers == gpu::kCompositeMaxLayers);
 static_assert(kMaxExactFragmentsPerPixel == gpu::kCompositeExactMaxPerPixel);
 
-// Bindings of the one descriptor set layout every pipeline shares.
-enum Binding : uint32_t {
-    kBindAtlas = gpu::kCompositeBindAtlas,
-    kBindQuads = gpu::kCompositeBindQuads,
-    kBindAccumulators = gpu::kCompositeBindAccumulators,
-    kBindNodes = gpu::kCompositeBindNodes,
-    kBindStats = gpu::kCompositeBindStats,
-    kBindTarget = gpu::kCompositeBindTarget,
-    kBindTiles = gpu::kCompositeBindTiles,
-};
-constexpr uint32_t kBindings[] = {kBindAtlas, kBindQuads,  kBindAccumulators, kBindNodes,
-                                  kBindStats, kBindTarget, kBindTiles};
-constexpr uint32_t kBindingCount = std::size(kBindings);
 constexpr VkShaderStageFlags kPushStages =
     VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT | VK_SHADER_STAGE_COMPUTE_BIT;
+// The one descriptor set layout every pipeline shares, visible to the push constants' stages.
+constexpr vk::Binding kBindings[] = {
+    {gpu::kCompositeBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+    {gpu::kCompositeBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindAccumulators, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindNodes, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindStats, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+    {gpu::kCompositeBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+};
+constexpr vk::BindingTable kTable{kBindings, kPushStages};
 
 }  // namespace
 
@@ -219,20 +218,8 @@ Status ReferenceCompositor::create(const vk::DeviceRef& device, const Compositor
 
 // The descriptor set layout every pipeline shares, one set and one stats read-back per frame slot.
 Status ReferenceCompositor::create_descriptors() {
-    const VkShaderStageFlags stages =
-        VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT | VK_SHADER_STAGE_COMPUTE_BIT;
-    const VkDescriptorSetLayoutBinding bindings[] = {
-        {kBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stages, nullptr},
-        {kBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
-        {kBindAccumulators, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
-        {kBindNodes, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
-        {kBindStats, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
-        {kBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stages, nullptr},
-        {kBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
-    };
-    static_assert(std::size(bindings) == kBindingCount);
-    if (Status s = vk::create_descriptor_sets(ref, bindings, stages, sizeof(gpu::CompositePushConstants),
-                                              frames_in_flight, "compositor", descriptors);
+    if (Status s = vk::create_descriptor_sets(ref, kTable, sizeof(gpu::CompositePushConstants), frames_in_flight,
+                                              "compositor", descriptors);
         !s) {
         return s;
     }
@@ -333,47 +320,15 @@ Status ReferenceCompositor::upload(vk::DeviceBuffer& buffer, uint32_t& capacity,
 }
 
 void ReferenceCompositor::write_descriptors(const FrameSlot& slot, VkImageView atlas_view) {
-    const VkDescriptorImageInfo atlas_info{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
-    const VkDescriptorImageInfo target_info{VK_NULL_HANDLE, target_.view, VK_IMAGE_LAYOUT_GENERAL};
-    const VkDescriptorBufferInfo quads_info{slot.quads.buffer, 0, VK_WHOLE_SIZE};
-    const VkDescriptorBufferInfo accumulator_info{accumulators.buffer, 0, VK_WHOLE_SIZE};
-    const VkDescriptorBufferInfo node_info{nodes.buffer, 0, VK_WHOLE_SIZE};
-    const VkDescriptorBufferInfo stats_info{stats_words.buffer, 0, VK_WHOLE_SIZE};
-    const VkDescriptorBufferInfo tiles_info{slot.tiles.buffer, 0, VK_WHOLE_SIZE};
-    VkWriteDescriptorSet writes[kBindingCount]{};
-    for (uint32_t i = 0; i < kBindingCount; ++i) {
-        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        writes[i].dstSet = slot.set;
-        writes[i].dstBinding = kBindings[i];
-        writes[i].descriptorCount = 1;
-        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        switch (kBindings[i]) {
-            case kBindAtlas:
-                writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-                writes[i].pImageInfo = &atlas_info;
-                break;
-            case kBindTarget:
-                writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-                writes[i].pImageInfo = &target_info;
-                break;
-            case kBindQuads:
-                writes[i].pBufferInfo = &quads_info;
-                break;
-            case kBindAccumulators:
-                writes[i].pBufferInfo = &accumulator_info;
-                break;
-            case kBindNodes:
-                writes[i].pBufferInfo = &node_info;
-                break;
-            case kBindStats:
-                writes[i].pBufferInfo = &stats_info;
-                break;
-            default:
-                writes[i].pBufferInfo = &tiles_info;
-                break;
-        }
-    }
-    ref.fn->vkUpdateDescriptorSets(ref.device, kBindingCount, writes, 0, nullptr);
+    vk::DescriptorWrites(kTable, slot.set)
+        .storage_image(gpu::kCompositeBindAtlas, atlas_view)
+        .storage_buffer(gpu::kCompositeBindQuads, slot.quads.buffer)
+        .storage_buffer(gpu::kCompositeBindAccumulators, accumulators.buffer)
+        .storage_buffer(gpu::kCompositeBindNodes, nodes.buffer)
+        .storage_buffer(gpu::kCompositeBindStats, stats_words.buffer)
+        .storage_image(gpu::kCompositeBindTarget, target_.view)
+        .storage_buffer(gpu::kCompositeBindTiles, slot.tiles.buffer)
+        .update(ref);
 }
 
 Status ReferenceCompositor::check(const CompositeParams& params) const {

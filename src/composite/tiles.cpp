@@ -3,6 +3,7 @@
 
 #include "composite/quads.hpp"
 #include "vk/barriers.hpp"
+#include "vk/bindings.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -15,6 +16,19 @@ namespace crisp::composite {
 namespace {
 
 constexpr VkDeviceSize kWord = 4;
+
+// The descriptor set of every pass of the tile compositor (tiles_common.glsl declares it).
+constexpr vk::Binding kBindings[] = {
+    {gpu::kTileBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+    {gpu::kTileBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kTileBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kTileBindBins, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kTileBindHeader, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kTileBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+};
+static_assert(std::size(kBindings) == gpu::kTileBindingCount);
+constexpr vk::BindingTable kTable{kBindings, VK_SHADER_STAGE_COMPUTE_BIT};
+
 size_t variant_index(VkFormat format, VkFormat view_format) {
     const auto found = std::find_if(kTileVariants.begin(), kTileVariants.end(),
                                     [&](const TileVariant& v) { return v.image == format && v.view == view_format; });
@@ -58,18 +72,8 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     if (!vk::has_compute_subgroup_arithmetic(*ref_.fn, config.physical_device)) {
         return Error{ErrorCode::vulkan, "compositor: the device has no subgroup arithmetic in compute shaders"};
     }
-    constexpr VkShaderStageFlags stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    const VkDescriptorSetLayoutBinding bindings[] = {
-        {gpu::kTileBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stage, nullptr},
-        {gpu::kTileBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
-        {gpu::kTileBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
-        {gpu::kTileBindBins, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
-        {gpu::kTileBindHeader, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stage, nullptr},
-        {gpu::kTileBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, stage, nullptr},
-    };
-    static_assert(std::size(bindings) == gpu::kTileBindingCount);
-    if (Status s = vk::create_descriptor_sets(ref_, bindings, stage, sizeof(gpu::TilePushConstants),
-                                              config.frames_in_flight, "tile compositor", descriptors_);
+    if (Status s = vk::create_descriptor_sets(ref_, kTable, sizeof(gpu::TilePushConstants), config.frames_in_flight,
+                                              "tile compositor", descriptors_);
         !s) {
         return s;
     }
@@ -161,31 +165,14 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
 }
 
 void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view) {
-    const VkDescriptorImageInfo atlas{VK_NULL_HANDLE, atlas_view, VK_IMAGE_LAYOUT_GENERAL};
-    const VkDescriptorImageInfo target{VK_NULL_HANDLE, target_view, VK_IMAGE_LAYOUT_GENERAL};
-    const VkDescriptorBufferInfo buffers[] = {
-        {slot.quads.buffer, 0, VK_WHOLE_SIZE},
-        {slot.tiles.buffer, 0, VK_WHOLE_SIZE},
-        {slot.bins.buffer, 0, VK_WHOLE_SIZE},
-        {slot.header.buffer, 0, VK_WHOLE_SIZE},
-    };
-    VkWriteDescriptorSet writes[gpu::kTileBindingCount]{};
-    for (uint32_t i = 0; i < gpu::kTileBindingCount; ++i) {
-        writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        writes[i].dstSet = slot.set;
-        writes[i].dstBinding = i;
-        writes[i].descriptorCount = 1;
-        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    }
-    writes[gpu::kTileBindAtlas].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    writes[gpu::kTileBindAtlas].pImageInfo = &atlas;
-    writes[gpu::kTileBindTarget].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    writes[gpu::kTileBindTarget].pImageInfo = &target;
-    writes[gpu::kTileBindQuads].pBufferInfo = &buffers[0];
-    writes[gpu::kTileBindTiles].pBufferInfo = &buffers[1];
-    writes[gpu::kTileBindBins].pBufferInfo = &buffers[2];
-    writes[gpu::kTileBindHeader].pBufferInfo = &buffers[3];
-    ref_.fn->vkUpdateDescriptorSets(ref_.device, gpu::kTileBindingCount, writes, 0, nullptr);
+    vk::DescriptorWrites(kTable, slot.set)
+        .storage_image(gpu::kTileBindAtlas, atlas_view)
+        .storage_buffer(gpu::kTileBindQuads, slot.quads.buffer)
+        .storage_buffer(gpu::kTileBindTiles, slot.tiles.buffer)
+        .storage_buffer(gpu::kTileBindBins, slot.bins.buffer)
+        .storage_buffer(gpu::kTileBindHeader, slot.header.buffer)
+        .storage_image(gpu::kTileBindTarget, target_view)
+        .update(ref_);
 }
 
 // Count, prefix sum, scatter: the frame's quads into the slot's bins. The descriptor set and push
