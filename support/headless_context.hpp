@@ -12,6 +12,8 @@
 // move-only; resources must be destroyed before the context that made them.
 #pragma once
 
+#include "vulkan_device.hpp"
+
 #include <crisp/compositor.hpp>
 #include <crisp/device_features.hpp>
 #include <crisp/renderer.hpp>
@@ -23,16 +25,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 namespace crisp {
-
-namespace vk {
-struct Functions;  // the Vulkan functions crisp calls through (private)
-}
 
 // How a buffer's memory is used; picks the memory type (one VkDeviceMemory per resource).
 enum class MemoryUsage {
@@ -120,49 +117,15 @@ private:
     VkImageUsageFlags usage_ = 0;
 };
 
-struct HeadlessContextOptions {
+// What the device must have (DeviceRequirements, support/vulkan_device.hpp: its api_version is
+// also what the instance asks for and the floor the loader must meet), and whether to validate.
+struct HeadlessContextOptions : DeviceRequirements {
     // Turn on VK_LAYER_KHRONOS_validation and count its messages (validation_messages()).
     // create() fails, saying so, when the layer is not installed.
     bool validation = false;
     // With validation: also turn on the layer's synchronization validation (missing or wrong
     // barriers), which costs more CPU time.
     bool synchronization_validation = false;
-    // Pick a device whose name contains this (case-sensitive); empty: any. Among the candidates
-    // that meet every requirement, prefer discrete > integrated > virtual > CPU.
-    std::string device_name_contains;
-    // The Vulkan version the caller programs against; also the floor both the instance and the
-    // device must meet. At least VK_API_VERSION_1_2.
-    uint32_t api_version = VK_API_VERSION_1_2;
-    // Features the device must offer; exactly these are enabled. Null: none. Its pNext chain may
-    // hold VkPhysicalDeviceVulkan11Features, VkPhysicalDeviceVulkan12Features and (with
-    // api_version >= 1.3) VkPhysicalDeviceVulkan13Features, each at most once; any other
-    // structure is an invalid_argument error. Read only during create().
-    const VkPhysicalDeviceFeatures2* required_features = nullptr;
-    // Device extensions the device must offer; exactly these are enabled ("VK_KHR_push_descriptor").
-    std::vector<std::string> required_extensions;
-    // Subgroup operations (VK_SUBGROUP_FEATURE_*_BIT) the device must offer in compute shaders.
-    VkSubgroupFeatureFlags required_compute_subgroup_operations = 0;
-    // Also what crisp's parts need, as an engine asks for it: for each candidate device,
-    // add_crisp_features() adds to required_features what `crisp_needs` names (a device that lacks
-    // something is passed over, its rejection saying what), and crisp's compute subgroup
-    // operations (basic, arithmetic) are required. storage_without_format is turned on only where
-    // the device offers it. With draw_path, api_version is raised to at least 1.3 (dynamic
-    // rendering). nullopt: only what the fields above ask for.
-    std::optional<CrispFeatureNeeds> crisp_needs;
-    // Where the chosen device offers VK_KHR_pipeline_executable_properties and its
-    // pipelineExecutableInfo feature, enable both (enabled_features() then chains the feature
-    // structure), so that renderers and compositors made from this context report their shaders'
-    // statistics (Renderer::shader_statistics()). Never a reason to pass a device over.
-    bool shader_statistics = false;
-};
-
-// What the validation layer has said so far (warnings and errors only; info and verbose messages
-// are not requested).
-struct ValidationMessages {
-    uint32_t warnings = 0;
-    uint32_t errors = 0;
-    // The last few message texts, oldest first, each prefixed "error: " or "warning: ".
-    std::vector<std::string> recent;
 };
 
 // Owns a Vulkan instance, a device, one queue and a command pool for one-off submissions.

@@ -1,5 +1,4 @@
 #include "vulkan_window.hpp"
-#include "headless_context.hpp"
 
 #include "vk/resources.hpp"
 
@@ -8,35 +7,10 @@
 
 #include <crisp/device_features.hpp>
 
-#include <cstdio>
-#include <cstring>
 #include <utility>
+#include <vector>
 
 namespace crisp::editor {
-namespace {
-
-VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                                     VkDebugUtilsMessageTypeFlagsEXT,
-                                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
-    auto* count = static_cast<std::atomic<uint32_t>*>(user);
-    count->fetch_add(1);
-    const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
-    std::fprintf(stderr, "crisp-layout-editor: validation %s: %s\n", level, data->pMessage ? data->pMessage : "");
-    return VK_FALSE;
-}
-
-bool has_layer(const char* name) {
-    uint32_t count = 0;
-    vkEnumerateInstanceLayerProperties(&count, nullptr);
-    std::vector<VkLayerProperties> layers(count);
-    vkEnumerateInstanceLayerProperties(&count, layers.data());
-    for (const VkLayerProperties& layer : layers) {
-        if (std::strcmp(layer.layerName, name) == 0) return true;
-    }
-    return false;
-}
-
-}  // namespace
 
 // GLFW's callbacks, turning each into an InputEvent in delivery order.
 struct WindowCallbacks {
@@ -103,52 +77,22 @@ Result<std::unique_ptr<VulkanWindow>> VulkanWindow::create(const WindowOptions& 
 }
 
 // The instance: GLFW's surface extensions, and with validation the layer and a messenger that
-// counts its messages (chained into the instance info too, so that instance creation is covered).
+// logs its messages (which also covers instance creation).
 Status VulkanWindow::create_instance() {
     uint32_t glfw_count = 0;
     const char** glfw_extensions = glfwGetRequiredInstanceExtensions(&glfw_count);
-    std::vector<const char*> extensions(glfw_extensions, glfw_extensions + glfw_count);
-    std::vector<const char*> layers;
-    if (options_.validation) {
-        if (!has_layer("VK_LAYER_KHRONOS_validation")) {
-            return Error{
-                ErrorCode::vulkan,
-                "--validation: VK_LAYER_KHRONOS_validation is not installed (Debian: vulkan-validationlayers)"};
-        }
-        layers.push_back("VK_LAYER_KHRONOS_validation");
-        extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-    }
-    VkApplicationInfo app{};
-    app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
-    app.pApplicationName = "crisp-layout-editor";
-    app.apiVersion = VK_API_VERSION_1_3;
-    VkDebugUtilsMessengerCreateInfoEXT messenger{};
-    messenger.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
-    messenger.messageSeverity =
-        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    messenger.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                            VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                            VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    messenger.pfnUserCallback = on_validation_message;
-    messenger.pUserData = &validation_messages_;
-    VkInstanceCreateInfo instance_info{};
-    instance_info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
-    instance_info.pNext = options_.validation ? &messenger : nullptr;
-    instance_info.pApplicationInfo = &app;
-    instance_info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
-    instance_info.ppEnabledExtensionNames = extensions.data();
-    instance_info.enabledLayerCount = static_cast<uint32_t>(layers.size());
-    instance_info.ppEnabledLayerNames = layers.data();
-    if (VkResult r = vkCreateInstance(&instance_info, nullptr, &instance_); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateInstance", r);
-    }
-    if (!options_.validation) return {};
-    auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-    if (!create_messenger) return Error{ErrorCode::vulkan, "vkCreateDebugUtilsMessengerEXT is missing"};
-    if (VkResult r = create_messenger(instance_, &messenger, nullptr, &messenger_); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateDebugUtilsMessengerEXT", r);
-    }
+    InstanceOptions instance_options;
+    instance_options.application_name = "crisp-layout-editor";
+    instance_options.api_version = VK_API_VERSION_1_3;
+    instance_options.minimum_version = VK_API_VERSION_1_2;  // the renderer's floor
+    instance_options.extensions.assign(glfw_extensions, glfw_extensions + glfw_count);
+    instance_options.validation = options_.validation;
+    instance_options.validation_log = &validation_log_;
+    // The loader GLFW and the editor's own calls use.
+    instance_options.get_instance_proc_addr = vkGetInstanceProcAddr;
+    Result<VulkanInstance> created = VulkanInstance::create(instance_options);
+    if (!created) return created.error();
+    instance_ = std::move(*created);
     return {};
 }
 
@@ -166,85 +110,39 @@ Status VulkanWindow::create_window() {
     glfwSetMouseButtonCallback(window_, WindowCallbacks::button);
     glfwSetKeyCallback(window_, WindowCallbacks::key);
     glfwSetCharCallback(window_, WindowCallbacks::character);
-    if (VkResult r = glfwCreateWindowSurface(instance_, window_, nullptr, &surface_); r != VK_SUCCESS) {
+    if (VkResult r = glfwCreateWindowSurface(instance(), window_, nullptr, &surface_); r != VK_SUCCESS) {
         return vk::vulkan_error("glfwCreateWindowSurface", r);
     }
     return {};
 }
 
-// The device: the first with a queue family that computes, draws and presents, at Vulkan 1.2 or
-// later (the renderer's floor).
+// The device: one at Vulkan 1.2 or later (the renderer's floor) with the swapchain extension, what
+// crisp's renderer and tile path need (and B8G8R8A8 storage views where the GPU has them: crisp is
+// then told what it was created with), and a queue family that computes, draws and presents.
 Status VulkanWindow::choose_device() {
-    uint32_t device_count = 0;
-    vkEnumeratePhysicalDevices(instance_, &device_count, nullptr);
-    std::vector<VkPhysicalDevice> devices(device_count);
-    vkEnumeratePhysicalDevices(instance_, &device_count, devices.data());
-    std::string rejected;
-    for (VkPhysicalDevice candidate : devices) {
-        VkPhysicalDeviceProperties properties{};
-        vkGetPhysicalDeviceProperties(candidate, &properties);
-        if (properties.apiVersion < VK_API_VERSION_1_2) {
-            rejected += std::string(properties.deviceName) + ": below Vulkan 1.2; ";
-            continue;
-        }
-        uint32_t family_count = 0;
-        vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, nullptr);
-        std::vector<VkQueueFamilyProperties> families(family_count);
-        vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, families.data());
-        for (uint32_t family = 0; family < family_count; ++family) {
-            const VkQueueFlags needed = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
-            VkBool32 presents = VK_FALSE;
-            vkGetPhysicalDeviceSurfaceSupportKHR(candidate, family, surface_, &presents);
-            if ((families[family].queueFlags & needed) == needed && presents) {
-                physical_device_ = candidate;
-                queue_family_ = family;
-                timestamp_valid_bits_ = families[family].timestampValidBits;
-                break;
-            }
-        }
-        if (physical_device_) break;
-        rejected += std::string(properties.deviceName) + ": no queue that computes, draws and presents; ";
-    }
-    if (!physical_device_) {
-        return Error{ErrorCode::vulkan, "no Vulkan device can show the editor: " +
-                                            (rejected.empty() ? std::string("no devices") : rejected)};
-    }
-    vkGetPhysicalDeviceProperties(physical_device_, &properties_);
-    vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+    DeviceRequirements requirements;
+    requirements.required_extensions = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
+    requirements.crisp_needs = CrispFeatureNeeds{.storage_without_format = true};
+    requirements.queue_family_check = [this](VkPhysicalDevice candidate, uint32_t family) {
+        VkBool32 presents = VK_FALSE;
+        vkGetPhysicalDeviceSurfaceSupportKHR(candidate, family, surface_, &presents);
+        return presents == VK_TRUE;
+    };
+    requirements.queue_family_check_name = "presents to the window's surface";
+    Result<PhysicalDevice> chosen = choose_physical_device(instance_, requirements);
+    if (!chosen) return chosen.error();
+    physical_ = std::move(*chosen);
     return {};
 }
 
-// The device with the swapchain extension and what crisp's renderer and tile path need (and
-// B8G8R8A8 storage views where the GPU has them: crisp is then told what it was created with), its
-// queue, and the semaphore that orders rendering after image acquisition.
+// The device, its queue, and the semaphore that orders rendering after image acquisition.
 Status VulkanWindow::create_device() {
-    const float priority = 1.0f;
-    VkDeviceQueueCreateInfo queue_info{};
-    queue_info.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
-    queue_info.queueFamilyIndex = queue_family_;
-    queue_info.queueCount = 1;
-    queue_info.pQueuePriorities = &priority;
-    features_ = VkPhysicalDeviceFeatures2{};
-    features_.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    if (Status s = add_crisp_features(instance_, physical_device_, features_, {.storage_without_format = true}); !s) {
-        return s.error();
-    }
-    storage_without_format_ = features_.features.shaderStorageImageWriteWithoutFormat == VK_TRUE;
-    const char* device_extensions[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
-    VkDeviceCreateInfo device_info{};
-    device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
-    device_info.queueCreateInfoCount = 1;
-    device_info.pQueueCreateInfos = &queue_info;
-    device_info.pNext = &features_;
-    device_info.enabledExtensionCount = 1;
-    device_info.ppEnabledExtensionNames = device_extensions;
-    if (VkResult r = vkCreateDevice(physical_device_, &device_info, nullptr, &device_); r != VK_SUCCESS) {
-        return vk::vulkan_error("vkCreateDevice", r);
-    }
-    vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+    Result<VulkanDevice> created = VulkanDevice::create(instance_, physical_);
+    if (!created) return created.error();
+    device_ = std::move(*created);
     VkSemaphoreCreateInfo semaphore_info{};
     semaphore_info.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
-    if (VkResult r = vkCreateSemaphore(device_, &semaphore_info, nullptr, &image_ready_); r != VK_SUCCESS) {
+    if (VkResult r = vkCreateSemaphore(device(), &semaphore_info, nullptr, &image_ready_); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateSemaphore", r);
     }
     return {};
@@ -252,15 +150,15 @@ Status VulkanWindow::create_device() {
 
 Status VulkanWindow::create_swapchain() {
     VkSurfaceCapabilitiesKHR capabilities{};
-    vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_device_, surface_, &capabilities);
+    vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_.handle, surface_, &capabilities);
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;  // the canvas is blitted in
     if ((capabilities.supportedUsageFlags & usage) != usage) {
         return Error{ErrorCode::vulkan, "the surface's images cannot be transfer destinations"};
     }
     uint32_t format_count = 0;
-    vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, surface_, &format_count, nullptr);
+    vkGetPhysicalDeviceSurfaceFormatsKHR(physical_.handle, surface_, &format_count, nullptr);
     std::vector<VkSurfaceFormatKHR> formats(format_count);
-    vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, surface_, &format_count, formats.data());
+    vkGetPhysicalDeviceSurfaceFormatsKHR(physical_.handle, surface_, &format_count, formats.data());
     // The canvas holds sRGB-encoded bytes: a UNORM swapchain shows them as they are.
     VkSurfaceFormatKHR chosen{VK_FORMAT_UNDEFINED, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR};
     for (const VkSurfaceFormatKHR& format : formats) {
@@ -273,7 +171,7 @@ Status VulkanWindow::create_swapchain() {
     if (chosen.format == VK_FORMAT_UNDEFINED)
         return Error{ErrorCode::vulkan, "the surface offers no 8-bit UNORM format"};
     VkFormatProperties format_properties{};
-    vkGetPhysicalDeviceFormatProperties(physical_device_, chosen.format, &format_properties);
+    vkGetPhysicalDeviceFormatProperties(physical_.handle, chosen.format, &format_properties);
     if (!(format_properties.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_DST_BIT)) {
         return Error{ErrorCode::vulkan, "the swapchain format cannot be a blit destination"};
     }
@@ -300,20 +198,20 @@ Status VulkanWindow::create_swapchain() {
     info.clipped = VK_TRUE;
     info.oldSwapchain = swapchain_;
     VkSwapchainKHR created = VK_NULL_HANDLE;
-    if (VkResult r = vkCreateSwapchainKHR(device_, &info, nullptr, &created); r != VK_SUCCESS) {
+    if (VkResult r = vkCreateSwapchainKHR(device(), &info, nullptr, &created); r != VK_SUCCESS) {
         return vk::vulkan_error("vkCreateSwapchainKHR", r);
     }
     destroy_swapchain();
     swapchain_ = created;
     uint32_t count = 0;
-    vkGetSwapchainImagesKHR(device_, swapchain_, &count, nullptr);
+    vkGetSwapchainImagesKHR(device(), swapchain_, &count, nullptr);
     swapchain_images_.resize(count);
-    vkGetSwapchainImagesKHR(device_, swapchain_, &count, swapchain_images_.data());
+    vkGetSwapchainImagesKHR(device(), swapchain_, &count, swapchain_images_.data());
     VkSemaphoreCreateInfo semaphore_info{};
     semaphore_info.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
     rendered_.assign(count, VK_NULL_HANDLE);
     for (VkSemaphore& semaphore : rendered_) {
-        if (VkResult r = vkCreateSemaphore(device_, &semaphore_info, nullptr, &semaphore); r != VK_SUCCESS) {
+        if (VkResult r = vkCreateSemaphore(device(), &semaphore_info, nullptr, &semaphore); r != VK_SUCCESS) {
             return vk::vulkan_error("vkCreateSemaphore", r);
         }
     }
@@ -321,31 +219,24 @@ Status VulkanWindow::create_swapchain() {
 }
 
 void VulkanWindow::destroy_swapchain() {
-    if (!device_) return;
-    vkDeviceWaitIdle(device_);
+    if (!device()) return;
+    vkDeviceWaitIdle(device());
     for (VkSemaphore semaphore : rendered_) {
-        if (semaphore) vkDestroySemaphore(device_, semaphore, nullptr);
+        if (semaphore) vkDestroySemaphore(device(), semaphore, nullptr);
     }
     rendered_.clear();
     swapchain_images_.clear();
-    if (swapchain_) vkDestroySwapchainKHR(device_, swapchain_, nullptr);
+    if (swapchain_) vkDestroySwapchainKHR(device(), swapchain_, nullptr);
     swapchain_ = VK_NULL_HANDLE;
 }
 
 VulkanWindow::~VulkanWindow() {
     destroy_swapchain();
-    if (device_) {
-        if (image_ready_) vkDestroySemaphore(device_, image_ready_, nullptr);
-        vkDestroyDevice(device_, nullptr);
-    }
-    if (surface_) vkDestroySurfaceKHR(instance_, surface_, nullptr);
+    if (image_ready_) vkDestroySemaphore(device(), image_ready_, nullptr);
+    device_ = {};
+    if (surface_) vkDestroySurfaceKHR(instance(), surface_, nullptr);
     if (window_) glfwDestroyWindow(window_);
-    if (messenger_) {
-        auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-            vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
-        if (destroy_messenger) destroy_messenger(instance_, messenger_, nullptr);
-    }
-    if (instance_) vkDestroyInstance(instance_, nullptr);
+    instance_ = {};
     glfwTerminate();
 }
 
@@ -361,7 +252,7 @@ std::vector<InputEvent> VulkanWindow::poll_events() {
 Result<VulkanWindow::Acquired> VulkanWindow::acquire() {
     Acquired acquired;
     const VkResult r =
-        vkAcquireNextImageKHR(device_, swapchain_, UINT64_MAX, image_ready_, VK_NULL_HANDLE, &acquired.index);
+        vkAcquireNextImageKHR(device(), swapchain_, UINT64_MAX, image_ready_, VK_NULL_HANDLE, &acquired.index);
     if (r == VK_ERROR_OUT_OF_DATE_KHR) {
         if (Status status = create_swapchain(); !status) return status.error();
         return acquired;
@@ -381,7 +272,7 @@ Status VulkanWindow::present(const Acquired& acquired) {
     info.swapchainCount = 1;
     info.pSwapchains = &swapchain_;
     info.pImageIndices = &acquired.index;
-    const VkResult r = vkQueuePresentKHR(queue_, &info);
+    const VkResult r = vkQueuePresentKHR(queue(), &info);
     if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) return create_swapchain();
     if (r != VK_SUCCESS) return vk::vulkan_error("vkQueuePresentKHR", r);
     return {};

@@ -1,12 +1,15 @@
 // crisp-layout-editor: the GLFW window, the Vulkan instance, device and swapchain behind it, and
-// the window's input as an ordered list of events.
+// the window's input as an ordered list of events. The instance, the device's choice and the
+// device are made as the headless context makes them (support/vulkan_device.hpp); the window adds
+// its surface, a queue family that presents to it, and the swapchain.
 #pragma once
+
+#include "vulkan_device.hpp"
 
 #include <crisp/result.hpp>
 
 #include <vulkan/vulkan.h>
 
-#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -46,17 +49,20 @@ public:
     VulkanWindow& operator=(const VulkanWindow&) = delete;
     ~VulkanWindow();
 
-    VkInstance instance() const { return instance_; }
-    VkPhysicalDevice physical_device() const { return physical_device_; }
-    VkDevice device() const { return device_; }
-    uint32_t queue_family() const { return queue_family_; }
-    VkQueue queue() const { return queue_; }
-    const VkPhysicalDeviceProperties& properties() const { return properties_; }
-    const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_properties_; }
-    bool storage_without_format() const { return storage_without_format_; }
+    VkInstance instance() const { return instance_.handle(); }
+    VkPhysicalDevice physical_device() const { return physical_.handle; }
+    VkDevice device() const { return device_.handle(); }
+    uint32_t queue_family() const { return physical_.queue_family; }
+    VkQueue queue() const { return device_.queue(); }
+    const VkPhysicalDeviceProperties& properties() const { return physical_.properties; }
+    const VkPhysicalDeviceMemoryProperties& memory_properties() const { return physical_.memory_properties; }
+    // B8G8R8A8 storage views (shaderStorageImageWriteWithoutFormat), on where the GPU has them.
+    bool storage_without_format() const {
+        return device_.enabled_features()->features.shaderStorageImageWriteWithoutFormat == VK_TRUE;
+    }
     // The feature chain the device was created with, for crisp's create infos.
-    const VkPhysicalDeviceFeatures2* enabled_features() const { return &features_; }
-    uint32_t timestamp_valid_bits() const { return timestamp_valid_bits_; }
+    const VkPhysicalDeviceFeatures2* enabled_features() const { return device_.enabled_features(); }
+    uint32_t timestamp_valid_bits() const { return physical_.queue_family_properties.timestampValidBits; }
     uint32_t width() const { return options_.width; }
     uint32_t height() const { return options_.height; }
 
@@ -80,7 +86,10 @@ public:
     VkFormat swapchain_format() const { return swapchain_format_; }
 
     // Warnings and errors the validation layer reported so far.
-    uint32_t validation_messages() const { return validation_messages_.load(); }
+    uint32_t validation_messages() const {
+        const ValidationMessages messages = validation_log_.snapshot();
+        return messages.warnings + messages.errors;
+    }
 
 private:
     VulkanWindow() = default;
@@ -94,19 +103,13 @@ private:
     friend struct WindowCallbacks;
 
     WindowOptions options_;
+    // Each message goes to stderr as it arrives, and is counted.
+    ValidationLog validation_log_{"crisp-layout-editor: "};
     GLFWwindow* window_ = nullptr;
-    VkInstance instance_ = VK_NULL_HANDLE;
-    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+    VulkanInstance instance_;
     VkSurfaceKHR surface_ = VK_NULL_HANDLE;
-    VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
-    VkPhysicalDeviceProperties properties_{};
-    VkPhysicalDeviceMemoryProperties memory_properties_{};
-    bool storage_without_format_ = false;
-    VkPhysicalDeviceFeatures2 features_{};  // as the device was created with them
-    uint32_t timestamp_valid_bits_ = 0;
-    VkDevice device_ = VK_NULL_HANDLE;
-    uint32_t queue_family_ = 0;
-    VkQueue queue_ = VK_NULL_HANDLE;
+    PhysicalDevice physical_;
+    VulkanDevice device_;
     VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
     VkFormat swapchain_format_ = VK_FORMAT_UNDEFINED;
     std::vector<VkImage> swapchain_images_;
@@ -114,7 +117,6 @@ private:
     VkSemaphore image_ready_ = VK_NULL_HANDLE;
     std::vector<InputEvent> events_;
     double cursor_x_ = 0.0, cursor_y_ = 0.0;
-    std::atomic<uint32_t> validation_messages_{0};
 };
 
 }  // namespace crisp::editor
