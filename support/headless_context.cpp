@@ -370,9 +370,10 @@ Status HeadlessContext::State::create_instance(const HeadlessContextOptions& opt
     instance_info.ppEnabledExtensionNames = extensions.data();
     if (VkResult result = fn.vkCreateInstance(&instance_info, nullptr, &instance); result != VK_SUCCESS) {
         if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
-            return Error{ErrorCode::vulkan, "no Vulkan driver supports Vulkan " +
-                                                vk::version_string(options.api_version) +
-                                                " (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER)"};
+            return Error{ErrorCode::vulkan,
+                         "no Vulkan driver supports Vulkan " + vk::version_string(options.api_version) +
+                             " (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER)",
+                         result};
         }
         return vk::vulkan_error("vkCreateInstance", result);
     }
@@ -644,7 +645,9 @@ Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer
     State& s = *state_;
     const vk::Functions& fn = s.fn;
     assert(!s.recording && "submit_and_wait called from inside its own record callback");
-    if (s.lost) return Error{ErrorCode::device_lost, "the device was lost earlier: make a new context"};
+    if (s.lost) {
+        return Error{ErrorCode::device_lost, "the device was lost earlier: make a new context", VK_ERROR_DEVICE_LOST};
+    }
     // Leaves the command buffer reusable even if `record` throws.
     struct RecordingGuard {
         State& s;

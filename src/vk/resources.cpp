@@ -20,7 +20,7 @@ namespace vk {
 
 Error vulkan_error(std::string_view call, VkResult result) {
     const ErrorCode code = result == VK_ERROR_DEVICE_LOST ? ErrorCode::device_lost : ErrorCode::vulkan;
-    return Error{code, std::string(call) + " failed: " + vk_result_name(result)};
+    return Error{code, std::string(call) + " failed: " + vk_result_name(result), result};
 }
 
 std::optional<uint32_t> find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, uint32_t type_bits,

@@ -20,7 +20,7 @@
 namespace crisp::vk {
 
 // ErrorCode::vulkan (ErrorCode::device_lost for VK_ERROR_DEVICE_LOST) with "`call` failed:
-// VK_ERROR_..." as the message.
+// VK_ERROR_..." as the message and `result` as its vk_result.
 Error vulkan_error(std::string_view call, VkResult result);
 
 // The index of a memory type allowed by `type_bits` (VkMemoryRequirements::memoryTypeBits) that
