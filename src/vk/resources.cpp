@@ -1,4 +1,4 @@
-// The private Vulkan layer's owners, error values and memory-type choice (vk/resources.hpp).
+// The private Vulkan layer's objects, their owners and the errors they make (vk/resources.hpp).
 #include "vk/resources.hpp"
 
 #include "vk/barriers.hpp"
