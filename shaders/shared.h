@@ -61,6 +61,9 @@ CRISP_CONSTANT(uint, kRasterRowCrossings, 8u);
 // 1/16 + 1/128 + 1/1024 puts the first 64 and the first 512 samples within 1/1024 of their strata's
 // centres and the first 8 within 9/1024 (docs/rasterizer.md, "Row samples", says why not 8 too).
 CRISP_CONSTANT(float, kRasterRowOffset, 0.0712890625f);
+// The R2 sequence's steps 1/g, 1/g^2 (g the plastic number): frac(0.5 + n * step) fills any run of n evenly.
+CRISP_CONSTANT(float, kRasterR2StepX, 0.7548776662466927f);
+CRISP_CONSTANT(float, kRasterR2StepY, 0.5698402909980532f);
 // Storage buffers of curve points and of band bitsets, one each per font: with the work items
 // 18 storage buffers, within the 32 per stage that lavapipe and desktop drivers offer.
 CRISP_CONSTANT(uint, kRasterFontPages, 8u);  // font pages, each several fonts' points and bands

@@ -22,6 +22,8 @@ namespace crisp {
 static_assert(kRowCrossings == gpu::kRasterRowCrossings);
 static_assert(static_cast<float>(kRowOffset) == gpu::kRasterRowOffset);
 static_assert(kRowOffset == 1.0 / 16 + 1.0 / 128 + 1.0 / 1024);
+static_assert(static_cast<float>(kR2StepX) == gpu::kRasterR2StepX);
+static_assert(static_cast<float>(kR2StepY) == gpu::kRasterR2StepY);
 
 // -------------------------------------------------------------------------------------------------
 // 1. The sample function.
@@ -249,7 +251,7 @@ double row_height(uint32_t n) {
 }
 
 float row_dither(uint32_t n) {
-    const float u = 0.5f + static_cast<float>(n) * static_cast<float>(kR2StepX);
+    const float u = 0.5f + static_cast<float>(n) * gpu::kRasterR2StepX;
     return u - std::floor(u);
 }
 

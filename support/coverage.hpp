@@ -34,7 +34,8 @@ namespace crisp {
 // Below this |a| (the t^2 coefficient of y(t), em) the curve is solved as a line, as in Slug.
 inline constexpr double kLinearEpsilon = 1.0 / 65536.0;
 
-// The R2 sequence: sample n of a rectangle sits at frac(0.5 + n * (kR2StepX, kR2StepY)) of it.
+// The R2 sequence: sample n of a rectangle sits at frac(0.5 + n * (kR2StepX, kR2StepY)) of it
+// (the shader's gpu::kRasterR2StepX and kRasterR2StepY, in double).
 inline constexpr double kR2StepX = 0.7548776662466927;  // 1 / g, g the plastic number 1.3247...
 inline constexpr double kR2StepY = 0.5698402909980532;  // 1 / g^2
 

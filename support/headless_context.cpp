@@ -204,7 +204,9 @@ Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer
     State& s = *state_;
     const vk::Functions& fn = s.device.functions();
     assert(!s.recording && "submit_and_wait called from inside its own record callback");
-    if (s.lost) return Error{ErrorCode::device_lost, "the device was lost earlier: make a new context"};
+    if (s.lost) {
+        return Error{ErrorCode::device_lost, "the device was lost earlier: make a new context", VK_ERROR_DEVICE_LOST};
+    }
     // Leaves the command buffer reusable even if `record` throws.
     struct RecordingGuard {
         State& s;

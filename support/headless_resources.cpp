@@ -315,10 +315,12 @@ Result<Image> HeadlessContext::create_image(const ImageDesc& desc) {
         physical_device(), desc.format, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_OPTIMAL, desc.usage, flags, &limits);
     if (supported == VK_ERROR_FORMAT_NOT_SUPPORTED ||
         (supported == VK_SUCCESS && (desc.width > limits.maxExtent.width || desc.height > limits.maxExtent.height))) {
-        return Error{ErrorCode::vulkan, "create_image: the device does not support a " + std::to_string(desc.width) +
-                                            "x" + std::to_string(desc.height) + " image of VkFormat " +
-                                            std::to_string(static_cast<int>(desc.format)) + " with usage flags " +
-                                            std::to_string(desc.usage)};
+        return Error{ErrorCode::vulkan,
+                     "create_image: the device does not support a " + std::to_string(desc.width) + "x" +
+                         std::to_string(desc.height) + " image of VkFormat " +
+                         std::to_string(static_cast<int>(desc.format)) + " with usage flags " +
+                         std::to_string(desc.usage),
+                     supported};
     }
     if (supported != VK_SUCCESS) return vk::vulkan_error("vkGetPhysicalDeviceImageFormatProperties", supported);
 

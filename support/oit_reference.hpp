@@ -68,7 +68,7 @@ bool is_neutral(const Fragment& fragment);
 struct TailAccumulators {
     uint32_t count = 0;                           // additive blend or atomicAdd
     float transmittance[3] = {1.0f, 1.0f, 1.0f};  // product of code / 255: multiplicative blend
-    float absorbance[3] = {};                     // sum of kAbsorbance[code]: additive blend
+    float absorbance[3] = {};                     // sum of absorbance_from_code(code): additive blend
     float opacity[3] = {};                        // sum of 1 - code / 255: additive blend
     uint32_t depth_min = 0xFFFFFFFFu;             // atomicMin of key_depth
     uint32_t depth_max = 0;                       // atomicMax of key_depth

@@ -349,9 +349,10 @@ Result<VulkanInstance> VulkanInstance::create(const InstanceOptions& options) {
     instance_info.ppEnabledExtensionNames = extensions.data();
     if (VkResult result = fn.vkCreateInstance(&instance_info, nullptr, &s.instance); result != VK_SUCCESS) {
         if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
-            return Error{ErrorCode::vulkan, "no Vulkan driver supports Vulkan " +
-                                                vk::version_string(options.api_version) +
-                                                " (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER)"};
+            return Error{ErrorCode::vulkan,
+                         "no Vulkan driver supports Vulkan " + vk::version_string(options.api_version) +
+                             " (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER)",
+                         result};
         }
         return vk::vulkan_error("vkCreateInstance", result);
     }

@@ -1,4 +1,4 @@
-// The GPU rasterizer's accuracy against exact area coverage, and the hard cases of DESIGN.md, on
+// The GPU rasterizer's accuracy against exact area coverage, and its hard cases (docs/accuracy.md), on
 // lavapipe with validation on. Each texel channel's coverage (hits / samples) is compared with the
 // exact area fraction of that channel's sample rectangle covered by the glyph (nonzero rule).
 #include "bake/bands.hpp"

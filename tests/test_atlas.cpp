@@ -945,6 +945,26 @@ TEST(Atlas, IsAMovableValue) {
     EXPECT_EQ(moved.stats().resident_glyphs, 1u);
 }
 
+// Copy assignment takes the other atlas's whole state (its size too); afterwards neither sees the
+// other's changes, and each schedule() is its own.
+TEST(Atlas, CopyAssignmentIsDeep) {
+    GlyphAtlas atlas = make_atlas(256, 256);
+    GlyphAtlas copy = make_atlas(64, 64);
+    const uint32_t id = atlas.acquire(key_of('a'), 12, 14, 1).entry;
+    copy = atlas;
+    EXPECT_EQ(copy.config().width, 256u);
+    EXPECT_EQ(copy.find(key_of('a')), id);
+    const std::span<const RasterWork> work = copy.schedule();
+    ASSERT_EQ(work.size(), 1u);
+    EXPECT_GT(copy.entry(id)->samples, 0u);
+    EXPECT_EQ(atlas.entry(id)->samples, 0u);
+    atlas.begin_frame();
+    atlas.acquire(key_of('b'), 12, 14, 1);
+    EXPECT_EQ(copy.find(key_of('b')), kNoAtlasEntry);
+    EXPECT_EQ(copy.schedule().data(), work.data());
+    EXPECT_EQ(copy.frame(), atlas.frame() - 1);
+}
+
 TEST(Atlas, StatusNames) {
     EXPECT_STREQ(atlas_status_name(AtlasStatus::placed), "placed");
     EXPECT_STREQ(atlas_status_name(AtlasStatus::empty), "empty");

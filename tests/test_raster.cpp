@@ -1,6 +1,7 @@
 // The GPU rasterizer held to the CPU reference, texel by texel, on lavapipe with validation on.
 #include "coverage.hpp"
 #include "headless_context.hpp"
+#include "shared.h"
 #include "test_support.hpp"
 #include "text/utf8.hpp"
 
@@ -62,8 +63,8 @@ std::vector<Texel> render(Renderer& renderer, const TextLayout& layout, uint32_t
 // The float positions the shader computes for sample n of texel (tx, ty), channel c.
 void gpu_sample(const TexelToEm& map, const SampleRect& rect, uint32_t tx, uint32_t ty, uint32_t n, float& x,
                 float& y) {
-    float u = 0.5f + static_cast<float>(n) * 0.7548776662466927f;
-    float v = 0.5f + static_cast<float>(n) * 0.5698402909980532f;
+    float u = 0.5f + static_cast<float>(n) * gpu::kRasterR2StepX;
+    float v = 0.5f + static_cast<float>(n) * gpu::kRasterR2StepY;
     u -= std::floor(u);
     v -= std::floor(v);
     const float px = static_cast<float>(tx) + (rect.x0 + (rect.x1 - rect.x0) * u);

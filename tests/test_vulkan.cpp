@@ -884,6 +884,90 @@ TEST_F(VulkanTest, ShaderStatisticsFollowTheEnabledFeature) {
     EXPECT_EQ(messages.errors + messages.warnings, 0u) << describe(messages);
 }
 
+TEST(VulkanErrors, CarryTheResultOfTheFailedCall) {
+    EXPECT_EQ(vk::vulkan_error("vkQueueSubmit", VK_ERROR_DEVICE_LOST).vk_result, VK_ERROR_DEVICE_LOST);
+    const Error oom = vk::vulkan_error("vkAllocateMemory", VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    EXPECT_EQ(oom.vk_result, VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    EXPECT_EQ(oom.message, "vkAllocateMemory failed: VK_ERROR_OUT_OF_DEVICE_MEMORY");
+    EXPECT_EQ(Error{}.vk_result, VK_SUCCESS);
+}
+
+// An allocator that refuses every allocation: a driver that allocates host memory for an object
+// made with it fails that call with VK_ERROR_OUT_OF_HOST_MEMORY.
+void* VKAPI_CALL refuse_allocation(void*, size_t, size_t, VkSystemAllocationScope) {
+    return nullptr;
+}
+void* VKAPI_CALL refuse_reallocation(void*, void*, size_t, size_t, VkSystemAllocationScope) {
+    return nullptr;
+}
+void VKAPI_CALL free_nothing(void*, void*) {}  // it never gave out memory
+
+// The Error of a failed Vulkan call carries what the call returned, from the renderer's and the
+// compositor's creation down to the support library's; an error no Vulkan call caused carries
+// VK_SUCCESS, whatever its code.
+TEST_F(VulkanTest, FailedCallsCarryTheirVkResult) {
+    HeadlessContextOptions options = validated_options();
+    options.crisp_needs = CrispFeatureNeeds{};
+    CRISP_CREATE_CONTEXT(context, options);
+    VkAllocationCallbacks refusing{};
+    refusing.pfnAllocation = refuse_allocation;
+    refusing.pfnReallocation = refuse_reallocation;
+    refusing.pfnFree = free_nothing;
+    const auto expect_out_of_host_memory = [](const Error& error) {
+        EXPECT_EQ(error.code, ErrorCode::vulkan) << error.message;
+        EXPECT_EQ(error.vk_result, VK_ERROR_OUT_OF_HOST_MEMORY) << error.message;
+        EXPECT_NE(error.message.find("VK_ERROR_OUT_OF_HOST_MEMORY"), std::string::npos) << error.message;
+    };
+    RendererCreateInfo renderer_info = renderer_create_info(context);
+    renderer_info.allocator = &refusing;
+    Result<Renderer> renderer = Renderer::create(renderer_info);
+    ASSERT_FALSE(renderer.ok());
+    expect_out_of_host_memory(renderer.error());
+    CompositorCreateInfo compositor_info = compositor_create_info(context);
+    compositor_info.allocator = &refusing;
+    Result<Compositor> compositor = Compositor::create(compositor_info);
+    ASSERT_FALSE(compositor.ok());
+    expect_out_of_host_memory(compositor.error());
+    // Mesa reports each refusal through the messenger itself; nothing else may be reported (the
+    // validation layer finds nothing wrong with the calls).
+    const ValidationMessages refusals = context.validation_messages();
+    EXPECT_EQ(refusals.warnings, 0u) << describe(refusals);
+    ASSERT_EQ(refusals.recent.size(), refusals.errors) << describe(refusals);
+    for (const std::string& message : refusals.recent) {
+        EXPECT_NE(message.find("VK_ERROR_OUT_OF_HOST_MEMORY"), std::string::npos) << describe(refusals);
+    }
+
+    // A compressed format as a storage image: vkGetPhysicalDeviceImageFormatProperties refuses it.
+    ImageDesc compressed;
+    compressed.format = VK_FORMAT_BC1_RGBA_UNORM_BLOCK;
+    compressed.width = compressed.height = 64;
+    compressed.usage = VK_IMAGE_USAGE_STORAGE_BIT;
+    Result<Image> unsupported = context.create_image(compressed);
+    ASSERT_FALSE(unsupported.ok());
+    EXPECT_EQ(unsupported.error().code, ErrorCode::vulkan);
+    EXPECT_EQ(unsupported.error().vk_result, VK_ERROR_FORMAT_NOT_SUPPORTED) << unsupported.error().message;
+
+    // Refused with no Vulkan call failing: a size past the device's limit (the query succeeded),
+    // and a bad argument.
+    ImageDesc huge;
+    huge.width = context.properties().limits.maxImageDimension2D + 1;
+    huge.height = 1;
+    huge.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    Result<Image> too_large = context.create_image(huge);
+    ASSERT_FALSE(too_large.ok());
+    EXPECT_EQ(too_large.error().code, ErrorCode::vulkan);
+    EXPECT_EQ(too_large.error().vk_result, VK_SUCCESS) << too_large.error().message;
+    renderer_info.allocator = nullptr;
+    renderer_info.frames_in_flight = 0;
+    Result<Renderer> invalid = Renderer::create(renderer_info);
+    ASSERT_FALSE(invalid.ok());
+    EXPECT_EQ(invalid.error().code, ErrorCode::invalid_argument);
+    EXPECT_EQ(invalid.error().vk_result, VK_SUCCESS);
+    const ValidationMessages messages = context.validation_messages();
+    EXPECT_EQ(messages.errors, refusals.errors) << describe(messages);
+    EXPECT_EQ(messages.warnings, 0u) << describe(messages);
+}
+
 TEST(VulkanErrors, DeviceLossIsItsOwnErrorCode) {
     const Error lost = vk::vulkan_error("vkQueueSubmit", VK_ERROR_DEVICE_LOST);
     EXPECT_EQ(lost.code, ErrorCode::device_lost);

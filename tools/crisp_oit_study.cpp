@@ -1,4 +1,4 @@
-// Measures every compositing mode of src/oit_reference against composite_exact on random text-like
+// Measures every compositing mode of support/oit_reference against composite_exact on random text-like
 // pixels and prints a Markdown table (docs/oit.md). No GPU. Usage: crisp-oit-study [pixels] [seed]
 #include "cli.hpp"
 #include "oit_reference.hpp"

@@ -351,13 +351,13 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 // What is drawn: the scene (from --scene, or the one run the command line describes), its
-// resolved layout and fonts, and the glyphs its runs laid out.
+// resolved subpixel layout and fonts, and the glyphs its runs laid out.
 struct Job {
     crisp::Scene scene;
-    crisp::SubpixelLayout layout;
+    crisp::SubpixelLayout subpixel_layout;
     std::vector<crisp::Font> fonts;            // FontIds 1, 2, ... in scene order
     std::vector<crisp::GlyphInstance> glyphs;  // every run's glyphs that touch the canvas, in paint order
-    size_t laid_out = 0;                       // instances the layout produced, culled ones included
+    size_t laid_out = 0;                       // instances the text layouts produced, culled ones included
     uint32_t missing = 0, blank = 0, out_of_range = 0;
 };
 
@@ -600,7 +600,7 @@ int read_atlas_rects(crisp::HeadlessContext& context, const crisp::Renderer& ren
 
 int render(crisp::HeadlessContext& context, const Arguments& args, const Job& job, RenderReport& report) {
     crisp::RendererCreateInfo info = crisp::renderer_create_info(context);
-    info.layout = job.layout;
+    info.layout = job.subpixel_layout;
     info.atlas.max_samples = args.samples;
     for (uint32_t& samples : info.atlas.ramp) samples = std::min(samples, args.samples);
     report.atlas_side = atlas_side_for(job.glyphs);
@@ -836,7 +836,9 @@ void print_json(const Summary& s) {
         .field("driver", s.context->driver_name())
         .field("driver_info", s.context->driver_info())
         .end_object();
-    json.field("layout", job.layout.name).field("scene", unless_empty(args.scene)).field("runs", job.scene.runs.size());
+    json.field("layout", job.subpixel_layout.name)
+        .field("scene", unless_empty(args.scene))
+        .field("runs", job.scene.runs.size());
     json.field("size", args.scene.empty() ? args.size : std::nullopt).key("origin");
     if (args.scene.empty()) {
         json.begin_array().value((*args.origin)[0]).value((*args.origin)[1]).end_array();
@@ -884,8 +886,8 @@ void print_human(const Summary& s) {
     if (!args.scene.empty()) std::printf("  scene    %s, %zu runs\n", args.scene.c_str(), job.scene.runs.size());
     std::printf("  device   %s (%s, %s)\n", s.context->device_name().c_str(), s.context->driver_name().c_str(),
                 s.context->driver_info().c_str());
-    std::printf("  layout   %s, %u samples per texel and channel\n", crisp::cli::printable(job.layout.name).c_str(),
-                args.samples);
+    std::printf("  layout   %s, %u samples per texel and channel\n",
+                crisp::cli::printable(job.subpixel_layout.name).c_str(), args.samples);
     std::printf("  glyphs   %u drawn, %zu laid out (%u outside the canvas), %u missing, %u failed\n",
                 r.last_frame.drawn_glyphs, job.laid_out, s.culled_glyphs, job.missing, r.last_frame.failed_glyphs);
     std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)\n", static_cast<unsigned long long>(r.frames),
@@ -932,7 +934,7 @@ void lay_out(const Arguments& args, Job& job) {
         }
         crisp::TextStyle style;
         style.size = run.size;
-        std::copy(std::begin(run.color), std::end(run.color), style.color);  // sRGB: the layout linearizes it
+        std::copy(std::begin(run.color), std::end(run.color), style.color);  // sRGB: the layouter linearizes it
         style.depth = run.depth;
         crisp::LayoutOptions options;
         options.origin_x = run.origin_x;
@@ -962,8 +964,8 @@ void lay_out(const Arguments& args, Job& job) {
     }
 }
 
-// The scene (from --scene, or the one run the command line describes), its layout and fonts,
-// and its runs laid out; exits on a failure.
+// The scene (from --scene, or the one run the command line describes), its subpixel layout and
+// fonts, and its runs laid out; exits on a failure.
 Job load_job(const Arguments& args) {
     Job job;
     if (args.scene.empty()) {
@@ -974,12 +976,12 @@ Job load_job(const Arguments& args) {
         job.scene = std::move(*scene);
     }
 
-    crisp::Result<crisp::SubpixelLayout> layout = crisp::resolve_subpixel_layout(job.scene.layout);
-    if (!layout) {
+    crisp::Result<crisp::SubpixelLayout> subpixel_layout = crisp::resolve_subpixel_layout(job.scene.layout);
+    if (!subpixel_layout) {
         fail(kExitLayout, (args.scene.empty() ? "--layout " : args.scene + ": layout ") + job.scene.layout + ": " +
-                              layout.error().message);
+                              subpixel_layout.error().message);
     }
-    job.layout = std::move(*layout);
+    job.subpixel_layout = std::move(*subpixel_layout);
 
     job.fonts.reserve(job.scene.fonts.size());
     for (size_t i = 0; i < job.scene.fonts.size(); ++i) {

@@ -100,7 +100,7 @@ public:
         info.queryType = VK_QUERY_TYPE_TIMESTAMP;
         info.queryCount = 2;
         if (VkResult r = vkCreateQueryPool(timer.device_, &info, nullptr, &timer.pool_); r != VK_SUCCESS) {
-            return Error{ErrorCode::vulkan, "vkCreateQueryPool failed: " + vk_result_name(r)};
+            return Error{ErrorCode::vulkan, "vkCreateQueryPool failed: " + vk_result_name(r), r};
         }
         return timer;
     }
@@ -135,7 +135,7 @@ public:
         uint64_t stamps[2] = {};
         const VkResult r = vkGetQueryPoolResults(device_, pool_, 0, 2, sizeof stamps, stamps, sizeof(uint64_t),
                                                  VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
-        if (r != VK_SUCCESS) return Error{ErrorCode::vulkan, "vkGetQueryPoolResults failed: " + vk_result_name(r)};
+        if (r != VK_SUCCESS) return Error{ErrorCode::vulkan, "vkGetQueryPoolResults failed: " + vk_result_name(r), r};
         return static_cast<double>((stamps[1] - stamps[0]) & mask_) * period_ns_ * 1e-6;
     }
 

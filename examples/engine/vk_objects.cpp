@@ -35,7 +35,7 @@ crisp::Result<OwnedMemory> allocate(const MemoryContext& context, const VkMemory
 crisp::Error vulkan_error(const char* call, VkResult result) {
     const crisp::ErrorCode code =
         result == VK_ERROR_DEVICE_LOST ? crisp::ErrorCode::device_lost : crisp::ErrorCode::vulkan;
-    return crisp::Error{code, std::string(call) + " failed: " + crisp::vk_result_name(result)};
+    return crisp::Error{code, std::string(call) + " failed: " + crisp::vk_result_name(result), result};
 }
 
 crisp::Status check(const char* call, VkResult result) {

@@ -12,7 +12,8 @@
 namespace engine {
 
 // A failed Vulkan call as crisp's error type, so that the engine and crisp report alike:
-// crisp::ErrorCode::device_lost for VK_ERROR_DEVICE_LOST, as crisp's own calls report it.
+// crisp::ErrorCode::device_lost for VK_ERROR_DEVICE_LOST, and `result` as its vk_result, as
+// crisp's own calls report it.
 crisp::Error vulkan_error(const char* call, VkResult result);
 // Success, or vulkan_error(call, result).
 crisp::Status check(const char* call, VkResult result);

@@ -38,8 +38,8 @@
 #include <crisp/result.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <span>
-#include <unordered_map>
 #include <vector>
 
 namespace crisp {
@@ -193,6 +193,14 @@ public:
     // [1, kAtlasMaxSamples] or a frame_budget of 0 returns ErrorCode::invalid_argument naming it.
     static Result<GlyphAtlas> create(const AtlasConfig& config = {});
 
+    // An atlas is a value: a copy is a deep copy, independent of the original. A moved-from atlas
+    // may only be assigned to or destroyed.
+    GlyphAtlas(const GlyphAtlas& other);
+    GlyphAtlas& operator=(const GlyphAtlas& other);
+    GlyphAtlas(GlyphAtlas&& other) noexcept;
+    GlyphAtlas& operator=(GlyphAtlas&& other) noexcept;
+    ~GlyphAtlas();
+
     // Ends the current frame and starts the next: unpins every entry, clears the work list and
     // the per-frame counters.
     void begin_frame();
@@ -219,11 +227,12 @@ public:
     // The same for a glyph of which only `visible` (texels of its rect; clipped to the rect) can
     // reach the target: the entry holds that part grown by kAtlasPartMargin per side, and only
     // its texels get samples. A resident entry whose part contains `visible` is a hit; one whose
-    // part does not is evicted and placed anew with the new part (its samples are lost, and so is the entry
-    // when the new part does not fit: counted in parts_replaced) unless it is pinned this frame: a pinned entry never moves, and the
-    // lookup returns it as it is (lookup.part says what it holds). Callers that draw one glyph
-    // several times in a frame should acquire it once with the bounding box of the visible parts.
-    // `visible` empty after clipping: status empty, nothing changes.
+    // part does not is evicted and placed anew with the new part (its samples are lost, and so is
+    // the entry when the new part does not fit: counted in parts_replaced) unless it is pinned
+    // this frame: a pinned entry never moves, and the lookup returns it as it is (lookup.part says
+    // what it holds). Callers that draw one glyph several times in a frame should acquire it once
+    // with the bounding box of the visible parts. `visible` empty after clipping: status empty,
+    // nothing changes.
     AtlasLookup acquire(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample,
                         const TexelRect& visible);
 
@@ -287,83 +296,16 @@ public:
     const AtlasEntry* entry(uint32_t id) const;
 
     // Every resident entry's id is below this.
-    uint32_t entry_capacity() const { return static_cast<uint32_t>(slots_.size()); }
+    uint32_t entry_capacity() const;
 
     AtlasStats stats() const;
-    const AtlasConfig& config() const { return config_; }
-    uint64_t frame() const { return frame_; }
+    const AtlasConfig& config() const;
+    uint64_t frame() const;
 
 private:
-    struct Slot {
-        AtlasEntry entry;
-        uint32_t first_bit = 0;             // N-order index of the block's first cell
-        uint32_t bit_count = 0;             // cells in the block
-        uint32_t served_frames = 0;         // frames that scheduled samples since the last reset
-        uint32_t lru_prev = kNoAtlasEntry;  // towards more recently used
-        uint32_t lru_next = kNoAtlasEntry;  // towards less recently used
-        bool resident = false;
-    };
-
-    GlyphAtlas() = default;
-
-    bool pinned(const Slot& slot) const { return slot.entry.last_used_frame == frame_; }
-    void pin(uint32_t id);
-    void lru_unlink(uint32_t id);
-    void lru_push_front(uint32_t id);
-    void mark_cells(uint32_t first_bit, uint32_t bit_count, bool used);
-    uint32_t find_block(uint32_t bit_count) const;
-    uint32_t make_room(uint32_t bit_count);
-    void evict(uint32_t id);
-    uint32_t share(const Slot& slot) const;
-    // The new entries' first frame (waiting_ids_[0, new_count)): `samples` each (the first ramp
-    // step, or the power of two below it that fits the budget for all), and `spare` curve tests
-    // that can bring some of them, in order, to their whole step.
-    struct FirstFrame {
-        uint32_t samples = 0;
-        uint64_t spare = 0;
-    };
-    FirstFrame fit_first_frame(size_t new_count) const;
-    AtlasLookup lookup_of(uint32_t id) const;
-    AtlasLookup place(const GlyphKey& key, uint32_t width, uint32_t height, uint64_t curve_tests_per_sample,
-                      const TexelRect& part);
-    uint64_t schedule_split(uint32_t id, uint64_t allowance, bool force);
-    void count_work(const RasterWork& work);
-
-    AtlasConfig config_;
-    uint32_t cells_x_ = 0;
-    uint32_t cells_y_ = 0;
-    uint32_t usable_cells_ = 0;
-    uint32_t used_cells_ = 0;
-    std::vector<uint64_t> used_words_;       // bit i set: N-order cell i is taken or outside the atlas
-    std::vector<uint64_t> pinned_words_;     // bit i set: cell i is pinned this frame or outside
-    std::vector<uint64_t> permanent_words_;  // bit i set: cell i is outside the atlas
-    uint32_t first_free_word_ = 0;           // every used_words_ word below it is full
-    std::vector<uint64_t> ramp_totals_;      // ramp_totals_[k] = ramp[0] + ... + ramp[k]
-    std::vector<uint32_t> block_used_;       // scratch for make_room(): used cells per block
-
-    std::vector<Slot> slots_;
-    std::vector<uint32_t> free_ids_;
-    std::unordered_map<GlyphKey, uint32_t, GlyphKeyHash> ids_by_key_;
-    uint32_t lru_head_ = kNoAtlasEntry;  // most recently used
-    uint32_t lru_tail_ = kNoAtlasEntry;  // least recently used
-
-    uint64_t frame_ = 0;
-    std::vector<uint32_t> pinned_ids_;   // pinned this frame, in acquire order
-    std::vector<uint32_t> waiting_ids_;  // scratch for schedule()
-    std::vector<uint32_t> split_ids_;    // scratch for schedule(): split entries short of their piece
-    uint32_t cursor_ = 0;                // entry id the next frame's round starts at
-    bool scheduled_ = false;
-    std::vector<RasterWork> work_;
-    struct Undo {
-        uint32_t id = 0;
-        uint32_t samples = 0;
-        uint32_t split_texels_done = 0;
-        uint32_t served_frames = 0;
-    };
-    std::vector<Undo> undo_;  // the entries' state before this frame's schedule()
-    uint32_t undo_cursor_ = 0;
-    AtlasCounters frame_counters_;
-    AtlasCounters total_counters_;
+    struct State;
+    explicit GlyphAtlas(std::unique_ptr<State> state);
+    std::unique_ptr<State> state_;
 };
 
 }  // namespace crisp

@@ -2,11 +2,14 @@
 //
 // Anything that can fail because of its input (a font file, an asset, a layout file, text, sizes,
 // a missing Vulkan feature, a full atlas) returns a Result<T>: either the value, or an Error with
-// a code a program can branch on and a message a person can act on. No exception crosses the
-// public API; programmer errors (broken preconditions) assert.
+// a code a program can branch on, a message a person can act on and, where a Vulkan call failed,
+// the VkResult it returned. No exception crosses the public API; programmer errors (broken
+// preconditions) assert.
 #pragma once
 
 #include <crisp/export.hpp>
+
+#include <vulkan/vulkan.h>
 
 #include <cassert>
 #include <string>
@@ -36,6 +39,11 @@ CRISP_API const char* error_code_name(ErrorCode code);
 struct Error {
     ErrorCode code = ErrorCode::invalid_argument;
     std::string message;
+    // What the failed Vulkan call returned (VK_ERROR_OUT_OF_DEVICE_MEMORY, ...) where one caused
+    // the error, for a program that handles some results itself; VK_ERROR_DEVICE_LOST with every
+    // ErrorCode::device_lost. VK_SUCCESS where no Vulkan call failed: every other code, and
+    // ErrorCode::vulkan for a missing version, feature, extension, limit or memory type.
+    VkResult vk_result = VK_SUCCESS;
 };
 
 // Either a T or an Error. Reading the value of a failed Result (or the error of a successful

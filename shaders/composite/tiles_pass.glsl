@@ -3,8 +3,9 @@
 // front to back on the CPU, so a quad's index is its key: (depth, paint order, content).
 //
 // - The exact way, when the tile's list fits in workgroup memory (kCapacity quads): the list is
-//   loaded, sorted by index (bitonic), and each pixel walks it front to back, per channel
-//   light += T * L, T *= 1 - o, stopping once T is below kTileOpaque in every channel.
+//   loaded, sorted by index (a rank sort: each entry goes to the count of smaller keys), and each
+//   pixel walks it front to back, per channel light += T * L, T *= 1 - o, stopping once T is below
+//   kTileOpaque in every channel.
 // - The layered way, when it does not (a second, indirect dispatch over the tiles the first handed
 //   on): each pixel keeps its kLayers nearest fragments (the smallest quad indices) in registers
 //   while reading the list unsorted; what falls off the K goes to a tail of absorbance sums,

@@ -335,7 +335,7 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
     for (uint k = 0u; k < item.sample_count; ++k) {
         // R2: frac(0.5 + n * (1/g, 1/g^2)), g the plastic number. n stays far below 2^24.
         float n = float(item.first_sample + k);
-        vec2 r2 = fract(0.5 + n * vec2(0.7548776662466927, 0.5698402909980532));
+        vec2 r2 = fract(0.5 + n * vec2(kRasterR2StepX, kRasterR2StepY));
         vec2 em[3];
         uint lo_band = 0xFFFFFFFFu, hi_band = 0u;
         for (int c = 0; c < 3; ++c) {
@@ -395,7 +395,7 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
         uint n = item.first_sample + k;
         float v = row_height(n);
         // The R2 x offset of n, free now that rows need no x: the dither of the quantization.
-        float dither = fract(0.5 + float(n) * 0.7548776662466927);
+        float dither = fract(0.5 + float(n) * kRasterR2StepX);
         vec3 covered = vec3(0.0);
         for (uint row = 0u; row < rows; ++row) {
             vec4 rect = pc.channel_rects[row];

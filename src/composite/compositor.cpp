@@ -1,6 +1,5 @@
-// The GPU compositor's public face (docs/compositing.md): the tile path (composite_tiles), the
-// draw path (composite_draw) and the reference modes (composite_reference) over one set of quads
-// (composite_quads).
+// The GPU compositor's public face (docs/compositing.md): the tile path (tiles.cpp), the draw path
+// (draw.cpp) and the reference modes (reference.cpp) over one set of quads (quads.cpp).
 #include "composite/draw.hpp"
 #include "composite/quads.hpp"
 #include "composite/reference.hpp"

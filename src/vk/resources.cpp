@@ -1,4 +1,4 @@
-// The private Vulkan layer's owners, error values and memory-type choice (vk/resources.hpp).
+// The private Vulkan layer's objects, their owners and the errors they make (vk/resources.hpp).
 #include "vk/resources.hpp"
 
 #include "vk/barriers.hpp"
@@ -20,7 +20,7 @@ namespace vk {
 
 Error vulkan_error(std::string_view call, VkResult result) {
     const ErrorCode code = result == VK_ERROR_DEVICE_LOST ? ErrorCode::device_lost : ErrorCode::vulkan;
-    return Error{code, std::string(call) + " failed: " + vk_result_name(result)};
+    return Error{code, std::string(call) + " failed: " + vk_result_name(result), result};
 }
 
 std::optional<uint32_t> find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, uint32_t type_bits,

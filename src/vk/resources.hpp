@@ -1,4 +1,6 @@
-// Private helpers shared by the Vulkan sources: error values and memory-type choice.
+// The private Vulkan layer's objects: the DeviceRef everything is made from, move-only owners of
+// buffers, images, descriptor sets and pipelines with the functions that make them, and the error
+// values, memory-type choice and device checks they share.
 #pragma once
 
 #include "vk/functions.hpp"
@@ -20,7 +22,7 @@
 namespace crisp::vk {
 
 // ErrorCode::vulkan (ErrorCode::device_lost for VK_ERROR_DEVICE_LOST) with "`call` failed:
-// VK_ERROR_..." as the message.
+// VK_ERROR_..." as the message and `result` as its vk_result.
 Error vulkan_error(std::string_view call, VkResult result);
 
 // The index of a memory type allowed by `type_bits` (VkMemoryRequirements::memoryTypeBits) that
@@ -124,11 +126,10 @@ void name_object(const DeviceRef& device, VkObjectType type, Handle handle, std:
 }
 
 // Makes `out` (at least 16 bytes): device-local, or host-visible and coherent and mapped, named
-// `what`; its memory comes from the device's arena where it has one. On failure `out` is left empty and the error names
-// the call and `what`.
+// `what`; its memory comes from the device's arena where it has one. On failure `out` is left
+// empty and the error names the call and `what`.
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
                      const char* what, DeviceBuffer& out);
-// Frees both objects (either may be null) and empties `buffer`.
 
 // A 2D colour image (one mip level, one layer, optimal tiling) in device-local memory, with a view.
 struct ImageFields {

@@ -3,7 +3,7 @@
 // alpha. Per mode (the tile path into RGBA32F and RGBA8 images, the whole frame of converged text
 // with it, the draw path, and the reference modes: exact, unsorted, wboit): the GPU time of its
 // record call on converged static text (Vulkan timestamp queries), the error of its image against
-// the exact CPU reference (src/oit_reference) in 8-bit sRGB codes, and its bytes per pixel.
+// the exact CPU reference (support/oit_reference) in 8-bit sRGB codes, and its bytes per pixel.
 // docs/benchmarks-compositing.md.
 #include "bench.hpp"
 #include "gpu_tools.hpp"

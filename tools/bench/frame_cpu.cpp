@@ -273,7 +273,7 @@ public:
 private:
     FrameSlots() = default;
     static crisp::Error failure(const char* call, VkResult r) {
-        return crisp::Error{crisp::ErrorCode::vulkan, std::string(call) + " failed: " + crisp::vk_result_name(r)};
+        return crisp::Error{crisp::ErrorCode::vulkan, std::string(call) + " failed: " + crisp::vk_result_name(r), r};
     }
     VkDevice device_ = VK_NULL_HANDLE;
     VkQueue queue_ = VK_NULL_HANDLE;

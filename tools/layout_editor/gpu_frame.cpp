@@ -100,7 +100,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
         }
     }
 
-    // The interface's text: a neutral gray layout, whatever is being edited.
+    // The interface's text: the neutral gray subpixel layout, whatever is being edited.
     RendererCreateInfo renderer_info;
     renderer_info.instance = window.instance();
     renderer_info.physical_device = window.physical_device();

@@ -1,7 +1,8 @@
 // crisp-layout-editor: one frame on the GPU. The CPU-drawn canvas is uploaded into an RGBA8
-// image, crisp's renderers rasterize the interface's text (gray layout) and the preview's text
-// (the edited layout), crisp's compositors composite both into the image (the tile path), and the
-// image is copied back (for the magnified view and screenshots) and blitted to the swapchain.
+// image, crisp's renderers rasterize the interface's text (the gray subpixel layout) and the
+// preview's text (the edited one), crisp's compositors composite both into the image (the tile
+// path), and the image is copied back (for the magnified view and screenshots) and blitted to the
+// swapchain.
 // One frame in flight: wait() before touching the canvas or reading the previous frame.
 #pragma once
 

@@ -126,7 +126,7 @@ void lay_out(crisp::Layouter& layouter, const crisp::Font& font, const std::vect
     out.preview_glyphs.clear();
     out.moving.clear();
     const crisp::Font* fonts[] = {&font};
-    crisp::TextLayout layout;
+    crisp::TextLayout laid;
     uint32_t paint_order = 0;
     for (const TextItem& item : items) {
         crisp::TextStyle style;
@@ -139,14 +139,14 @@ void lay_out(crisp::Layouter& layouter, const crisp::Font& font, const std::vect
         options.origin_y = item.y;
         options.wrap_width = item.wrap_width;
         options.first_paint_order = paint_order;
-        if (crisp::Status status = layouter.layout(fonts, item.text, style, options, layout); !status) {
+        if (crisp::Status status = layouter.layout(fonts, item.text, style, options, laid); !status) {
             errors.push_back(status.error().message);
             continue;
         }
-        if (item.moving) out.moving.emplace_back(paint_order, layout.next_paint_order);
-        paint_order = layout.next_paint_order;
+        if (item.moving) out.moving.emplace_back(paint_order, laid.next_paint_order);
+        paint_order = laid.next_paint_order;
         auto& target = item.preview ? out.preview_glyphs : out.interface_glyphs;
-        target.insert(target.end(), layout.glyphs.begin(), layout.glyphs.end());
+        target.insert(target.end(), laid.glyphs.begin(), laid.glyphs.end());
     }
 }
 
