@@ -1,5 +1,5 @@
 // Private: first-fit placement of byte ranges in a span of fixed size: the blocks of a
-// vk::MemoryArena place their buffers' ranges with it.
+// vk::MemoryArena and the buffers of the renderer's font pages place their ranges with it.
 #pragma once
 
 #include <cstdint>
