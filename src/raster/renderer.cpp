@@ -8,9 +8,7 @@
 #include "raster/raster.hpp"
 #include "raster/requests.hpp"
 #include "raster/retired.hpp"
-#include "vk/features.hpp"
-#include "vk/memory.hpp"
-#include "vk/resources.hpp"
+#include "vk/context.hpp"
 
 #include <crisp/renderer.hpp>
 
@@ -21,10 +19,7 @@
 namespace crisp {
 
 struct CRISP_HIDDEN Renderer::State {
-    vk::Functions fn;  // the caller's Vulkan entry points (RendererCreateInfo::get_instance_proc_addr)
-    std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory: declared first, destroyed last
-    vk::DeviceRef ref;                       // device, allocator, memory properties, pipeline cache, debug names, arena
-    std::vector<ShaderStatistic> shader_statistics;  // the driver's, where the device enabled them
+    std::unique_ptr<vk::Context> context;  // every part's functions and memory: declared first, destroyed last
     uint32_t frames_in_flight = 2;
     SampleKind sample_kind = SampleKind::rows;
     raster::AtlasLimits limits;
@@ -44,18 +39,18 @@ struct CRISP_HIDDEN Renderer::State {
     uint64_t frame = 0;
     bool recorded = false;  // record() since begin_frame(): abandon_frame() has a frame to take back
 
-    // The parts keep `ref`, which create() fills in before it makes anything.
-    State(GlyphAtlas glyph_atlas, SubpixelLayout subpixel_layout, const RendererCreateInfo& info,
-          const VkPhysicalDeviceLimits& device_limits)
-        : frames_in_flight(info.frames_in_flight),
+    State(std::unique_ptr<vk::Context> vk_context, GlyphAtlas glyph_atlas, SubpixelLayout subpixel_layout,
+          const RendererCreateInfo& info)
+        : context(std::move(vk_context)),
+          frames_in_flight(info.frames_in_flight),
           sample_kind(info.sample_kind),
-          limits{device_limits.maxImageDimension2D, info.atlas_memory_budget},
+          limits{context->properties.limits.maxImageDimension2D, info.atlas_memory_budget},
           atlas(std::move(glyph_atlas)),
           subpixel(std::move(subpixel_layout)),
-          fonts(ref, device_limits.maxStorageBufferRange),
+          fonts(context->ref, context->properties.limits.maxStorageBufferRange),
           requests(atlas, fonts, coarsening, stats),
-          image(ref),
-          raster(ref, {info.frames_in_flight, info.shared_row_roots, info.sample_kind}) {}
+          image(context->ref),
+          raster(context->ref, {info.frames_in_flight, info.shared_row_roots, info.sample_kind}) {}
 
     Status prepare_atlas_image(VkCommandBuffer command_buffer, uint64_t this_frame);
 };
@@ -83,44 +78,32 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     auto atlas = GlyphAtlas::create(info.atlas);
     if (!atlas) return atlas.error();
 
-    vk::Functions fn;
-    if (Status s = vk::load_functions(info.get_instance_proc_addr, info.instance, info.device, fn); !s) {
-        return Error{s.error().code, "renderer: " + s.error().message};
-    }
-    VkPhysicalDeviceProperties properties{};
-    fn.vkGetPhysicalDeviceProperties(info.physical_device, &properties);
-    if (properties.apiVersion < VK_API_VERSION_1_2) {
-        return Error{ErrorCode::vulkan, std::string("renderer: ") + properties.deviceName + " offers Vulkan " +
-                                            vk::version_string(properties.apiVersion) + "; crisp needs 1.2"};
-    }
-    Result<vk::DeviceFeatures> enabled = vk::read_enabled_features(info.enabled_features, "renderer");
-    if (!enabled) return enabled.error();
-    if (!enabled->features2.features.shaderStorageBufferArrayDynamicIndexing) {
+    Result<std::unique_ptr<vk::Context>> context = vk::Context::create(
+        {info.instance, info.get_instance_proc_addr, info.physical_device, info.device, info.allocator,
+         info.pipeline_cache, info.enabled_features, VK_API_VERSION_1_2, "renderer"});
+    if (!context) return context.error();
+    const vk::Context& vulkan = **context;
+    if (!vulkan.enabled.features2.features.shaderStorageBufferArrayDynamicIndexing) {
         return Error{ErrorCode::vulkan,
                      "renderer: the device was created without shaderStorageBufferArrayDynamicIndexing (enable it; "
                      "add_crisp_features() does)"};
     }
     const uint32_t buffers_needed = 2 + 2 * kRendererFontPages;
-    if (properties.limits.maxPerStageDescriptorStorageBuffers < buffers_needed) {
-        return Error{ErrorCode::vulkan, "renderer: the device offers " +
-                                            std::to_string(properties.limits.maxPerStageDescriptorStorageBuffers) +
-                                            " storage buffers per shader stage (maxPerStageDescriptorStorageBuffers); "
-                                            "crisp needs " +
-                                            std::to_string(buffers_needed)};
+    if (vulkan.properties.limits.maxPerStageDescriptorStorageBuffers < buffers_needed) {
+        return Error{ErrorCode::vulkan,
+                     "renderer: the device offers " +
+                         std::to_string(vulkan.properties.limits.maxPerStageDescriptorStorageBuffers) +
+                         " storage buffers per shader stage (maxPerStageDescriptorStorageBuffers); "
+                         "crisp needs " +
+                         std::to_string(buffers_needed)};
     }
     VkFormatProperties format{};
-    fn.vkGetPhysicalDeviceFormatProperties(info.physical_device, raster::kAtlasFormat, &format);
+    vulkan.fn.vkGetPhysicalDeviceFormatProperties(info.physical_device, raster::kAtlasFormat, &format);
     if (!(format.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT)) {
         return Error{ErrorCode::vulkan, "renderer: the device lacks storage images of R16G16B16A16_UINT"};
     }
 
-    auto state = std::make_unique<State>(std::move(*atlas), std::move(subpixel), info, properties.limits);
-    state->fn = fn;
-    state->ref = vk::make_device_ref(state->fn, info.physical_device, info.device, info.allocator, info.pipeline_cache);
-    state->arena =
-        std::make_unique<vk::MemoryArena>(state->fn, info.device, info.allocator, state->ref.memory_properties);
-    state->ref.arena = state->arena.get();
-    if (enabled->pipeline_executable_info) state->ref.statistics = &state->shader_statistics;
+    auto state = std::make_unique<State>(std::move(*context), std::move(*atlas), std::move(subpixel), info);
     const AtlasConfig& config = state->atlas.config();
     if (Status s = state->image.create(config); !s) return s.error();
     if (Status s = state->raster.create(state->atlas.stats().usable_cells, uint64_t{config.width} * config.height,
@@ -250,11 +233,11 @@ const RendererStats& Renderer::stats() const {
     return state_->stats;
 }
 const std::vector<ShaderStatistic>& Renderer::shader_statistics() const {
-    return state_->shader_statistics;
+    return state_->context->shader_statistics;
 }
 DeviceMemoryUse Renderer::device_memory() const {
     const State& s = *state_;
-    DeviceMemoryUse use{s.arena->block_count(), s.arena->block_bytes()};
+    DeviceMemoryUse use{s.context->arena.block_count(), s.context->arena.block_bytes()};
     for (const vk::DeviceImage* image : {&s.image.image()}) {
         use.allocations += image->memory != VK_NULL_HANDLE ? 1 : 0;
         use.bytes += image->memory_size;
