@@ -4,8 +4,7 @@
 #include "composite/quads.hpp"
 #include "composite/reference.hpp"
 #include "composite/tiles.hpp"
-#include "vk/features.hpp"
-#include "vk/memory.hpp"
+#include "vk/context.hpp"
 
 #include <crisp/compositor.hpp>
 
@@ -131,10 +130,9 @@ std::optional<float> depth_from_view_projection(const float view_projection[16],
 }
 
 struct CRISP_HIDDEN Compositor::State {
-    vk::Functions fn;  // the caller's Vulkan entry points (CompositorCreateInfo::get_instance_proc_addr)
-    std::unique_ptr<vk::MemoryArena> arena;  // every buffer's memory; outlives the paths below
-    vk::DeviceRef ref;
-    std::vector<ShaderStatistic> shader_statistics;  // the driver's, where the device enabled them
+    // The caller's Vulkan entry points (CompositorCreateInfo::get_instance_proc_addr) and every
+    // buffer's memory; outlives the paths below.
+    std::unique_ptr<vk::Context> context;
     bool storage_without_format = false;
     composite::TileCompositor tiles;
     std::unique_ptr<composite::DrawCompositor> draw;            // with draw_format
@@ -167,16 +165,19 @@ Compositor::~Compositor() = default;
 
 Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     if (Status s = check_create_info(info); !s) return s.error();
-    Result<vk::DeviceFeatures> enabled = vk::read_enabled_features(info.enabled_features, "compositor");
-    if (!enabled) return enabled.error();
-    const VkPhysicalDeviceFeatures& core = enabled->features2.features;
+    Result<std::unique_ptr<vk::Context>> context =
+        vk::Context::create({info.instance, info.get_instance_proc_addr, info.physical_device, info.device,
+                             info.allocator, info.pipeline_cache, info.enabled_features, 0, "compositor"});
+    if (!context) return context.error();
+    const vk::DeviceFeatures& enabled = (*context)->enabled;
+    const VkPhysicalDeviceFeatures& core = enabled.features2.features;
     // What each asked-for path needs, against what the device was created with.
     const auto lacks = [](const char* path, const char* feature) {
         return Error{ErrorCode::vulkan,
                      std::string("compositor: ") + path + " needs " + feature +
                          ", and the device was created without it (add_crisp_features() enables it)"};
     };
-    if (info.draw_format != VK_FORMAT_UNDEFINED && !enabled->vulkan13.dynamicRendering) {
+    if (info.draw_format != VK_FORMAT_UNDEFINED && !enabled.vulkan13.dynamicRendering) {
         return lacks("the draw path (draw_format)", "dynamicRendering");
     }
     if (info.draw_format != VK_FORMAT_UNDEFINED && !core.dualSrcBlend) {
@@ -189,14 +190,8 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     const bool storage_without_format =
         core.shaderStorageImageReadWithoutFormat && core.shaderStorageImageWriteWithoutFormat;
     auto state = std::make_unique<State>();
-    if (Status s = vk::load_functions(info.get_instance_proc_addr, info.instance, info.device, state->fn); !s) {
-        return Error{s.error().code, "compositor: " + s.error().message};
-    }
-    state->ref = vk::make_device_ref(state->fn, info.physical_device, info.device, info.allocator, info.pipeline_cache);
-    state->arena =
-        std::make_unique<vk::MemoryArena>(state->fn, info.device, info.allocator, state->ref.memory_properties);
-    state->ref.arena = state->arena.get();
-    if (enabled->pipeline_executable_info) state->ref.statistics = &state->shader_statistics;
+    state->context = std::move(*context);
+    const vk::DeviceRef& ref = state->context->ref;
     state->storage_without_format = storage_without_format;
     composite::TileConfig tiles;
     tiles.physical_device = info.physical_device;
@@ -205,14 +200,14 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     tiles.capacity = info.tile_capacity;
     tiles.storage_without_format = storage_without_format;
     tiles.reuse_static_bins = info.reuse_static_bins;
-    if (Status s = state->tiles.create(state->ref, tiles); !s) return s.error();
+    if (Status s = state->tiles.create(ref, tiles); !s) return s.error();
     if (!std::any_of(std::begin(kTileTargetFormats), std::end(kTileTargetFormats),
                      [&](VkFormat format) { return state->tiles.supports(format, format); })) {
         return Error{ErrorCode::vulkan, "compositor: the device can store to none of the tile path's formats"};
     }
     if (info.draw_format != VK_FORMAT_UNDEFINED) {
         state->draw = std::make_unique<composite::DrawCompositor>();
-        if (Status s = state->draw->create(state->ref, info.physical_device, info.draw_format, info.draw_depth_format,
+        if (Status s = state->draw->create(ref, info.physical_device, info.draw_format, info.draw_depth_format,
                                            info.frames_in_flight);
             !s) {
             return s.error();
@@ -222,7 +217,7 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
         state->width = info.width;
         state->height = info.height;
         state->reference = std::make_unique<composite::ReferenceCompositor>();
-        if (Status s = state->reference->create(state->ref, info, state->warnings); !s) return s.error();
+        if (Status s = state->reference->create(ref, info, state->warnings); !s) return s.error();
     }
     return Compositor(std::move(state));
 }
@@ -337,11 +332,11 @@ const CompositorStats& Compositor::stats() const {
     return state_->stats;
 }
 const std::vector<ShaderStatistic>& Compositor::shader_statistics() const {
-    return state_->shader_statistics;
+    return state_->context->shader_statistics;
 }
 DeviceMemoryUse Compositor::device_memory() const {
     const State& s = *state_;
-    DeviceMemoryUse use{s.arena->block_count(), s.arena->block_bytes()};
+    DeviceMemoryUse use{s.context->arena.block_count(), s.context->arena.block_bytes()};
     if (s.reference) {
         const vk::DeviceImage& target = s.reference->target();
         use.allocations += target.memory != VK_NULL_HANDLE ? 1 : 0;

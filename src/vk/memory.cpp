@@ -4,17 +4,10 @@
 
 #include <algorithm>
 #include <cassert>
+#include <optional>
 #include <string>
 
 namespace crisp::vk {
-
-namespace {
-
-VkDeviceSize align_up(VkDeviceSize value, VkDeviceSize alignment) {
-    return alignment <= 1 ? value : (value + alignment - 1) / alignment * alignment;
-}
-
-}  // namespace
 
 MemoryArena::MemoryArena(const Functions& fn, VkDevice device, const VkAllocationCallbacks* allocator,
                          const VkPhysicalDeviceMemoryProperties& properties)
@@ -33,22 +26,12 @@ VkDeviceSize MemoryArena::block_bytes() const {
     return bytes;
 }
 
-// First fit: the lowest free run that holds the aligned request.
 bool MemoryArena::take(Block& block, const VkMemoryRequirements& requirements, VkDeviceSize& offset) {
-    for (auto it = block.free.begin(); it != block.free.end(); ++it) {
-        const VkDeviceSize start = align_up(it->first, requirements.alignment);
-        const VkDeviceSize end = it->first + it->second;
-        if (start > end || end - start < requirements.size) continue;
-        const VkDeviceSize run_start = it->first;
-        block.free.erase(it);
-        if (start > run_start) block.free.emplace(run_start, start - run_start);
-        if (end > start + requirements.size)
-            block.free.emplace(start + requirements.size, end - start - requirements.size);
-        offset = start;
-        ++block.ranges;
-        return true;
-    }
-    return false;
+    const std::optional<VkDeviceSize> at = block.free.take(requirements.size, requirements.alignment);
+    if (!at) return false;
+    offset = *at;
+    ++block.ranges;
+    return true;
 }
 
 Result<MemoryArena::Block*> MemoryArena::add_block(VkDeviceSize least, uint32_t type, const char* what) {
@@ -77,7 +60,7 @@ Result<MemoryArena::Block*> MemoryArena::add_block(VkDeviceSize least, uint32_t 
         }
         block.mapped = static_cast<std::byte*>(mapped);
     }
-    block.free.emplace(0, block.size);
+    block.free = RangeAllocator(block.size);
     blocks_.push_back(std::move(block));
     return &blocks_.back();
 }
@@ -113,23 +96,7 @@ void MemoryArena::free(const Range& range) {
     auto block = std::find_if(blocks_.begin(), blocks_.end(), [&](const Block& b) { return b.memory == range.memory; });
     assert(block != blocks_.end() && "a range from another arena");
     if (block == blocks_.end()) return;
-    // Back into the free list, merged with the runs on either side.
-    VkDeviceSize start = range.offset;
-    VkDeviceSize size = range.size;
-    auto next = block->free.lower_bound(start);
-    if (next != block->free.end() && next->first == start + size) {
-        size += next->second;
-        next = block->free.erase(next);
-    }
-    if (next != block->free.begin()) {
-        auto previous = std::prev(next);
-        if (previous->first + previous->second == start) {
-            start = previous->first;
-            size += previous->second;
-            block->free.erase(previous);
-        }
-    }
-    block->free.emplace(start, size);
+    block->free.give(range.offset, range.size);
     --block->ranges;
     // An empty block goes back to the driver, unless it is the last of its type (the next buffer of
     // that type, a frame later, would only allocate it again).

@@ -9,6 +9,7 @@
 // the blocks keeps bufferImageGranularity out of them too.
 #pragma once
 
+#include "core/range_allocator.hpp"
 #include "vk/functions.hpp"
 
 #include <crisp/result.hpp>
@@ -16,7 +17,6 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
-#include <map>
 #include <vector>
 
 namespace crisp::vk {
@@ -56,8 +56,8 @@ private:
         VkDeviceSize size = 0;
         uint32_t type = 0;
         std::byte* mapped = nullptr;
-        std::map<VkDeviceSize, VkDeviceSize> free;  // offset -> size, neighbours merged
-        uint32_t ranges = 0;                        // handed out and not yet given back
+        RangeAllocator free;  // its free runs
+        uint32_t ranges = 0;  // handed out and not yet given back
     };
 
     Result<Block*> add_block(VkDeviceSize least, uint32_t type, const char* what);

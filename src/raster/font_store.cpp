@@ -1,0 +1,169 @@
+#include "raster/font_store.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <utility>
+
+namespace crisp::raster {
+
+FontStore::FontStore(const vk::DeviceRef& ref, VkDeviceSize max_range) : ref_(ref), max_range_(max_range) {}
+
+const HeldFont* FontStore::find(FontId id) const {
+    const auto slot = font_slot_.find(id);
+    return slot == font_slot_.end() ? nullptr : &fonts_[slot->second];
+}
+
+// Finds `font` its ranges in a page with room, or in a new page.
+Status FontStore::place(GpuFont& font) {
+    for (uint32_t i = 0; i < pages_.size(); ++i) {
+        FontPage& page = pages_[i];
+        const auto points_at = page.point_ranges.take(font.points_bytes, sizeof(Point));
+        if (!points_at) continue;
+        const auto bands_at = page.band_ranges.take(font.bands_bytes, sizeof(uint32_t));
+        if (!bands_at) {
+            page.point_ranges.give(*points_at, font.points_bytes);
+            continue;
+        }
+        font.page = i;
+        font.points_at = *points_at;
+        font.bands_at = *bands_at;
+        return {};
+    }
+    if (pages_.size() >= kRendererFontPages) {
+        return Error{ErrorCode::invalid_argument,
+                     "renderer: the font does not fit the " + std::to_string(kRendererFontPages) +
+                         " font pages, which the fonts added before fill; remove one first"};
+    }
+    const auto capacity = [&](VkDeviceSize need, VkDeviceSize least) {
+        return std::max(need, std::min(std::max(2 * need, least), max_range_));
+    };
+    FontPage page;
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    Status status =
+        vk::create_buffer(ref_, capacity(font.points_bytes, kMinPagePoints), usage, false, "font points", page.points);
+    if (status) {
+        status =
+            vk::create_buffer(ref_, capacity(font.bands_bytes, kMinPageBands), usage, false, "font bands", page.bands);
+    }
+    if (!status) {
+        page.points.reset();
+        page.bands.reset();
+        return status;
+    }
+    page.point_ranges = RangeAllocator(page.points.size);
+    page.band_ranges = RangeAllocator(page.bands.size);
+    pages_.push_back(std::move(page));
+    return place(font);
+}
+
+Status FontStore::add(const Font& font) {
+    if (font_slot_.count(font.id()) && std::find(removals_.begin(), removals_.end(), font.id()) == removals_.end()) {
+        return Error{ErrorCode::invalid_argument,
+                     "renderer: a font with id " + std::to_string(font.id()) + " was added already"};
+    }
+    if (font_slot_.count(font.id())) {
+        return Error{ErrorCode::invalid_argument, "renderer: the font with id " + std::to_string(font.id()) +
+                                                      " is removed at the next begin_frame(); add it after that"};
+    }
+    const FontAsset& asset = font.asset();
+    GpuFont gpu;
+    gpu.asset = &asset;
+    gpu.points_bytes = asset.points.size() * sizeof(Point);
+    gpu.bands_bytes = asset.band_words.size() * sizeof(uint32_t);
+    if (std::max(gpu.points_bytes, gpu.bands_bytes) > max_range_) {
+        return Error{ErrorCode::vulkan,
+                     "renderer: the font's " +
+                         std::string(gpu.points_bytes > gpu.bands_bytes ? "curve points" : "band bitsets") + " (" +
+                         std::to_string(std::max(gpu.points_bytes, gpu.bands_bytes)) +
+                         " bytes) pass the device's maxStorageBufferRange of " + std::to_string(max_range_)};
+    }
+    if (Status placed = place(gpu); !placed) return placed;
+    if (Status made = vk::create_buffer(ref_, gpu.points_bytes + gpu.bands_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                        true, "font staging", gpu.staging);
+        !made) {
+        pages_[gpu.page].point_ranges.give(gpu.points_at, gpu.points_bytes);
+        pages_[gpu.page].band_ranges.give(gpu.bands_at, gpu.bands_bytes);
+        return made;
+    }
+    auto* bytes = static_cast<std::byte*>(gpu.staging.mapped);
+    if (gpu.points_bytes) std::memcpy(bytes, asset.points.data(), gpu.points_bytes);
+    if (gpu.bands_bytes) std::memcpy(bytes + gpu.points_bytes, asset.band_words.data(), gpu.bands_bytes);
+    // A removed font's place is taken again before the list grows.
+    const auto free_place = std::find_if(fonts_.begin(), fonts_.end(), [](const GpuFont& f) { return !f.asset; });
+    const auto index = static_cast<uint32_t>(free_place - fonts_.begin());
+    if (free_place == fonts_.end()) {
+        fonts_.push_back(std::move(gpu));
+    } else {
+        *free_place = std::move(gpu);
+    }
+    font_slot_[font.id()] = index;
+    return {};
+}
+
+Status FontStore::remove(FontId id) {
+    if (!font_slot_.count(id) || std::find(removals_.begin(), removals_.end(), id) != removals_.end()) {
+        return Error{ErrorCode::invalid_argument, "renderer: no font with id " + std::to_string(id) + " to remove"};
+    }
+    removals_.push_back(id);
+    return {};
+}
+
+void FontStore::apply_removals(GlyphAtlas& atlas, RetireLists& retired, uint64_t frame) {
+    for (FontId id : removals_) {
+        const auto slot = font_slot_.find(id);
+        if (slot == font_slot_.end()) continue;
+        GpuFont& font = fonts_[slot->second];
+        atlas.evict_font(id);
+        if (font.staging.buffer) retired.buffers.push_back({std::move(font.staging), frame});
+        retired.ranges.push_back(
+            {font.page, {font.points_at, font.points_bytes}, {font.bands_at, font.bands_bytes}, frame});
+        font = GpuFont{};
+        font_slot_.erase(slot);
+    }
+    removals_.clear();
+}
+
+bool FontStore::record_uploads(VkCommandBuffer command_buffer, uint64_t this_frame, RetireLists& retired,
+                               RendererStats& stats) {
+    uploaded_.clear();
+    bool uploaded = false;
+    for (GpuFont& font : fonts_) {
+        if (font.uploaded || !font.asset) continue;
+        uploaded_.push_back(static_cast<uint32_t>(&font - fonts_.data()));
+        const FontPage& page = pages_[font.page];
+        if (font.points_bytes) {
+            const VkBufferCopy copy{0, font.points_at, font.points_bytes};
+            ref_.fn->vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.points.buffer, 1, &copy);
+        }
+        if (font.bands_bytes) {
+            const VkBufferCopy copy{font.points_bytes, font.bands_at, font.bands_bytes};
+            ref_.fn->vkCmdCopyBuffer(command_buffer, font.staging.buffer, page.bands.buffer, 1, &copy);
+        }
+        stats.upload_bytes += font.points_bytes + font.bands_bytes;
+        font.uploaded = true;
+        font.retired_staging = font.staging.buffer;
+        retired.buffers.push_back({std::move(font.staging), this_frame});
+        uploaded = true;
+    }
+    return uploaded;
+}
+
+void FontStore::abandon_uploads(RetireLists& retired, uint64_t frame) {
+    for (uint32_t index : uploaded_) {
+        GpuFont& font = fonts_[index];
+        std::optional<vk::DeviceBuffer> staging = retired.take_back(font.retired_staging, frame);
+        if (!staging) continue;
+        font.staging = std::move(*staging);
+        font.uploaded = false;
+    }
+}
+
+void FontStore::give_back(const RetiredRanges& ranges) {
+    FontPage& page = pages_[ranges.page];
+    page.point_ranges.give(ranges.points.offset, ranges.points.size);
+    page.band_ranges.give(ranges.bands.offset, ranges.bands.size);
+}
+
+}  // namespace crisp::raster

@@ -1,0 +1,243 @@
+#include "raster/raster.hpp"
+
+#include "vk/barriers.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cstring>
+#include <utility>
+
+namespace crisp::raster {
+
+static_assert(kCoverageOne == gpu::kRasterCoverageOne);
+static_assert(static_cast<uint32_t>(SampleKind::rows) == gpu::kRasterSampleRows);
+static_assert(static_cast<uint32_t>(SampleKind::points) == gpu::kRasterSamplePoints);
+static_assert(kRendererFontPages == gpu::kRasterFontPages);
+
+uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fonts, std::vector<gpu::RasterItem>& items,
+                          std::vector<uint32_t>& workgroup_items) {
+    items.clear();
+    workgroup_items.clear();
+    uint32_t workgroups = 0;
+    for (const RasterWork& w : work) {
+        const HeldFont* font = fonts.find(w.key.font);
+        if (!font || w.sample_count == 0) continue;
+        const GlyphRecord& glyph = font->asset->glyphs[w.key.glyph];
+        const GlyphRect rect = glyph_rect(glyph, w.key);
+        const TexelToEm map = texel_to_em(rect, w.key);
+        gpu::RasterItem item{};
+        item.atlas_x = w.x;
+        item.atlas_y = w.y;
+        item.width = w.width;
+        item.height = w.height;
+        item.offset_x = map.offset_x;
+        item.offset_y = map.offset_y;
+        item.scale_x = map.scale_x;
+        item.scale_y = map.scale_y;
+        item.bbox_min_y = glyph.bbox_min_y;
+        item.bbox_max_y = glyph.bbox_max_y;
+        item.point_offset = static_cast<uint32_t>(font->points_at / sizeof(Point)) + glyph.point_offset;
+        item.band_offset = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + glyph.band_offset;
+        item.band_count = glyph.band_count;
+        item.band_words = glyph.band_words;
+        item.font = font->page;
+        item.first_sample = w.first_sample;
+        item.sample_count = w.sample_count;
+        item.part_x = w.part_x;
+        item.part_y = w.part_y;
+        item.first_texel = w.first_texel;
+        item.texel_count = w.texel_count;
+        item.first_workgroup = workgroups;
+        const uint32_t own = (w.texel_count + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
+        workgroups += own;
+        workgroup_items.insert(workgroup_items.end(), own, static_cast<uint32_t>(items.size()));
+        items.push_back(item);
+    }
+    return workgroups;
+}
+
+RasterPass::RasterPass(const vk::DeviceRef& ref, const RasterOptions& options) : ref_(ref), options_(options) {}
+
+Status RasterPass::make_item_buffers(uint32_t capacity, uint64_t atlas_texels, uint64_t retire_at,
+                                     RetireLists& retired) {
+    // Items cover disjoint parts of the atlas, so a dispatch has at most a workgroup per 64 atlas
+    // texels plus one partial workgroup per item.
+    const uint64_t workgroups = atlas_texels / gpu::kRasterWorkgroupSize + capacity;
+    if (workgroups > UINT32_MAX) return Error{ErrorCode::invalid_argument, "renderer: the atlas is too large"};
+    // The table starts at an offset every device accepts for a storage buffer (at most 256).
+    const VkDeviceSize offset = (VkDeviceSize{capacity} * sizeof(gpu::RasterItem) + 255) / 256 * 256;
+    const VkDeviceSize bytes = offset + workgroups * sizeof(uint32_t);
+    vk::DeviceBuffer device_items;
+    if (Status s = vk::create_buffer(ref_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                     false, "work items", device_items);
+        !s) {
+        return s;
+    }
+    std::vector<vk::DeviceBuffer> staging(options_.frames_in_flight);
+    for (vk::DeviceBuffer& slot : staging) {
+        if (Status s =
+                vk::create_buffer(ref_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "work item staging", slot);
+            !s) {
+            return s;
+        }
+    }
+    if (items_.buffer) retired.buffers.push_back({std::move(items_), retire_at});
+    for (vk::DeviceBuffer& old : item_staging_) retired.buffers.push_back({std::move(old), retire_at});
+    items_ = std::move(device_items);
+    item_staging_ = std::move(staging);
+    item_capacity_ = capacity;
+    workgroup_capacity_ = static_cast<uint32_t>(workgroups);
+    table_offset_ = offset;
+    return {};
+}
+
+Status RasterPass::create(uint32_t cells, uint64_t atlas_texels, RetireLists& retired) {
+    // Work items: an entry takes at least one cell, so a frame never has more items than cells.
+    if (Status s = make_item_buffers(cells, atlas_texels, 0, retired); !s) return s;
+    if (Status s = vk::create_buffer(ref_, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false, "empty font slot", dummy_);
+        !s) {
+        return s;
+    }
+
+    // The pipeline.
+    Result<VkShaderModule> module = vk::create_embedded_shader(ref_, "raster.comp");
+    if (!module) return module.error();
+    shader_ = objects_.keep(ref_, *module);
+    const VkDescriptorSetLayoutBinding bindings[] = {
+        {gpu::kRasterBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {gpu::kRasterBindItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        {gpu::kRasterBindPoints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT,
+         nullptr},
+        {gpu::kRasterBindBands, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT,
+         nullptr},
+        {gpu::kRasterBindWorkgroupItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+    };
+    // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
+    if (Status s =
+            vk::create_descriptor_sets(ref_, bindings, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(gpu::RasterPushConstants),
+                                       options_.frames_in_flight, "renderer", descriptors_);
+        !s) {
+        return s;
+    }
+    Result<VkPipeline> made =
+        vk::create_compute_pipeline(ref_, shader_, descriptors_.pipeline_layout, nullptr, "raster.comp");
+    if (!made) return made.error();
+    pipeline_ = objects_.keep(ref_, *made);
+    return {};
+}
+
+void RasterPass::write_descriptors(VkDescriptorSet set, VkImageView atlas, std::span<const FontPage> pages) {
+    VkDescriptorImageInfo image{VK_NULL_HANDLE, atlas, VK_IMAGE_LAYOUT_GENERAL};
+    VkDescriptorBufferInfo item_info{items_.buffer, 0, table_offset_};
+    VkDescriptorBufferInfo table_info{items_.buffer, table_offset_, VK_WHOLE_SIZE};
+    std::array<VkDescriptorBufferInfo, kRendererFontPages> point_infos{}, band_infos{};
+    for (uint32_t page = 0; page < kRendererFontPages; ++page) {
+        const bool used = page < pages.size();
+        point_infos[page] = {used ? pages[page].points.buffer : dummy_.buffer, 0, VK_WHOLE_SIZE};
+        band_infos[page] = {used ? pages[page].bands.buffer : dummy_.buffer, 0, VK_WHOLE_SIZE};
+    }
+    VkWriteDescriptorSet writes[5]{};
+    for (VkWriteDescriptorSet& write : writes) {
+        write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        write.dstSet = set;
+        write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        write.descriptorCount = 1;
+    }
+    writes[0].dstBinding = gpu::kRasterBindAtlas;
+    writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    writes[0].pImageInfo = &image;
+    writes[1].dstBinding = gpu::kRasterBindItems;
+    writes[1].pBufferInfo = &item_info;
+    writes[2].dstBinding = gpu::kRasterBindPoints;
+    writes[2].descriptorCount = kRendererFontPages;
+    writes[2].pBufferInfo = point_infos.data();
+    writes[3].dstBinding = gpu::kRasterBindBands;
+    writes[3].descriptorCount = kRendererFontPages;
+    writes[3].pBufferInfo = band_infos.data();
+    writes[4].dstBinding = gpu::kRasterBindWorkgroupItems;
+    writes[4].pBufferInfo = &table_info;
+    ref_.fn->vkUpdateDescriptorSets(ref_.device, 5, writes, 0, nullptr);
+}
+
+Status RasterPass::fit(uint32_t cells, uint64_t atlas_texels, uint64_t this_frame, RetireLists& retired) {
+    if (cells > item_capacity_ || atlas_texels / gpu::kRasterWorkgroupSize + cells > workgroup_capacity_) {
+        return make_item_buffers(cells, atlas_texels, this_frame, retired);
+    }
+    return {};
+}
+
+uint32_t RasterPass::build(std::span<const RasterWork> work, const HeldFonts& fonts, const GlyphAtlas& atlas,
+                           RendererStats& stats) {
+    const uint32_t workgroups = build_work_items(work, fonts, item_data_, workgroup_items_);
+    stats.work_items = static_cast<uint32_t>(item_data_.size());
+    stats.workgroups = workgroups;
+    stats.samples = atlas.stats().frame.samples;
+    stats.curve_tests = atlas.stats().frame.curve_tests;
+    return workgroups;
+}
+
+// The work list into the items buffer: written into this frame's staging buffer (the frame that
+// last used it is done: the caller waits for frame N - frames_in_flight before recording frame N)
+// and copied. vkCmdUpdateBuffer, which carries the bytes in the command buffer, took 0.1-0.2 ms
+// of every frame on an H200 for the 1.1 MB of a new 4K screen; with the copy, a frame whose shader
+// does nothing takes 0.03 ms (docs/results/h200-row-kernel.md). A barrier first keeps last frame's reads before the
+// copy, one after makes it (and the fonts' copies) visible to the rasterizer.
+void RasterPass::record_upload(VkCommandBuffer command_buffer, uint64_t this_frame, bool fonts_uploaded,
+                               RendererStats& stats) {
+    const vk::Functions& fn = *ref_.fn;
+    if (!item_data_.empty()) {
+        vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_ACCESS_TRANSFER_WRITE_BIT);
+        // Items are parts of disjoint atlas entries: make_item_buffers() sized both for every atlas texel.
+        assert(item_data_.size() <= item_capacity_ && workgroup_items_.size() <= workgroup_capacity_);
+        const vk::DeviceBuffer& staging = item_staging_[this_frame % options_.frames_in_flight];
+        const VkDeviceSize item_bytes = item_data_.size() * sizeof(gpu::RasterItem);
+        const VkDeviceSize table_bytes = workgroup_items_.size() * sizeof(uint32_t);
+        auto* bytes = static_cast<std::byte*>(staging.mapped);
+        std::memcpy(bytes, item_data_.data(), item_bytes);
+        std::memcpy(bytes + table_offset_, workgroup_items_.data(), table_bytes);
+        const VkBufferCopy copies[2] = {{0, 0, item_bytes}, {table_offset_, table_offset_, table_bytes}};
+        fn.vkCmdCopyBuffer(command_buffer, staging.buffer, items_.buffer, 2, copies);
+        stats.upload_bytes += item_bytes + table_bytes;
+    }
+    if (fonts_uploaded || !item_data_.empty()) {
+        vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+    }
+}
+
+// The rasterizer's dispatch over `workgroups`, between barriers against last frame's readers of
+// the atlas (composite shaders, copies) and for this frame's.
+void RasterPass::record_dispatch(VkCommandBuffer command_buffer, uint64_t this_frame, uint32_t workgroups,
+                                 VkImageView atlas, std::span<const FontPage> pages, const SubpixelLayout& subpixel) {
+    const vk::Functions& fn = *ref_.fn;
+    constexpr VkPipelineStageFlags kReaders =
+        VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+    vk::memory_barrier(fn, command_buffer, kReaders, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);
+    const VkDescriptorSet set = descriptors_.sets[this_frame % options_.frames_in_flight];
+    write_descriptors(set, atlas, pages);
+    fn.vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+    fn.vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &set,
+                               0, nullptr);
+    gpu::RasterPushConstants push{};
+    for (size_t c = 0; c < 3; ++c) {
+        const SampleRect& r = subpixel.channels[c];
+        push.channel_rects[c] = {r.x0, r.y0, r.x1, r.y1};
+    }
+    push.item_count = static_cast<uint32_t>(item_data_.size());
+    push.workgroup_count = workgroups;
+    push.shared_rows = options_.shared_row_roots && shares_sample_rows(subpixel) ? 1u : 0u;
+    push.sample_kind = options_.sample_kind == SampleKind::points ? gpu::kRasterSamplePoints : gpu::kRasterSampleRows;
+    fn.vkCmdPushConstants(command_buffer, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
+                          &push);
+    const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);
+    const uint32_t height = (workgroups + gpu::kRasterDispatchWidth - 1) / gpu::kRasterDispatchWidth;
+    fn.vkCmdDispatch(command_buffer, width, height, 1);
+    vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, kReaders,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+}
+
+}  // namespace crisp::raster

@@ -1,0 +1,284 @@
+#include "raster/requests.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+
+namespace crisp::raster {
+
+bool moved(const FontAsset* asset, GlyphInstance& glyph, double dx, double dy) {
+    if (dx == 0.0 && dy == 0.0) return true;
+    if (!asset) return true;  // acquire() counts it
+    if (glyph.key.glyph >= asset->glyphs.size()) return true;
+    const GlyphRecord& record = asset->glyphs[glyph.key.glyph];
+    const GlyphRect old_rect = glyph_rect(record, glyph.key);
+    const double pens[2] = {static_cast<double>(glyph.pen_x) + dx, static_cast<double>(glyph.pen_y) + dy};
+    int32_t whole[2] = {glyph.x - old_rect.x, glyph.y - old_rect.y};
+    uint8_t* offsets[2] = {&glyph.key.subpixel_x, &glyph.key.subpixel_y};
+    const double deltas[2] = {dx, dy};
+    for (int axis = 0; axis < 2; ++axis) {
+        if (deltas[axis] == 0.0) continue;
+        constexpr double kMaxPen = 16777216.0;  // 2^24 px
+        if (!(std::abs(pens[axis]) <= kMaxPen)) return false;
+        double base = std::floor(pens[axis]);
+        double step = std::round((pens[axis] - base) * kSubpixelSteps);
+        if (step >= kSubpixelSteps) {
+            base += 1.0;
+            step = 0.0;
+        }
+        whole[axis] = static_cast<int32_t>(base);
+        *offsets[axis] = static_cast<uint8_t>(step);
+    }
+    const GlyphRect rect = glyph_rect(record, glyph.key);
+    glyph.x = whole[0] + rect.x;
+    glyph.y = whole[1] + rect.y;
+    glyph.width = rect.width;
+    glyph.height = rect.height;
+    glyph.pen_x = static_cast<float>(pens[0]);
+    glyph.pen_y = static_cast<float>(pens[1]);
+    return true;
+}
+
+void MotionTracker::begin_frame() {
+    ++frames_begun_;
+    if (frames_begun_ % kForgetMotionFrames == 0) {
+        std::erase_if(motions_, [&](const auto& m) { return frames_begun_ - m.second.seen > kForgetMotionFrames; });
+    }
+    undo_.clear();
+}
+
+bool MotionTracker::moving(uint64_t id, double x, double y) {
+    auto [it, added] = motions_.try_emplace(id, Motion{x, y, 0, frames_begun_});
+    Motion& m = it->second;
+    if (added) {
+        undo_.emplace_back(id, std::nullopt);
+    } else if (m.seen != frames_begun_) {  // its first draw this frame
+        undo_.emplace_back(id, m);
+    }
+    if (!added && (m.pen_x != x || m.pen_y != y)) {
+        m.moved = frames_begun_;
+        m.pen_x = x;
+        m.pen_y = y;
+    }
+    m.seen = frames_begun_;
+    return m.moved != 0 && frames_begun_ - m.moved < kMotionSettleFrames;
+}
+
+void MotionTracker::abandon_frame() {
+    for (auto it = undo_.rbegin(); it != undo_.rend(); ++it) {
+        if (it->second) {
+            motions_[it->first] = *it->second;
+        } else {
+            motions_.erase(it->first);
+        }
+    }
+    undo_.clear();
+    --frames_begun_;
+}
+
+FrameRequests::FrameRequests(GlyphAtlas& atlas, const HeldFonts& fonts, Coarsening& coarsening, RendererStats& stats)
+    : atlas_(atlas), fonts_(fonts), coarsening_(coarsening), stats_(stats) {}
+
+void FrameRequests::begin_frame() {
+    pending_.clear();
+    clipped_.clear();
+    requests_.clear();
+    atlas_full_ = 0;
+    unplaceable_ = 0;
+    drawn_.clear();
+    converged_ = true;
+}
+
+void FrameRequests::add(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps) {
+    requests_.push_back({glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps});
+    request(glyph, visible, steps);
+}
+
+void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions& options, MotionTracker& motion) {
+    if (glyphs.empty()) return;
+    const double dx = static_cast<double>(options.offset_x), dy = static_cast<double>(options.offset_y);
+    if (!std::isfinite(dx) || !std::isfinite(dy)) {
+        const auto count = static_cast<uint32_t>(std::min<size_t>(glyphs.size(), UINT32_MAX));
+        stats_.skipped_glyphs += count;
+        unplaceable_ += count;
+        return;
+    }
+    float color[4] = {};
+    if (options.color) {
+        for (int c = 0; c < 4; ++c) {
+            const float v = (*options.color)[static_cast<size_t>(c)];
+            color[c] = v == v ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+            if (c < 3) color[c] = srgb_to_linear(color[c]);
+        }
+    }
+    uint32_t steps = kSubpixelSteps;
+    if (options.id != 0) {
+        const GlyphInstance& first = glyphs.front();
+        if (motion.moving(options.id, static_cast<double>(first.pen_x) + dx, static_cast<double>(first.pen_y) + dy)) {
+            steps = kMovingSubpixelSteps;
+            stats_.moving_glyphs += static_cast<uint32_t>(std::min<size_t>(glyphs.size(), UINT32_MAX));
+        }
+    }
+    const VkRect2D* visible = options.visible ? &*options.visible : nullptr;
+    for (const GlyphInstance& asked : glyphs) {
+        GlyphInstance glyph = asked;
+        if (!moved(fonts_.asset(glyph.key.font), glyph, dx, dy)) {
+            ++stats_.skipped_glyphs;
+            ++unplaceable_;
+            continue;
+        }
+        if (options.color) std::copy(std::begin(color), std::end(color), std::begin(glyph.color));
+        if (options.depth) glyph.depth = *options.depth;
+        add(glyph, visible, steps);
+    }
+}
+
+// One draw()n instance: at the frame's subpixel steps, then culled, acquired whole, or kept
+// for acquire_clipped() with its visible part.
+void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps) {
+    const GlyphInstance glyph = coarsened(fonts_.asset(asked.key.font), asked, std::min(coarsening_.steps(), steps));
+    if (glyph.key != asked.key) ++stats_.coarsened_glyphs;
+    if (!visible) {
+        acquire(glyph, TexelRect{0, 0, glyph.width, glyph.height});
+        return;
+    }
+    if (glyph.width == 0 || glyph.height == 0) return;
+    // The visible texels of the glyph's rect.
+    const int64_t vx0 = visible->offset.x, vy0 = visible->offset.y;
+    const int64_t vx1 = vx0 + visible->extent.width, vy1 = vy0 + visible->extent.height;
+    const int64_t x0 = std::max<int64_t>(vx0 - glyph.x, 0), y0 = std::max<int64_t>(vy0 - glyph.y, 0);
+    const int64_t x1 = std::min<int64_t>(vx1 - glyph.x, glyph.width);
+    const int64_t y1 = std::min<int64_t>(vy1 - glyph.y, glyph.height);
+    if (x0 >= x1 || y0 >= y1) {
+        ++stats_.culled_glyphs;
+        return;
+    }
+    const TexelRect part{static_cast<uint32_t>(x0), static_cast<uint32_t>(y0), static_cast<uint32_t>(x1 - x0),
+                         static_cast<uint32_t>(y1 - y0)};
+    if (part.width == glyph.width && part.height == glyph.height) {
+        acquire(glyph, part);
+    } else {
+        ++stats_.clipped_glyphs;
+        clipped_.push_back({glyph, part});
+    }
+}
+
+// Finds or places `glyph` with `part` of its rect visible and adds it to the pending glyphs.
+// `shown` (within `part`; nullptr: all the atlas holds) is what drawn() reports of it: a
+// clipped glyph shows only its visible texels, though the atlas holds a margin around them.
+void FrameRequests::acquire(const GlyphInstance& glyph, const TexelRect& part, const TexelRect* shown) {
+    if (glyph.width == 0 || glyph.height == 0) return;
+    const FontAsset* asset = fonts_.asset(glyph.key.font);
+    if (!asset) {
+        ++stats_.unknown_fonts;
+        ++stats_.skipped_glyphs;
+        return;
+    }
+    if (glyph.key.glyph >= asset->glyphs.size()) {
+        ++stats_.skipped_glyphs;
+        return;
+    }
+    const AtlasLookup lookup = place(*asset, glyph, part);
+    if (lookup.status == AtlasStatus::placed) {
+        const TexelRect& held = lookup.part;
+        TexelRect show = held;
+        if (shown) {  // the visible texels, within what the atlas holds
+            const uint32_t x0 = std::max(shown->x, held.x), y0 = std::max(shown->y, held.y);
+            const uint32_t x1 = std::min(shown->x + shown->width, held.x + held.width);
+            const uint32_t y1 = std::min(shown->y + shown->height, held.y + held.height);
+            if (x0 >= x1 || y0 >= y1) return;
+            show = {x0, y0, x1 - x0, y1 - y0};
+        }
+        DrawnGlyph placed{glyph, lookup.x + (show.x - held.x), lookup.y + (show.y - held.y), 0, show.x, show.y};
+        placed.instance.x += static_cast<int32_t>(show.x);
+        placed.instance.y += static_cast<int32_t>(show.y);
+        placed.instance.width = show.width;
+        placed.instance.height = show.height;
+        pending_.push_back({placed, lookup.entry});
+    } else if (lookup.status == AtlasStatus::atlas_full || lookup.status == AtlasStatus::too_large) {
+        ++stats_.failed_glyphs;
+        ++stats_.skipped_glyphs;
+        if (lookup.status == AtlasStatus::atlas_full) ++atlas_full_;
+    }
+}
+
+// Finds or places one instance whose `part` is visible.
+AtlasLookup FrameRequests::place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part) {
+    // Only a glyph the atlas may place anew needs its cost: a new one, or one held in part.
+    uint64_t cost = 0;
+    const AtlasEntry* resident = atlas_.entry(atlas_.find(glyph.key));
+    if (!resident || resident->part.width != resident->width || resident->part.height != resident->height)
+        cost = curve_tests_per_sample(asset, asset.glyphs[glyph.key.glyph], glyph.key);
+    return atlas_.acquire(glyph.key, glyph.width, glyph.height, cost, part);
+}
+
+// Acquires the glyphs drawn in part, each glyph once for the bounding box of its parts.
+void FrameRequests::acquire_clipped() {
+    if (clipped_.empty()) return;
+    clipped_parts_.clear();
+    for (const Clipped& c : clipped_) {
+        auto [it, added] = clipped_parts_.try_emplace(c.glyph.key, c.part);
+        if (added) continue;
+        TexelRect& box = it->second;
+        const uint32_t x1 = std::max(box.x + box.width, c.part.x + c.part.width);
+        const uint32_t y1 = std::max(box.y + box.height, c.part.y + c.part.height);
+        box.x = std::min(box.x, c.part.x);
+        box.y = std::min(box.y, c.part.y);
+        box.width = x1 - box.x;
+        box.height = y1 - box.y;
+    }
+    for (const Clipped& c : clipped_) acquire(c.glyph, clipped_parts_.at(c.glyph.key), &c.part);
+    clipped_.clear();
+}
+
+void FrameRequests::settle(const AtlasLimits& limits) {
+    acquire_clipped();
+    while (atlas_full_ > 0) {
+        if (limits.can_grow(atlas_.config())) {
+            atlas_.grow();  // record() makes the larger image and copies the old one into it
+            ++stats_.atlas_grown;
+        } else if (!coarsening_.coarsen()) {
+            break;
+        }
+        atlas_.begin_frame();
+        pending_.clear();
+        clipped_.clear();
+        // The requests count again; what draw() counted before them stays.
+        const uint32_t moving = stats_.moving_glyphs, grown = stats_.atlas_grown;
+        stats_ = {};
+        stats_.moving_glyphs = moving;
+        stats_.atlas_grown = grown;
+        stats_.skipped_glyphs = unplaceable_;
+        atlas_full_ = 0;
+        for (const Request& r : requests_) request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps);
+        acquire_clipped();
+    }
+    stats_.subpixel_steps = coarsening_.steps();
+    stats_.atlas_width = atlas_.config().width;
+    stats_.atlas_height = atlas_.config().height;
+    const AtlasStats now = atlas_.stats();
+    coarsening_.end_frame(atlas_full_ == 0 && now.pinned_cells < now.usable_cells / 4);
+}
+
+// The glyphs this frame draws: those whose texels hold samples once the frame's work has run.
+void FrameRequests::collect_drawn() {
+    for (Pending& p : pending_) {
+        DrawnGlyph& d = p.glyph;
+        const AtlasEntry* entry = atlas_.entry(p.entry);
+        d.samples = entry ? entry->samples : 0;
+        if (entry && entry->samples < atlas_.config().max_samples) converged_ = false;
+        if (d.samples > 0) {
+            drawn_.push_back(d);
+            ++stats_.drawn_glyphs;
+        } else {
+            ++stats_.skipped_glyphs;
+        }
+    }
+}
+
+void FrameRequests::abandon_frame() {
+    drawn_.clear();
+    converged_ = false;
+}
+
+}  // namespace crisp::raster
