@@ -1,6 +1,7 @@
 #include "raster/raster.hpp"
 
 #include "vk/barriers.hpp"
+#include "vk/bindings.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,6 +10,21 @@
 #include <utility>
 
 namespace crisp::raster {
+
+namespace {
+
+// The bindings raster.comp declares: the atlas, the work items, each font page's curve points and
+// band words (unused pages bound to an empty buffer), and each workgroup's item.
+constexpr vk::Binding kBindings[] = {
+    {gpu::kRasterBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+    {gpu::kRasterBindItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kRasterBindPoints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages},
+    {gpu::kRasterBindBands, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages},
+    {gpu::kRasterBindWorkgroupItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+};
+constexpr vk::BindingTable kTable{kBindings, VK_SHADER_STAGE_COMPUTE_BIT};
+
+}  // namespace
 
 static_assert(kCoverageOne == gpu::kRasterCoverageOne);
 static_assert(static_cast<uint32_t>(SampleKind::rows) == gpu::kRasterSampleRows);
@@ -104,19 +120,10 @@ Status RasterPass::create(uint32_t cells, uint64_t atlas_texels, RetireLists& re
     Result<VkShaderModule> module = vk::create_embedded_shader(ref_, "raster.comp");
     if (!module) return module.error();
     shader_ = objects_.keep(ref_, *module);
-    const VkDescriptorSetLayoutBinding bindings[] = {
-        {gpu::kRasterBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-        {gpu::kRasterBindItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-        {gpu::kRasterBindPoints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT,
-         nullptr},
-        {gpu::kRasterBindBands, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages, VK_SHADER_STAGE_COMPUTE_BIT,
-         nullptr},
-        {gpu::kRasterBindWorkgroupItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-    };
     // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
     if (Status s =
-            vk::create_descriptor_sets(ref_, bindings, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(gpu::RasterPushConstants),
-                                       options_.frames_in_flight, "renderer", descriptors_);
+            vk::create_descriptor_sets(ref_, kTable, sizeof(gpu::RasterPushConstants), options_.frames_in_flight,
+                                       "renderer", descriptors_);
         !s) {
         return s;
     }
@@ -128,36 +135,19 @@ Status RasterPass::create(uint32_t cells, uint64_t atlas_texels, RetireLists& re
 }
 
 void RasterPass::write_descriptors(VkDescriptorSet set, VkImageView atlas, std::span<const FontPage> pages) {
-    VkDescriptorImageInfo image{VK_NULL_HANDLE, atlas, VK_IMAGE_LAYOUT_GENERAL};
-    VkDescriptorBufferInfo item_info{items_.buffer, 0, table_offset_};
-    VkDescriptorBufferInfo table_info{items_.buffer, table_offset_, VK_WHOLE_SIZE};
     std::array<VkDescriptorBufferInfo, kRendererFontPages> point_infos{}, band_infos{};
     for (uint32_t page = 0; page < kRendererFontPages; ++page) {
         const bool used = page < pages.size();
         point_infos[page] = {used ? pages[page].points.buffer : dummy_.buffer, 0, VK_WHOLE_SIZE};
         band_infos[page] = {used ? pages[page].bands.buffer : dummy_.buffer, 0, VK_WHOLE_SIZE};
     }
-    VkWriteDescriptorSet writes[5]{};
-    for (VkWriteDescriptorSet& write : writes) {
-        write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        write.dstSet = set;
-        write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        write.descriptorCount = 1;
-    }
-    writes[0].dstBinding = gpu::kRasterBindAtlas;
-    writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    writes[0].pImageInfo = &image;
-    writes[1].dstBinding = gpu::kRasterBindItems;
-    writes[1].pBufferInfo = &item_info;
-    writes[2].dstBinding = gpu::kRasterBindPoints;
-    writes[2].descriptorCount = kRendererFontPages;
-    writes[2].pBufferInfo = point_infos.data();
-    writes[3].dstBinding = gpu::kRasterBindBands;
-    writes[3].descriptorCount = kRendererFontPages;
-    writes[3].pBufferInfo = band_infos.data();
-    writes[4].dstBinding = gpu::kRasterBindWorkgroupItems;
-    writes[4].pBufferInfo = &table_info;
-    ref_.fn->vkUpdateDescriptorSets(ref_.device, 5, writes, 0, nullptr);
+    vk::DescriptorWrites(kTable, set)
+        .storage_image(gpu::kRasterBindAtlas, atlas)
+        .storage_buffer(gpu::kRasterBindItems, items_.buffer, 0, table_offset_)
+        .storage_buffers(gpu::kRasterBindPoints, point_infos)
+        .storage_buffers(gpu::kRasterBindBands, band_infos)
+        .storage_buffer(gpu::kRasterBindWorkgroupItems, items_.buffer, table_offset_)
+        .update(ref_);
 }
 
 Status RasterPass::fit(uint32_t cells, uint64_t atlas_texels, uint64_t this_frame, RetireLists& retired) {

@@ -20,7 +20,7 @@ Context::~Context() = default;
 Result<std::unique_ptr<Context>> Context::create(const ContextCreateInfo& info) {
     Functions fn;
     if (Status s = load_functions(info.get_instance_proc_addr, info.instance, info.device, fn); !s) {
-        return Error{s.error().code, std::string(info.who) + ": " + s.error().message};
+        return Error{s.error().code, std::string(info.who) + ": " + s.error().message, s.error().vk_result};
     }
     VkPhysicalDeviceProperties properties{};
     fn.vkGetPhysicalDeviceProperties(info.physical_device, &properties);
