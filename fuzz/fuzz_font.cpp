@@ -1,6 +1,6 @@
 // Fuzzes the baker's font path: FreeType's parsers, the outline walk, cubic lowering, bands and
 // the asset validation the baker applies to its own output.
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/bake.hpp>
 

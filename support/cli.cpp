@@ -1,6 +1,6 @@
 #include "cli.hpp"
 
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <algorithm>
 #include <cstdio>

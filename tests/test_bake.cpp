@@ -1,5 +1,5 @@
 #include "test_support.hpp"
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/bake.hpp>

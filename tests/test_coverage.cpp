@@ -5,7 +5,7 @@
 #include "coverage.hpp"
 #include "bake/outline.hpp"
 #include "test_support.hpp"
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/bake.hpp>
 

@@ -3,7 +3,7 @@
 #include "headless_context.hpp"
 #include "shared.h"
 #include "test_support.hpp"
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/compositor.hpp>

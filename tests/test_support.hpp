@@ -3,7 +3,7 @@
 
 #include "harness.hpp"
 #include "headless_context.hpp"
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>

@@ -1,6 +1,6 @@
 #include "core/json.hpp"
 
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <charconv>
 #include <cmath>

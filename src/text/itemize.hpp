@@ -3,7 +3,7 @@
 // levels, resolved scripts and the font of every character.
 #pragma once
 
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>

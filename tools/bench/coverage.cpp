@@ -6,7 +6,7 @@
 #include "bench.hpp"
 #include "freetype_reference.hpp"
 #include "harness.hpp"
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>

@@ -1,5 +1,5 @@
 // UTF-8 decoding: the run time's (layout, the JSON reader) and the tools'.
-#include "text/utf8.hpp"
+#include "core/utf8.hpp"
 
 namespace crisp {
 
