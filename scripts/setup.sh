@@ -16,6 +16,7 @@ packages=(
   libpng-dev                             # PNG output of crisp-render
   libgtest-dev                           # GoogleTest
   clang libclang-rt-14-dev               # libFuzzer for the fuzz targets
+  clang-format                           # the format check (scripts/check_format.sh)
   python3                                # the CLI tests check --json output with it
   python3-matplotlib                     # crisp-bench's plots (scripts/plot_bench.py)
   python3-fonttools                      # tests derive a 16384 units-per-em font from DejaVu Sans

@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
-# Every test: installs what is missing, builds, runs the test suite, runs the CPU tests again
-# under AddressSanitizer + UndefinedBehaviorSanitizer, and runs each fuzz target for a bounded
+# Every test: installs what is missing, checks the formatting, builds, runs the test suite, runs the
+# CPU tests again under AddressSanitizer + UndefinedBehaviorSanitizer, and runs each fuzz target for
+# a bounded time over its corpus. Set CRISP_FUZZ_SECONDS to change that time (default 20 per target).
 # time over its corpus. Set CRISP_FUZZ_SECONDS to change that time (default 20 per target).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
 jobs=$(nproc 2>/dev/null || echo 2)
 
+echo "== format (.clang-format)"
+./scripts/check_format.sh
 echo "== build"
 ./scripts/build.sh build
 echo "== tests"

@@ -70,10 +70,10 @@ CRISP_CONSTANT(uint, kRasterFontPages, 8u);  // font pages, each several fonts' 
 // Workgroups per row of the 2D dispatch (maxComputeWorkGroupCount[0] is at least 65535).
 CRISP_CONSTANT(uint, kRasterDispatchWidth, 65535u);
 // The rasterizer's descriptor set.
-CRISP_CONSTANT(uint, kRasterBindAtlas, 0u);   // the atlas, storage image
-CRISP_CONSTANT(uint, kRasterBindItems, 1u);   // RasterItem[]
-CRISP_CONSTANT(uint, kRasterBindPoints, 2u);  // kRasterFontPages buffers of curve points
-CRISP_CONSTANT(uint, kRasterBindBands, 3u);   // kRasterFontPages buffers of band words
+CRISP_CONSTANT(uint, kRasterBindAtlas, 0u);           // the atlas, storage image
+CRISP_CONSTANT(uint, kRasterBindItems, 1u);           // RasterItem[]
+CRISP_CONSTANT(uint, kRasterBindPoints, 2u);          // kRasterFontPages buffers of curve points
+CRISP_CONSTANT(uint, kRasterBindBands, 3u);           // kRasterFontPages buffers of band words
 CRISP_CONSTANT(uint, kRasterBindWorkgroupItems, 4u);  // uint[]: the item of each workgroup
 
 // One glyph's work this frame, in a std430 storage buffer.
@@ -91,13 +91,13 @@ struct RasterItem {
     uint point_offset;  // first point of the glyph in its font's point buffer
     uint band_offset;   // first word of its bands in its font's band buffer
     uint band_count;
-    uint band_words;       // words per band
-    uint font;             // index into the per-font buffer arrays
-    uint first_sample;     // index of the first sample to add; 0: start from empty accumulators
-    uint sample_count;     // samples to add
-    uint part_x;           // texel (0, 0) of the work is texel (part_x, part_y) of the glyph rect
+    uint band_words;    // words per band
+    uint font;          // index into the per-font buffer arrays
+    uint first_sample;  // index of the first sample to add; 0: start from empty accumulators
+    uint sample_count;  // samples to add
+    uint part_x;        // texel (0, 0) of the work is texel (part_x, part_y) of the glyph rect
     uint part_y;
-    uint first_texel;      // the work's texels, row-major over width x height
+    uint first_texel;  // the work's texels, row-major over width x height
     uint texel_count;
     uint first_workgroup;  // this item's first workgroup; the items' ranges tile the dispatch, in order
 };
@@ -109,7 +109,6 @@ struct RasterPushConstants {
     uint shared_rows;      // 1: the three rects share their rows: one set of roots, one row list, serves all
     uint sample_kind;      // kRasterSampleRows or kRasterSamplePoints
 };
-
 
 // ---- The compositor (quad_pipeline.vert and the *.frag / *_resolve.comp of each mode).
 
@@ -150,9 +149,9 @@ CRISP_CONSTANT(uint, kExactHead, 0u);
 CRISP_CONSTANT(uint, kExactWords, 1u);
 
 // The stats buffer, uint words, cleared every frame and copied back for the host.
-CRISP_CONSTANT(uint, kStatNodesUsed, 0u);      // exact: nodes asked for (past capacity: lost)
-CRISP_CONSTANT(uint, kStatListOverflow, 1u);   // exact: fragments past kCompositeExactMaxPerPixel
-CRISP_CONSTANT(uint, kStatMaxOverlap, 2u);     // exact: most fragments in one pixel
+CRISP_CONSTANT(uint, kStatNodesUsed, 0u);     // exact: nodes asked for (past capacity: lost)
+CRISP_CONSTANT(uint, kStatListOverflow, 1u);  // exact: fragments past kCompositeExactMaxPerPixel
+CRISP_CONSTANT(uint, kStatMaxOverlap, 2u);    // exact: most fragments in one pixel
 CRISP_CONSTANT(uint, kStatWords, 3u);
 
 // One glyph quad, in a std430 storage buffer: its rect on the target and in the atlas, and what
@@ -177,18 +176,17 @@ struct CompositePushConstants {
     vec4 background;  // linear, premultiplied
     uint width;       // the target
     uint height;
-    uint pixels;            // width * height
+    uint pixels;  // width * height
     uint padding3;
-    uint node_capacity;     // exact: nodes in the pool
-    uint tile_count;        // compute quad passes: tiles in the frame's tile list
-    uint quad_count;        // quads in the quad buffer
-    uint back_to_front;     // 1: instance i draws quad quad_count - 1 - i (the draw path)
-    int origin_x;           // the draw path: the caller's rect, whose corner is glyph pixel (0, 0)
+    uint node_capacity;  // exact: nodes in the pool
+    uint tile_count;     // compute quad passes: tiles in the frame's tile list
+    uint quad_count;     // quads in the quad buffer
+    uint back_to_front;  // 1: instance i draws quad quad_count - 1 - i (the draw path)
+    int origin_x;        // the draw path: the caller's rect, whose corner is glyph pixel (0, 0)
     int origin_y;
     uint padding0;
     uint padding1;
 };
-
 
 // ---- The tile compositor (tiles_bin.comp, tiles_scan.comp, tiles_pass_*.comp): the frame's quads,
 // sorted front to back on the CPU (so a quad's index is its key), binned into screen tiles on the
@@ -213,19 +211,20 @@ CRISP_CONSTANT(uint, kTileBinInvocations, 64u);
 CRISP_CONSTANT(uint, kTileDefaultCapacity, 256u);
 // Quads staged in workgroup memory at a time for the exact way's walk (28 bytes each).
 CRISP_CONSTANT(uint, kTileChunk, 64u);
-CRISP_CONSTANT(uint, kTileMaxCapacity, 1024u);  // about 10 KiB of workgroup memory in all, of the 16 KiB every device offers
+CRISP_CONSTANT(uint, kTileMaxCapacity,
+               1024u);  // about 10 KiB of workgroup memory in all, of the 16 KiB every device offers
 CRISP_CONSTANT(uint, kTileNoQuad, 0xFFFFFFFFu);
 // Below this in every channel the transmittance left hides whatever lies behind (less than a
 // 16-bit code): a pixel's walk stops there.
 CRISP_CONSTANT(float, kTileOpaque, 1.0f / 65536.0f);
 
 // Bindings of the tile compositor's descriptor set (tiles_common.glsl declares the same).
-CRISP_CONSTANT(uint, kTileBindAtlas, 0u);    // the atlas, storage image
-CRISP_CONSTANT(uint, kTileBindQuads, 1u);    // CompositeQuad[], front to back
-CRISP_CONSTANT(uint, kTileBindTiles, 2u);    // per tile: count, start, cursor (plane-major); block sums
-CRISP_CONSTANT(uint, kTileBindBins, 3u);     // TileBinEntry[], each tile's at its start
-CRISP_CONSTANT(uint, kTileBindHeader, 4u);   // TileHeader, then the non-empty tiles' indices
-CRISP_CONSTANT(uint, kTileBindTarget, 5u);   // the caller's image, storage image
+CRISP_CONSTANT(uint, kTileBindAtlas, 0u);   // the atlas, storage image
+CRISP_CONSTANT(uint, kTileBindQuads, 1u);   // CompositeQuad[], front to back
+CRISP_CONSTANT(uint, kTileBindTiles, 2u);   // per tile: count, start, cursor (plane-major); block sums
+CRISP_CONSTANT(uint, kTileBindBins, 3u);    // TileBinEntry[], each tile's at its start
+CRISP_CONSTANT(uint, kTileBindHeader, 4u);  // TileHeader, then the non-empty tiles' indices
+CRISP_CONSTANT(uint, kTileBindTarget, 5u);  // the caller's image, storage image
 CRISP_CONSTANT(uint, kTileBindingCount, 6u);
 
 // Target encodings of the tile pass (specialization constant 1).

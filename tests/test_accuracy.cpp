@@ -43,7 +43,7 @@ struct Accuracy {
     double p99 = 0.0;
     double max = 0.0;
     uint64_t channels = 0;
-    bool in_range = true;  // every coverage finite and within [0, 1]
+    bool in_range = true;                  // every coverage finite and within [0, 1]
     uint64_t texels_unlike_reference = 0;  // rows: texel channels whose sum differs from the CPU's
     uint64_t extra_row_passes = 0;         // rows: passes beyond one per sample (segments with many crossings)
 };

@@ -889,7 +889,7 @@ TEST(Atlas, VisiblePartsAreHeldWithAMarginAndReplacedWhenLeft) {
     EXPECT_EQ(lookup.part.height, 50 + 2 * m);
     const AtlasEntry* entry = atlas.entry(lookup.entry);
     ASSERT_NE(entry, nullptr);
-    EXPECT_EQ(entry->block_width, 256u);  // the part's block (9 x 6 cells, rounded up); the
+    EXPECT_EQ(entry->block_width, 256u);   // the part's block (9 x 6 cells, rounded up); the
     EXPECT_EQ(entry->block_height, 256u);  // rect's would be 2048 x 2048
     // Its cost is the part's share of the rect's: 132 x 82 of 2000 x 1000 texels, rounded up.
     EXPECT_EQ(entry->curve_tests_per_sample, (2000000ull * 132 * 82 + 1999999) / 2000000);

@@ -69,8 +69,12 @@ TEST(Json, WritesWhatItReads) {
     EXPECT_EQ(value->array[1].number, 0.1);
     // Ill-formed UTF-8 becomes U+FFFD, so the output is still valid JSON.
     std::string bad;
-    json::append_string(bad, "a\xFF" "b\xC3\xA9");
-    EXPECT_EQ(bad, "\"a\xEF\xBF\xBD" "b\xC3\xA9\"");
+    json::append_string(bad,
+                        "a\xFF"
+                        "b\xC3\xA9");
+    EXPECT_EQ(bad,
+              "\"a\xEF\xBF\xBD"
+              "b\xC3\xA9\"");
     EXPECT_TRUE(json::parse(bad));
 }
 

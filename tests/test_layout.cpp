@@ -52,7 +52,7 @@ class Layout : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
         dejavu_ = bake(kDejaVuPath, kDejaVuId, {}).release();
-        inter_ = bake(kInterPath, kInterId, range(0x20, 0x7E)).release();  // Latin only: no Hebrew, no CJK
+        inter_ = bake(kInterPath, kInterId, range(0x20, 0x7E)).release();       // Latin only: no Hebrew, no CJK
         cjk_ = bake(kNotoCjkPath, kCjkId, {0x6F22, 0x5B57, 0x3002}).release();  // 漢字。
     }
     static void TearDownTestSuite() {
@@ -108,11 +108,11 @@ TEST_F(Layout, FontReportsMetricsAndCoverage) {
     EXPECT_LT(dejavu_->descender(), 0.0f);
     EXPECT_FLOAT_EQ(dejavu_->line_height(), dejavu_->ascender() - dejavu_->descender() + dejavu_->line_gap());
     EXPECT_TRUE(dejavu_->has_glyph_for('A'));
-    EXPECT_TRUE(dejavu_->has_glyph_for(0x05D0));   // Hebrew alef
+    EXPECT_TRUE(dejavu_->has_glyph_for(0x05D0));  // Hebrew alef
     EXPECT_FALSE(inter_->has_glyph_for(0x05D0));
     EXPECT_FALSE(dejavu_->has_glyph_for(0x6F22));  // no CJK
     EXPECT_TRUE(cjk_->has_glyph_for(0x6F22));
-    EXPECT_FALSE(cjk_->has_glyph_for('A'));        // in the font's cmap, but not in this subset
+    EXPECT_FALSE(cjk_->has_glyph_for('A'));  // in the font's cmap, but not in this subset
     EXPECT_NE(cjk_->nominal_glyph(0x5B57), 0u);
     EXPECT_EQ(cjk_->nominal_glyph('A'), 0u);
     EXPECT_FALSE(dejavu_->has_glyph_for(0xD800));
@@ -244,7 +244,7 @@ TEST_F(Layout, CombiningMarksSitOnTheirBase) {
     EXPECT_GT(mark_left, base.pen_x);
     EXPECT_LT(mark_right, base.pen_x + base_advance);
     EXPECT_LE(mark.y + static_cast<int32_t>(mark.height), base.y + 2);  // rects overlap only in padding
-    EXPECT_EQ(layout.lines[0].width, base_advance);  // the mark adds no advance
+    EXPECT_EQ(layout.lines[0].width, base_advance);                     // the mark adds no advance
 
     // e + U+0301 composes into é, which the font has.
     const TextLayout composed = lay("e\u0301");
@@ -296,7 +296,10 @@ TEST_F(Layout, NotdefOnlyWhenNoFontHasTheCharacter) {
 TEST_F(Layout, InvalidUtf8BecomesReplacementCharacter) {
     const uint32_t replacement = dejavu_->nominal_glyph(0xFFFD);
     ASSERT_NE(replacement, 0u);
-    const TextLayout layout = lay("a\xFF" "b\xE2\x82" "c");
+    const TextLayout layout =
+        lay("a\xFF"
+            "b\xE2\x82"
+            "c");
     ASSERT_EQ(layout.glyphs.size(), 5u);
     EXPECT_EQ(layout.missing_glyphs, 0u);
     const uint32_t clusters[] = {0, 1, 2, 3, 5};
@@ -452,7 +455,8 @@ TEST_F(Layout, WrapsCjkBetweenIdeographs) {
 TEST_F(Layout, AlignsLines) {
     const float wrap = 250.0f, origin = 30.0f;
     for (Align align : {Align::left, Align::center, Align::right}) {
-        const TextLayout layout = lay(kParagraph, {.size = 16}, {.origin_x = origin, .wrap_width = wrap, .align = align});
+        const TextLayout layout =
+            lay(kParagraph, {.size = 16}, {.origin_x = origin, .wrap_width = wrap, .align = align});
         ASSERT_GT(layout.lines.size(), 2u);
         for (const TextLine& line : layout.lines) {
             const float end = line.x + line.width;
@@ -477,7 +481,8 @@ TEST_F(Layout, AlignsLines) {
     EXPECT_FLOAT_EQ(right.lines[0].x, 0.0f);
     EXPECT_GT(right.lines[1].x, 10.0f);
     // start and end follow the paragraph's direction.
-    const TextLayout start = lay("abc\n\u05D0\u05D1\u05D2 \u05D3", {.size = 16}, {.wrap_width = 300, .align = Align::start});
+    const TextLayout start =
+        lay("abc\n\u05D0\u05D1\u05D2 \u05D3", {.size = 16}, {.wrap_width = 300, .align = Align::start});
     EXPECT_FLOAT_EQ(start.lines[0].x, 0.0f);
     EXPECT_NEAR(start.lines[1].x + start.lines[1].width, 300.0f, 1e-3f);
 }
@@ -493,13 +498,14 @@ TEST_F(Layout, RightToLeftParagraphsWrapFromTheRight) {
         EXPECT_NEAR(line.x + line.width, 120.0f, 1e-3f);
         // The logically first glyph is the rightmost.
         const GlyphInstance& first = layout.glyphs[line.glyph_begin];
-        for (uint32_t i = 1; i < line.glyph_count; ++i) EXPECT_LT(layout.glyphs[line.glyph_begin + i].pen_x, first.pen_x);
+        for (uint32_t i = 1; i < line.glyph_count; ++i)
+            EXPECT_LT(layout.glyphs[line.glyph_begin + i].pen_x, first.pen_x);
     }
 }
 
 TEST_F(Layout, SnapsPensToWholePixels) {
-    const TextLayout layout =
-        lay(kParagraph, {.size = 13.3f}, {.origin_x = 10.3f, .origin_y = 20.7f, .wrap_width = 300, .snap_to_pixels = true});
+    const TextLayout layout = lay(kParagraph, {.size = 13.3f},
+                                  {.origin_x = 10.3f, .origin_y = 20.7f, .wrap_width = 300, .snap_to_pixels = true});
     ASSERT_FALSE(layout.glyphs.empty());
     for (const GlyphInstance& glyph : layout.glyphs) {
         EXPECT_EQ(glyph.key.subpixel_x, 0);
@@ -522,7 +528,8 @@ TEST_F(Layout, SnapsPensToWholePixels) {
 }
 
 TEST_F(Layout, QuantizesSubpixelOffsets) {
-    const TextLayout layout = lay(kParagraph, {.size = 13.3f}, {.origin_x = 0.37f, .origin_y = 10.2f, .subpixel_steps = 4});
+    const TextLayout layout =
+        lay(kParagraph, {.size = 13.3f}, {.origin_x = 0.37f, .origin_y = 10.2f, .subpixel_steps = 4});
     std::set<int> seen;
     for (const GlyphInstance& glyph : layout.glyphs) {
         EXPECT_EQ(glyph.key.subpixel_x % 64, 0);
@@ -532,8 +539,9 @@ TEST_F(Layout, QuantizesSubpixelOffsets) {
         const double pen = static_cast<double>(glyph.pen_x);
         const double quantized = std::floor(pen) + std::round((pen - std::floor(pen)) * 4) / 4;
         const GlyphRect rect = glyph_rect(*dejavu_->glyph_record(glyph.key.glyph), glyph.key);
-        EXPECT_DOUBLE_EQ(static_cast<double>(glyph.x - rect.x) + static_cast<double>(subpixel_to_float(glyph.key.subpixel_x)),
-                         quantized);
+        EXPECT_DOUBLE_EQ(
+            static_cast<double>(glyph.x - rect.x) + static_cast<double>(subpixel_to_float(glyph.key.subpixel_x)),
+            quantized);
     }
     EXPECT_EQ(seen.size(), 4u);  // a paragraph visits every offset
 
@@ -551,7 +559,8 @@ TEST_F(Layout, QuantizesSubpixelOffsets) {
 }
 
 TEST_F(Layout, EqualGlyphsAtEqualOffsetsShareKeys) {
-    const TextLayout layout = lay(kParagraph, {.size = 15.5f, .size_y = 17.25f}, {.origin_x = 0.3f, .subpixel_steps = 2});
+    const TextLayout layout =
+        lay(kParagraph, {.size = 15.5f, .size_y = 17.25f}, {.origin_x = 0.3f, .subpixel_steps = 2});
     std::map<std::pair<uint32_t, uint8_t>, const GlyphInstance*> first;
     GlyphKeyHash hash;
     size_t repeats = 0;
@@ -602,8 +611,8 @@ TEST_F(Layout, TabsAdvanceToStops) {
     EXPECT_NEAR(layout.glyphs[2].pen_x, 8 * space, 1e-3f);
     EXPECT_EQ(layout.missing_glyphs, 0u);
     const TextLayout spaces = lay("a\tb", {.size = 16}, {.tab_spaces = 0});
-    EXPECT_NEAR(spaces.glyphs[1].pen_x - spaces.glyphs[0].pen_x, advance(*dejavu_, spaces.glyphs[0].key.glyph, 16) + space,
-                1e-3f);
+    EXPECT_NEAR(spaces.glyphs[1].pen_x - spaces.glyphs[0].pen_x,
+                advance(*dejavu_, spaces.glyphs[0].key.glyph, 16) + space, 1e-3f);
 }
 
 TEST_F(Layout, ReusedLayouterGivesTheSameResult) {
@@ -626,18 +635,32 @@ TEST_F(Layout, ReusedLayouterGivesTheSameResult) {
 TEST_F(Layout, HostileTextNeverCrashes) {
     std::mt19937 random(1234);
     const Font* fonts[] = {inter_, dejavu_, cjk_};
-    const std::string pieces[] = {"a", " ", "\n", "\r", "\t", "\u05D0", "\u0627", "\u0644", "\u0301", "\u200D",
-                                  "\u202E", "\u2067", "\u2069", "(", ")", "1", "\u6F22", "\xFF", "\xE2\x82",
-                                  "\xF0\x9F\x98\x80", "-", std::string(1, '\0'), "\uFFFD", "\u200B", "\uFE0F",
-                                  "\u00AD", "\u3002", "\u3000", "\u0085", "\u2029", "\u05B8"};
+    const std::string pieces[] = {"a",        " ",
+                                  "\n",       "\r",
+                                  "\t",       "\u05D0",
+                                  "\u0627",   "\u0644",
+                                  "\u0301",   "\u200D",
+                                  "\u202E",   "\u2067",
+                                  "\u2069",   "(",
+                                  ")",        "1",
+                                  "\u6F22",   "\xFF",
+                                  "\xE2\x82", "\xF0\x9F\x98\x80",
+                                  "-",        std::string(1, '\0'),
+                                  "\uFFFD",   "\u200B",
+                                  "\uFE0F",   "\u00AD",
+                                  "\u3002",   "\u3000",
+                                  "\u0085",   "\u2029",
+                                  "\u05B8"};
     Layouter layouter;
     TextLayout layout;
     for (int round = 0; round < 300; ++round) {
         std::string text;
         const int length = static_cast<int>(random() % 64);
         for (int i = 0; i < length; ++i) {
-            if (random() % 8 == 0) text += static_cast<char>(random() % 256);
-            else text += pieces[random() % std::size(pieces)];
+            if (random() % 8 == 0)
+                text += static_cast<char>(random() % 256);
+            else
+                text += pieces[random() % std::size(pieces)];
         }
         LayoutOptions options;
         options.wrap_width = static_cast<float>(random() % 4) * 20.0f;
@@ -665,7 +688,8 @@ TEST_F(Layout, AMillionCharacters) {
     const std::string words = "lorem ipsum dolor sit amet, consectetur adipiscing elit ";
     while (text.size() < 1'000'000) text += words;
     text.resize(1'000'000);
-    Result<TextLayout> wrapped = layout_text(std::vector<const Font*>{dejavu_}, text, {.size = 12}, {.wrap_width = 900});
+    Result<TextLayout> wrapped =
+        layout_text(std::vector<const Font*>{dejavu_}, text, {.size = 12}, {.wrap_width = 900});
     ASSERT_TRUE(wrapped) << wrapped.error().message;
     // About 7 in 8 characters are letters (spaces are blank); "fi" ligatures are rare here.
     EXPECT_GT(wrapped->glyphs.size(), 800'000u);

@@ -16,7 +16,9 @@ using crisp::editor::kEditStep;
 using crisp::editor::kMinRectSize;
 using crisp::editor::LayoutModel;
 
-SubpixelLayout preset(const char* name) { return *crisp::subpixel_preset(name); }
+SubpixelLayout preset(const char* name) {
+    return *crisp::subpixel_preset(name);
+}
 
 TEST(LayoutEditorModel, DragMovesOneEdgeSnappedToTheStepAsOneUndoStep) {
     LayoutModel model(preset("rgb"));

@@ -101,8 +101,8 @@ TEST(Limits, FontContainersThatCannotBeShapedAreRefusedUpFront) {
         {"%!FontType1-1.0: Test", "Type 1"},
     };
     for (const auto& [magic, advice] : cases) {
-        std::vector<std::byte> bytes = bytes_of(std::string_view(magic, std::string_view(magic).size() +
-                                                                             (magic[0] == 'w' ? 4 : 0)));
+        std::vector<std::byte> bytes =
+            bytes_of(std::string_view(magic, std::string_view(magic).size() + (magic[0] == 'w' ? 4 : 0)));
         bytes.resize(bytes.size() + 64);
         auto baked = bake_font(bytes, BakeOptions{});
         ASSERT_FALSE(baked) << magic;

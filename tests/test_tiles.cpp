@@ -139,8 +139,9 @@ Target make_target(VkFormat format, uint32_t width, uint32_t height, VkImageUsag
     t.view_format = view_format;
     t.width = width;
     t.height = height;
-    auto image = context.create_image(
-        {format, width, height, usage | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, view_format});
+    auto image =
+        context.create_image({format, width, height,
+                              usage | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, view_format});
     EXPECT_TRUE(image) << (image ? "" : image.error().message);
     if (!image) return t;
     t.image = std::move(*image);
@@ -221,9 +222,11 @@ std::vector<Rgba> expected_image(const Scene& scene, const Target& t, VkOffset2D
                     light[c] += transmittance[c] * double{f.light[c]};
                     transmittance[c] *= double{f.transmittance[c]};
                 }
-                coverage_transmittance *= double{std::min({f.transmittance[0], f.transmittance[1], f.transmittance[2]})};
+                coverage_transmittance *=
+                    double{std::min({f.transmittance[0], f.transmittance[1], f.transmittance[2]})};
             }
-            for (size_t c = 0; c < 3; ++c) out[at][c] = static_cast<float>(light[c] + transmittance[c] * double{back[c]});
+            for (size_t c = 0; c < 3; ++c)
+                out[at][c] = static_cast<float>(light[c] + transmittance[c] * double{back[c]});
             out[at][3] = static_cast<float>(1.0 - (1.0 - double{back[3]}) * coverage_transmittance);
         }
     }
@@ -240,7 +243,9 @@ double worst_difference(const Target& t, const std::vector<std::byte>& bytes, co
         for (size_t c = 0; c < 4; ++c) {
             double d = std::abs(double{got[c]} - double{expected[i][c]});
             if (is_8bit(t.format)) {
-                const auto code = [&](float v) { return double{c < 3 ? linear_to_srgb(v) : std::clamp(v, 0.0f, 1.0f)} * 255.0; };
+                const auto code = [&](float v) {
+                    return double{c < 3 ? linear_to_srgb(v) : std::clamp(v, 0.0f, 1.0f)} * 255.0;
+                };
                 d = std::abs(code(got[c]) - code(expected[i][c]));
             }
             worst = std::max(worst, d);
@@ -279,8 +284,8 @@ constexpr TileFormat kTileFormats[] = {
     {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_UNDEFINED},
     {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_UNDEFINED},
 };
-constexpr VkFormat kDrawFormats[] = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB,
-                                     VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT};
+constexpr VkFormat kDrawFormats[] = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB, VK_FORMAT_R16G16B16A16_SFLOAT,
+                                     VK_FORMAT_R32G32B32A32_SFLOAT};
 
 // ---- Tests -------------------------------------------------------------------------------------
 
@@ -617,8 +622,11 @@ TEST(TileCompositor, LongListsAreWalkedChunkAfterChunk) {
     std::vector<TextRun> runs;
     for (int i = 0; i < 72; ++i) {  // whole-pixel offsets: the same atlas entries serve every run
         const float f = static_cast<float>(i);
-        runs.push_back({"Hamburg", 0.5f + static_cast<float>(i % 6), 22.0f + static_cast<float>(i / 6),
-                        {0.2f + 0.01f * f, 0.5f, 0.9f - 0.01f * f, 0.08f}, 0.013f * f});
+        runs.push_back({"Hamburg",
+                        0.5f + static_cast<float>(i % 6),
+                        22.0f + static_cast<float>(i / 6),
+                        {0.2f + 0.01f * f, 0.5f, 0.9f - 0.01f * f, 0.08f},
+                        0.013f * f});
     }
     const Scene scene = render_scene(runs);
     auto compositor = Compositor::create(tile_info(1));
@@ -861,7 +869,8 @@ std::vector<std::byte> run_with_drops(const std::vector<bool>& drops, uint32_t& 
     EXPECT_TRUE(compositor);
     if (!compositor) return {};
     Target t = make_target(VK_FORMAT_R8G8B8A8_UNORM, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
-    CompositeTarget target{t.image.view(), t.format, VK_FORMAT_UNDEFINED, {kWidth, kHeight}, {{0, 0}, {kWidth, kHeight}}};
+    CompositeTarget target{
+        t.image.view(), t.format, VK_FORMAT_UNDEFINED, {kWidth, kHeight}, {{0, 0}, {kWidth, kHeight}}};
 
     const char* texts[] = {"Hamburg", "fonstiv", "Hamb@&1", "vitsnof"};
     std::vector<TextLayout> layouts;

@@ -230,8 +230,8 @@ int run_check(const Arguments& args) {
     } else if (!args.quiet) {
         std::printf("%s: valid crisp asset (version %u)\n", args.check.c_str(), crisp::kAssetVersion);
         std::printf("  font        %s %s, face %u, %u units per em%s\n", crisp::cli::printable(info.family).c_str(),
-                    crisp::cli::printable(info.style).c_str(),
-                    info.face_index, info.units_per_em, (info.flags & crisp::kFontCubic) ? ", cubic outlines" : "");
+                    crisp::cli::printable(info.style).c_str(), info.face_index, info.units_per_em,
+                    (info.flags & crisp::kFontCubic) ? ", cubic outlines" : "");
         if (!info.axes.empty()) std::printf("  axes        %s\n", axes_text(info).c_str());
         std::printf("  metrics     ascender %d, descender %d, line gap %d\n", info.ascender, info.descender,
                     info.line_gap);
@@ -305,8 +305,7 @@ void print_report(const Arguments& args, const crisp::FontInfo& info, const cris
     if (args.quiet) return;
     std::printf("%s -> %s\n", args.font.c_str(), args.output.c_str());
     std::printf("  font          %s %s, face %u, %u units per em\n", crisp::cli::printable(info.family).c_str(),
-                crisp::cli::printable(info.style).c_str(),
-                info.face_index, info.units_per_em);
+                crisp::cli::printable(info.style).c_str(), info.face_index, info.units_per_em);
     if (!info.axes.empty()) std::printf("  axes          %s\n", axes_text(info).c_str());
     std::printf("  glyphs        %u in the face, %u baked (%u empty), %u failed\n", r.glyph_count, r.baked_glyphs,
                 r.empty_glyphs, r.failed_glyphs);

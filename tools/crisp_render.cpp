@@ -365,8 +365,8 @@ struct CompositeReport {
     crisp::CompositorStats stats;  // the image's frame; its measurements are the first frame's
     std::vector<std::string> warnings;
     bool storage_without_format = false;  // the device's, as the context enabled it
-    std::vector<double> frame_ms;  // CPU wall time of each composite frame: record, submit and wait
-    std::vector<float> target;     // premultiplied linear RGBA, top row first
+    std::vector<double> frame_ms;         // CPU wall time of each composite frame: record, submit and wait
+    std::vector<float> target;            // premultiplied linear RGBA, top row first
 };
 
 struct RenderReport {
@@ -430,16 +430,16 @@ std::vector<float> backdrop_pixels(const std::string& kind, uint32_t width, uint
                 }
             } else if (kind == "photo") {
                 // A sky-to-ground ramp, three soft blobs of colour and a fine texture.
-                const std::array<std::array<float, 5>, 3> blobs = {{{0.25f, 0.3f, 0.9f, 0.5f, 0.2f},
-                                                                   {0.7f, 0.6f, 0.2f, 0.7f, 0.3f},
-                                                                   {0.5f, 0.9f, 0.8f, 0.2f, 0.6f}}};
+                const std::array<std::array<float, 5>, 3> blobs = {
+                    {{0.25f, 0.3f, 0.9f, 0.5f, 0.2f}, {0.7f, 0.6f, 0.2f, 0.7f, 0.3f}, {0.5f, 0.9f, 0.8f, 0.2f, 0.6f}}};
                 colour = {0.35f + 0.3f * v, 0.5f + 0.1f * v, 0.8f - 0.5f * v};
                 for (const auto& b : blobs) {
                     const float dx = u - b[0], dy = v - b[1];
                     const float weight = std::exp(-(dx * dx + dy * dy) * 12.0f);
                     for (size_t c = 0; c < 3; ++c) colour[c] += weight * (b[c + 2] - colour[c]);
                 }
-                const float grain = 0.04f * std::sin(static_cast<float>(x) * 1.7f) * std::sin(static_cast<float>(y) * 2.3f);
+                const float grain =
+                    0.04f * std::sin(static_cast<float>(x) * 1.7f) * std::sin(static_cast<float>(y) * 2.3f);
                 for (float& c : colour) c = std::clamp(c + grain, 0.0f, 1.0f);
             }
             float* p = &pixels[(size_t{y} * width + x) * 4];

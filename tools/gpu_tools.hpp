@@ -123,9 +123,9 @@ public:
     // are not counted), rather than when the GPU reaches this point (they may still be running).
     void begin(VkCommandBuffer command_buffer, bool after_earlier_work = false) const {
         vkCmdResetQueryPool(command_buffer, pool_, 0, 2);
-        vkCmdWriteTimestamp(command_buffer,
-                            after_earlier_work ? VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-                            pool_, 0);
+        vkCmdWriteTimestamp(
+            command_buffer,
+            after_earlier_work ? VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT : VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, pool_, 0);
     }
     void end(VkCommandBuffer command_buffer) const {
         vkCmdWriteTimestamp(command_buffer, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool_, 1);

@@ -97,7 +97,7 @@ private:
     crisp::RendererStats last_submitted_{};
     bool have_stats_ = false;
     OverlayFrame frame_;
-    bool composited_ = false;                 // the compositor recorded this frame
+    bool composited_ = false;  // the compositor recorded this frame
 };
 
 }  // namespace engine

@@ -53,7 +53,7 @@ struct BakeOptions {
     bool split_y_extrema = false;              // split quadratics at y-extrema (docs/cubic-lowering.md)
     // A glyph with more curves fails; at most kMaxCurvesPerGlyph (asset.hpp).
     uint32_t max_curves_per_glyph = kMaxCurvesPerGlyph;
-    bool allow_failed = false;                 // keep going past failed glyphs, baking them empty
+    bool allow_failed = false;  // keep going past failed glyphs, baking them empty
     // Called now and then with (glyphs done, glyphs to do); may be empty.
     std::function<void(uint32_t, uint32_t)> progress;
 };

@@ -45,9 +45,9 @@ public:
     const FontAsset& asset() const;
     FontId id() const;
     uint32_t units_per_em() const;
-    float ascender() const;    // em, positive above the baseline
-    float descender() const;   // em, negative below the baseline
-    float line_gap() const;    // em
+    float ascender() const;   // em, positive above the baseline
+    float descender() const;  // em, negative below the baseline
+    float line_gap() const;   // em
     // Baseline-to-baseline distance in em: ascender - descender + line_gap.
     float line_height() const;
 

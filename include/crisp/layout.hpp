@@ -66,16 +66,16 @@ enum class Direction : uint8_t {
 };
 
 struct TextStyle {
-    float size = 16.0f;    // pixels per em, horizontally; (0, kMaxTextSize]
-    float size_y = 0.0f;   // pixels per em, vertically; 0: same as size
+    float size = 16.0f;                         // pixels per em, horizontally; (0, kMaxTextSize]
+    float size_y = 0.0f;                        // pixels per em, vertically; 0: same as size
     float color[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // sRGB, straight (not premultiplied) alpha; clamped to [0, 1]
-    float depth = 0.0f;    // copied to every instance, for the compositor
+    float depth = 0.0f;                         // copied to every instance, for the compositor
 };
 
 struct LayoutOptions {
-    float origin_x = 0.0f;    // pen of the first line on its baseline, canvas pixels, y down
+    float origin_x = 0.0f;  // pen of the first line on its baseline, canvas pixels, y down
     float origin_y = 0.0f;
-    float wrap_width = 0.0f;  // pixels; 0: no wrapping
+    float wrap_width = 0.0f;    // pixels; 0: no wrapping
     Align align = Align::left;  // within wrap_width, or within the widest line when there is none
     Direction direction = Direction::auto_detect;
     // Rounds every advance and offset and the start of every line to whole pixels, and every
@@ -99,14 +99,14 @@ struct LayoutOptions {
 };
 
 struct GlyphInstance {
-    GlyphKey key;           // font id, glyph index, size (u24.8), subpixel offset (u0.8)
-    int32_t x = 0;          // top-left of the glyph's atlas rect on the target, whole pixels:
-    int32_t y = 0;          // pen's whole pixel + glyph_rect(record, key).x / .y
-    uint32_t width = 0;     // rect size in texels; 0 x 0 only for kept blank glyphs
+    GlyphKey key;        // font id, glyph index, size (u24.8), subpixel offset (u0.8)
+    int32_t x = 0;       // top-left of the glyph's atlas rect on the target, whole pixels:
+    int32_t y = 0;       // pen's whole pixel + glyph_rect(record, key).x / .y
+    uint32_t width = 0;  // rect size in texels; 0 x 0 only for kept blank glyphs
     uint32_t height = 0;
-    float pen_x = 0.0f;     // the glyph's pen position before quantization, canvas pixels (a float:
-    float pen_y = 0.0f;     // finer than 1/256 px within 32768 px of the canvas origin; keys use doubles)
-    float color[4] = {};    // LINEAR RGB (exact sRGB transfer function) and alpha, NOT premultiplied
+    float pen_x = 0.0f;   // the glyph's pen position before quantization, canvas pixels (a float:
+    float pen_y = 0.0f;   // finer than 1/256 px within 32768 px of the canvas origin; keys use doubles)
+    float color[4] = {};  // LINEAR RGB (exact sRGB transfer function) and alpha, NOT premultiplied
     float depth = 0.0f;
     uint32_t paint_order = 0;  // consecutive from first_paint_order, in logical order
     uint32_t cluster = 0;      // byte offset in the UTF-8 text of the first character it shows
@@ -114,14 +114,14 @@ struct GlyphInstance {
 };
 
 struct TextLine {
-    uint32_t text_begin = 0;   // byte range of the line's characters, without its hard break
+    uint32_t text_begin = 0;  // byte range of the line's characters, without its hard break
     uint32_t text_end = 0;
     uint32_t glyph_begin = 0;  // range in TextLayout::glyphs
     uint32_t glyph_count = 0;
-    float x = 0.0f;            // left edge of the line's content (its visual start), canvas pixels
+    float x = 0.0f;  // left edge of the line's content (its visual start), canvas pixels
     float baseline_y = 0.0f;
-    float width = 0.0f;        // advance width of the content, spaces hanging at its end excluded
-    bool rtl = false;          // the paragraph's direction
+    float width = 0.0f;  // advance width of the content, spaces hanging at its end excluded
+    bool rtl = false;    // the paragraph's direction
 };
 
 struct TextLayout {
@@ -133,13 +133,13 @@ struct TextLayout {
     float y = 0.0f;
     float width = 0.0f;
     float height = 0.0f;
-    float line_height = 0.0f;      // pixels between baselines (whole when snapping)
-    uint32_t shaped_glyphs = 0;    // glyphs HarfBuzz produced, blank and dropped ones included
-    uint32_t missing_glyphs = 0;   // .notdef glyphs (characters no font has); they are emitted
-    uint32_t blank_glyphs = 0;     // glyphs without an outline (dropped unless keep_blank_glyphs)
+    float line_height = 0.0f;          // pixels between baselines (whole when snapping)
+    uint32_t shaped_glyphs = 0;        // glyphs HarfBuzz produced, blank and dropped ones included
+    uint32_t missing_glyphs = 0;       // .notdef glyphs (characters no font has); they are emitted
+    uint32_t blank_glyphs = 0;         // glyphs without an outline (dropped unless keep_blank_glyphs)
     uint32_t out_of_range_glyphs = 0;  // not emitted: pen beyond kMaxCoordinate
-    uint32_t mark_splits = 0;      // clusters cut after kMaxMarksPerCluster combining marks
-    uint32_t next_paint_order = 0; // first_paint_order + glyphs.size()
+    uint32_t mark_splits = 0;          // clusters cut after kMaxMarksPerCluster combining marks
+    uint32_t next_paint_order = 0;     // first_paint_order + glyphs.size()
 };
 
 // Lays out text, keeping HarfBuzz buffers and scratch memory between calls so that an engine

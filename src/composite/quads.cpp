@@ -46,8 +46,8 @@ bool reaches(const GlyphInstance& g, uint32_t width, uint32_t height) {
 
 // Everything a quad's fragments depend on, most significant first: the sort key.
 auto content(const gpu::CompositeQuad& q) {
-    return std::make_tuple(q.key_depth, ~q.rank, q.y, q.x, q.height, q.width, q.atlas_y, q.atlas_x,
-                           q.color.w, q.color.x, q.color.y, q.color.z);
+    return std::make_tuple(q.key_depth, ~q.rank, q.y, q.x, q.height, q.width, q.atlas_y, q.atlas_x, q.color.w,
+                           q.color.x, q.color.y, q.color.z);
 }
 
 }  // namespace
@@ -64,9 +64,7 @@ void sort_front_to_back(std::span<const DrawnGlyph> glyphs, uint32_t width, uint
         quad.rank = glyph.instance.paint_order;
         out.push_back(quad);
     }
-    auto front_first = [](const gpu::CompositeQuad& a, const gpu::CompositeQuad& b) {
-        return content(a) < content(b);
-    };
+    auto front_first = [](const gpu::CompositeQuad& a, const gpu::CompositeQuad& b) { return content(a) < content(b); };
     // A UI submits runs in paint order at few depths: often already sorted back to front.
     std::reverse(out.begin(), out.end());
     if (!std::is_sorted(out.begin(), out.end(), front_first)) std::sort(out.begin(), out.end(), front_first);

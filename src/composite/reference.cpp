@@ -349,7 +349,8 @@ Result<bool> ReferenceCompositor::compute_pass_for(const CompositeParams& params
         const bool is_wboit = params.mode == CompositeMode::wboit;
         VkPipeline& pipeline = is_wboit ? wboit_compute : exact_compute;
         if (!pipeline) {
-            Result<VkPipeline> made = compute_pipeline(is_wboit ? "reference_wboit_quads.comp" : "reference_exact_quads.comp", nullptr);
+            Result<VkPipeline> made =
+                compute_pipeline(is_wboit ? "reference_wboit_quads.comp" : "reference_exact_quads.comp", nullptr);
             if (!made) return made.error();
             pipeline = *made;
         }

@@ -147,7 +147,8 @@ Status stage(const std::filesystem::path& path, std::span<const std::byte> bytes
     remove_stale_temporaries(hidden_prefix(path, staged.directory));
     auto fail = [&](std::string_view what, int error) -> Status {
         discard(staged);
-        return Error{ErrorCode::io, "cannot write " + path.string() + ": " + std::string(what) + ": " + errno_text(error)};
+        return Error{ErrorCode::io,
+                     "cannot write " + path.string() + ": " + std::string(what) + ": " + errno_text(error)};
     };
     // An unnamed file is later given its name through /proc/self/fd: without /proc, a named one.
     static const bool can_link_unnamed = ::access("/proc/self/fd", X_OK) == 0;
@@ -185,7 +186,8 @@ Status commit(Staged& staged) {
         const std::string prefix = hidden_prefix(staged.path, staged.directory);
         const std::string proc = "/proc/self/fd/" + std::to_string(staged.fd);
         for (int attempt = 0; attempt < 100; ++attempt) {
-            name = prefix + temporary_suffix(static_cast<uint64_t>(attempt) * 7919u + static_cast<uint64_t>(::getpid()));
+            name =
+                prefix + temporary_suffix(static_cast<uint64_t>(attempt) * 7919u + static_cast<uint64_t>(::getpid()));
             if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0) break;
             if (errno != EEXIST) return fail("linking the written file", errno);
             name.clear();

@@ -121,9 +121,8 @@ Status RasterPass::create(uint32_t cells, uint64_t atlas_texels, RetireLists& re
     if (!module) return module.error();
     shader_ = objects_.keep(ref_, *module);
     // One descriptor set per frame in flight: a set is rewritten only when its last use is done.
-    if (Status s =
-            vk::create_descriptor_sets(ref_, kTable, sizeof(gpu::RasterPushConstants), options_.frames_in_flight,
-                                       "renderer", descriptors_);
+    if (Status s = vk::create_descriptor_sets(ref_, kTable, sizeof(gpu::RasterPushConstants), options_.frames_in_flight,
+                                              "renderer", descriptors_);
         !s) {
         return s;
     }

@@ -33,7 +33,7 @@ hb_bool_t get_nominal_glyph(hb_font_t* font, void* font_data, hb_codepoint_t uni
 }
 
 unsigned get_nominal_glyphs(hb_font_t* font, void* font_data, unsigned count, const hb_codepoint_t* first_unicode,
-                        unsigned unicode_stride, hb_codepoint_t* first_glyph, unsigned glyph_stride, void*) {
+                            unsigned unicode_stride, hb_codepoint_t* first_glyph, unsigned glyph_stride, void*) {
     // Same contract as HarfBuzz's: the number of leading code points mapped, stopping at the first
     // that is not. Strides are in bytes.
     const unsigned done = hb_font_get_nominal_glyphs(hb_font_get_parent(font), count, first_unicode, unicode_stride,
@@ -48,7 +48,7 @@ unsigned get_nominal_glyphs(hb_font_t* font, void* font_data, unsigned count, co
 }
 
 hb_bool_t get_variation_glyph(hb_font_t* font, void* font_data, hb_codepoint_t unicode, hb_codepoint_t selector,
-                          hb_codepoint_t* glyph, void*) {
+                              hb_codepoint_t* glyph, void*) {
     hb_codepoint_t found = 0;
     if (!hb_font_get_variation_glyph(hb_font_get_parent(font), unicode, selector, &found)) return false;
     if (!is_baked_glyph(*static_cast<const FontAsset*>(font_data), found)) return false;
@@ -56,7 +56,9 @@ hb_bool_t get_variation_glyph(hb_font_t* font, void* font_data, hb_codepoint_t u
     return true;
 }
 
-Error invalid(std::string message) { return Error{ErrorCode::asset_invalid, std::move(message)}; }
+Error invalid(std::string message) {
+    return Error{ErrorCode::asset_invalid, std::move(message)};
+}
 
 }  // namespace
 
@@ -69,7 +71,7 @@ struct CRISP_HIDDEN Font::State {
     hb_face_t* face = nullptr;
     hb_font_t* parent = nullptr;  // HarfBuzz's OpenType font functions
     hb_font_funcs_t* funcs = nullptr;
-    hb_font_t* font = nullptr;    // child of `parent` with crisp's glyph look-up
+    hb_font_t* font = nullptr;  // child of `parent` with crisp's glyph look-up
 
     State() = default;
     State(const State&) = delete;
@@ -93,9 +95,9 @@ Result<Font> Font::create(FontAsset asset, FontId id) {
     const FontAsset& owned = state->asset;
 
     // validate_asset checked that the bytes fit HarfBuzz's unsigned length and hold the face.
-    state->blob = hb_blob_create(reinterpret_cast<const char*>(owned.font_bytes.data()),
-                                 static_cast<unsigned>(owned.font_bytes.size()), HB_MEMORY_MODE_READONLY, nullptr,
-                                 nullptr);
+    state->blob =
+        hb_blob_create(reinterpret_cast<const char*>(owned.font_bytes.data()),
+                       static_cast<unsigned>(owned.font_bytes.size()), HB_MEMORY_MODE_READONLY, nullptr, nullptr);
     if (owned.info.face_index >= hb_face_count(state->blob))
         return invalid("font: HarfBuzz finds no face " + std::to_string(owned.info.face_index) + " in the font bytes");
     state->face = hb_face_create(state->blob, owned.info.face_index);
@@ -149,7 +151,9 @@ FontId Font::id() const {
     return state_->id;
 }
 
-uint32_t Font::units_per_em() const { return asset().info.units_per_em; }
+uint32_t Font::units_per_em() const {
+    return asset().info.units_per_em;
+}
 
 float Font::ascender() const {
     return static_cast<float>(asset().info.ascender) / static_cast<float>(units_per_em());
@@ -163,7 +167,9 @@ float Font::line_gap() const {
     return static_cast<float>(asset().info.line_gap) / static_cast<float>(units_per_em());
 }
 
-float Font::line_height() const { return ascender() - descender() + line_gap(); }
+float Font::line_height() const {
+    return ascender() - descender() + line_gap();
+}
 
 bool Font::has_glyph_for(uint32_t codepoint) const {
     hb_codepoint_t glyph = 0;
@@ -180,7 +186,9 @@ const GlyphRecord* Font::glyph_record(uint32_t glyph) const {
     return glyph < glyphs.size() ? &glyphs[glyph] : nullptr;
 }
 
-bool Font::is_baked(uint32_t glyph) const { return is_baked_glyph(asset(), glyph); }
+bool Font::is_baked(uint32_t glyph) const {
+    return is_baked_glyph(asset(), glyph);
+}
 
 hb_font_t* Font::harfbuzz_font() const {
     assert(state_);

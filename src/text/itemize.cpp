@@ -53,11 +53,43 @@ bool breaks_around(uint32_t cp) {
 // IS, NS: the common ones).
 bool no_break_before(uint32_t cp) {
     switch (cp) {
-        case ')': case ']': case '}': case '!': case ',': case '.': case ':': case ';': case '?': case '%':
-        case 0x3001: case 0x3002: case 0xFF0C: case 0xFF0E: case 0xFF1A: case 0xFF1B: case 0xFF01: case 0xFF1F:
-        case 0xFF09: case 0x300D: case 0x300F: case 0x3011: case 0x3015: case 0x3009: case 0x300B: case 0x3019:
-        case 0x3017: case 0x301B: case 0xFF5D: case 0xFF3D: case 0x30FB: case 0x30FC: case 0x3005: case 0x309D:
-        case 0x309E: case 0x30FD: case 0x30FE:
+        case ')':
+        case ']':
+        case '}':
+        case '!':
+        case ',':
+        case '.':
+        case ':':
+        case ';':
+        case '?':
+        case '%':
+        case 0x3001:
+        case 0x3002:
+        case 0xFF0C:
+        case 0xFF0E:
+        case 0xFF1A:
+        case 0xFF1B:
+        case 0xFF01:
+        case 0xFF1F:
+        case 0xFF09:
+        case 0x300D:
+        case 0x300F:
+        case 0x3011:
+        case 0x3015:
+        case 0x3009:
+        case 0x300B:
+        case 0x3019:
+        case 0x3017:
+        case 0x301B:
+        case 0xFF5D:
+        case 0xFF3D:
+        case 0x30FB:
+        case 0x30FC:
+        case 0x3005:
+        case 0x309D:
+        case 0x309E:
+        case 0x30FD:
+        case 0x30FE:
             return true;
         default:
             return false;
@@ -67,15 +99,32 @@ bool no_break_before(uint32_t cp) {
 // Opening punctuation that must not end a line (UAX #14 OP: the common ones).
 bool no_break_after(uint32_t cp) {
     switch (cp) {
-        case '(': case '[': case '{': case 0xFF08: case 0x300C: case 0x300E: case 0x3010: case 0x3014: case 0x3008:
-        case 0x300A: case 0x3018: case 0x3016: case 0x301A: case 0xFF5B: case 0xFF3B: case 0x201C: case 0x2018:
+        case '(':
+        case '[':
+        case '{':
+        case 0xFF08:
+        case 0x300C:
+        case 0x300E:
+        case 0x3010:
+        case 0x3014:
+        case 0x3008:
+        case 0x300A:
+        case 0x3018:
+        case 0x3016:
+        case 0x301A:
+        case 0xFF5B:
+        case 0xFF3B:
+        case 0x201C:
+        case 0x2018:
             return true;
         default:
             return false;
     }
 }
 
-bool is_hyphen(uint32_t cp) { return cp == '-' || cp == 0x2010 || cp == 0x2012 || cp == 0x2013; }
+bool is_hyphen(uint32_t cp) {
+    return cp == '-' || cp == 0x2010 || cp == 0x2012 || cp == 0x2013;
+}
 
 }  // namespace
 
@@ -135,8 +184,8 @@ uint8_t resolve_levels(std::span<const uint32_t> text, Direction direction, Bidi
     FriBidiParType base = direction == Direction::ltr   ? static_cast<FriBidiParType>(FRIBIDI_PAR_LTR)
                           : direction == Direction::rtl ? static_cast<FriBidiParType>(FRIBIDI_PAR_RTL)
                                                         : static_cast<FriBidiParType>(FRIBIDI_PAR_ON);
-    const FriBidiLevel max_level = fribidi_get_par_embedding_levels_ex(
-        scratch.types.data(), scratch.brackets.data(), length, &base, scratch.levels.data());
+    const FriBidiLevel max_level = fribidi_get_par_embedding_levels_ex(scratch.types.data(), scratch.brackets.data(),
+                                                                       length, &base, scratch.levels.data());
     if (max_level == 0) {
         // FriBidi failed (out of memory): lay out in the requested direction, unreordered.
         std::fill(levels.begin(), levels.end(), forced);
@@ -156,7 +205,8 @@ void resolve_scripts(std::span<const uint32_t> text, std::span<const uint8_t> fl
         }
         const uint32_t cp = text[i];
         const hb_script_t script = cp < 0x80 ? HB_SCRIPT_LATIN : hb_unicode_script(unicode, cp);
-        if (current == HB_SCRIPT_INVALID) std::fill(scripts.begin(), scripts.begin() + static_cast<ptrdiff_t>(i), script);
+        if (current == HB_SCRIPT_INVALID)
+            std::fill(scripts.begin(), scripts.begin() + static_cast<ptrdiff_t>(i), script);
         current = script;
         scripts[i] = script;
     }

@@ -20,15 +20,14 @@ namespace crisp::detail {
 // Per-character bits. The first group comes from the code points alone (classify); the shaping
 // step adds the second.
 enum CharFlags : uint8_t {
-    kCharSpace = 1u << 0,        // breaking white space: hangs at the end of a line
-    kCharTab = 1u << 1,          // U+0009 (also kCharSpace)
-    kCharBreakBefore = 1u << 2,  // a line may break before this character
-    kCharAttached = 1u << 3,     // a combining mark, joiner or variation selector: part of the previous cluster
-    kCharCommon = 1u << 4,       // script Common, Inherited or Unknown: follows its neighbours
-    kCharClusterStart = 1u << 5, // a shaped cluster starts here
-    kCharUnsafe = 1u << 6,       // HarfBuzz: breaking before this cluster changes the shaping
+    kCharSpace = 1u << 0,         // breaking white space: hangs at the end of a line
+    kCharTab = 1u << 1,           // U+0009 (also kCharSpace)
+    kCharBreakBefore = 1u << 2,   // a line may break before this character
+    kCharAttached = 1u << 3,      // a combining mark, joiner or variation selector: part of the previous cluster
+    kCharCommon = 1u << 4,        // script Common, Inherited or Unknown: follows its neighbours
+    kCharClusterStart = 1u << 5,  // a shaped cluster starts here
+    kCharUnsafe = 1u << 6,        // HarfBuzz: breaking before this cluster changes the shaping
 };
-
 
 // Mandatory breaks (UAX #14 BK, CR, LF, NL): LF, VT, FF, CR, NEL, U+2028, U+2029.
 inline bool is_hard_break(uint32_t cp) {
@@ -39,9 +38,9 @@ inline bool is_hard_break(uint32_t cp) {
 void classify(std::span<const uint32_t> text, std::span<uint8_t> flags);
 
 struct BidiScratch {
-    std::vector<uint32_t> types;     // FriBidiCharType
-    std::vector<uint32_t> brackets;  // FriBidiBracketType
-    std::vector<signed char> levels; // FriBidiLevel
+    std::vector<uint32_t> types;      // FriBidiCharType
+    std::vector<uint32_t> brackets;   // FriBidiBracketType
+    std::vector<signed char> levels;  // FriBidiLevel
 };
 
 // Embedding levels of one paragraph (UAX #9 up to I2, with L1 for segment separators and the

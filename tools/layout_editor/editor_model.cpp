@@ -12,14 +12,20 @@ namespace {
 constexpr float kLow = -static_cast<float>(kGlyphPadding);
 constexpr float kHigh = 1.0f + static_cast<float>(kGlyphPadding);
 
-float snap(float value) { return std::round(value / kEditStep) * kEditStep; }
+float snap(float value) {
+    return std::round(value / kEditStep) * kEditStep;
+}
 
 float& coordinate_ref(SampleRect& rect, int coordinate) {
     switch (coordinate) {
-        case 0: return rect.x0;
-        case 1: return rect.y0;
-        case 2: return rect.x1;
-        default: return rect.y1;
+        case 0:
+            return rect.x0;
+        case 1:
+            return rect.y0;
+        case 2:
+            return rect.x1;
+        default:
+            return rect.y1;
     }
 }
 
@@ -34,10 +40,14 @@ void shift_span(float& lo, float& hi, float delta) {
 
 float rect_coordinate(const SampleRect& rect, int coordinate) {
     switch (coordinate) {
-        case 0: return rect.x0;
-        case 1: return rect.y0;
-        case 2: return rect.x1;
-        default: return rect.y1;
+        case 0:
+            return rect.x0;
+        case 1:
+            return rect.y0;
+        case 2:
+            return rect.x1;
+        default:
+            return rect.y1;
     }
 }
 
@@ -52,7 +62,9 @@ void LayoutModel::push_undo() {
     redo_.clear();
 }
 
-void LayoutModel::changed() { ++revision_; }
+void LayoutModel::changed() {
+    ++revision_;
+}
 
 void LayoutModel::rename_if_preset() {
     const auto names = subpixel_preset_names();
@@ -100,10 +112,18 @@ void LayoutModel::drag_to(float dx, float dy) {
     dy = snap(dy);
     SampleRect rect = drag_start_;
     switch (drag_handle_) {
-        case Handle::left: rect.x0 = std::clamp(rect.x0 + dx, kLow, rect.x1 - kMinRectSize); break;
-        case Handle::right: rect.x1 = std::clamp(rect.x1 + dx, rect.x0 + kMinRectSize, kHigh); break;
-        case Handle::top: rect.y0 = std::clamp(rect.y0 + dy, kLow, rect.y1 - kMinRectSize); break;
-        case Handle::bottom: rect.y1 = std::clamp(rect.y1 + dy, rect.y0 + kMinRectSize, kHigh); break;
+        case Handle::left:
+            rect.x0 = std::clamp(rect.x0 + dx, kLow, rect.x1 - kMinRectSize);
+            break;
+        case Handle::right:
+            rect.x1 = std::clamp(rect.x1 + dx, rect.x0 + kMinRectSize, kHigh);
+            break;
+        case Handle::top:
+            rect.y0 = std::clamp(rect.y0 + dy, kLow, rect.y1 - kMinRectSize);
+            break;
+        case Handle::bottom:
+            rect.y1 = std::clamp(rect.y1 + dy, rect.y0 + kMinRectSize, kHigh);
+            break;
         case Handle::body:
             shift_span(rect.x0, rect.x1, dx);
             shift_span(rect.y0, rect.y1, dy);

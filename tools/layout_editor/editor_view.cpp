@@ -22,8 +22,8 @@ constexpr float kToolbarY = 10.0f, kButtonHeight = 28.0f;
 constexpr float kPresetX = kMargin, kPresetWidth = 82.0f, kPresetStride = 88.0f;
 constexpr float kCommandX = 736.0f, kCommandWidth = 64.0f, kCommandStride = 70.0f;
 constexpr Rect kPathField{1016.0f, kToolbarY, 248.0f, kButtonHeight};
-constexpr float kFieldsX = 72.0f, kFieldsY = 384.0f, kFieldWidth = 60.0f, kFieldStrideX = 66.0f,
-                kFieldHeight = 26.0f, kFieldStrideY = 30.0f;
+constexpr float kFieldsX = 72.0f, kFieldsY = 384.0f, kFieldWidth = 60.0f, kFieldStrideX = 66.0f, kFieldHeight = 26.0f,
+                kFieldStrideY = 30.0f;
 constexpr Rect kLightPanel{360.0f, 52.0f, 446.0f, 278.0f};
 constexpr Rect kDarkPanel{818.0f, 52.0f, 446.0f, 278.0f};
 constexpr Rect kLightStrip{360.0f, 336.0f, 446.0f, 92.0f};  // the moving line and the fringe test
@@ -56,8 +56,12 @@ constexpr const char* kParagraph =
     "Subpixel text fitted to your own monitor: sharp stems, no fringes. 0123456789 (fi fl)";
 constexpr float kParagraphSizes[] = {9.0f, 11.0f, 13.0f, 16.0f, 20.0f};
 
-Rect preset_button(size_t i) { return {kPresetX + static_cast<float>(i) * kPresetStride, kToolbarY, kPresetWidth, kButtonHeight}; }
-Rect command_button(size_t i) { return {kCommandX + static_cast<float>(i) * kCommandStride, kToolbarY, kCommandWidth, kButtonHeight}; }
+Rect preset_button(size_t i) {
+    return {kPresetX + static_cast<float>(i) * kPresetStride, kToolbarY, kPresetWidth, kButtonHeight};
+}
+Rect command_button(size_t i) {
+    return {kCommandX + static_cast<float>(i) * kCommandStride, kToolbarY, kCommandWidth, kButtonHeight};
+}
 
 Rect channel_rect_on_screen(const SampleRect& rect, float cell_x, float cell_y) {
     return {cell_x + rect.x0 * kMagnifiedPixelScale, cell_y + rect.y0 * kMagnifiedPixelScale,
@@ -86,8 +90,10 @@ void button(Canvas& canvas, std::vector<TextItem>& text, const Rect& rect, const
 }  // namespace
 
 EditorView::EditorView(LayoutModel& model, std::filesystem::path path)
-    : model_(model), path_(path.string()),
-      crop_x_(static_cast<int>(kLightStrip.x) + 4), crop_y_(static_cast<int>(kLightStrip.y) + 30) {}
+    : model_(model),
+      path_(path.string()),
+      crop_x_(static_cast<int>(kLightStrip.x) + 4),
+      crop_y_(static_cast<int>(kLightStrip.y) + 30) {}
 
 std::vector<EditorView::Field> EditorView::fields() const {
     std::vector<Field> out;
@@ -95,7 +101,8 @@ std::vector<EditorView::Field> EditorView::fields() const {
         for (int coordinate = 0; coordinate < 4; ++coordinate) {
             out.push_back({{kFieldsX + static_cast<float>(coordinate) * kFieldStrideX,
                             kFieldsY + static_cast<float>(channel) * kFieldStrideY, kFieldWidth, kFieldHeight},
-                           channel, coordinate});
+                           channel,
+                           coordinate});
         }
     }
     out.push_back({kPathField, -1, 0});
@@ -222,7 +229,9 @@ void EditorView::handle(const InputEvent& event) {
         case InputEvent::Kind::mouse_up:
             if (event.button == GLFW_MOUSE_BUTTON_LEFT) model_.end_drag();
             break;
-        case InputEvent::Kind::key: handle_key(event); break;
+        case InputEvent::Kind::key:
+            handle_key(event);
+            break;
         case InputEvent::Kind::character:
             if (active_field_ >= 0 && event.codepoint >= 0x20 && event.codepoint < 0x7F) {
                 // The first character typed replaces the value shown, as in a selected field.
@@ -263,11 +272,20 @@ void EditorView::handle_key(const InputEvent& event) {
     } else if (!control) {
         const int step = shift ? 8 : 1;
         switch (event.key) {
-            case GLFW_KEY_LEFT: model_.nudge(-step, 0); break;
-            case GLFW_KEY_RIGHT: model_.nudge(step, 0); break;
-            case GLFW_KEY_UP: model_.nudge(0, -step); break;
-            case GLFW_KEY_DOWN: model_.nudge(0, step); break;
-            default: break;
+            case GLFW_KEY_LEFT:
+                model_.nudge(-step, 0);
+                break;
+            case GLFW_KEY_RIGHT:
+                model_.nudge(step, 0);
+                break;
+            case GLFW_KEY_UP:
+                model_.nudge(0, -step);
+                break;
+            case GLFW_KEY_DOWN:
+                model_.nudge(0, step);
+                break;
+            default:
+                break;
         }
     }
 }
@@ -397,7 +415,8 @@ void EditorView::draw_magnified_pixel(Canvas& canvas, std::vector<TextItem>& tex
             canvas.fill({r.x - h, r.y + r.height / 2 - h, 2 * h, 2 * h}, kActive);
             canvas.fill({r.x + r.width - h, r.y + r.height / 2 - h, 2 * h, 2 * h}, kActive);
         }
-        text.push_back({kChannelNames[c], r.x + r.width / 2 - 4.0f, r.y + r.height / 2 + 5.0f, 14.0f, Color{255, 255, 255}});
+        text.push_back(
+            {kChannelNames[c], r.x + r.width / 2 - 4.0f, r.y + r.height / 2 + 5.0f, 14.0f, Color{255, 255, 255}});
     }
 }
 
@@ -418,8 +437,8 @@ void EditorView::draw_fields(Canvas& canvas, std::vector<TextItem>& text) const 
         } else if (field.channel < 0) {
             value = path_.empty() ? "(no file)" : path_;
         } else {
-            value = format_number(rect_coordinate(model_.layout().channels[static_cast<size_t>(field.channel)],
-                                                  field.coordinate));
+            value = format_number(
+                rect_coordinate(model_.layout().channels[static_cast<size_t>(field.channel)], field.coordinate));
         }
         // Long paths show their end, where the file name is.
         const size_t room = field.channel < 0 ? 34 : 9;
@@ -429,7 +448,8 @@ void EditorView::draw_fields(Canvas& canvas, std::vector<TextItem>& text) const 
             const bool selected = field.channel == model_.selected();
             const Rect swatch{kMargin + 8.0f, field.rect.y + 3.0f, 20.0f, 20.0f};
             canvas.fill(swatch, kChannelColors[static_cast<size_t>(field.channel)]);
-            if (selected) canvas.outline({swatch.x - 3, swatch.y - 3, swatch.width + 6, swatch.height + 6}, kActive, 2.0f);
+            if (selected)
+                canvas.outline({swatch.x - 3, swatch.y - 3, swatch.width + 6, swatch.height + 6}, kActive, 2.0f);
         }
     }
 }
@@ -441,7 +461,8 @@ void EditorView::draw_side_text(std::vector<TextItem>& text) const {
                     kMargin, 490.0f, 13.0f, kPanelText});
     float y = 514.0f;
     for (const Message& message : messages_) {
-        text.push_back({cli::printable(message.text), kMargin, y, 11.0f, message.error ? kErrorText : kDimText, 330.0f});
+        text.push_back(
+            {cli::printable(message.text), kMargin, y, 11.0f, message.error ? kErrorText : kDimText, 330.0f});
         y += 28.0f;
     }
     const char* help[] = {
@@ -498,7 +519,8 @@ void EditorView::draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> p
     const float s = static_cast<float>(kRenderedScale);
     for (int py = 0; py < kCropHeight; ++py) {
         for (int px = 0; px < kCropWidth; ++px) {
-            const size_t source = (static_cast<size_t>(crop_y_ + py) * kWindowWidth + static_cast<size_t>(crop_x_ + px)) * 4;
+            const size_t source =
+                (static_cast<size_t>(crop_y_ + py) * kWindowWidth + static_cast<size_t>(crop_x_ + px)) * 4;
             const float cell_x = kRenderedView.x + static_cast<float>(px) * s;
             const float cell_y = kRenderedView.y + static_cast<float>(py) * s;
             for (size_t c = 0; c < 3; ++c) {
@@ -517,7 +539,7 @@ void EditorView::draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> p
 void EditorView::draw_status(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const {
     canvas.fill(kStatusBar, Color{24, 25, 28});
     char line[256];
-    const char* state = stats.glyphs == 0                            ? "no glyphs yet"
+    const char* state = stats.glyphs == 0                           ? "no glyphs yet"
                         : stats.min_samples >= stats.target_samples ? "converged"
                                                                     : "converging";
     char gpu[32] = "GPU -";

@@ -38,8 +38,8 @@ struct TextItem {
 // What the status line reports, measured by the frame loop.
 struct FrameStats {
     uint64_t frame = 0;
-    uint32_t glyphs = 0;        // preview glyphs drawn with samples
-    uint32_t min_samples = 0;   // samples per glyph over the preview's glyphs
+    uint32_t glyphs = 0;       // preview glyphs drawn with samples
+    uint32_t min_samples = 0;  // samples per glyph over the preview's glyphs
     uint32_t max_samples = 0;
     uint32_t target_samples = 0;
     float atlas_occupancy = 0.0f;  // the preview atlas, 0..1
@@ -77,7 +77,7 @@ public:
 private:
     struct Field {
         Rect rect;
-        int channel = -1;     // -1: the file path field
+        int channel = -1;  // -1: the file path field
         int coordinate = 0;
     };
     std::vector<Field> fields() const;

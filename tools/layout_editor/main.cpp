@@ -159,8 +159,9 @@ FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
     bool first = true;
     for (const crisp::DrawnGlyph& glyph : gpu.preview_renderer().drawn()) {
         const uint32_t order = glyph.instance.paint_order;
-        const bool moving = std::any_of(text.moving.begin(), text.moving.end(),
-                                        [&](const auto& range) { return order >= range.first && order < range.second; });
+        const bool moving = std::any_of(text.moving.begin(), text.moving.end(), [&](const auto& range) {
+            return order >= range.first && order < range.second;
+        });
         if (moving) continue;
         stats.min_samples = first ? glyph.samples : std::min(stats.min_samples, glyph.samples);
         stats.max_samples = first ? glyph.samples : std::max(stats.max_samples, glyph.samples);
@@ -173,7 +174,8 @@ FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
 bool write_screenshot(const std::string& path, std::span<const uint8_t> rgba, uint32_t width, uint32_t height) {
     std::vector<float> pixels(size_t{width} * height * 3);
     for (size_t i = 0; i < size_t{width} * height; ++i) {
-        for (size_t c = 0; c < 3; ++c) pixels[i * 3 + c] = crisp::srgb_to_linear(static_cast<float>(rgba[i * 4 + c]) / 255.0f);
+        for (size_t c = 0; c < 3; ++c)
+            pixels[i * 3 + c] = crisp::srgb_to_linear(static_cast<float>(rgba[i * 4 + c]) / 255.0f);
     }
     if (crisp::Status status = crisp::write_png_srgb8(path, width, height, 3, pixels); !status) {
         std::fprintf(stderr, "crisp-layout-editor: --screenshot: %s\n", status.error().message.c_str());
