@@ -2,7 +2,6 @@
 # Every test: installs what is missing, checks the formatting, builds, runs the test suite, runs the
 # CPU tests again under AddressSanitizer + UndefinedBehaviorSanitizer, and runs each fuzz target for
 # a bounded time over its corpus. Set CRISP_FUZZ_SECONDS to change that time (default 20 per target).
-# time over its corpus. Set CRISP_FUZZ_SECONDS to change that time (default 20 per target).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
