@@ -166,11 +166,17 @@ struct CompositeQuad {
     uint key_depth;  // exact mode: depth fixed point, one step nearer per 256 paint-order ranks
     uint rank;       // exact mode: dense rank of the paint order among the quads of its depth plane
     float depth;     // [0, 1], for the WBOIT weight
-    uint padding0;
-    uint padding1;
-    uint padding2;
+    // Its contrast settings (include/crisp/contrast.hpp, GlyphContrast): gamma 1, contrast 0 and
+    // darkening 1 blend its coverage as is.
+    float contrast_gamma;
+    float contrast_k;
+    float contrast_darkening;
     vec4 color;  // linear, straight alpha
 };
+
+// Text and background luminances closer than this blend the corrected coverage as it is (the
+// gamma-space blend's quotient would divide rounding errors by their difference).
+CRISP_CONSTANT(float, kContrastSameLuminance, 1.0e-3f);
 
 struct CompositePushConstants {
     vec4 background;  // linear, premultiplied

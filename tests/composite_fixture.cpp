@@ -29,6 +29,9 @@ Scene render_scene(const std::vector<TextRun>& runs, const char* layout_name, fl
     info.atlas.width = info.atlas.height = 256;
     info.atlas.max_samples = kSamples;
     info.layout = *subpixel_preset(layout_name);
+    // The CPU references these scenes are held to blend coverage as it is; the contrast model is
+    // held to its own reference (test_contrast.cpp).
+    info.contrast.mode = ContrastMode::linear;
     auto renderer = Renderer::create(info);
     EXPECT_TRUE(renderer) << (renderer ? "" : renderer.error().message);
     scene.renderer = std::make_unique<Renderer>(std::move(*renderer));

@@ -25,6 +25,7 @@
 #include <crisp/export.hpp>
 
 #include <crisp/atlas.hpp>
+#include <crisp/contrast.hpp>
 #include <crisp/device_features.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
@@ -105,6 +106,10 @@ struct RendererCreateInfo {
     // Row samples by default; points to measure against. Any other value: create() returns
     // invalid_argument.
     SampleKind sample_kind = SampleKind::rows;
+    // How the compositor blends the glyphs' coverage over what is behind them (contrast.hpp): the
+    // contrast model by default, ContrastMode::linear for coverage as it is. It changes no atlas
+    // texel. A setting validate_text_contrast() refuses fails create() (invalid_argument).
+    TextContrast contrast;
 };
 
 // How one draw() call shows its glyphs, without a new layout: where, in which colour, at which depth,
@@ -133,6 +138,9 @@ struct DrawOptions {
     // instead of starting over in a new entry every frame. Once it rests, it returns to the fine
     // steps. Counted in RendererStats::moving_glyphs.
     uint64_t id = 0;
+    // Contrast settings for these glyphs instead of the renderer's (set_contrast()). A setting
+    // validate_text_contrast() refuses draws nothing (skipped_glyphs).
+    std::optional<TextContrast> contrast;
 };
 
 // Subpixel steps per pixel of moving text (DrawOptions::id).
@@ -154,6 +162,9 @@ struct DrawnGlyph {
                            // a split sample in progress hold one more)
     uint32_t part_x = 0;
     uint32_t part_y = 0;
+    // How the compositor blends its coverage (RendererCreateInfo::contrast, DrawOptions::contrast),
+    // resolved for its size; a DrawnGlyph made by hand is linear unless it says otherwise.
+    GlyphContrast contrast;
 };
 
 // What a recorded frame hands the compositor (Renderer::drawn_frame(), Compositor::record()): the
@@ -239,6 +250,11 @@ public:
     const SubpixelLayout& subpixel_layout() const;
     // What each sample is (RendererCreateInfo::sample_kind), fixed at create().
     SampleKind sample_kind() const;
+    // Replaces the contrast settings of draws whose options give none, from the next draw() on.
+    // The atlas is untouched: only compositing changes. A setting validate_text_contrast() refuses
+    // is refused (invalid_argument) and the old one stays.
+    Status set_contrast(const TextContrast& contrast);
+    const TextContrast& contrast() const;
 
     // Starts a frame: unpins the atlas and forgets last frame's drawn glyphs.
     void begin_frame();

@@ -21,6 +21,7 @@ layout(std430, set = 0, binding = kCompositeBindQuads) readonly buffer Quads {
 };
 
 #include "atlas/atlas_texel.glsl"
+#include "contrast.glsl"
 
 #ifdef CRISP_COMPUTE
 // Per tile: the quad's index, and the tile's top-left texel in the quad's rect (x | y << 16).
@@ -59,7 +60,13 @@ bool load_fragment(out GlyphFragment f) {
 #endif
     f.pixel = uint(pixel.y) * pc.width + uint(pixel.x);
     // A rect that does not lie in the atlas (not from Renderer::drawn()) draws nothing there.
-    if (!glyph_texel_opacity(f.quad, pixel, f.opacity)) return false;
+    vec3 coverage;
+    if (!glyph_texel_coverage(f.quad, pixel, coverage)) return false;
+    // The contrast model against the background these passes cannot read (contrast.glsl).
+    const float lt = contrast_luminance(f.quad.color.rgb);
+    coverage = corrected_coverage(coverage, f.quad.contrast_gamma, f.quad.contrast_k, f.quad.contrast_darkening, lt,
+                                  assumed_background_luminance(lt));
+    f.opacity = f.quad.color.a * coverage;
     f.transmittance = 1.0 - f.opacity;
     f.light = f.quad.color.rgb * f.opacity;
     return true;

@@ -32,6 +32,9 @@ layout(constant_id = 3) const uint kSwapRedBlue = 0u;
 // 0: the exact pass over the busy tiles; 1: the layered pass over the tiles it could not take.
 // Separate pipelines, so that each is compiled with only its own registers.
 layout(constant_id = 4) const uint kLayeredPass = 0u;
+// 1: some quad's coverage is corrected (contrast.glsl) against the luminance of the caller's pixel.
+// Linear frames use the pipelines made with 0, which carry none of its registers.
+layout(constant_id = 5) const uint kContrast = 0u;
 
 layout(set = 0, binding = kTileBindAtlas, rgba16ui) uniform readonly uimage2D atlas;
 #ifdef CRISP_TARGET_FORMAT
@@ -41,6 +44,7 @@ layout(set = 0, binding = kTileBindTarget) uniform image2D target;
 #endif
 
 #include "atlas/atlas_texel.glsl"
+#include "contrast.glsl"
 
 shared uint unsorted[kCapacity];  // the keys of the tile's list as the scatter left it
 shared uint list[kCapacity];      // ... sorted, as positions in that list
@@ -49,6 +53,8 @@ shared uint list[kCapacity];      // ... sorted, as positions in that list
 shared uint chunk_rect[kTileChunk];
 shared ivec2 chunk_texel[kTileChunk];
 shared vec4 chunk_colour[kTileChunk];
+// With kContrast: per staged quad its gamma, contrast and darkening, and its colour's luminance.
+shared vec4 chunk_contrast[kTileChunk];
 shared uint tile_overlap;
 shared uint tile_tail_pixels;
 shared uint tile_busy_pixels;  // pixels of the tile still walking
@@ -66,6 +72,11 @@ void stage_entry(uint slot, TileBinEntry e) {
     chunk_rect[slot] = e.rect;
     chunk_texel[slot] = ivec2(e.texel_x, e.texel_y);
     chunk_colour[slot] = e.color;
+    if (kContrast != 0u) {
+        const CompositeQuad q = quads[e.quad];
+        chunk_contrast[slot] =
+            vec4(q.contrast_gamma, q.contrast_k, q.contrast_darkening, contrast_luminance(e.color.rgb));
+    }
 }
 
 // Entry i's place in the sorted list: the number of keys smaller than its own (a quad is in a
@@ -104,12 +115,20 @@ void sort_list(uint start, uint count) {
 
 // Quad `index`'s opacity at the pixel; false where it draws nothing there (outside its rect, no
 // samples, or no opacity in any channel: such a fragment would change nothing).
-bool quad_opacity(uint index, ivec2 pixel, out vec3 opacity, out vec3 colour) {
+bool quad_opacity(uint index, ivec2 pixel, float background_luminance, out vec3 opacity, out vec3 colour) {
     const CompositeQuad q = quads[index];
     if (pixel.x < q.x || pixel.y < q.y || pixel.x - q.x >= int(q.width) || pixel.y - q.y >= int(q.height)) {
         return false;
     }
-    if (!glyph_texel_opacity(q, pixel, opacity)) return false;
+    if (kContrast == 0u) {
+        if (!glyph_texel_opacity(q, pixel, opacity)) return false;
+    } else {
+        vec3 coverage;
+        if (!glyph_texel_coverage(q, pixel, coverage)) return false;
+        coverage = corrected_coverage(coverage, q.contrast_gamma, q.contrast_k, q.contrast_darkening,
+                                      contrast_luminance(q.color.rgb), background_luminance);
+        opacity = q.color.a * coverage;
+    }
     colour = q.color.rgb;
     return any(greaterThan(opacity, vec3(0.0)));
 }
@@ -131,7 +150,7 @@ void blend_over(inout Blend b, vec3 opacity, vec3 colour) {
 // chunk by the sort itself), walked front to back by every pixel; the workgroup stops after a
 // chunk once every pixel's transmittance is spent. Inside a chunk the walk carries no early exit,
 // so that the texel loads of successive quads do not wait on each other.
-Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) {
+Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside, float background_luminance) {
     if (gl_LocalInvocationIndex == 0u) tile_busy_pixels = 0u;
     sort_list(start, count);  // its barriers also order tile_busy_pixels' reset before the adds
     Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
@@ -160,8 +179,12 @@ Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) 
                 const uvec4 sums = imageLoad(atlas, texel);
                 if (sums.a == 0u) continue;
                 const vec4 colour = chunk_colour[j];
-                const vec3 opacity =
-                    colour.a * min(vec3(sums.rgb) / (float(kRasterCoverageOne) * float(sums.a)), vec3(1.0));
+                vec3 coverage = min(vec3(sums.rgb) / (float(kRasterCoverageOne) * float(sums.a)), vec3(1.0));
+                if (kContrast != 0u) {
+                    const vec4 c = chunk_contrast[j];
+                    coverage = corrected_coverage(coverage, c.x, c.y, c.z, c.w, background_luminance);
+                }
+                const vec3 opacity = colour.a * coverage;
                 if (!any(greaterThan(opacity, vec3(0.0)))) continue;
                 blend_over(b, opacity, colour.rgb);
                 ++b.fragments;
@@ -179,7 +202,7 @@ Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside) 
     return b;
 }
 
-Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, out bool tail) {
+Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, float background_luminance, out bool tail) {
     Blend b = Blend(vec3(0.0), vec3(1.0), 1.0, 0u);
     tail = false;
     if (!inside) return b;
@@ -193,7 +216,7 @@ Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, out bool tai
     for (uint i = 0u; i < count; ++i) {
         uint candidate = bins[start + i].quad;
         vec3 opacity, colour;
-        if (!quad_opacity(candidate, pixel, opacity, colour)) continue;
+        if (!quad_opacity(candidate, pixel, background_luminance, opacity, colour)) continue;
         ++b.fragments;
         // The compare-and-swap chain keeps the K smallest indices sorted; what is left falls off.
         for (uint s = 0u; s < kLayers; ++s) {
@@ -205,7 +228,7 @@ Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, out bool tai
         }
         if (candidate == kTileNoQuad) continue;
         tail = true;
-        quad_opacity(candidate, pixel, opacity, colour);
+        quad_opacity(candidate, pixel, background_luminance, opacity, colour);
         const vec3 transmittance = 1.0 - opacity;
         opaque = bvec3(uvec3(opaque) | uvec3(equal(transmittance, vec3(0.0))));
         const vec3 a = min(-log(max(transmittance, vec3(1e-30))), vec3(kCompositeMaxAbsorbance));
@@ -215,7 +238,7 @@ Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, out bool tai
     }
     for (uint s = 0u; s < kLayers; ++s) {
         vec3 opacity, colour;
-        if (slots[s] != kTileNoQuad && quad_opacity(slots[s], pixel, opacity, colour)) blend_over(b, opacity, colour);
+        if (slots[s] != kTileNoQuad && quad_opacity(slots[s], pixel, background_luminance, opacity, colour)) blend_over(b, opacity, colour);
     }
     if (tail) {
         // absorbance_share: the tail absorbs 1 - P of what reaches it, P = exp(-A) (0 where a tail
@@ -227,6 +250,21 @@ Blend layered_way(uint start, uint count, ivec2 pixel, bool inside, out bool tai
         b.coverage_transmittance *= tail_coverage;
     }
     return b;
+}
+
+// The caller's pixel, in linear colour.
+vec4 load_destination(ivec2 at) {
+    vec4 destination = imageLoad(target, at);
+    if (kSwapRedBlue != 0u) destination = destination.bgra;
+    if (kEncode == kTileEncodeSrgb) destination.rgb = srgb_to_linear(destination.rgb);
+    return destination;
+}
+
+// The luminance the contrast model corrects against: the caller's pixel before any glyph, read
+// only by the contrast passes (0 otherwise, unused).
+float background_luminance(ivec2 pixel, bool inside) {
+    if (kContrast == 0u || !inside) return 0.0;
+    return contrast_luminance(load_destination(pixel + ivec2(pc.origin_x, pc.origin_y)).rgb);
 }
 
 // The pixel's result into the caller's image, and the tile's statistics: one workgroup-memory
@@ -246,9 +284,7 @@ void finish_tile(ivec2 pixel, Blend b, bool tail) {
     }
     if (b.fragments > 0u) {
         const ivec2 at = pixel + ivec2(pc.origin_x, pc.origin_y);
-        vec4 destination = imageLoad(target, at);
-        if (kSwapRedBlue != 0u) destination = destination.bgra;
-        if (kEncode == kTileEncodeSrgb) destination.rgb = srgb_to_linear(destination.rgb);
+        const vec4 destination = load_destination(at);
         vec3 colour = b.light + b.transmittance * destination.rgb;
         const float alpha = 1.0 - (1.0 - destination.a) * b.coverage_transmittance;
         if (kEncode == kTileEncodeSrgb) colour = linear_to_srgb(colour);
@@ -293,7 +329,8 @@ void exact_pass() {
     }
     ivec2 corner, pixel;
     const bool inside = tile_pixel(tile, corner, pixel);
-    finish_tile(pixel, exact_way(start, count, corner, pixel, inside), false);
+    const float lb = background_luminance(pixel, inside);
+    finish_tile(pixel, exact_way(start, count, corner, pixel, inside, lb), false);
 }
 
 // The layered pass: the overflow list's tiles, workgroup i taking i, i + kRasterDispatchWidth, ...
@@ -304,7 +341,8 @@ void layered_pass() {
         ivec2 corner, pixel;
         const bool inside = tile_pixel(tile, corner, pixel);
         bool tail = false;
-        const Blend b = layered_way(tile_words[tile_total() + tile], tile_words[tile], pixel, inside, tail);
+        const float lb = background_luminance(pixel, inside);
+        const Blend b = layered_way(tile_words[tile_total() + tile], tile_words[tile], pixel, inside, lb, tail);
         finish_tile(pixel, b, tail);
     }
 }

@@ -31,6 +31,14 @@ gpu::CompositeQuad make_quad(const DrawnGlyph& glyph) {
     q.depth = clamp01(instance.depth);
     q.color = {clamp01(instance.color[0]), clamp01(instance.color[1]), clamp01(instance.color[2]),
                clamp01(instance.color[3])};
+    // Settings outside the ranges resolve_contrast() gives (a DrawnGlyph made by hand) blend as is.
+    const GlyphContrast& c = glyph.contrast;
+    const bool valid = c.gamma >= 1.0f && c.gamma <= 4.0f && c.contrast >= 0.0f && c.contrast <= 4.0f &&
+                       c.darkening >= 1.0f && c.darkening <= kMaxStemDarkeningFactor;
+    const GlyphContrast used = valid ? c : GlyphContrast{};
+    q.contrast_gamma = used.gamma;
+    q.contrast_k = used.contrast;
+    q.contrast_darkening = used.darkening;
     return q;
 }
 

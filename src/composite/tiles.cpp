@@ -80,30 +80,17 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     slots_.resize(config.frames_in_flight);
     for (uint32_t i = 0; i < config.frames_in_flight; ++i) slots_[i].set = descriptors_.sets[i];
 
-    // `label` names the pipeline in errors and shader statistics: the shader, and which of its
-    // specializations where it has several.
-    auto pipeline = [&](const char* shader, const VkSpecializationInfo* specialization, const std::string& label,
-                        VkPipeline& out) -> Status {
-        Result<VkShaderModule> module = vk::create_embedded_shader(ref_, shader);
-        if (!module) return module.error();
-        objects_.keep(ref_, *module);
-        Result<VkPipeline> made =
-            vk::create_compute_pipeline(ref_, *module, descriptors_.pipeline_layout, specialization, label.c_str());
-        if (!made) return made.error();
-        out = objects_.keep(ref_, *made);
-        return {};
-    };
     const uint32_t scatter = 1;
     const VkSpecializationMapEntry scatter_entry{0, 0, 4};
     const VkSpecializationInfo scatter_info{1, &scatter_entry, 4, &scatter};
-    if (Status s = pipeline("tiles_bin.comp", nullptr, "tiles_bin.comp (count)", count_); !s) return s;
-    if (Status s = pipeline("tiles_bin.comp", &scatter_info, "tiles_bin.comp (scatter)", scatter_); !s) return s;
+    if (Status s = make_pipeline("tiles_bin.comp", nullptr, "tiles_bin.comp (count)", count_); !s) return s;
+    if (Status s = make_pipeline("tiles_bin.comp", &scatter_info, "tiles_bin.comp (scatter)", scatter_); !s) return s;
     for (uint32_t phase = 0; phase < scan_.size(); ++phase) {
         const VkSpecializationMapEntry phase_entry{0, 0, 4};
         const VkSpecializationInfo phase_info{1, &phase_entry, 4, &phase};
         constexpr const char* kPhases[] = {"reduce", "blocks", "down"};
-        if (Status s = pipeline("tiles_scan.comp", &phase_info, std::string("tiles_scan.comp (") + kPhases[phase] + ")",
-                                scan_[phase]);
+        if (Status s = make_pipeline("tiles_scan.comp", &phase_info,
+                                     std::string("tiles_scan.comp (") + kPhases[phase] + ")", scan_[phase]);
             !s)
             return s;
     }
@@ -114,18 +101,41 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
         ref_.fn->vkGetPhysicalDeviceFormatProperties(config.physical_device, variant.view, &properties);
         if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT) == 0) continue;
         if (std::string_view(variant.shader) == "tiles_pass_any.comp" && !config.storage_without_format) continue;
-        // constant_id 0: K; 1: the target's encoding; 2: the list capacity; 3: red and blue swap;
-        // 4: the pass (exact, layered).
-        for (uint32_t pass = 0; pass < 2; ++pass) {
-            const uint32_t constants[5] = {
-                config.layers, is_srgb_encoded(variant.image) ? gpu::kTileEncodeSrgb : gpu::kTileEncodeLinear,
-                config.capacity, variant.image != variant.view ? 1u : 0u, pass};
-            const VkSpecializationMapEntry entries[5] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {4, 16, 4}};
-            const VkSpecializationInfo specialization{5, entries, sizeof(constants), constants};
-            const std::string label = std::string(variant.shader) + (pass == 0 ? " (exact pass)" : " (layered pass)") +
-                                      (variant.image != variant.view ? ", red and blue swapped" : "");
-            if (Status s = pipeline(variant.shader, &specialization, label, tile_pipelines_[i][pass]); !s) return s;
-        }
+        if (Status s = make_tile_passes(i, 0, tile_pipelines_[i]); !s) return s;
+    }
+    return {};
+}
+
+Status TileCompositor::make_pipeline(const char* shader, const VkSpecializationInfo* specialization,
+                                     const std::string& label, VkPipeline& out) {
+    Result<VkShaderModule> module = vk::create_embedded_shader(ref_, shader);
+    if (!module) return module.error();
+    objects_.keep(ref_, *module);
+    Result<VkPipeline> made =
+        vk::create_compute_pipeline(ref_, *module, descriptors_.pipeline_layout, specialization, label.c_str());
+    if (!made) return made.error();
+    out = objects_.keep(ref_, *made);
+    return {};
+}
+
+Status TileCompositor::make_tile_passes(size_t index, uint32_t contrast, std::array<VkPipeline, 2>& out) {
+    const TileVariant& variant = kTileVariants[index];
+    // constant_id 0: K; 1: the target's encoding; 2: the list capacity; 3: red and blue swap;
+    // 4: the pass (exact, layered); 5: the contrast model.
+    for (uint32_t pass = 0; pass < 2; ++pass) {
+        const uint32_t constants[6] = {config_.layers,
+                                       is_srgb_encoded(variant.image) ? gpu::kTileEncodeSrgb : gpu::kTileEncodeLinear,
+                                       config_.capacity,
+                                       variant.image != variant.view ? 1u : 0u,
+                                       pass,
+                                       contrast};
+        const VkSpecializationMapEntry entries[6] = {{0, 0, 4},  {1, 4, 4},  {2, 8, 4},
+                                                     {3, 12, 4}, {4, 16, 4}, {5, 20, 4}};
+        const VkSpecializationInfo specialization{6, entries, sizeof(constants), constants};
+        const std::string label = std::string(variant.shader) + (pass == 0 ? " (exact pass)" : " (layered pass)") +
+                                  (variant.image != variant.view ? ", red and blue swapped" : "") +
+                                  (contrast != 0 ? ", contrast" : "");
+        if (Status s = make_pipeline(variant.shader, &specialization, label, out[pass]); !s) return s;
     }
     return {};
 }
@@ -312,8 +322,17 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
         slot.binned_height = push.height;
         slot.bins_valid = true;
     }
+    // The contrast model's passes only for frames that correct some glyph: linear frames keep the
+    // passes, registers and speed they had without it.
+    const size_t variant = variant_index(target.format, target.view_format);
+    const bool corrected = std::any_of(quads.begin(), quads.end(), [](const gpu::CompositeQuad& q) {
+        return q.contrast_gamma != 1.0f || q.contrast_k != 0.0f || q.contrast_darkening != 1.0f;
+    });
+    if (corrected && contrast_pipelines_[variant][0] == VK_NULL_HANDLE) {
+        if (Status s = make_tile_passes(variant, 1, contrast_pipelines_[variant]); !s) return s.error();
+    }
     write_descriptors(slot, atlas_view, target.view);
-    record_passes(command_buffer, slot, tile_pipelines_[variant_index(target.format, target.view_format)], push,
+    record_passes(command_buffer, slot, corrected ? contrast_pipelines_[variant] : tile_pipelines_[variant], push,
                   reused);
     ++frame_;
     slot.pending = true;

@@ -112,6 +112,13 @@ private:
     void reset_header(const Slot& slot, bool reuse_bins);
     void record_passes(VkCommandBuffer command_buffer, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
                        const gpu::TilePushConstants& push, bool reuse_bins);
+    // `label` names the pipeline in errors and shader statistics: the shader, and which of its
+    // specializations where it has several.
+    Status make_pipeline(const char* shader, const VkSpecializationInfo* specialization, const std::string& label,
+                         VkPipeline& out);
+    // The exact and layered passes of variant `variant`, with the contrast model (contrast 1) or
+    // without it (0).
+    Status make_tile_passes(size_t variant, uint32_t contrast, std::array<VkPipeline, 2>& out);
 
     vk::DeviceRef ref_;
     TileConfig config_;
@@ -121,6 +128,8 @@ private:
     VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
     std::array<VkPipeline, 3> scan_{};                                              // reduce, blocks, down
     std::array<std::array<VkPipeline, 2>, kTileVariants.size()> tile_pipelines_{};  // exact, layered pass
+    // The same with the contrast model, made at the first frame that has a corrected glyph.
+    std::array<std::array<VkPipeline, 2>, kTileVariants.size()> contrast_pipelines_{};
     std::vector<Slot> slots_;
     uint64_t frame_ = 0;
     bool recorded_ = false;     // record() since the last abandon_frame()

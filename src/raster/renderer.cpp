@@ -50,7 +50,9 @@ struct CRISP_HIDDEN Renderer::State {
           fonts(context->ref, context->properties.limits.maxStorageBufferRange),
           requests(atlas, fonts, coarsening, stats),
           image(context->ref),
-          raster(context->ref, {info.frames_in_flight, info.shared_row_roots, info.sample_kind}) {}
+          raster(context->ref, {info.frames_in_flight, info.shared_row_roots, info.sample_kind}) {
+        requests.set_contrast(info.contrast);
+    }
 
     Status prepare_atlas_image(VkCommandBuffer command_buffer, uint64_t this_frame);
 };
@@ -71,6 +73,9 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
         return Error{ErrorCode::invalid_argument, "renderer: sample_kind " +
                                                       std::to_string(static_cast<uint32_t>(info.sample_kind)) +
                                                       " is neither rows (0) nor points (1)"};
+    }
+    if (Status s = validate_text_contrast(info.contrast); !s) {
+        return Error{ErrorCode::invalid_argument, "renderer: " + s.error().message};
     }
     SubpixelLayout subpixel = info.layout;
     if (subpixel.name.empty() && subpixel == SubpixelLayout{}) subpixel = *subpixel_preset("rgb");
@@ -140,6 +145,16 @@ const SubpixelLayout& Renderer::subpixel_layout() const {
 
 SampleKind Renderer::sample_kind() const {
     return state_->sample_kind;
+}
+
+Status Renderer::set_contrast(const TextContrast& contrast) {
+    if (Status s = validate_text_contrast(contrast); !s) return s;
+    state_->requests.set_contrast(contrast);
+    return {};
+}
+
+const TextContrast& Renderer::contrast() const {
+    return state_->requests.contrast();
 }
 
 void Renderer::abandon_frame() {

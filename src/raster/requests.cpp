@@ -90,14 +90,20 @@ void FrameRequests::begin_frame() {
 }
 
 void FrameRequests::add(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps) {
-    requests_.push_back({glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps});
-    request(glyph, visible, steps);
+    add(glyph, visible, steps, contrast_);
+}
+
+void FrameRequests::add(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps,
+                        const TextContrast& contrast) {
+    const GlyphContrast resolved = resolve_contrast(contrast, static_cast<float>(glyph.key.size_x) / 256.0f);
+    requests_.push_back({glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps, resolved});
+    request(glyph, visible, steps, resolved);
 }
 
 void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions& options, MotionTracker& motion) {
     if (glyphs.empty()) return;
     const double dx = static_cast<double>(options.offset_x), dy = static_cast<double>(options.offset_y);
-    if (!std::isfinite(dx) || !std::isfinite(dy)) {
+    if (!std::isfinite(dx) || !std::isfinite(dy) || (options.contrast && !validate_text_contrast(*options.contrast))) {
         const auto count = static_cast<uint32_t>(std::min<size_t>(glyphs.size(), UINT32_MAX));
         stats_.skipped_glyphs += count;
         unplaceable_ += count;
@@ -129,17 +135,18 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
         }
         if (options.color) std::copy(std::begin(color), std::end(color), std::begin(glyph.color));
         if (options.depth) glyph.depth = *options.depth;
-        add(glyph, visible, steps);
+        add(glyph, visible, steps, options.contrast ? *options.contrast : contrast_);
     }
 }
 
 // One draw()n instance: at the frame's subpixel steps, then culled, acquired whole, or kept
 // for acquire_clipped() with its visible part.
-void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps) {
+void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps,
+                            const GlyphContrast& contrast) {
     const GlyphInstance glyph = coarsened(fonts_.asset(asked.key.font), asked, std::min(coarsening_.steps(), steps));
     if (glyph.key != asked.key) ++stats_.coarsened_glyphs;
     if (!visible) {
-        acquire(glyph, TexelRect{0, 0, glyph.width, glyph.height});
+        acquire(glyph, TexelRect{0, 0, glyph.width, glyph.height}, contrast);
         return;
     }
     if (glyph.width == 0 || glyph.height == 0) return;
@@ -156,17 +163,18 @@ void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible,
     const TexelRect part{static_cast<uint32_t>(x0), static_cast<uint32_t>(y0), static_cast<uint32_t>(x1 - x0),
                          static_cast<uint32_t>(y1 - y0)};
     if (part.width == glyph.width && part.height == glyph.height) {
-        acquire(glyph, part);
+        acquire(glyph, part, contrast);
     } else {
         ++stats_.clipped_glyphs;
-        clipped_.push_back({glyph, part});
+        clipped_.push_back({glyph, part, contrast});
     }
 }
 
 // Finds or places `glyph` with `part` of its rect visible and adds it to the pending glyphs.
 // `shown` (within `part`; nullptr: all the atlas holds) is what drawn() reports of it: a
 // clipped glyph shows only its visible texels, though the atlas holds a margin around them.
-void FrameRequests::acquire(const GlyphInstance& glyph, const TexelRect& part, const TexelRect* shown) {
+void FrameRequests::acquire(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
+                            const TexelRect* shown) {
     if (glyph.width == 0 || glyph.height == 0) return;
     const FontAsset* asset = fonts_.asset(glyph.key.font);
     if (!asset) {
@@ -189,7 +197,8 @@ void FrameRequests::acquire(const GlyphInstance& glyph, const TexelRect& part, c
             if (x0 >= x1 || y0 >= y1) return;
             show = {x0, y0, x1 - x0, y1 - y0};
         }
-        DrawnGlyph placed{glyph, lookup.x + (show.x - held.x), lookup.y + (show.y - held.y), 0, show.x, show.y};
+        DrawnGlyph placed{glyph,   lookup.x + (show.x - held.x), lookup.y + (show.y - held.y), 0, show.x, show.y,
+                          contrast};
         placed.instance.x += static_cast<int32_t>(show.x);
         placed.instance.y += static_cast<int32_t>(show.y);
         placed.instance.width = show.width;
@@ -227,7 +236,7 @@ void FrameRequests::acquire_clipped() {
         box.width = x1 - box.x;
         box.height = y1 - box.y;
     }
-    for (const Clipped& c : clipped_) acquire(c.glyph, clipped_parts_.at(c.glyph.key), &c.part);
+    for (const Clipped& c : clipped_) acquire(c.glyph, clipped_parts_.at(c.glyph.key), c.contrast, &c.part);
     clipped_.clear();
 }
 
@@ -250,7 +259,7 @@ void FrameRequests::settle(const AtlasLimits& limits) {
         stats_.atlas_grown = grown;
         stats_.skipped_glyphs = unplaceable_;
         atlas_full_ = 0;
-        for (const Request& r : requests_) request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps);
+        for (const Request& r : requests_) request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps, r.contrast);
         acquire_clipped();
     }
     stats_.subpixel_steps = coarsening_.steps();

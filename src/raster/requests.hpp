@@ -58,6 +58,7 @@ public:
     // One draw()n instance, at the frame's subpixel steps or `steps` (moving text: fewer) where
     // fewer; `visible` (null: all) is what of the target can be seen.
     void add(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps);
+    void add(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps, const TextContrast& contrast);
     // draw(glyphs, options): moved, recoloured and at their depth; named draws' motion in `motion`.
     void add(std::span<const GlyphInstance> glyphs, const DrawOptions& options, MotionTracker& motion);
     // After the frame's draws: where the atlas had no room for some glyph, the frame starts over
@@ -70,6 +71,10 @@ public:
     // The frame's drawn glyphs are forgotten, and the next frame is not converged.
     void abandon_frame();
 
+    // The contrast of draws whose options give none (RendererCreateInfo::contrast; valid).
+    void set_contrast(const TextContrast& contrast) { contrast_ = contrast; }
+    const TextContrast& contrast() const { return contrast_; }
+
     std::span<const DrawnGlyph> drawn() const { return drawn_; }
     bool converged() const { return converged_; }
 
@@ -79,6 +84,7 @@ private:
         bool has_visible = false;
         VkRect2D visible{};
         uint32_t steps = kSubpixelSteps;  // the finest subpixel steps it may take (moving text: fewer)
+        GlyphContrast contrast;           // the draw's, resolved for the glyph's size
     };
     struct Pending {
         DrawnGlyph glyph;
@@ -87,10 +93,12 @@ private:
     struct Clipped {
         GlyphInstance glyph;
         TexelRect part;  // visible texels of its rect
+        GlyphContrast contrast;
     };
 
-    void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps);
-    void acquire(const GlyphInstance& glyph, const TexelRect& part, const TexelRect* shown = nullptr);
+    void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps, const GlyphContrast& contrast);
+    void acquire(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
+                 const TexelRect* shown = nullptr);
     AtlasLookup place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part);
     void acquire_clipped();
 
@@ -104,6 +112,7 @@ private:
     std::unordered_map<GlyphKey, TexelRect, GlyphKeyHash> clipped_parts_;  // scratch: bounding parts
     std::vector<DrawnGlyph> drawn_;
     bool converged_ = true;
+    TextContrast contrast_;
     uint32_t atlas_full_ = 0;   // instances refused as atlas_full this frame
     uint32_t unplaceable_ = 0;  // instances draw() could not move (a pen out of range)
 };
