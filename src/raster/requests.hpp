@@ -90,9 +90,9 @@ private:
     };
 
     void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps);
-    void acquire(const GlyphInstance& glyph, const TexelRect& part, const TexelRect* shown = nullptr);
-    AtlasLookup place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part);
-    void acquire_clipped();
+    void admit(const GlyphInstance& glyph, const TexelRect& part, const TexelRect* shown = nullptr);
+    AtlasLookup look_up_or_place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part);
+    void admit_clipped();
 
     GlyphAtlas& atlas_;
     const HeldFonts& fonts_;
@@ -100,7 +100,7 @@ private:
     RendererStats& stats_;
     std::vector<Request> requests_;  // this frame's draw()n instances, as asked
     std::vector<Pending> pending_;   // draw()n this frame, before record() knows their samples
-    std::vector<Clipped> clipped_;   // draw()n partly visible, acquired in record()
+    std::vector<Clipped> clipped_;   // draw()n partly visible, admitted in record()
     std::unordered_map<GlyphKey, TexelRect, GlyphKeyHash> clipped_parts_;  // scratch: bounding parts
     std::vector<DrawnGlyph> drawn_;
     bool converged_ = true;
