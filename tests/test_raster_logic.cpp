@@ -155,7 +155,7 @@ TEST(RasterRequests, MovedFollowsThePenAndRefusesBadOnes) {
     glyph = base;
     EXPECT_TRUE(raster::moved(asset, glyph, 16777000.0 - static_cast<double>(base.pen_x), 0.0));
     glyph = base;
-    EXPECT_TRUE(raster::moved(nullptr, glyph, 5.0, 5.0));  // acquire() counts it as an unknown font
+    EXPECT_TRUE(raster::moved(nullptr, glyph, 5.0, 5.0));  // admit() counts it as an unknown font
     EXPECT_EQ(glyph.x, base.x);
 
     // draw() with such an offset draws nothing, counted as skipped, also when the frame starts over.

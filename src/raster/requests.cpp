@@ -8,7 +8,7 @@ namespace crisp::raster {
 
 bool moved(const FontAsset* asset, GlyphInstance& glyph, double dx, double dy) {
     if (dx == 0.0 && dy == 0.0) return true;
-    if (!asset) return true;  // acquire() counts it
+    if (!asset) return true;  // admit() counts it
     if (glyph.key.glyph >= asset->glyphs.size()) return true;
     const GlyphRecord& record = asset->glyphs[glyph.key.glyph];
     const GlyphRect old_rect = glyph_rect(record, glyph.key);
@@ -139,14 +139,14 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
     }
 }
 
-// One draw()n instance: at the frame's subpixel steps, then culled, acquired whole, or kept
-// for acquire_clipped() with its visible part.
+// One draw()n instance: at the frame's subpixel steps, then culled, admitted whole, or kept
+// for admit_clipped() with its visible part.
 void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps,
                             const GlyphContrast& contrast) {
     const GlyphInstance glyph = coarsened(fonts_.asset(asked.key.font), asked, std::min(coarsening_.steps(), steps));
     if (glyph.key != asked.key) ++stats_.coarsened_glyphs;
     if (!visible) {
-        acquire(glyph, TexelRect{0, 0, glyph.width, glyph.height}, contrast);
+        admit(glyph, TexelRect{0, 0, glyph.width, glyph.height}, contrast);
         return;
     }
     if (glyph.width == 0 || glyph.height == 0) return;
@@ -163,18 +163,19 @@ void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible,
     const TexelRect part{static_cast<uint32_t>(x0), static_cast<uint32_t>(y0), static_cast<uint32_t>(x1 - x0),
                          static_cast<uint32_t>(y1 - y0)};
     if (part.width == glyph.width && part.height == glyph.height) {
-        acquire(glyph, part, contrast);
+        admit(glyph, part, contrast);
     } else {
         ++stats_.clipped_glyphs;
         clipped_.push_back({glyph, part, contrast});
     }
 }
 
-// Finds or places `glyph` with `part` of its rect visible and adds it to the pending glyphs.
+// Finds or places `glyph` in the atlas with `part` of its rect visible and adds it to the
+// frame's pending glyphs.
 // `shown` (within `part`; nullptr: all the atlas holds) is what drawn() reports of it: a
 // clipped glyph shows only its visible texels, though the atlas holds a margin around them.
-void FrameRequests::acquire(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
-                            const TexelRect* shown) {
+void FrameRequests::admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
+                          const TexelRect* shown) {
     if (glyph.width == 0 || glyph.height == 0) return;
     const FontAsset* asset = fonts_.asset(glyph.key.font);
     if (!asset) {
@@ -186,7 +187,7 @@ void FrameRequests::acquire(const GlyphInstance& glyph, const TexelRect& part, c
         ++stats_.skipped_glyphs;
         return;
     }
-    const AtlasLookup lookup = place(*asset, glyph, part);
+    const AtlasLookup lookup = look_up_or_place(*asset, glyph, part);
     if (lookup.status == AtlasStatus::placed) {
         const TexelRect& held = lookup.part;
         TexelRect show = held;
@@ -211,8 +212,9 @@ void FrameRequests::acquire(const GlyphInstance& glyph, const TexelRect& part, c
     }
 }
 
-// Finds or places one instance whose `part` is visible.
-AtlasLookup FrameRequests::place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part) {
+// GlyphAtlas::acquire for one instance whose `part` is visible, with the curve tests it costs
+// where the atlas may place it anew.
+AtlasLookup FrameRequests::look_up_or_place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part) {
     // Only a glyph the atlas may place anew needs its cost: a new one, or one held in part.
     uint64_t cost = 0;
     const AtlasEntry* resident = atlas_.entry(atlas_.find(glyph.key));
@@ -221,8 +223,8 @@ AtlasLookup FrameRequests::place(const FontAsset& asset, const GlyphInstance& gl
     return atlas_.acquire(glyph.key, glyph.width, glyph.height, cost, part);
 }
 
-// Acquires the glyphs drawn in part, each glyph once for the bounding box of its parts.
-void FrameRequests::acquire_clipped() {
+// Admits the glyphs drawn in part, each glyph once for the bounding box of its parts.
+void FrameRequests::admit_clipped() {
     if (clipped_.empty()) return;
     clipped_parts_.clear();
     for (const Clipped& c : clipped_) {
@@ -236,12 +238,12 @@ void FrameRequests::acquire_clipped() {
         box.width = x1 - box.x;
         box.height = y1 - box.y;
     }
-    for (const Clipped& c : clipped_) acquire(c.glyph, clipped_parts_.at(c.glyph.key), c.contrast, &c.part);
+    for (const Clipped& c : clipped_) admit(c.glyph, clipped_parts_.at(c.glyph.key), c.contrast, &c.part);
     clipped_.clear();
 }
 
 void FrameRequests::settle(const AtlasLimits& limits) {
-    acquire_clipped();
+    admit_clipped();
     while (atlas_full_ > 0) {
         if (limits.can_grow(atlas_.config())) {
             atlas_.grow();  // record() makes the larger image and copies the old one into it
@@ -260,7 +262,7 @@ void FrameRequests::settle(const AtlasLimits& limits) {
         stats_.skipped_glyphs = unplaceable_;
         atlas_full_ = 0;
         for (const Request& r : requests_) request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps, r.contrast);
-        acquire_clipped();
+        admit_clipped();
     }
     stats_.subpixel_steps = coarsening_.steps();
     stats_.atlas_width = atlas_.config().width;

@@ -97,10 +97,10 @@ private:
     };
 
     void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps, const GlyphContrast& contrast);
-    void acquire(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
-                 const TexelRect* shown = nullptr);
-    AtlasLookup place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part);
-    void acquire_clipped();
+    void admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
+               const TexelRect* shown = nullptr);
+    AtlasLookup look_up_or_place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part);
+    void admit_clipped();
 
     GlyphAtlas& atlas_;
     const HeldFonts& fonts_;
