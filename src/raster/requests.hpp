@@ -108,7 +108,7 @@ private:
     RendererStats& stats_;
     std::vector<Request> requests_;  // this frame's draw()n instances, as asked
     std::vector<Pending> pending_;   // draw()n this frame, before record() knows their samples
-    std::vector<Clipped> clipped_;   // draw()n partly visible, acquired in record()
+    std::vector<Clipped> clipped_;   // draw()n partly visible, admitted in record()
     std::unordered_map<GlyphKey, TexelRect, GlyphKeyHash> clipped_parts_;  // scratch: bounding parts
     std::vector<DrawnGlyph> drawn_;
     bool converged_ = true;
