@@ -9,7 +9,9 @@ for the suites the JSON holds, and prints each PNG's path on a line of its own:
 - error-vs-time: the same errors against the GPU ms the frames suite's screen took to reach each
   sample count, with FreeType at its CPU ms for the same glyphs;
 - scaling: the scaling suite's GPU ms against canvas size and against glyphs on screen;
-- atlas: the atlas suite's entries and quantization error against subpixel steps.
+- atlas: the atlas suite's entries and quantization error against subpixel steps;
+- contrast: the contrast suite's ink ratio (dark on light / light on dark) and dark stems' contrast
+  against the size, per setting and font, with the issue's band for the ratio.
 
 Needs matplotlib (Debian: python3-matplotlib, which scripts/setup.sh installs).
 """
@@ -176,6 +178,35 @@ def plot_atlas(data, stem, written):
     finish(fig, data, "atlas reuse against subpixel quantization", stem, "atlas", written)
 
 
+def plot_contrast(data, stem, written):
+    contrast = data["suites"].get("contrast")
+    if not contrast or not contrast.get("fonts"):
+        return
+    fig, axes = panels(1)
+    styles = ["-", "--", ":"]
+    colors = {}
+    axes[0][0].axhspan(0.9, 1.1, color="tab:green", alpha=0.12, label="0.9 to 1.1")
+    for f, font in enumerate(contrast["fonts"]):
+        settings = list(dict.fromkeys(r["setting"] for r in font["rows"]))
+        for i, setting in enumerate(settings):
+            rows = sorted((r for r in font["rows"] if r["setting"] == setting), key=lambda r: r["size"])
+            color = colors.setdefault(setting, f"C{i}")
+            label = setting if f == 0 else None  # colours name the settings, line styles the fonts
+            for col, key in enumerate(("ratio", "stem_dark")):
+                axes[0][col].plot([r["size"] for r in rows], [r[key] for r in rows], styles[f % len(styles)],
+                                  marker="o", markersize=3, color=color, label=label)
+    names = ["solid", "dashed", "dotted"]
+    fonts = ", ".join(f"{font['name']} {names[f % 3]}" for f, font in enumerate(contrast["fonts"]))
+    for ax, ylabel, title in ((axes[0][0], "ink ratio, dark on light / light on dark", f"ink ratio ({fonts})"),
+                              (axes[0][1], "encoded ink of pixels covered 1/2 or more", "dark stems")):
+        ax.set_xlabel("size, px per em")
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        ax.grid(True, alpha=0.3)
+    axes[0][0].legend(fontsize=7, ncol=2, loc="center", bbox_to_anchor=(0.5, 0.42))
+    finish(fig, data, "ink dark on light against light on dark", stem, "contrast", written)
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: plot_bench.py RESULTS.json")
@@ -187,6 +218,7 @@ def main():
     plot_error_vs_time(data, stem, written)
     plot_scaling(data, stem, written)
     plot_atlas(data, stem, written)
+    plot_contrast(data, stem, written)
     for path in written:
         print(path)
 

@@ -8,14 +8,14 @@ bench=$1 source=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 cd "$source" || exit 1  # the suites' default fonts are relative to the repository root
 . "$(dirname "${BASH_SOURCE[0]}")/cli_common.sh"
-suites=(frames coverage compositing scaling atlas frame-cpu cpu)
+suites=(frames coverage compositing scaling atlas frame-cpu cpu contrast)
 
 # ---- --help and usage errors: exit 2, nothing measured.
 expect_exit 0 "--help" -- "$bench" --help
 for suite in "${suites[@]}"; do
   grep -q "^  $suite " "$work/out" || fail "--help does not list the suite $suite"
 done
-for option in --quick --suite --out --canvas --samples --sample-kind --clock-load --modes --variants --steps; do
+for option in --quick --suite --out --canvas --samples --sample-kind --clock-load --modes --variants --steps --pictures; do
   grep -qF -- "$option" "$work/out" || fail "--help does not list $option"
 done
 expect_exit 2 "unknown suite" -- "$bench" --suite nonesuch
@@ -52,7 +52,7 @@ python3 - "$json" <<'EOF' || fail "the JSON is not what the suites write"
 import json, math, sys
 data = json.load(open(sys.argv[1]))
 suites = data["suites"]
-for name in ["frames", "coverage", "compositing", "scaling", "atlas", "frame-cpu", "cpu"]:
+for name in ["frames", "coverage", "compositing", "scaling", "atlas", "frame-cpu", "cpu", "contrast"]:
     assert name in suites, name
 assert data["tool"] == "crisp-bench" and data["quick"] is True and data["command"].startswith("crisp-bench")
 def unit(x):
@@ -78,10 +78,24 @@ assert [r["steps"] for r in suites["atlas"]["rows"]] == [256, 4, 1]
 assert suites["atlas"]["rows"][0]["gray_mean"] == 0 and suites["atlas"]["rows"][0]["entries"] > 0
 assert [v["name"] for v in suites["frame-cpu"]["variants"]] == ["static", "changed", "moving"]
 assert suites["compositing"]["scenes"] and not suites["compositing"]["warnings"], suites["compositing"]["warnings"]
+contrast = suites["contrast"]
+settings = ["linear", "default", "gamma 1.8", "contrast 0.5", "stem darkening 1", "FreeType, linear", "FreeType, sRGB"]
+assert [f["name"] for f in contrast["fonts"]] == ["DejaVu Sans"], contrast["fonts"]
+rows = contrast["fonts"][0]["rows"]
+assert [(r["size"], r["setting"]) for r in rows] == [(s, n) for s in (9, 11, 16) for n in settings], rows
+for r in rows:
+    for k in ("ink_dark", "ink_light", "stem_dark", "stem_light"):
+        assert unit(r[k]) and r[k] > 0, r
+    assert r["ratio"] > 0 and math.isclose(r["ratio"], r["ink_dark"] / r["ink_light"], rel_tol=1e-9), r
+assert contrast["pictures"] == ["quick-%s-%s.png" % (p, s) for s in ("linear", "default") for p in ("dark", "light")]
 EOF
+for picture in quick-{dark,light}-{linear,default}.png; do
+  [ "$(head -c 4 "$work/results/$picture" 2>/dev/null | od -An -c | tr -d ' ')" = "211PNG" ] || fail "$picture is not a PNG"
+  grep -qF "]($picture)" "$md" || fail "the Markdown does not show $picture"
+done
 # Plots where some python3 has matplotlib, else the Markdown says how to make them.
 if python3 -c 'import matplotlib' 2>/dev/null || /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then
-  for plot in error-vs-samples error-vs-time scaling atlas; do
+  for plot in error-vs-samples error-vs-time scaling atlas contrast; do
     png=$work/results/quick-$plot.png
     [ "$(head -c 4 "$png" 2>/dev/null | od -An -c | tr -d ' ')" = "211PNG" ] || fail "$png is not a PNG"
     grep -qF "](quick-$plot.png)" "$md" || fail "the Markdown does not show quick-$plot.png"

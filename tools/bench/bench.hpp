@@ -74,6 +74,9 @@ struct Options {
     std::optional<int> runs;
     std::string only;
 
+    // contrast
+    std::string pictures_dir;  // empty: out_dir
+
     // coverage
     uint32_t cells_gray = 16;
     uint32_t cells_rgb = 64;
@@ -97,6 +100,7 @@ inline constexpr SuiteInfo kSuites[] = {
     {"atlas", "atlas entries of a page at each subpixel quantization, and the error it costs", false},
     {"frame-cpu", "CPU time of a frame of UI text (was crisp-bench-frame)", true},
     {"cpu", "layout and atlas CPU time (was crisp-bench-cpu)", false},
+    {"contrast", "ink dark on light against light on dark per contrast setting and size; FreeType as a peer", true},
 };
 
 // Parses argv; prints --help, or exits 2 on a usage error.
@@ -130,6 +134,7 @@ struct Session {
     explicit Session(const Options& run_options) : options(run_options) {}
 
     const Options& options;
+    std::string name;  // the result files' stem: --name, else the device's slug (-quick with --quick)
     HeadlessContext* context = nullptr;
     bool storage_without_format = false;
     bool cpu_device = false;  // lavapipe and the like: the suites pick smaller defaults
@@ -157,5 +162,6 @@ void run_scaling(Session& session);
 void run_atlas(Session& session);
 void run_frame_cpu(Session& session);
 void run_cpu(Session& session);
+void run_contrast(Session& session);
 
 }  // namespace crisp::bench

@@ -109,6 +109,7 @@ void run_suite(Session& session, const std::string& name) {
     if (name == "atlas") return run_atlas(session);
     if (name == "frame-cpu") return run_frame_cpu(session);
     if (name == "cpu") return run_cpu(session);
+    if (name == "contrast") return run_contrast(session);
 }
 
 // The error at each sample count against the GPU ms the frames suite spent reaching that count:
@@ -251,8 +252,7 @@ void finish_json(Session& session) {
 // DIR/NAME.json, the plots made from it, and DIR/NAME.md: the header, warnings, tables and plots.
 void write_result_files(Session& session, const std::string& header, const std::string& tables) {
     const Options& options = session.options;
-    const std::string name =
-        !options.name.empty() ? options.name : device_slug(session.context) + (options.quick ? "-quick" : "");
+    const std::string& name = session.name;
     std::error_code ec;
     std::filesystem::create_directories(options.out_dir, ec);
     const std::filesystem::path json_path = std::filesystem::path(options.out_dir) / (name + ".json");
@@ -302,6 +302,8 @@ int main(int argc, char** argv) {
         session.context = &*context;
         session.cpu_device = context->properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     }
+    session.name =
+        !options.name.empty() ? options.name : device_slug(session.context) + (options.quick ? "-quick" : "");
 
     const std::string tables = run_suites(session);
 

@@ -192,7 +192,7 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
                "(default static,changed,moving)",
                name_list(o.variants));
 
-    cli.section("cpu:");
+    cli.section("cpu, contrast:");
     cli.text("--dejavu", "PATH", "DejaVu Sans (default fonts/DejaVuSans.ttf)", o.dejavu);
     cli.text("--inter", "PATH", "Inter Regular, first font of the fallback chain (default fonts/Inter-Regular.otf)",
              o.inter);
@@ -201,6 +201,9 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
              "(default /usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc)",
              o.cjk);
     cli.number<int>("--runs", "N", "timed runs per case (default 21)", o.runs, {1, 1000000});
+
+    cli.section("contrast:");
+    cli.text("--pictures", "DIR", "where its pictures go (default: the --out directory)", o.pictures_dir);
     cli.text("--only", "TEXT", "run only the cases whose name contains TEXT", o.only);
 }
 
