@@ -32,12 +32,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (scene->height < 1 || scene->height > crisp::kMaxSceneCanvas) __builtin_trap();
     if (!in_unit_range(scene->background)) __builtin_trap();
     if (scene->layout.empty() || scene->layout.find('\0') != std::string::npos) __builtin_trap();
+    if (scene->contrast && !crisp::validate_text_contrast(*scene->contrast)) __builtin_trap();
     for (const crisp::SceneRun& run : scene->runs) {
         if (run.font >= scene->fonts.size()) __builtin_trap();
         if (!(run.size > 0.0f && run.size <= crisp::kMaxSceneTextSize)) __builtin_trap();
         if (!std::isfinite(run.origin_x) || !std::isfinite(run.origin_y)) __builtin_trap();
         if (!in_unit_range(run.color)) __builtin_trap();
         if (!(run.depth >= 0.0f && run.depth <= 1.0f)) __builtin_trap();
+        if (run.contrast && !crisp::validate_text_contrast(*run.contrast)) __builtin_trap();
     }
     // The reader is a function of its input.
     auto again = crisp::parse_scene(text);

@@ -16,8 +16,9 @@ namespace {
 
 using Type = json::Value::Type;
 
-constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "runs"};
-constexpr std::string_view kRunMembers[] = {"font", "text", "size", "origin", "color", "depth"};
+constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "contrast", "runs"};
+constexpr std::string_view kRunMembers[] = {"font", "text", "size", "origin", "color", "depth", "contrast"};
+constexpr std::string_view kContrastMembers[] = {"mode", "gamma", "contrast", "stem_darkening"};
 
 Error fault(const std::string& path, const std::string& what) {
     return Error{ErrorCode::invalid_argument, "scene: " + path + ": " + what};
@@ -95,7 +96,47 @@ std::optional<Error> read_color(const json::Value& value, const std::string& pat
     return std::nullopt;
 }
 
-std::optional<Error> read_run(const json::Value& value, const std::string& path, size_t font_count, SceneRun& run) {
+// A "contrast" object over `contrast`: the members it gives replace those fields. The ranges are
+// validate_text_contrast()'s, checked here to name the member's path.
+std::optional<Error> read_contrast(const json::Value& value, const std::string& path, TextContrast& contrast) {
+    if (value.type != Type::object) return fault(path, "expected an object, got " + std::string(value.type_name()));
+    if (auto error = unknown_member(value, path, kContrastMembers)) return error;
+    if (const json::Value* mode = value.find("mode")) {
+        if (mode->type == Type::string && mode->string == "linear") {
+            contrast.mode = ContrastMode::linear;
+        } else if (mode->type == Type::string && mode->string == "corrected") {
+            contrast.mode = ContrastMode::corrected;
+        } else {
+            const std::string got = mode->type == Type::string ? "\"" + mode->string + "\"" : mode->type_name();
+            return fault(path + ".mode", "expected \"linear\" or \"corrected\", got " + got);
+        }
+    }
+    const auto number = [&](const char* name, double low, double high, float& field) -> std::optional<Error> {
+        const json::Value* member = value.find(name);
+        if (!member) return std::nullopt;
+        std::string range;
+        json::append_number(range, low);
+        range += ", ";
+        json::append_number(range, high);
+        if (member->type != Type::number) {
+            return fault(path + "." + name,
+                         "expected a number in [" + range + "], got " + std::string(member->type_name()));
+        }
+        if (!(member->number >= low && member->number <= high)) {
+            std::string written;
+            json::append_number(written, member->number);
+            return fault(path + "." + name, written + " is not in [" + range + "]");
+        }
+        field = static_cast<float>(member->number);
+        return std::nullopt;
+    };
+    if (auto error = number("gamma", 1.0, 4.0, contrast.gamma)) return error;
+    if (auto error = number("contrast", 0.0, 4.0, contrast.contrast)) return error;
+    if (auto error = number("stem_darkening", 0.0, 4.0, contrast.stem_darkening)) return error;
+    return std::nullopt;
+}
+
+std::optional<Error> read_run(const json::Value& value, const std::string& path, const Scene& scene, SceneRun& run) {
     if (value.type != Type::object) return fault(path, "expected an object, got " + std::string(value.type_name()));
     if (auto error = unknown_member(value, path, kRunMembers)) return error;
 
@@ -103,6 +144,7 @@ std::optional<Error> read_run(const json::Value& value, const std::string& path,
         if (font->type != Type::number || font->number < 0.0 || font->number != std::floor(font->number)) {
             return fault(path + ".font", "expected an index into fonts (an integer from 0)");
         }
+        const size_t font_count = scene.fonts.size();
         if (font->number >= static_cast<double>(font_count)) {
             std::string index;
             json::append_number(index, font->number);
@@ -150,6 +192,13 @@ std::optional<Error> read_run(const json::Value& value, const std::string& path,
         }
         run.depth = static_cast<float>(depth->number);
     }
+
+    run.contrast = scene.contrast;
+    if (const json::Value* contrast = value.find("contrast")) {
+        TextContrast own = scene.contrast.value_or(TextContrast{});
+        if (auto error = read_contrast(*contrast, path + ".contrast", own)) return error;
+        run.contrast = own;
+    }
     return std::nullopt;
 }
 
@@ -186,6 +235,12 @@ Result<Scene> parse_scene(std::string_view json) {
         scene.layout = layout->string;
     }
 
+    if (const json::Value* contrast = root.find("contrast")) {
+        TextContrast defaults;
+        if (auto error = read_contrast(*contrast, "contrast", defaults)) return *error;
+        scene.contrast = defaults;
+    }
+
     const json::Value* runs = root.find("runs");
     if (!runs) return Error{ErrorCode::invalid_argument, "scene: the \"runs\" member is missing"};
     if (runs->type != Type::array) {
@@ -197,7 +252,7 @@ Result<Scene> parse_scene(std::string_view json) {
     }
     scene.runs.resize(runs->array.size());
     for (size_t i = 0; i < runs->array.size(); ++i) {
-        if (auto error = read_run(runs->array[i], element("runs", i), scene.fonts.size(), scene.runs[i])) {
+        if (auto error = read_run(runs->array[i], element("runs", i), scene, scene.runs[i])) {
             return *error;
         }
     }

@@ -8,10 +8,12 @@
 // ("scene: runs[2].size: must be in (0, 4096]"); a parsed Scene always satisfies the limits.
 #pragma once
 
+#include <crisp/contrast.hpp>
 #include <crisp/result.hpp>
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -32,6 +34,9 @@ struct SceneRun {
     float origin_x = 0.0f, origin_y = 0.0f;     // pen position on the baseline, canvas pixels, y down
     float color[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // sRGB-encoded, straight alpha, each in [0, 1]
     float depth = 0.5f;                         // in [0, 1]; smaller is nearer, as Vulkan's depth
+    // How the run's coverage is blended (DrawOptions::contrast): its own "contrast" member over the
+    // scene's, field by field; nullopt where neither says, for the drawer's default.
+    std::optional<TextContrast> contrast;
     friend bool operator==(const SceneRun&, const SceneRun&) = default;
 };
 
@@ -40,6 +45,7 @@ struct Scene {
     uint32_t width = 0, height = 0;                  // each in 1..kMaxSceneCanvas
     float background[4] = {1.0f, 1.0f, 1.0f, 1.0f};  // sRGB-encoded, straight alpha, each in [0, 1]
     std::string layout = "rgb";                      // a subpixel preset name or a layout file path
+    std::optional<TextContrast> contrast;            // the runs' default, as written; valid
     std::vector<SceneRun> runs;                      // drawn in this (file) order
     friend bool operator==(const Scene&, const Scene&) = default;
 };

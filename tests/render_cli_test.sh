@@ -87,6 +87,29 @@ for option in "--font $font" "--text Hi" "--size 20" "--origin 0,20" "--canvas 4
   expect_exit 2 "--scene with $option" -- "$render" --scene "$work/any.json" $option -o x.png
   expect_stderr "${option%% *}" "--scene with $option"
 done
+# The contrast model's settings: each out of its range, or not a number, names the option and the range.
+for value in 0.5 0.999 4.001 -2.2 nan inf abc ""; do
+  expect_exit 2 "--gamma '$value'" -- "$render" "${base[@]}" --gamma "$value" -o x.png
+  expect_stderr "--gamma" "--gamma '$value'"
+done
+expect_exit 2 "--gamma 0.5, the range" -- "$render" "${base[@]}" --gamma 0.5 -o x.png
+expect_stderr "--gamma must be in 1..4" "--gamma 0.5, the range"
+for option in --enhanced-contrast --stem-darkening; do
+  for value in -0.01 4.5 1e9 nan x; do
+    expect_exit 2 "$option '$value'" -- "$render" "${base[@]}" "$option" "$value" -o x.png
+    expect_stderr "$option" "$option '$value'"
+  done
+  expect_exit 2 "$option -1, the range" -- "$render" "${base[@]}" "$option" -1 -o x.png
+  expect_stderr "$option must be in 0..4" "$option -1, the range"
+done
+expect_exit 2 "--contrast bogus" -- "$render" "${base[@]}" --contrast srgb -o x.png
+expect_stderr "--contrast" "--contrast bogus"
+expect_stderr "srgb" "--contrast bogus"
+for option in "--gamma 2" "--enhanced-contrast 1" "--stem-darkening 1"; do
+  # shellcheck disable=SC2086
+  expect_exit 2 "--contrast linear with $option" -- "$render" "${base[@]}" --contrast linear $option -o x.png
+  expect_stderr "${option%% *}" "--contrast linear with $option"
+done
 expect_exit 2 "--scene without output" -- "$render" --scene "$work/any.json"
 expect_exit 2 "--scene with an empty name" -- "$render" --scene "" -o x.png
 
@@ -140,6 +163,13 @@ expect_stderr "missing.crisp" "scene with a missing font"
 printf '{"fonts": ["dejavu.crisp"], "canvas": [48, 32], "layout": "no-such-layout", "runs": []}' \
   >"$work/bad-layout.json"
 expect_exit 6 "scene with an unknown layout" -- "$render" --scene "$work/bad-layout.json" -o "$work/scene-bad.png"
+scene_run bad-contrast.json '{"text": "Hi", "size": 20, "origin": [4, 24], "contrast": {"gamma": 0.5}}'
+expect_exit 7 "scene run with gamma 0.5" -- "$render" --scene "$work/bad-contrast.json" -o "$work/scene-bad.png"
+expect_stderr "runs[0].contrast.gamma: 0.5 is not in [1, 4]" "scene run with gamma 0.5"
+scene_run bad-contrast-mode.json '{"text": "Hi", "size": 20, "origin": [4, 24], "contrast": {"mode": "srgb"}}'
+expect_exit 7 "scene run with contrast mode srgb" -- \
+  "$render" --scene "$work/bad-contrast-mode.json" -o "$work/scene-bad.png"
+expect_stderr 'runs[0].contrast.mode: expected "linear" or "corrected", got "srgb"' "scene run with contrast mode srgb"
 [ ! -e "$work/scene-bad.png" ] || fail "a failed scene run wrote an output"
 
 # ---- No Vulkan driver, or no device of that name: exit 5 naming it.
@@ -196,9 +226,68 @@ assert 0.4 < max(stem_row) < 0.6, stem_row
 PY
 [ -z "$(ls -A "$work" | grep -F '.tmp')" ] || fail "temporary files were left behind"
 
+# ---- Contrast: the default is corrected and says so; --contrast linear blends the coverage as it
+# is, and black on white is then lighter (the default makes it heavier), not the same image.
+python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['contrast']
+assert c == {'mode': 'corrected', 'gamma': 2.2, 'contrast': 0, 'stem_darkening': 0, 'own_runs': 0}, c" \
+  "$work/hi.json" || fail "the default contrast is not reported as corrected, gamma 2.2"
+expect_exit 0 "--contrast linear" -- "$render" "${base[@]}" --contrast linear -o "$work/hi-linear.png" --json
+python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['contrast']; assert c['mode'] == 'linear', c" \
+  "$work/out" || fail "--contrast linear is not reported"
+expect_exit 0 "--contrast corrected, every setting" -- "$render" "${base[@]}" --contrast corrected --gamma 1.8 \
+  --enhanced-contrast 0.5 --stem-darkening 1 -o "$work/hi-heavier.png" --json
+python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['contrast']
+assert c == {'mode': 'corrected', 'gamma': 1.8, 'contrast': 0.5, 'stem_darkening': 1, 'own_runs': 0}, c" \
+  "$work/out" || fail "the contrast settings given are not reported"
+expect_exit 0 "the ends of the contrast ranges" -- "$render" "${base[@]}" --gamma 4 --enhanced-contrast 4 \
+  --stem-darkening 4 -o "$work/hi-ends.png"
+expect_exit 0 "gamma 1, no enhanced contrast" -- "$render" "${base[@]}" --gamma 1 --enhanced-contrast 0 \
+  --stem-darkening 0 -o "$work/hi-gamma1.png"
+python3 - "$work" <<'PY' || fail "--contrast linear and the default do not differ as they should"
+import sys, zlib, struct
+work = sys.argv[1]
+def pixels(path):  # the filtered scanlines: equal images give equal bytes (one encoder)
+    data = open(path, "rb").read()
+    pos, idat = 8, b""
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IDAT": idat += data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+    return zlib.decompress(idat)
+corrected, linear = pixels(work + "/hi.png"), pixels(work + "/hi-linear.png")
+heavier, gamma1 = pixels(work + "/hi-heavier.png"), pixels(work + "/hi-gamma1.png")
+assert len(corrected) == len(linear) == 32 * (1 + 48 * 3)
+assert corrected != linear, "--contrast linear gives the default's image"
+assert heavier != corrected, "--gamma 1.8 --enhanced-contrast 0.5 --stem-darkening 1 gives the default's image"
+# Gamma 1 with no enhanced contrast and no darkening is the identity: the linear image.
+assert gamma1 == linear, "gamma 1, contrast 0, darkening 0 is not the linear image"
+PY
+# A scene's runs: their own settings (DrawOptions::contrast) over the scene's default, over the
+# command line's. A linear run draws the linear image whichever way it says so.
+scene_run run-linear.json '{"text": "Hi", "size": 20, "origin": [4.25, 24.5], "contrast": {"mode": "linear"}}'
+printf '{"fonts": ["dejavu.crisp"], "canvas": [48, 32], "contrast": {"mode": "linear"}, "runs": [%s]}' \
+  '{"text": "Hi", "size": 20, "origin": [4.25, 24.5]}' >"$work/scene-linear.json"
+scene_run run-default.json '{"text": "Hi", "size": 20, "origin": [4.25, 24.5]}'
+expect_exit 0 "a scene run's own linear contrast" -- "$render" --scene "$work/run-linear.json" --samples 16 \
+  -o "$work/run-linear.png" --json
+python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['contrast']; assert c['own_runs'] == 1, c" \
+  "$work/out" || fail "a scene run's own contrast is not counted"
+cmp -s "$work/run-linear.png" "$work/hi-linear.png" || fail "a scene run's linear contrast is not the linear image"
+expect_exit 0 "a scene's linear default" -- "$render" --scene "$work/scene-linear.json" --samples 16 \
+  -o "$work/scene-linear.png" --contrast corrected --gamma 3
+cmp -s "$work/scene-linear.png" "$work/hi-linear.png" || fail "a scene's linear default is not the linear image"
+expect_exit 0 "--contrast linear with a scene" -- "$render" --scene "$work/run-default.json" --samples 16 \
+  -o "$work/run-default-linear.png" --contrast linear
+cmp -s "$work/run-default-linear.png" "$work/hi-linear.png" || fail "--contrast linear does not reach a scene's runs"
+expect_exit 0 "a scene without contrast" -- "$render" --scene "$work/run-default.json" --samples 16 \
+  -o "$work/run-default.png"
+cmp -s "$work/run-default.png" "$work/hi.png" || fail "a scene without contrast is not drawn as the default"
+
 # The human summary goes to stdout, nothing to stderr.
 expect_exit 0 "render without --json" -- "$render" "${base[@]}" -o "$work/hi2.png"
 grep -q "frames" "$work/out" || fail "no summary on stdout"
+grep -q "contrast corrected, gamma 2.2, contrast 0, stem darkening 0" "$work/out" ||
+  fail "the summary does not give the contrast settings: $(cat "$work/out")"
 [ ! -s "$work/err" ] || fail "a good run wrote to stderr: $(head -c 400 "$work/err")"
 
 # -q: nothing on stdout or stderr.

@@ -101,7 +101,7 @@ TEST(Scene, BadScenesNameTheirFault) {
         {R"({"fonts": ["a"], "fonts": ["b"], "canvas": [1, 1], "runs": []})", "scene: line 1"},  // duplicate
         {"[]", "scene: expected an object, got an array"},
         {R"({"fonts": ["a"], "canvas": [8, 8], "runs": [], "colour": 1})",
-         "scene: unknown member \"colour\" (known: fonts, canvas, background, layout, runs)"},
+         "scene: unknown member \"colour\" (known: fonts, canvas, background, layout, contrast, runs)"},
         // fonts
         {R"({"canvas": [8, 8], "runs": []})", "scene: the \"fonts\" member is missing"},
         {R"({"fonts": "a.crisp", "canvas": [8, 8], "runs": []})", "scene: fonts: expected a non-empty array"},
@@ -142,7 +142,7 @@ TEST(Scene, BadScenesNameTheirFault) {
         {with_run("5"), "scene: runs[0]: expected an object, got a number"},
         {with_run(
              R"({"text": "a", "size": 9, "origin": [0, 0]}, {"text": "a", "size": 9, "origin": [0, 0], "colour": [0, 0, 0]})"),
-         "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth)"},
+         "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth, contrast)"},
         // runs[].font
         {with_run(R"({"font": -1, "text": "a", "size": 9, "origin": [0, 0]})"),
          "scene: runs[0].font: expected an index into fonts (an integer from 0)"},
@@ -181,6 +181,35 @@ TEST(Scene, BadScenesNameTheirFault) {
          "scene: runs[0].depth: expected a number from 0 (nearest) to 1 (farthest)"},
         {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "depth": -0.1})"), "scene: runs[0].depth: expected"},
         {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "depth": "near"})"), "scene: runs[0].depth: expected"},
+        // contrast, at the top level and in runs: the member's path and the value
+        {R"({"fonts": ["a"], "canvas": [8, 8], "contrast": "linear", "runs": []})",
+         "scene: contrast: expected an object, got a string"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "contrast": {"gama": 2}, "runs": []})",
+         "scene: contrast: unknown member \"gama\" (known: mode, gamma, contrast, stem_darkening)"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "contrast": {"gamma": 0.5}, "runs": []})",
+         "scene: contrast.gamma: 0.5 is not in [1, 4]"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "contrast": {"mode": "srgb"}, "runs": []})",
+         "scene: contrast.mode: expected \"linear\" or \"corrected\", got \"srgb\""},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "contrast": {"mode": 1}, "runs": []})",
+         "scene: contrast.mode: expected \"linear\" or \"corrected\", got a number"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": {"gamma": 4.5}})"),
+         "scene: runs[0].contrast.gamma: 4.5 is not in [1, 4]"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": {"gamma": -2.2}})"),
+         "scene: runs[0].contrast.gamma: -2.2 is not in [1, 4]"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": {"gamma": "2.2"}})"),
+         "scene: runs[0].contrast.gamma: expected a number in [1, 4], got a string"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": {"contrast": -0.25}})"),
+         "scene: runs[0].contrast.contrast: -0.25 is not in [0, 4]"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": {"contrast": 1e300}})"),
+         "scene: runs[0].contrast.contrast: 1e+300 is not in [0, 4]"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": {"stem_darkening": 5}})"),
+         "scene: runs[0].contrast.stem_darkening: 5 is not in [0, 4]"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": {"stem_darkening": null}})"),
+         "scene: runs[0].contrast.stem_darkening: expected a number in [0, 4], got null"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": []})"),
+         "scene: runs[0].contrast: expected an object, got an array"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "contrast": {"mode": "linear", "level": 1}})"),
+         "scene: runs[0].contrast: unknown member \"level\" (known: mode, gamma, contrast, stem_darkening)"},
     };
     for (const auto& c : cases) {
         auto scene = parse_scene(c.text);
@@ -189,6 +218,51 @@ TEST(Scene, BadScenesNameTheirFault) {
         EXPECT_NE(scene.error().message.find(c.fragment), std::string::npos)
             << "message: " << scene.error().message << "\nexpected: " << c.fragment;
     }
+}
+
+TEST(Scene, ContrastIsPerRunOverTheScenesDefault) {
+    auto scene = parse_scene(R"({"fonts": ["a"], "canvas": [8, 8],
+        "contrast": {"gamma": 1.8, "contrast": 0.5},
+        "runs": [
+            {"text": "a", "size": 9, "origin": [0, 0]},
+            {"text": "b", "size": 9, "origin": [0, 0], "contrast": {"mode": "linear"}},
+            {"text": "c", "size": 9, "origin": [0, 0], "contrast": {"gamma": 4, "stem_darkening": 1}},
+            {"text": "d", "size": 9, "origin": [0, 0], "contrast": {}}
+        ]})");
+    ASSERT_TRUE(scene) << scene.error().message;
+    const TextContrast defaults{ContrastMode::corrected, 1.8f, 0.5f, 0.0f};
+    EXPECT_EQ(scene->contrast, defaults);
+    ASSERT_EQ(scene->runs.size(), 4u);
+    EXPECT_EQ(scene->runs[0].contrast, defaults);  // none of its own: the scene's
+    EXPECT_EQ(scene->runs[1].contrast, (TextContrast{ContrastMode::linear, 1.8f, 0.5f, 0.0f}));
+    EXPECT_EQ(scene->runs[2].contrast, (TextContrast{ContrastMode::corrected, 4.0f, 0.5f, 1.0f}));
+    EXPECT_EQ(scene->runs[3].contrast, defaults);
+    for (const SceneRun& run : scene->runs) EXPECT_TRUE(validate_text_contrast(*run.contrast)) << run.text;
+}
+
+TEST(Scene, ContrastLeftOutIsTheDrawersAndTextContrastsDefaultsFillARun) {
+    auto scene = parse_scene(R"({"fonts": ["a"], "canvas": [8, 8], "runs": [
+        {"text": "a", "size": 9, "origin": [0, 0]},
+        {"text": "b", "size": 9, "origin": [0, 0], "contrast": {"stem_darkening": 0.5}},
+        {"text": "c", "size": 9, "origin": [0, 0], "contrast": {"mode": "corrected", "gamma": 1, "contrast": 0,
+                                                                "stem_darkening": 0}}]})");
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_FALSE(scene->contrast);
+    EXPECT_FALSE(scene->runs[0].contrast);
+    TextContrast darkened;
+    darkened.stem_darkening = 0.5f;
+    EXPECT_EQ(scene->runs[1].contrast, darkened);  // gamma 2.2, contrast 0, corrected
+    EXPECT_EQ(scene->runs[2].contrast, (TextContrast{ContrastMode::corrected, 1.0f, 0.0f, 0.0f}));
+    // The ends of each range are in it.
+    EXPECT_TRUE(parse_scene(with_run(R"({"text": "a", "size": 9, "origin": [0, 0],
+        "contrast": {"gamma": 4, "contrast": 4, "stem_darkening": 4}})")));
+}
+
+TEST(Scene, TheFirstContrastFaultIsTheScenesThenTheRunsInOrder) {
+    auto scene = parse_scene(R"({"runs": [{"text": "a", "size": 9, "origin": [0, 0], "contrast": {"gamma": 0}}],
+        "contrast": {"stem_darkening": -1, "gamma": 9}, "fonts": ["a"], "canvas": [8, 8]})");
+    ASSERT_FALSE(scene);
+    EXPECT_EQ(scene.error().message, "scene: contrast.gamma: 9 is not in [1, 4]");
 }
 
 TEST(Scene, TheThirdRunsFaultNamesItsIndex) {

@@ -12,6 +12,7 @@
 #include <crisp/asset.hpp>
 #include <crisp/atlas.hpp>
 #include <crisp/compositor.hpp>
+#include <crisp/contrast.hpp>
 #include <crisp/font.hpp>
 #include <crisp/glyph.hpp>
 #include <crisp/layout.hpp>
@@ -31,6 +32,7 @@
 #include <map>
 #include <new>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -70,7 +72,9 @@ constexpr const char* kSynopsis = R"(usage: crisp-render --font A.crisp [--font 
        crisp-render --scene SCENE.json -o OUT.png [options]
 
 Renders text with crisp's GPU rasterizer, frame after frame until every glyph holds its samples,
-then composites the glyphs over the background on the GPU (crisp::Compositor), in linear light.
+then composites the glyphs over the background on the GPU (crisp::Compositor) with the contrast
+model's correction, so that dark text on light is as heavy as light text on dark (docs/contrast.md),
+or in linear light, the coverage as it is, with --contrast linear.
 
 )";
 
@@ -95,6 +99,7 @@ struct Arguments {
     crisp::CompositeMode composite = crisp::CompositeMode::tiled;
     std::string backdrop = "flat";
     crisp::QuadPath path = crisp::QuadPath::raster;
+    crisp::TextContrast contrast;  // the renderer's; a scene's runs may carry their own
     std::string output;
     std::string coverage_output;
     bool json = false;
@@ -189,6 +194,32 @@ void declare_text_options(crisp::cli::CommandLine& cli, Arguments& args) {
     cli.text("-o, --output", "OUT.png", "the composited image, 8-bit sRGB", args.output);
 }
 
+const char* contrast_mode_name(crisp::ContrastMode mode) {
+    return mode == crisp::ContrastMode::linear ? "linear" : "corrected";
+}
+
+// The contrast model's settings (include/crisp/contrast.hpp), with its ranges.
+void declare_contrast_options(crisp::cli::CommandLine& cli, crisp::TextContrast& contrast) {
+    cli.choice<crisp::ContrastMode>(
+        "--contrast", "linear|corrected",
+        "how coverage is blended: corrected (the default) as if in a space of\n"
+        "--gamma between the text's and the background's luminance, so that dark\n"
+        "text on light is as heavy as light on dark; linear: the coverage as it is,\n"
+        "in linear light (docs/contrast.md)",
+        contrast.mode, {crisp::ContrastMode::corrected, crisp::ContrastMode::linear},
+        [](const crisp::ContrastMode& mode) { return std::string(contrast_mode_name(mode)); });
+    cli.number<float>("--gamma", "G", "corrected: the blend space's gamma, in [1, 4] (default 2.2; 1: linear light)",
+                      contrast.gamma, {1.0f, 4.0f});
+    cli.number<float>("--enhanced-contrast", "K",
+                      "corrected: enhanced contrast, in [0, 4] (default 0); larger makes all\n"
+                      "text heavier, light and dark alike",
+                      contrast.contrast, {0.0f, 4.0f});
+    cli.number<float>("--stem-darkening", "S",
+                      "corrected: stem darkening by size, in [0, 4] (default 0, off; 1: as\n"
+                      "FreeType's CFF engine); thin stems at small sizes gain most",
+                      contrast.stem_darkening, {0.0f, 4.0f});
+}
+
 // How it is rendered and composited, what is reported, and on which device.
 void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
     using crisp::CompositeMode;
@@ -229,6 +260,7 @@ void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
                                 "(default) or compute over 8x8 tiles of each quad; the same image",
                                 args.path, {crisp::QuadPath::raster, crisp::QuadPath::compute},
                                 [](const crisp::QuadPath& path) { return std::string(crisp::quad_path_name(path)); });
+    declare_contrast_options(cli, args.contrast);
     cli.text("--coverage-out", "OUT.pfm", "the text's linear coverage per channel as a PFM image",
              args.coverage_output);
     cli.flag("--json", "print the report as one JSON object on stdout (compositor notes go\ninto it instead of stderr)",
@@ -288,6 +320,14 @@ Arguments parse_arguments(int argc, char** argv) {
             "--backdrop applies to --composite tiled and draw only (the reference modes draw over a flat "
             "background)");
     }
+    if (args.contrast.mode == crisp::ContrastMode::linear &&
+        (cli.given("--gamma") || cli.given("--enhanced-contrast") || cli.given("--stem-darkening"))) {
+        cli.fail(
+            "--gamma, --enhanced-contrast and --stem-darkening apply to --contrast corrected only (linear "
+            "blends the coverage as it is)");
+    }
+    // The options' ranges are the model's; this names a setting they let through, should they part.
+    if (crisp::Status valid = crisp::validate_text_contrast(args.contrast); !valid) cli.fail(valid.error().message);
     if (!args.coverage_output.empty() && std::filesystem::path(args.coverage_output).lexically_normal() ==
                                              std::filesystem::path(args.output).lexically_normal()) {
         cli.fail("-o and --coverage-out name the same file");
@@ -357,7 +397,14 @@ struct Job {
     crisp::SubpixelLayout subpixel_layout;
     std::vector<crisp::Font> fonts;            // FontIds 1, 2, ... in scene order
     std::vector<crisp::GlyphInstance> glyphs;  // every run's glyphs that touch the canvas, in paint order
-    size_t laid_out = 0;                       // instances the text layouts produced, culled ones included
+    // One draw() each: consecutive runs' glyphs with the same contrast settings (nullopt: the
+    // renderer's), so that the command line's text is one draw, as before scenes carried contrast.
+    struct Draw {
+        size_t first = 0, count = 0;  // in glyphs
+        std::optional<crisp::TextContrast> contrast;
+    };
+    std::vector<Draw> draws;
+    size_t laid_out = 0;  // instances the text layouts produced, culled ones included
     uint32_t missing = 0, blank = 0, out_of_range = 0;
 };
 
@@ -605,6 +652,7 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
     for (uint32_t& samples : info.atlas.ramp) samples = std::min(samples, args.samples);
     report.atlas_side = atlas_side_for(job.glyphs);
     info.atlas.width = info.atlas.height = report.atlas_side;
+    info.contrast = args.contrast;
 
     crisp::Result<crisp::Renderer> created = crisp::Renderer::create(info);
     if (!created) {
@@ -626,7 +674,18 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
         context, renderer, kMaxFrames,
         [&] {
             frame_start = std::chrono::steady_clock::now();
-            renderer.draw(job.glyphs, VkRect2D{{0, 0}, {job.scene.width, job.scene.height}});
+            const VkRect2D canvas{{0, 0}, {job.scene.width, job.scene.height}};
+            for (const Job::Draw& draw : job.draws) {
+                const std::span<const crisp::GlyphInstance> glyphs(job.glyphs.data() + draw.first, draw.count);
+                if (!draw.contrast) {
+                    renderer.draw(glyphs, canvas);
+                    continue;
+                }
+                crisp::DrawOptions options;
+                options.visible = canvas;
+                options.contrast = draw.contrast;
+                renderer.draw(glyphs, options);
+            }
         },
         [&] {
             report.frame_ms.push_back(milliseconds_since(frame_start));
@@ -811,6 +870,28 @@ std::optional<std::string> unless_empty(const std::string& text) {
     return text.empty() ? std::nullopt : std::optional<std::string>(text);
 }
 
+// The scene's runs drawn with contrast settings of their own rather than the command line's.
+size_t own_contrast_runs(const crisp::Scene& scene) {
+    return static_cast<size_t>(std::count_if(scene.runs.begin(), scene.runs.end(),
+                                             [](const crisp::SceneRun& run) { return run.contrast.has_value(); }));
+}
+
+// "corrected, gamma 2.2, contrast 0, stem darkening 0" or "linear", and the runs that say otherwise.
+std::string human_contrast(const crisp::TextContrast& contrast, const crisp::Scene& scene) {
+    std::string out = contrast_mode_name(contrast.mode);
+    if (contrast.mode == crisp::ContrastMode::corrected) {
+        char settings[96];
+        std::snprintf(settings, sizeof settings, ", gamma %g, contrast %g, stem darkening %g",
+                      static_cast<double>(contrast.gamma), static_cast<double>(contrast.contrast),
+                      static_cast<double>(contrast.stem_darkening));
+        out += settings;
+    }
+    if (const size_t own = own_contrast_runs(scene); own > 0) {
+        out += " (" + std::to_string(own) + (own == 1 ? " run has its own" : " runs have their own") + ")";
+    }
+    return out;
+}
+
 void print_json(const Summary& s) {
     const Arguments& args = *s.args;
     const Job& job = *s.job;
@@ -836,9 +917,15 @@ void print_json(const Summary& s) {
         .field("driver", s.context->driver_name())
         .field("driver_info", s.context->driver_info())
         .end_object();
-    json.field("layout", job.subpixel_layout.name)
-        .field("scene", unless_empty(args.scene))
-        .field("runs", job.scene.runs.size());
+    json.field("layout", job.subpixel_layout.name);
+    json.key("contrast").begin_object();
+    json.field("mode", contrast_mode_name(args.contrast.mode))
+        .field("gamma", args.contrast.gamma)
+        .field("contrast", args.contrast.contrast)
+        .field("stem_darkening", args.contrast.stem_darkening)
+        .field("own_runs", own_contrast_runs(job.scene))
+        .end_object();
+    json.field("scene", unless_empty(args.scene)).field("runs", job.scene.runs.size());
     json.field("size", args.scene.empty() ? args.size : std::nullopt).key("origin");
     if (args.scene.empty()) {
         json.begin_array().value((*args.origin)[0]).value((*args.origin)[1]).end_array();
@@ -893,6 +980,7 @@ void print_human(const Summary& s) {
     std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)\n", static_cast<unsigned long long>(r.frames),
                 frame_total, r.frames ? frame_total / static_cast<double>(r.frames) : 0.0);
     std::printf("  blend    %s\n", human_composite(args, r.composite).c_str());
+    std::printf("  contrast %s\n", human_contrast(args.contrast, job.scene).c_str());
     std::printf("  atlas    %ux%u, %.1f%% occupied, %u resident, %llu allocations, %llu evictions\n", r.atlas_side,
                 r.atlas_side, 100.0 * static_cast<double>(r.atlas.occupancy), r.atlas.resident_glyphs,
                 static_cast<unsigned long long>(r.atlas.total.allocations),
@@ -958,9 +1046,14 @@ void lay_out(const Arguments& args, Job& job) {
         job.missing += text.missing_glyphs;
         job.blank += text.blank_glyphs;
         job.out_of_range += text.out_of_range_glyphs;
+        if (job.draws.empty() || job.draws.back().contrast != run.contrast) {
+            job.draws.push_back({job.glyphs.size(), 0, run.contrast});
+        }
+        const size_t before = job.glyphs.size();
         for (const crisp::GlyphInstance& glyph : text.glyphs) {
             if (touches_canvas(glyph, job.scene.width, job.scene.height)) job.glyphs.push_back(glyph);
         }
+        job.draws.back().count += job.glyphs.size() - before;
     }
 }
 
