@@ -63,6 +63,10 @@ struct Options {
     uint32_t subpixel_steps = 4;
     QuadPath quad_path = QuadPath::raster;
     bool cpu_check = true;
+    // The renderer's contrast mode: linear by default, so that every mode composites the same
+    // coverage and the modes' errors compare compositing alone; corrected measures the contrast
+    // model's passes.
+    ContrastMode contrast = ContrastMode::linear;
 
     // frame-cpu
     std::vector<std::string> variants = {"static", "changed", "moving"};

@@ -82,6 +82,7 @@ struct Args {
     uint32_t samples = 512;
     uint32_t subpixel_steps = 4;
     crisp::QuadPath path = crisp::QuadPath::raster;
+    crisp::ContrastMode contrast = crisp::ContrastMode::linear;
     std::vector<std::string> modes = {"tiled", "tiled-rebin", "tiled-rgba8", "frame",
                                       "draw",  "exact",       "unsorted",    "wboit"};
     bool cpu_check = true;
@@ -535,7 +536,8 @@ void to_json(crisp::JsonWriter& json, const Args& args, const Header& header, co
         .field("api_version", header.api)
         .field("storage_without_format", header.storage_without_format)
         .field("layout", header.layout)
-        .field("quad_path", crisp::quad_path_name(args.path));
+        .field("quad_path", crisp::quad_path_name(args.path))
+        .field("contrast", args.contrast == crisp::ContrastMode::linear ? "linear" : "corrected");
     json.key("canvas").begin_array().value(args.width).value(args.height).end_array();
     json.field("font", args.font)
         .field("size", args.size)
@@ -557,11 +559,12 @@ void print_markdown(std::FILE* out, const Args& args, const Header& header, cons
     std::fprintf(out, "Device: %s, driver %s (%s); Vulkan %s in use.\n", header.device.c_str(),
                  header.driver_name.c_str(), header.driver_info.c_str(), header.api.c_str());
     std::fprintf(out,
-                 "Reference quad passes: %s. Canvas %ux%u; %s at %g px, layout %s, %u "
+                 "Reference quad passes: %s. Contrast %s. Canvas %ux%u; %s at %g px, layout %s, %u "
                  "subpixel steps, %u samples per glyph; background sRGB %g grey.\n",
-                 crisp::quad_path_name(args.path), args.width, args.height, args.font.c_str(),
-                 static_cast<double>(args.size), header.layout.c_str(), args.subpixel_steps, args.samples,
-                 static_cast<double>(kBackgroundSrgb));
+                 crisp::quad_path_name(args.path),
+                 args.contrast == crisp::ContrastMode::linear ? "linear" : "corrected", args.width, args.height,
+                 args.font.c_str(), static_cast<double>(args.size), header.layout.c_str(), args.subpixel_steps,
+                 args.samples, static_cast<double>(kBackgroundSrgb));
     for (const std::string& w : header.compositor_warnings) std::fprintf(out, "Compositor: %s.\n", w.c_str());
     const std::string load = args.clock_load == 0
                                  ? "no clock load"
@@ -644,6 +647,7 @@ crisp::Renderer make_renderer(const crisp::HeadlessContext& context, const Args&
     info.atlas.max_samples = args.samples;
     info.atlas.frame_budget = uint64_t{1} << 50;  // unbounded: converge in as few frames as the ramp allows
     info.layout = layout;
+    info.contrast.mode = args.contrast;
     auto renderer = crisp::Renderer::create(info);
     if (!renderer) fail(renderer.error().message);
     if (auto s = renderer->add_font(font); !s) fail(s.error().message);
@@ -836,6 +840,7 @@ Args args_from(const crisp::bench::Session& session) {
     args.subpixel_steps = o.subpixel_steps;
     args.path = o.quad_path;
     args.cpu_check = o.cpu_check;
+    args.contrast = o.contrast;
     return args;
 }
 

@@ -180,6 +180,12 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
                          o.quad_path, {QuadPath::raster, QuadPath::compute},
                          [](const QuadPath& path) { return std::string(quad_path_name(path)); });
     cli.flag("--no-cpu-check", "skip checking the exact mode against the CPU reference", o.cpu_check, false);
+    cli.choice<ContrastMode>("--contrast", "MODE",
+                             "linear (coverage as it is; the default, so that the modes' errors\n"
+                             "compare compositing alone) or corrected (the contrast model's passes)",
+                             o.contrast, {ContrastMode::linear, ContrastMode::corrected}, [](const ContrastMode& mode) {
+                                 return std::string(mode == ContrastMode::linear ? "linear" : "corrected");
+                             });
 
     cli.section("atlas:");
     cli.option("--steps", "LIST", "subpixel steps per pixel, comma-separated (default 256,64,16,8,4,2,1)",
