@@ -181,9 +181,9 @@ TEST(ContrastModel, BlackOnWhiteAndWhiteOnBlackShowTheirCoverageAsInk) {
 }
 
 TEST(ContrastModel, ResolvedSettingsAndStemDarkening) {
-    EXPECT_EQ(resolve_contrast(TextContrast{.mode = ContrastMode::linear, .contrast = 2.0f, .stem_darkening = 1.0f},
-                               12.0f),
-              GlyphContrast{});
+    EXPECT_EQ(
+        resolve_contrast(TextContrast{.mode = ContrastMode::linear, .contrast = 2.0f, .stem_darkening = 1.0f}, 12.0f),
+        GlyphContrast{});
     EXPECT_TRUE(resolve_contrast(TextContrast{.mode = ContrastMode::linear}, 12.0f).linear());
     const GlyphContrast standard = resolve_contrast(TextContrast{}, 12.0f);
     EXPECT_EQ(standard, (GlyphContrast{2.2f, 0.0f, 1.0f}));
@@ -222,7 +222,9 @@ TEST(ContrastModel, ResolvedSettingsAndStemDarkening) {
     EXPECT_EQ(dark, (GlyphContrast{2.2f, 0.5f, stem_darkening_factor(1.0f, 10.0f)}));
 }
 
-#else  // CRISP_GPU_TESTS
+#endif  // !CRISP_GPU_TESTS
+
+#ifdef CRISP_GPU_TESTS
 
 using compositing_test::expect_no_validation_messages;
 using compositing_test::fixture;
@@ -360,8 +362,9 @@ Target make_target(uint32_t width, uint32_t height, bool draw = false) {
     t.width = width;
     t.height = height;
     t.draw = draw;
-    const VkImageUsageFlags usage = VkImageUsageFlags{draw ? VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT : VK_IMAGE_USAGE_STORAGE_BIT} |
-                                    VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    const VkImageUsageFlags usage =
+        VkImageUsageFlags{draw ? VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT : VK_IMAGE_USAGE_STORAGE_BIT} |
+        VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     auto image = fixture().context->create_image({kFormat, width, height, usage});
     EXPECT_TRUE(image) << (image ? "" : image.error().message);
     if (image) t.image = std::move(*image);
@@ -377,8 +380,8 @@ Compositor make_compositor() {
 }
 
 // `glyphs` composited over `background` into the target (the tile path, or the draw path), read back.
-std::vector<Rgba> composite(Compositor& compositor, const Frame& frame, std::span<const DrawnGlyph> glyphs,
-                            Target& t, const std::vector<Rgba>& background) {
+std::vector<Rgba> composite(Compositor& compositor, const Frame& frame, std::span<const DrawnGlyph> glyphs, Target& t,
+                            const std::vector<Rgba>& background) {
     HeadlessContext& context = *fixture().context;
     std::vector<std::byte> bytes(background.size() * sizeof(Rgba));
     std::memcpy(bytes.data(), background.data(), bytes.size());
@@ -391,8 +394,8 @@ std::vector<Rgba> composite(Compositor& compositor, const Frame& frame, std::spa
             s = compositor.record_draw(cb, drawn, {{0, 0}, {t.width, t.height}});
             vkCmdEndRendering(cb);
         } else {
-            s = compositor.record(cb, drawn, CompositeTarget{t.image.view(), kFormat, VK_FORMAT_UNDEFINED,
-                                                             {t.width, t.height}, {}});
+            s = compositor.record(
+                cb, drawn, CompositeTarget{t.image.view(), kFormat, VK_FORMAT_UNDEFINED, {t.width, t.height}, {}});
         }
         EXPECT_TRUE(s) << (s ? "" : s.error().message);
     }));
@@ -401,6 +404,20 @@ std::vector<Rgba> composite(Compositor& compositor, const Frame& frame, std::spa
     std::vector<Rgba> image(background.size());
     if (read && read->size() == bytes.size()) std::memcpy(image.data(), read->data(), bytes.size());
     return image;
+}
+
+// Calls visit(x, y, pixel index) for each pixel of the width x height canvas inside a glyph's rect.
+template <class Visit>
+void for_each_rect_pixel(std::span<const DrawnGlyph> glyphs, uint32_t width, uint32_t height, Visit&& visit) {
+    for (const DrawnGlyph& g : glyphs) {
+        for (uint32_t ty = 0; ty < g.instance.height; ++ty) {
+            for (uint32_t tx = 0; tx < g.instance.width; ++tx) {
+                const int64_t x = int64_t{g.instance.x} + tx, y = int64_t{g.instance.y} + ty;
+                if (x < 0 || y < 0 || x >= width || y >= height) continue;
+                visit(x, y, static_cast<size_t>(y) * width + static_cast<size_t>(x));
+            }
+        }
+    }
 }
 
 // ---- The CPU computation -----------------------------------------------------------------------
@@ -416,9 +433,10 @@ struct Fragment {
 // corrected by corrected_coverage() against the background pixel's luminance (the tile path) or
 // the far end of the range (`assumed`: the draw path), then each pixel's fragments front to back
 // (depth ascending, later paint order in front) over the background; alpha is "over" with each
-// fragment's largest opacity.
+// fragment's largest opacity. `covered`, where given, says which pixels have a fragment.
 std::vector<Rgba> expected_image(const Frame& frame, std::span<const DrawnGlyph> glyphs,
-                                 const std::vector<Rgba>& background, bool assumed) {
+                                 const std::vector<Rgba>& background, bool assumed,
+                                 std::vector<bool>* covered = nullptr) {
     const uint32_t width = frame.width, height = frame.height;
     std::vector<std::vector<Fragment>> pixels(size_t{width} * height);
     for (const DrawnGlyph& d : glyphs) {
@@ -449,8 +467,10 @@ std::vector<Rgba> expected_image(const Frame& frame, std::span<const DrawnGlyph>
         }
     }
     std::vector<Rgba> out = background;
+    if (covered) covered->assign(out.size(), false);
     for (size_t at = 0; at < out.size(); ++at) {
         std::vector<Fragment>& list = pixels[at];
+        if (covered) (*covered)[at] = !list.empty();
         std::stable_sort(list.begin(), list.end(), [](const Fragment& a, const Fragment& b) {
             return a.depth != b.depth ? a.depth < b.depth : a.paint_order > b.paint_order;
         });
@@ -560,14 +580,25 @@ TEST(ContrastCompositing, TilePathMatchesTheCpuModelPerChannel) {
         const std::vector<Rgba> background = gradient(kWidth, kHeight);
         const std::vector<Rgba> image = composite(compositor, frame, frame.drawn, t, background);
         EXPECT_GT(changed_pixels(image, background), 200u);
-        const std::vector<Rgba> expected = expected_image(frame, frame.drawn, background, false);
+        std::vector<bool> covered;
+        const std::vector<Rgba> expected = expected_image(frame, frame.drawn, background, false, &covered);
         EXPECT_LE(worst_difference(image, expected), 1e-4);
+        // Where nothing is covered (texels of the glyphs' rects among them) the background stays,
+        // bit for bit: no coverage stays no opacity through the gamma space.
+        size_t uncovered_in_rects = 0;
+        for_each_rect_pixel(frame.drawn, kWidth, kHeight, [&](int64_t x, int64_t y, size_t at) {
+            if (covered[at]) return;
+            ++uncovered_in_rects;
+            EXPECT_EQ(image[at], background[at]) << "pixel " << x << ", " << y;
+        });
+        EXPECT_GT(uncovered_in_rects, 20u);
         // The correction did change the image: the linear expectation is far from it.
         const std::vector<DrawnGlyph> linear = with_contrast(frame.drawn, GlyphContrast{});
         EXPECT_GT(worst_difference(image, expected_image(frame, linear, background, false)), 0.05);
         // Contrast and stem darkening too.
         const std::vector<DrawnGlyph> heavy = with_contrast(
-            frame.drawn, resolve_contrast(TextContrast{.gamma = 1.8f, .contrast = 1.0f, .stem_darkening = 1.0f}, 13.0f));
+            frame.drawn,
+            resolve_contrast(TextContrast{.gamma = 1.8f, .contrast = 1.0f, .stem_darkening = 1.0f}, 13.0f));
         EXPECT_LE(worst_difference(composite(compositor, frame, heavy, t, background),
                                    expected_image(frame, heavy, background, false)),
                   1e-4);
@@ -610,15 +641,15 @@ TEST(ContrastCompositing, DefaultKeepsTheInkRatioOfBothPolaritiesNearOne) {
     const std::string latin = "Hamburgefonts", cjk = "永字文組版書";
     const auto dejavu = bake(test::kDejaVuSans, latin, 1);
     const auto inter = bake(test::kInterCff, latin, 2);
-    const auto noto = bake(test::kNotoCjk, cjk, 3);
+    const auto noto = bake(test::kNotoCjk, cjk, 3, 0);  // face 0: Japanese
     ASSERT_TRUE(dejavu && inter && noto);
     struct Face {
         const Font* font;
         const char* name;
         const std::string* text;
     };
-    const Face faces[] = {{dejavu.get(), "DejaVu Sans", &latin}, {inter.get(), "Inter", &latin},
-                          {noto.get(), "Noto Sans CJK", &cjk}};
+    const Face faces[] = {
+        {dejavu.get(), "DejaVu Sans", &latin}, {inter.get(), "Inter", &latin}, {noto.get(), "Noto Sans CJK", &cjk}};
     const float sizes[] = {9.0f, 12.0f, 16.0f};
     constexpr uint32_t kPitch = 24, kCanvasWidth = 150;
     std::vector<Line> lines;
@@ -678,7 +709,8 @@ TEST(ContrastCompositing, StemEdgesStayMonotonic) {
                                               << setting.contrast << ", darkening " << setting.darkening);
             const float text = dark ? 0.0f : 1.0f, back = dark ? 1.0f : 0.0f;
             const std::vector<Rgba> bg = flat(kWidth, 24, back);
-            const std::vector<DrawnGlyph> glyphs = with_color(with_contrast(frame.drawn, setting), {text, text, text, 1});
+            const std::vector<DrawnGlyph> glyphs =
+                with_color(with_contrast(frame.drawn, setting), {text, text, text, 1});
             const std::vector<Rgba> image = composite(compositor, frame, glyphs, t, bg);
             const auto ink = [&](int64_t x, uint32_t y) {
                 return std::abs(srgb_encode(image[size_t{y} * kWidth + static_cast<size_t>(x)][1]) - srgb_encode(back));
@@ -696,7 +728,8 @@ TEST(ContrastCompositing, StemEdgesStayMonotonic) {
                     EXPECT_GT(ink(peak, y), 0.7) << "row " << y;
                     for (int64_t x = x0; x < peak; ++x) EXPECT_LE(ink(x, y), ink(x + 1, y) + 1e-6) << x << ", " << y;
                     int64_t right_peak = x1 - 1;
-                    for (int64_t x = x1 - 1; x >= middle; --x) right_peak = ink(x, y) > ink(right_peak, y) ? x : right_peak;
+                    for (int64_t x = x1 - 1; x >= middle; --x)
+                        right_peak = ink(x, y) > ink(right_peak, y) ? x : right_peak;
                     EXPECT_GT(ink(right_peak, y), 0.7) << "row " << y;
                     for (int64_t x = x1 - 1; x > right_peak; --x) {
                         EXPECT_LE(ink(x, y), ink(x - 1, y) + 1e-6) << x << ", " << y;
@@ -734,30 +767,23 @@ TEST(ContrastCompositing, SubpixelEdgesKeepTheirChannelOrder) {
             composite(compositor, frame, with_contrast(frame.drawn, GlyphContrast{}), t, background);
         size_t compared = 0;
         for (const DrawnGlyph& g : frame.drawn) {
-            for (uint32_t ty = 0; ty < g.instance.height; ++ty) {
-                for (uint32_t tx = 0; tx < g.instance.width; ++tx) {
-                    const int64_t x = int64_t{g.instance.x} + tx, y = int64_t{g.instance.y} + ty;
-                    if (x < 0 || y < 0 || x >= kWidth || y >= kHeight) continue;
-                    const size_t at = static_cast<size_t>(y) * kWidth + static_cast<size_t>(x);
-                    double ink_linear[3], ink_corrected[3];
-                    bool usable = true;
-                    for (size_t c = 0; c < 3; ++c) {
-                        const double span = double{g.instance.color[c]} - double{background[at][c]};
-                        usable = usable && std::abs(span) > 0.2;
-                        ink_linear[c] = (double{linear[at][c]} - double{background[at][c]}) / span;
-                        ink_corrected[c] = (double{corrected[at][c]} - double{background[at][c]}) / span;
-                    }
-                    if (!usable) continue;
-                    for (size_t a = 0; a < 3; ++a) {
-                        for (size_t b = 0; b < 3; ++b) {
-                            if (ink_linear[a] < ink_linear[b] + 0.02) continue;
-                            ++compared;
-                            EXPECT_GE(ink_corrected[a], ink_corrected[b] - 1e-4)
-                                << "pixel " << x << ", " << y << " channels " << a << " > " << b;
-                        }
+            for_each_rect_pixel({&g, 1}, kWidth, kHeight, [&](int64_t x, int64_t y, size_t at) {
+                double ink_linear[3], ink_corrected[3];
+                for (size_t c = 0; c < 3; ++c) {
+                    const double span = double{g.instance.color[c]} - double{background[at][c]};
+                    if (std::abs(span) < 0.2) return;
+                    ink_linear[c] = (double{linear[at][c]} - double{background[at][c]}) / span;
+                    ink_corrected[c] = (double{corrected[at][c]} - double{background[at][c]}) / span;
+                }
+                for (size_t a = 0; a < 3; ++a) {
+                    for (size_t b = 0; b < 3; ++b) {
+                        if (ink_linear[a] < ink_linear[b] + 0.02) continue;
+                        ++compared;
+                        EXPECT_GE(ink_corrected[a], ink_corrected[b] - 1e-4)
+                            << "pixel " << x << ", " << y << " channels " << a << " > " << b;
                     }
                 }
-            }
+            });
         }
         EXPECT_GT(compared, 50u);  // the layouts' channels do differ at the edges
     }
