@@ -15,7 +15,10 @@ vec3 corrected_coverage(vec3 coverage, float gamma, float k, float darkening, fl
     if (abs(lt - lb) < kContrastSameLuminance) return c;
     const float blended_lb = pow(lb, 1.0 / gamma), blended_lt = pow(lt, 1.0 / gamma);
     const vec3 blended = mix(vec3(blended_lb), vec3(blended_lt), c);
-    return clamp((pow(blended, vec3(gamma)) - lb) / (lt - lb), 0.0, 1.0);
+    const vec3 corrected = clamp((pow(blended, vec3(gamma)) - lb) / (lt - lb), 0.0, 1.0);
+    // No coverage and full coverage stay exact (c is 0 or 1 exactly where |c - 0.5| is 0.5): the
+    // round trip through the gamma space would leave a trace of opacity where nothing is covered.
+    return mix(corrected, c, greaterThanEqual(abs(c - 0.5), vec3(0.5)));
 }
 
 // The background luminance the draw path and the reference modes assume: the far end of the range.

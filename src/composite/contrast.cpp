@@ -71,7 +71,9 @@ double corrected_coverage(double coverage, const GlyphContrast& contrast, double
     double c = coverage * (1.0 + k) / (1.0 + k * coverage);
     c = std::min(1.0, c * double{contrast.darkening});
     const double lt = text_luminance, lb = background_luminance;
-    if (std::abs(lt - lb) < double{gpu::kContrastSameLuminance}) return c;
+    // No coverage and full coverage stay exact: the round trip through the gamma space would
+    // leave a trace of opacity where nothing is covered.
+    if (c <= 0.0 || c >= 1.0 || std::abs(lt - lb) < double{gpu::kContrastSameLuminance}) return c;
     const double g = double{contrast.gamma};
     const double blended = (1.0 - c) * std::pow(lb, 1.0 / g) + c * std::pow(lt, 1.0 / g);
     return std::clamp((std::pow(blended, g) - lb) / (lt - lb), 0.0, 1.0);
