@@ -18,6 +18,9 @@ shoot docs/images/layout-editor-rgb.png 80 --layout rgb
 shoot docs/images/layout-editor-qd-oled.png 80 --layout qd-oled
 # A custom layout three frames after it was loaded: the preview still converging.
 shoot docs/images/layout-editor-converging.png 3 --layout docs/examples/layout-bgr-short-red.json
+# A layout file with its monitor's contrast settings: lighter gamma, enhanced contrast, stem darkening.
+printf '{"name": "bgr-heavy", "r": [0.6666667, 0, 1, 1], "g": [0.33333334, 0, 0.6666667, 1], "b": [0, 0, 0.33333334, 1], "contrast": {"mode": "corrected", "gamma": 1.8, "contrast": 1, "stem_darkening": 1}}\n' >"$work/bgr-heavy.json"
+(cd "$work" && shoot "$images/layout-editor-contrast.png" 80 --layout bgr-heavy.json)
 # A layout file with a fault: crisp's reader's error, shown in the window.
 printf '{"name": "broken", "r": [0, 0, 0.3, 1], "g": [0.3, 0, 0.6], "b": [0.6, 0, 1, 1]}\n' >"$work/broken.json"
 (cd "$work" && shoot "$images/layout-editor-bad-file.png" 3 --layout broken.json)

@@ -2,8 +2,9 @@
 # layout_editor_test.sh EDITOR CRISP_RENDER CRISP_BAKE SOURCE_DIR WORK_DIR: runs crisp-layout-editor
 # under Xvfb on whatever Vulkan device there is (lavapipe in CI) with the validation layer on, and
 # drives it with xdotool: pick the bgr preset, drag the red rectangle's bottom edge up 24 screen
-# pixels, nudge it one step left, undo and redo the nudge, type 0.125 into its y0 field, save
-# (Ctrl+S), quit (Ctrl+Q). Checks that the saved JSON is exactly bgr with those edits, that
+# pixels, nudge it one step left, undo and redo the nudge, type 0.125 into its y0 field, raise the
+# contrast model's gamma one step (G), save (Ctrl+S), quit (Ctrl+Q). Checks that the saved JSON is
+# exactly bgr with those edits and the default contrast with gamma 2.3, that
 # crisp-render accepts it, that the editor exits 0 (so the validation layer stayed silent), and
 # that screenshots of the display before and after the edit show the preview, the magnified pixel
 # and the magnified rendered pixels, each not blank and each changed by the edit. Also: a bad
@@ -146,6 +147,8 @@ sleep 0.5
 xdotool type --delay 50 0.125
 xdotool key Return
 sleep 0.5
+xdotool key g
+sleep 0.5
 xdotool key ctrl+s
 for _ in $(seq 1 60); do [ -f saved.json ] && break; sleep 0.5; done
 [ -f saved.json ] || fail "Ctrl+S wrote no saved.json"
@@ -177,6 +180,14 @@ for channel in "rgb":
     got, expected = saved[channel], want[channel]
     assert len(got) == 4 and all(abs(a - b) < 1e-5 for a, b in zip(got, expected)), (channel, got, expected)
 print("saved layout as expected:", json.dumps(saved))
+PY
+# ---- The contrast the saved layout carries: crisp's default with gamma one step up (G).
+python3 - saved.json <<'PY' || fail "saved contrast"
+import json, sys
+contrast = json.load(open(sys.argv[1])).get("contrast")
+want = {"mode": "corrected", "gamma": 2.3, "contrast": 0, "stem_darkening": 0}
+assert contrast == want, (contrast, want)
+print("saved contrast as expected:", json.dumps(contrast))
 PY
 "$bake" "$source/fonts/DejaVuSans.ttf" --text "Hi" -o dejavu.crisp -q || fail "crisp-bake"
 "$render" --font dejavu.crisp --text "Hi" --size 20 --origin 4,24 --canvas 48,32 --samples 16 \

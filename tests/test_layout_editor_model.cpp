@@ -1,5 +1,5 @@
 // The layout editor's model (tools/layout_editor/editor_model.hpp): edits, bounds, undo and redo,
-// without a window.
+// the monitor's contrast settings, without a window.
 #include "editor_model.hpp"
 
 #include <crisp/glyph.hpp>
@@ -7,10 +7,15 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace {
 
+using crisp::ContrastMode;
 using crisp::SampleRect;
 using crisp::SubpixelLayout;
+using crisp::TextContrast;
+using crisp::editor::ContrastParameter;
 using crisp::editor::Handle;
 using crisp::editor::kEditStep;
 using crisp::editor::kMinRectSize;
@@ -106,6 +111,58 @@ TEST(LayoutEditorModel, PresetsAndLoadsAreUndoableAndAnEditClearsRedo) {
     EXPECT_FALSE(model.can_redo());
     model.mark_saved();
     EXPECT_FALSE(model.modified());
+}
+
+TEST(LayoutEditorModel, ContrastStepsWithinItsRangeAsUndoableEditsOfTheLayout) {
+    LayoutModel model(preset("rgb"));
+    EXPECT_FALSE(model.layout().contrast);
+    EXPECT_EQ(model.contrast(), TextContrast{});  // crisp's default until the layout has its own
+    const uint64_t revision = model.revision();
+    model.step_contrast(ContrastParameter::gamma, 1);
+    ASSERT_TRUE(model.layout().contrast);
+    EXPECT_EQ(model.layout().contrast->gamma, 2.3f);  // the float nearest 2.3, not 2.2f + 0.1f
+    EXPECT_EQ(model.layout().channels, preset("rgb").channels);
+    EXPECT_GT(model.revision(), revision);
+    EXPECT_EQ(model.layout().name, "rgb-edited");
+    EXPECT_TRUE(model.modified());
+    model.step_contrast(ContrastParameter::gamma, -100);
+    EXPECT_EQ(model.contrast().gamma, 1.0f);  // stops at the range
+    model.step_contrast(ContrastParameter::contrast, 3);
+    model.step_contrast(ContrastParameter::stem_darkening, -1);  // already at 0: no change, no step
+    EXPECT_FLOAT_EQ(model.contrast().contrast, 0.3f);
+    EXPECT_EQ(model.contrast().stem_darkening, 0.0f);
+    model.toggle_contrast_mode();
+    EXPECT_EQ(model.contrast().mode, ContrastMode::linear);
+    EXPECT_TRUE(crisp::validate_subpixel_layout(model.layout()).ok());
+    ASSERT_TRUE(model.undo());  // the mode
+    ASSERT_TRUE(model.undo());  // contrast
+    EXPECT_EQ(model.contrast().contrast, 0.0f);
+    ASSERT_TRUE(model.undo());  // gamma down
+    ASSERT_TRUE(model.undo());  // gamma up
+    EXPECT_FALSE(model.can_undo());
+    EXPECT_EQ(model.layout(), preset("rgb"));
+}
+
+TEST(LayoutEditorModel, TypedContrastIsValidatedByCrispAndResetDropsIt) {
+    SubpixelLayout start = preset("bgr");
+    start.name = "monitor";
+    start.contrast = TextContrast{ContrastMode::corrected, 1.8f, 0.5f, 0.0f};
+    LayoutModel model(start);
+    EXPECT_EQ(model.contrast().gamma, 1.8f);  // the layout's own
+    EXPECT_TRUE(model.set_contrast_parameter(ContrastParameter::stem_darkening, 1.0f).ok());
+    EXPECT_EQ(model.layout().contrast->stem_darkening, 1.0f);
+    EXPECT_EQ(model.layout().name, "monitor");  // not a preset: the name stays
+    const SubpixelLayout before = model.layout();
+    const crisp::Status refused = model.set_contrast_parameter(ContrastParameter::gamma, 0.5f);
+    ASSERT_FALSE(refused.ok());
+    EXPECT_NE(refused.error().message.find("gamma"), std::string::npos) << refused.error().message;
+    EXPECT_FALSE(model.set_contrast_parameter(ContrastParameter::contrast, std::nanf("")).ok());
+    EXPECT_EQ(model.layout(), before);
+    EXPECT_TRUE(model.set_contrast(std::nullopt).ok());
+    EXPECT_FALSE(model.layout().contrast);
+    EXPECT_EQ(model.contrast(), TextContrast{});
+    ASSERT_TRUE(model.undo());
+    EXPECT_EQ(model.layout(), before);
 }
 
 }  // namespace

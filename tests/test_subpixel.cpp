@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -69,6 +70,79 @@ TEST(Subpixel, BadLayoutsNameTheirFault) {
     }
 }
 
+TEST(Subpixel, PresetsCarryNoContrastAndSaveAsBeforeContrastExisted) {
+    // The bytes subpixel_layout_to_json wrote before layouts could carry contrast settings.
+    EXPECT_EQ(subpixel_layout_to_json(*subpixel_preset("rgb")),
+              "{\"name\": \"rgb\", \"r\": [0, 0, 0.3333333432674408, 1], \"g\": [0.3333333432674408, 0, "
+              "0.6666666865348816, 1], \"b\": [0.6666666865348816, 0, 1, 1]}\n");
+    for (const std::string_view name : subpixel_preset_names()) {
+        EXPECT_FALSE(subpixel_preset(name)->contrast) << name;
+        EXPECT_EQ(subpixel_layout_to_json(*subpixel_preset(name)).find("contrast"), std::string::npos) << name;
+    }
+    auto parsed = parse_subpixel_layout(R"({"r": [0,0,1,1], "g": [0,0,1,1], "b": [0,0,1,1]})");
+    ASSERT_TRUE(parsed);
+    EXPECT_FALSE(parsed->contrast);
+}
+
+TEST(Subpixel, ContrastRoundTripsThroughJson) {
+    SubpixelLayout layout = *subpixel_preset("bgr");
+    layout.name = "my-monitor";
+    layout.contrast = TextContrast{ContrastMode::corrected, 1.8f, 0.5f, 1.25f};
+    const std::string json = subpixel_layout_to_json(layout);
+    EXPECT_NE(json.find(R"("contrast": {"mode": "corrected", "gamma": 1.8, "contrast": 0.5, "stem_darkening": 1.25})"),
+              std::string::npos)
+        << json;
+    auto parsed = parse_subpixel_layout(json);
+    ASSERT_TRUE(parsed) << parsed.error().message;
+    EXPECT_EQ(*parsed, layout);
+    layout.contrast = TextContrast{ContrastMode::linear, 2.2f, 0.0f, 0.0f};
+    parsed = parse_subpixel_layout(subpixel_layout_to_json(layout));
+    ASSERT_TRUE(parsed);
+    EXPECT_EQ(*parsed, layout);
+    // Members left out take TextContrast's defaults.
+    parsed = parse_subpixel_layout(R"({"r": [0,0,1,1], "g": [0,0,1,1], "b": [0,0,1,1], "contrast": {"gamma": 2}})");
+    ASSERT_TRUE(parsed) << parsed.error().message;
+    ASSERT_TRUE(parsed->contrast);
+    EXPECT_EQ(*parsed->contrast, (TextContrast{ContrastMode::corrected, 2.0f, 0.0f, 0.0f}));
+    parsed = parse_subpixel_layout(R"({"r": [0,0,1,1], "g": [0,0,1,1], "b": [0,0,1,1], "contrast": {}})");
+    ASSERT_TRUE(parsed);
+    EXPECT_EQ(parsed->contrast, TextContrast{});
+}
+
+TEST(Subpixel, BadContrastNamesItsField) {
+    const std::string rects = R"("r": [0,0,1,1], "g": [0,0,1,1], "b": [0,0,1,1])";
+    const struct {
+        const char* contrast;
+        const char* fragment;
+    } cases[] = {
+        {"5", "contrast: expected an object"},
+        {R"({"mode": "srgb"})", "contrast.mode: expected \"linear\" or \"corrected\""},
+        {R"({"mode": 1})", "contrast.mode: expected"},
+        {R"({"gamma": "2.2"})", "contrast.gamma: expected a number"},
+        {R"({"stem_darkening": 1e300})", "contrast.stem_darkening: expected a number"},
+        {R"({"level": 1})", "contrast: unknown member \"level\""},
+        {R"({"gamma": 0.5})", "contrast: gamma 0.500000 is not in [1, 4]"},
+        {R"({"contrast": -1})", "contrast: contrast -1.000000 is not in [0, 4]"},
+        {R"({"stem_darkening": 4.5})", "contrast: stem_darkening 4.500000 is not in [0, 4]"},
+    };
+    for (const auto& c : cases) {
+        auto layout = parse_subpixel_layout("{" + rects + ", \"contrast\": " + c.contrast + "}");
+        ASSERT_FALSE(layout) << c.contrast;
+        EXPECT_EQ(layout.error().code, ErrorCode::invalid_argument);
+        EXPECT_NE(layout.error().message.find(c.fragment), std::string::npos) << layout.error().message;
+    }
+    SubpixelLayout layout = *subpixel_preset("rgb");
+    layout.contrast = TextContrast{ContrastMode::corrected, std::nanf(""), 0.0f, 0.0f};
+    Status status = validate_subpixel_layout(layout);
+    ASSERT_FALSE(status);
+    EXPECT_NE(status.error().message.find("subpixel layout: contrast: gamma nan"), std::string::npos)
+        << status.error().message;
+    const std::filesystem::path path = std::filesystem::temp_directory_path() / "crisp_subpixel_bad_contrast.json";
+    std::filesystem::remove(path);
+    EXPECT_FALSE(save_subpixel_layout_file(layout, path));
+    EXPECT_FALSE(std::filesystem::exists(path));
+}
+
 TEST(Subpixel, FilesSaveLoadAndResolve) {
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crisp_subpixel_test";
     std::filesystem::remove_all(dir);
@@ -93,6 +167,12 @@ TEST(Subpixel, FilesSaveLoadAndResolve) {
     invalid.channels[0].x1 = -5.0f;
     EXPECT_FALSE(save_subpixel_layout_file(invalid, dir / "invalid.json"));
     EXPECT_FALSE(std::filesystem::exists(dir / "invalid.json"));
+    SubpixelLayout monitor = triad;
+    monitor.contrast = TextContrast{ContrastMode::corrected, 2.4f, 1.0f, 0.0f};
+    ASSERT_TRUE(save_subpixel_layout_file(monitor, dir / "monitor.json"));
+    auto monitor_loaded = resolve_subpixel_layout((dir / "monitor.json").string());
+    ASSERT_TRUE(monitor_loaded) << monitor_loaded.error().message;
+    EXPECT_EQ(*monitor_loaded, monitor);
     std::filesystem::remove_all(dir);
 }
 

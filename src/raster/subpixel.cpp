@@ -5,6 +5,7 @@
 #include <crisp/glyph.hpp>
 #include <crisp/subpixel.hpp>
 
+#include <charconv>
 #include <cmath>
 
 namespace crisp {
@@ -17,8 +18,55 @@ constexpr const char* kChannelNames[3] = {"r", "g", "b"};
 
 constexpr std::string_view kPresetNames[] = {"gray", "rgb", "bgr", "vrgb", "vbgr", "qd-oled", "woled", "pentile"};
 
+constexpr const char* kContrastNames[2] = {"linear", "corrected"};  // by ContrastMode
+
 SubpixelLayout make(std::string_view name, SampleRect r, SampleRect g, SampleRect b) {
-    return SubpixelLayout{std::string(name), {r, g, b}};
+    SubpixelLayout layout;
+    layout.name = std::string(name);
+    layout.channels = {r, g, b};
+    return layout;
+}
+
+Error bad_contrast(const std::string& what) {
+    return Error{ErrorCode::invalid_argument, "subpixel layout: contrast" + what};
+}
+
+// The "contrast" member: every member optional, the others TextContrast's defaults. Ranges are
+// validate_subpixel_layout's to check.
+Result<TextContrast> parse_contrast(const json::Value& value) {
+    if (value.type != json::Value::Type::object) return bad_contrast(": expected an object");
+    TextContrast contrast;
+    for (const auto& [key, member] : value.object) {
+        if (key == "mode") {
+            if (member.type == json::Value::Type::string && member.string == kContrastNames[0]) {
+                contrast.mode = ContrastMode::linear;
+            } else if (member.type == json::Value::Type::string && member.string == kContrastNames[1]) {
+                contrast.mode = ContrastMode::corrected;
+            } else {
+                return bad_contrast(".mode: expected \"linear\" or \"corrected\"");
+            }
+            continue;
+        }
+        float* field = key == "gamma"            ? &contrast.gamma
+                       : key == "contrast"       ? &contrast.contrast
+                       : key == "stem_darkening" ? &contrast.stem_darkening
+                                                 : nullptr;
+        if (!field) {
+            return bad_contrast(": unknown member \"" + key + "\" (expected mode, gamma, contrast, stem_darkening)");
+        }
+        if (member.type != json::Value::Type::number || std::fabs(member.number) > 1e6) {
+            return bad_contrast("." + key + ": expected a number");
+        }
+        *field = static_cast<float>(member.number);
+    }
+    return contrast;
+}
+
+// A float in its shortest form that reads back to the same float: 2.2, not 2.2000000476837158.
+void append_float(std::string& out, float value) {
+    char buffer[32];
+    const auto written = std::to_chars(buffer, buffer + sizeof buffer, value);
+    out.append(buffer, written.ptr);
 }
 
 }  // namespace
@@ -65,6 +113,11 @@ Status validate_subpixel_layout(const SubpixelLayout& layout) {
                                                           " pixel past its pixel (rectangles must lie within [-1, 2])"};
         }
     }
+    if (layout.contrast) {
+        if (Status status = validate_text_contrast(*layout.contrast); !status) {
+            return Error{ErrorCode::invalid_argument, "subpixel layout: " + status.error().message};
+        }
+    }
     return {};
 }
 
@@ -85,13 +138,19 @@ Result<SubpixelLayout> parse_subpixel_layout(std::string_view text) {
             layout.name = value.string;
             continue;
         }
+        if (key == "contrast") {
+            Result<TextContrast> contrast = parse_contrast(value);
+            if (!contrast) return contrast.error();
+            layout.contrast = *contrast;
+            continue;
+        }
         size_t channel = 3;
         for (size_t c = 0; c < 3; ++c) {
             if (key == kChannelNames[c]) channel = c;
         }
         if (channel == 3) {
             return Error{ErrorCode::invalid_argument,
-                         "subpixel layout: unknown member \"" + key + "\" (expected name, r, g, b)"};
+                         "subpixel layout: unknown member \"" + key + "\" (expected name, r, g, b, contrast)"};
         }
         if (value.type != json::Value::Type::array || value.array.size() != 4) {
             return Error{ErrorCode::invalid_argument,
@@ -139,6 +198,17 @@ std::string subpixel_layout_to_json(const SubpixelLayout& layout) {
             json::append_number(out, static_cast<double>(values[i]));
         }
         out += "]";
+    }
+    if (const std::optional<TextContrast>& contrast = layout.contrast) {
+        out += ", \"contrast\": {\"mode\": ";
+        json::append_string(out, contrast->mode == ContrastMode::linear ? kContrastNames[0] : kContrastNames[1]);
+        out += ", \"gamma\": ";
+        append_float(out, contrast->gamma);
+        out += ", \"contrast\": ";
+        append_float(out, contrast->contrast);
+        out += ", \"stem_darkening\": ";
+        append_float(out, contrast->stem_darkening);
+        out += "}";
     }
     return out + "}\n";
 }

@@ -16,6 +16,17 @@ float snap(float value) {
     return std::round(value / kEditStep) * kEditStep;
 }
 
+float& parameter_ref(TextContrast& contrast, ContrastParameter parameter) {
+    switch (parameter) {
+        case ContrastParameter::gamma:
+            return contrast.gamma;
+        case ContrastParameter::contrast:
+            return contrast.contrast;
+        default:
+            return contrast.stem_darkening;
+    }
+}
+
 float& coordinate_ref(SampleRect& rect, int coordinate) {
     switch (coordinate) {
         case 0:
@@ -49,6 +60,15 @@ float rect_coordinate(const SampleRect& rect, int coordinate) {
         default:
             return rect.y1;
     }
+}
+
+float contrast_parameter(const TextContrast& contrast, ContrastParameter parameter) {
+    TextContrast copy = contrast;
+    return parameter_ref(copy, parameter);
+}
+
+std::pair<float, float> contrast_range(ContrastParameter parameter) {
+    return parameter == ContrastParameter::gamma ? std::pair{1.0f, 4.0f} : std::pair{0.0f, 4.0f};
 }
 
 LayoutModel::LayoutModel(SubpixelLayout initial) : layout_(std::move(initial)), saved_(layout_) {}
@@ -142,6 +162,40 @@ void LayoutModel::end_drag() {
     undo_.push_back(drag_before_);
     redo_.clear();
     rename_if_preset();
+}
+
+Status LayoutModel::set_contrast(const std::optional<TextContrast>& contrast) {
+    if (contrast) {
+        if (Status status = validate_text_contrast(*contrast); !status) return status;
+    }
+    if (contrast == layout_.contrast) return {};
+    push_undo();
+    layout_.contrast = contrast;
+    rename_if_preset();
+    changed();
+    return {};
+}
+
+Status LayoutModel::set_contrast_parameter(ContrastParameter parameter, float value) {
+    TextContrast next = contrast();
+    parameter_ref(next, parameter) = value;
+    return set_contrast(next);
+}
+
+void LayoutModel::step_contrast(ContrastParameter parameter, int steps) {
+    const auto [low, high] = contrast_range(parameter);
+    const float value = contrast_parameter(contrast(), parameter);
+    // Divided rather than multiplied by the step, so that 2.3 is the float nearest 2.3.
+    const float per_unit = std::round(1.0f / kContrastStep);
+    const float stepped = (std::round(value * per_unit) + static_cast<float>(steps)) / per_unit;
+    // Within the range, always: set_contrast cannot refuse it.
+    (void)set_contrast_parameter(parameter, std::clamp(stepped, low, high));
+}
+
+void LayoutModel::toggle_contrast_mode() {
+    TextContrast next = contrast();
+    next.mode = next.mode == ContrastMode::linear ? ContrastMode::corrected : ContrastMode::linear;
+    (void)set_contrast(next);
 }
 
 Status LayoutModel::apply_preset(std::string_view name) {

@@ -1,12 +1,16 @@
-// crisp-layout-editor: the edited subpixel layout, the selected channel and the undo history.
+// crisp-layout-editor: the edited subpixel layout (with the monitor's contrast settings), the
+// selected channel and the undo history.
 // No window, no GPU: tests/test_layout_editor_model.cpp drives it directly.
 #pragma once
 
+#include <crisp/contrast.hpp>
 #include <crisp/result.hpp>
 #include <crisp/subpixel.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace crisp::editor {
@@ -16,6 +20,16 @@ namespace crisp::editor {
 inline constexpr float kEditStep = 1.0f / 96.0f;
 // The smallest width or height a rectangle can be dragged or nudged to.
 inline constexpr float kMinRectSize = kEditStep;
+
+// One step of a contrast parameter, by key.
+inline constexpr float kContrastStep = 0.1f;
+
+// The contrast parameters the editor sets, by index.
+enum class ContrastParameter : uint8_t { gamma, contrast, stem_darkening };
+
+// A parameter's value, and its range (validate_text_contrast's).
+float contrast_parameter(const TextContrast& contrast, ContrastParameter parameter);
+std::pair<float, float> contrast_range(ContrastParameter parameter);
 
 // What a drag grabs: one edge of a channel's rectangle, or the whole rectangle.
 enum class Handle : uint8_t { left, top, right, bottom, body };
@@ -28,8 +42,8 @@ public:
     explicit LayoutModel(SubpixelLayout initial);
 
     const SubpixelLayout& layout() const { return layout_; }
-    // Counts every change of the layout (edits, undo, redo, presets, loads): the renderer
-    // restarts its sample schedule when it moves.
+    // Counts every change of the layout (edits, contrast, undo, redo, presets, loads): the frame
+    // loop hands the renderer what moved (a new layout restarts its sample schedule).
     uint64_t revision() const { return revision_; }
 
     int selected() const { return selected_; }
@@ -52,6 +66,18 @@ public:
     void drag_to(float dx, float dy);
     void end_drag();
     bool dragging() const { return drag_channel_ >= 0; }
+
+    // The contrast the preview is drawn with: the layout's, else crisp's default.
+    TextContrast contrast() const { return layout_.contrast.value_or(TextContrast{}); }
+    // Sets the layout's contrast settings (nullopt: none, and the file saved carries none).
+    // Refused (invalid_argument, the layout unchanged) when validate_text_contrast refuses them;
+    // the message is crisp's. One undo step.
+    Status set_contrast(const std::optional<TextContrast>& contrast);
+    // Sets one parameter of contrast() (checked as set_contrast), or steps it by `steps`
+    // kContrastStep, rounded to the step and stopping at its range; toggles linear and corrected.
+    Status set_contrast_parameter(ContrastParameter parameter, float value);
+    void step_contrast(ContrastParameter parameter, int steps);
+    void toggle_contrast_mode();
 
     // Replaces the layout with a preset (subpixel_preset's error for an unknown name) or with a
     // loaded layout (validated first). One undo step each.

@@ -28,10 +28,18 @@ constexpr Rect kLightPanel{360.0f, 52.0f, 446.0f, 278.0f};
 constexpr Rect kDarkPanel{818.0f, 52.0f, 446.0f, 278.0f};
 constexpr Rect kLightStrip{360.0f, 336.0f, 446.0f, 92.0f};  // the moving line and the fringe test
 constexpr Rect kDarkStrip{818.0f, 336.0f, 446.0f, 92.0f};
-constexpr Rect kRenderedView{360.0f, 452.0f, 904.0f, 304.0f};
+// The contrast controls: the preview's mode, gamma, contrast and stem darkening, and Reset.
+constexpr float kContrastY = 436.0f, kContrastHeight = kButtonHeight;
+constexpr Rect kModeButton{424.0f, kContrastY, 88.0f, kContrastHeight};
+constexpr float kContrastFieldX[] = {572.0f, 696.0f, 862.0f};  // gamma, contrast, stem darkening
+constexpr float kContrastLabelWidth[] = {48.0f, 56.0f, 96.0f};
+constexpr float kContrastFieldWidth = 56.0f;
+constexpr Rect kResetButton{932.0f, kContrastY, 60.0f, kContrastHeight};
+constexpr int kContrastChannel = 3;  // Field::channel of the contrast fields
+constexpr Rect kRenderedView{360.0f, 484.0f, 904.0f, 272.0f};
 constexpr Rect kStatusBar{0.0f, 766.0f, 1280.0f, 34.0f};
 constexpr int kCropWidth = static_cast<int>(904 / kRenderedScale);
-constexpr int kCropHeight = static_cast<int>(304 / kRenderedScale);
+constexpr int kCropHeight = static_cast<int>(272 / kRenderedScale);
 // How near an edge (screen pixels) a press grabs it rather than the rectangle.
 constexpr float kEdgeGrab = 5.0f;
 
@@ -51,6 +59,8 @@ constexpr std::array<Color, 3> kChannelOutline = {Color{255, 110, 110}, Color{11
 constexpr const char* kChannelNames[] = {"R", "G", "B"};
 constexpr const char* kCoordinateNames[] = {"x0", "y0", "x1", "y1"};
 constexpr const char* kCommands[] = {"Undo", "Redo", "Load", "Save"};
+constexpr const char* kContrastLabels[] = {"gamma", "contrast", "stem darkening"};
+constexpr const char* kContrastKeys[] = {"gamma", "contrast", "stem_darkening"};  // geometry_json, JSON
 
 constexpr const char* kParagraph =
     "Subpixel text fitted to your own monitor: sharp stems, no fringes. 0123456789 (fi fl)";
@@ -66,6 +76,10 @@ Rect command_button(size_t i) {
 Rect channel_rect_on_screen(const SampleRect& rect, float cell_x, float cell_y) {
     return {cell_x + rect.x0 * kMagnifiedPixelScale, cell_y + rect.y0 * kMagnifiedPixelScale,
             (rect.x1 - rect.x0) * kMagnifiedPixelScale, (rect.y1 - rect.y0) * kMagnifiedPixelScale};
+}
+
+Rect contrast_field(int parameter) {
+    return {kContrastFieldX[parameter], kContrastY, kContrastFieldWidth, kContrastHeight};
 }
 
 Rect intersect(const Rect& a, const Rect& b) {
@@ -95,6 +109,14 @@ EditorView::EditorView(LayoutModel& model, std::filesystem::path path)
       crop_x_(static_cast<int>(kLightStrip.x) + 4),
       crop_y_(static_cast<int>(kLightStrip.y) + 30) {}
 
+std::string EditorView::field_value(const Field& field) const {
+    if (field.channel == kContrastChannel) {
+        return format_number(contrast_parameter(model_.contrast(), static_cast<ContrastParameter>(field.coordinate)));
+    }
+    return format_number(
+        rect_coordinate(model_.layout().channels[static_cast<size_t>(field.channel)], field.coordinate));
+}
+
 std::vector<EditorView::Field> EditorView::fields() const {
     std::vector<Field> out;
     for (int channel = 0; channel < 3; ++channel) {
@@ -104,6 +126,9 @@ std::vector<EditorView::Field> EditorView::fields() const {
                            channel,
                            coordinate});
         }
+    }
+    for (int parameter = 0; parameter < 3; ++parameter) {
+        out.push_back({contrast_field(parameter), kContrastChannel, parameter});
     }
     out.push_back({kPathField, -1, 0});
     return out;
@@ -131,6 +156,10 @@ std::string EditorView::geometry_json() {
                   kFieldsY + static_cast<float>(channel) * kFieldStrideY, kFieldWidth, kFieldHeight});
         }
     }
+    json.end_object().key("contrast").begin_object();
+    rect("mode", kModeButton);
+    for (int parameter = 0; parameter < 3; ++parameter) rect(kContrastKeys[parameter], contrast_field(parameter));
+    rect("reset", kResetButton);
     json.end_object();
     rect("path_field", kPathField);
     rect("magnified_pixel", {kPixelOriginX - kMagnifiedPixelScale, kPixelOriginY - kMagnifiedPixelScale,
@@ -188,11 +217,8 @@ void EditorView::begin_field_edit(int index) {
     active_field_ = index;
     field_fresh_ = true;
     const Field field = fields()[static_cast<size_t>(index)];
-    field_text_ = field.channel < 0
-                      ? path_
-                      : format_number(rect_coordinate(model_.layout().channels[static_cast<size_t>(field.channel)],
-                                                      field.coordinate));
-    if (field.channel >= 0) model_.select(field.channel);
+    field_text_ = field.channel < 0 ? path_ : field_value(field);
+    model_.select(field.channel);
 }
 
 void EditorView::commit_field_edit() {
@@ -205,14 +231,18 @@ void EditorView::commit_field_edit() {
     }
     std::string why;
     const std::optional<float> value = cli::parse_number<float>(field_text_, &why);
-    const std::string what = std::string(kChannelNames[field.channel]) + " " + kCoordinateNames[field.coordinate];
+    const bool contrast = field.channel == kContrastChannel;
+    const std::string what = contrast
+                                 ? std::string(kContrastLabels[field.coordinate])
+                                 : std::string(kChannelNames[field.channel]) + " " + kCoordinateNames[field.coordinate];
     if (!value) {
         report(what + ": \"" + cli::printable(field_text_) + "\" " + why, true);
         return;
     }
-    if (Status status = model_.set_coordinate(field.channel, field.coordinate, *value); !status) {
-        report(what + ": " + status.error().message, true);
-    }
+    const Status status = contrast
+                              ? model_.set_contrast_parameter(static_cast<ContrastParameter>(field.coordinate), *value)
+                              : model_.set_coordinate(field.channel, field.coordinate, *value);
+    if (!status) report(what + ": " + status.error().message, true);
 }
 
 void EditorView::handle(const InputEvent& event) {
@@ -269,6 +299,13 @@ void EditorView::handle_key(const InputEvent& event) {
         quit_ = true;
     } else if (event.key == GLFW_KEY_TAB) {
         model_.select((model_.selected() + (shift ? 2 : 1)) % 3);
+    } else if (!control && event.key == GLFW_KEY_M) {
+        model_.toggle_contrast_mode();
+    } else if (!control && (event.key == GLFW_KEY_G || event.key == GLFW_KEY_C || event.key == GLFW_KEY_D)) {
+        const ContrastParameter parameter = event.key == GLFW_KEY_G   ? ContrastParameter::gamma
+                                            : event.key == GLFW_KEY_C ? ContrastParameter::contrast
+                                                                      : ContrastParameter::stem_darkening;
+        model_.step_contrast(parameter, shift ? -1 : 1);
     } else if (!control) {
         const int step = shift ? 8 : 1;
         switch (event.key) {
@@ -305,6 +342,14 @@ void EditorView::handle_mouse_down(const InputEvent& event) {
         if (i == 1) model_.redo();
         if (i == 2) load();
         if (i == 3) save();
+        return;
+    }
+    if (kModeButton.contains(x, y)) {
+        model_.toggle_contrast_mode();
+        return;
+    }
+    if (kResetButton.contains(x, y)) {
+        (void)model_.set_contrast(std::nullopt);  // none is always accepted
         return;
     }
     const std::vector<Field> all = fields();
@@ -361,6 +406,7 @@ void EditorView::draw(Canvas& canvas, std::span<const uint8_t> previous, const F
     draw_toolbar(canvas, text);
     draw_magnified_pixel(canvas, text);
     draw_fields(canvas, text);
+    draw_contrast(canvas, text);
     draw_side_text(text);
     draw_preview(canvas, stats, text);
     draw_rendered_pixels(canvas, previous, text);
@@ -437,14 +483,13 @@ void EditorView::draw_fields(Canvas& canvas, std::vector<TextItem>& text) const 
         } else if (field.channel < 0) {
             value = path_.empty() ? "(no file)" : path_;
         } else {
-            value = format_number(
-                rect_coordinate(model_.layout().channels[static_cast<size_t>(field.channel)], field.coordinate));
+            value = field_value(field);
         }
         // Long paths show their end, where the file name is.
         const size_t room = field.channel < 0 ? 34 : 9;
         if (value.size() > room) value = "..." + value.substr(value.size() - room + 3);
         text.push_back({cli::printable(value), field.rect.x + 5.0f, field.rect.y + 18.0f, 12.0f, kPanelText});
-        if (field.coordinate == 0 && field.channel >= 0) {
+        if (field.coordinate == 0 && field.channel >= 0 && field.channel < 3) {
             const bool selected = field.channel == model_.selected();
             const Rect swatch{kMargin + 8.0f, field.rect.y + 3.0f, 20.0f, 20.0f};
             canvas.fill(swatch, kChannelColors[static_cast<size_t>(field.channel)]);
@@ -452,6 +497,23 @@ void EditorView::draw_fields(Canvas& canvas, std::vector<TextItem>& text) const 
                 canvas.outline({swatch.x - 3, swatch.y - 3, swatch.width + 6, swatch.height + 6}, kActive, 2.0f);
         }
     }
+}
+
+void EditorView::draw_contrast(Canvas& canvas, std::vector<TextItem>& text) const {
+    const TextContrast contrast = model_.contrast();
+    const bool linear = contrast.mode == ContrastMode::linear;
+    text.push_back({"Contrast", kRenderedView.x, kContrastY + 18.0f, 12.0f, kDimText});
+    button(canvas, text, kModeButton, linear ? "linear" : "corrected", false);
+    for (int parameter = 0; parameter < 3; ++parameter) {
+        const Rect field = contrast_field(parameter);
+        // The labels sit left of their fields; the parameters do nothing in linear mode.
+        text.push_back({kContrastLabels[parameter], field.x - kContrastLabelWidth[parameter], kContrastY + 18.0f, 12.0f,
+                        linear ? Color{120, 120, 124} : kDimText});
+    }
+    const bool has = model_.layout().contrast.has_value();
+    button(canvas, text, kResetButton, "Reset", false, has);
+    text.push_back({has ? "the layout's own (saved with it)" : "crisp's default (the layout has none)",
+                    kResetButton.x + kResetButton.width + 12.0f, kContrastY + 18.0f, 12.0f, kDimText});
 }
 
 void EditorView::draw_side_text(std::vector<TextItem>& text) const {
@@ -472,6 +534,8 @@ void EditorView::draw_side_text(std::vector<TextItem>& text) const {
         "Ctrl+Z undo, Ctrl+Y redo, Ctrl+S save, Ctrl+O load,",
         "Ctrl+Q quit.",
         "Click the preview to choose what is magnified.",
+        "G, C, D raise gamma, contrast, stem darkening by 0.1,",
+        "with Shift lower them; M: linear or corrected.",
     };
     y = 628.0f;
     for (const char* line : help) {
@@ -511,8 +575,8 @@ void EditorView::draw_preview(Canvas& canvas, const FrameStats& stats, std::vect
 
 void EditorView::draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> previous,
                                       std::vector<TextItem>& text) const {
-    text.push_back({"The outlined preview pixels, x8, lighting this layout's subpixels", kRenderedView.x, 446.0f, 12.0f,
-                    kDimText});
+    text.push_back({"The outlined preview pixels, x8, lighting this layout's subpixels", kRenderedView.x,
+                    kRenderedView.y - 6.0f, 12.0f, kDimText});
     canvas.fill(kRenderedView, Color{0, 0, 0});
     if (previous.size() < size_t{kWindowWidth} * kWindowHeight * 4) return;
     const SubpixelLayout& layout = model_.layout();

@@ -77,10 +77,11 @@ public:
 private:
     struct Field {
         Rect rect;
-        int channel = -1;  // -1: the file path field
+        int channel = -1;  // -1: the file path field; 3: a contrast parameter (ContrastParameter)
         int coordinate = 0;
     };
     std::vector<Field> fields() const;
+    std::string field_value(const Field& field) const;  // a number field's value, formatted
     void begin_field_edit(int index);
     void commit_field_edit();
     void handle_key(const InputEvent& event);
@@ -90,6 +91,7 @@ private:
     void draw_toolbar(Canvas& canvas, std::vector<TextItem>& text) const;
     void draw_magnified_pixel(Canvas& canvas, std::vector<TextItem>& text) const;
     void draw_fields(Canvas& canvas, std::vector<TextItem>& text) const;
+    void draw_contrast(Canvas& canvas, std::vector<TextItem>& text) const;
     void draw_side_text(std::vector<TextItem>& text) const;
     void draw_preview(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const;
     void draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> previous, std::vector<TextItem>& text) const;

@@ -42,7 +42,8 @@ GpuFrame::~GpuFrame() {
 }
 
 Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const Font& font,
-                                                   const SubpixelLayout& preview_layout) {
+                                                   const SubpixelLayout& preview_layout,
+                                                   const TextContrast& preview_contrast) {
     std::unique_ptr<GpuFrame> self(new GpuFrame(window));
     if (Status s = vk::load_functions(vkGetInstanceProcAddr, window.instance(), window.device(), self->functions_);
         !s) {
@@ -117,6 +118,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
     self->interface_renderer_.emplace(std::move(*interface_renderer));
     renderer_info.atlas = atlas_config(2048);
     renderer_info.layout = preview_layout;
+    renderer_info.contrast = preview_contrast;
     Result<Renderer> preview_renderer = Renderer::create(renderer_info);
     if (!preview_renderer) return preview_renderer.error();
     self->preview_renderer_.emplace(std::move(*preview_renderer));
@@ -174,6 +176,10 @@ std::span<const uint8_t> GpuFrame::previous_frame() const {
 
 Status GpuFrame::set_preview_layout(const SubpixelLayout& layout) {
     return preview_renderer_->set_subpixel_layout(layout);
+}
+
+Status GpuFrame::set_preview_contrast(const TextContrast& contrast) {
+    return preview_renderer_->set_contrast(contrast);
 }
 
 Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const GlyphInstance> interface_glyphs,

@@ -27,7 +27,8 @@ class GpuFrame {
 public:
     // The canvas is window.width() x window.height(). `font` must outlive the GpuFrame.
     static Result<std::unique_ptr<GpuFrame>> create(VulkanWindow& window, const Font& font,
-                                                    const SubpixelLayout& preview_layout);
+                                                    const SubpixelLayout& preview_layout,
+                                                    const TextContrast& preview_contrast);
     GpuFrame(const GpuFrame&) = delete;
     GpuFrame& operator=(const GpuFrame&) = delete;
     // Waits for the device, then destroys crisp's objects and its own.
@@ -44,6 +45,8 @@ public:
 
     // Restarts the preview's sample schedule with a new layout (crisp's error when invalid).
     Status set_preview_layout(const SubpixelLayout& layout);
+    // The preview's contrast settings, from the next frame on (the samples stay).
+    Status set_preview_contrast(const TextContrast& contrast);
 
     // Records and submits one frame into the acquired swapchain image.
     Status render(const VulkanWindow::Acquired& target, std::span<const GlyphInstance> interface_glyphs,

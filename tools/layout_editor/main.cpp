@@ -13,6 +13,7 @@
 #include <crisp/subpixel.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -187,7 +188,7 @@ bool write_screenshot(const std::string& path, std::span<const uint8_t> rgba, ui
 // The window's life: returns the exit code. Everything Vulkan is gone when it returns, except the
 // window, whose validation count the caller reads.
 int run(const Args& args, VulkanWindow& window, const crisp::Font& font, LayoutModel& model, EditorView& view) {
-    crisp::Result<std::unique_ptr<GpuFrame>> created = GpuFrame::create(window, font, model.layout());
+    crisp::Result<std::unique_ptr<GpuFrame>> created = GpuFrame::create(window, font, model.layout(), model.contrast());
     if (!created) {
         std::fprintf(stderr, "crisp-layout-editor: Vulkan: %s\n", created.error().message.c_str());
         return kExitVulkan;
@@ -197,6 +198,9 @@ int run(const Args& args, VulkanWindow& window, const crisp::Font& font, LayoutM
     std::vector<TextItem> items;
     FrameText text;
     uint64_t applied_revision = model.revision();
+    // What the preview's renderer has: a change of contrast alone keeps the samples.
+    std::array<crisp::SampleRect, 3> applied_channels = model.layout().channels;
+    crisp::TextContrast applied_contrast = model.contrast();
     uint64_t frame = 0;
     while (!window.should_close() && !view.quit_requested()) {
         if (crisp::Status status = gpu.wait(); !status) {
@@ -208,8 +212,17 @@ int run(const Args& args, VulkanWindow& window, const crisp::Font& font, LayoutM
         for (const InputEvent& event : window.poll_events()) view.handle(event);
         if (model.revision() != applied_revision) {
             applied_revision = model.revision();
-            if (crisp::Status status = gpu.set_preview_layout(model.layout()); !status) {
-                view.report(status.error().message, true);
+            if (model.layout().channels != applied_channels) {
+                applied_channels = model.layout().channels;
+                if (crisp::Status status = gpu.set_preview_layout(model.layout()); !status) {
+                    view.report(status.error().message, true);
+                }
+            }
+            if (model.contrast() != applied_contrast) {
+                applied_contrast = model.contrast();
+                if (crisp::Status status = gpu.set_preview_contrast(applied_contrast); !status) {
+                    view.report(status.error().message, true);
+                }
             }
         }
         crisp::Result<VulkanWindow::Acquired> acquired = window.acquire();
