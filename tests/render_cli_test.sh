@@ -283,6 +283,20 @@ expect_exit 0 "a scene without contrast" -- "$render" --scene "$work/run-default
   -o "$work/run-default.png"
 cmp -s "$work/run-default.png" "$work/hi.png" || fail "a scene without contrast is not drawn as the default"
 
+# A layout file's contrast (a monitor's settings) is the renderer's unless an option gives one.
+cat >"$work/rgb-linear.json" <<'JSON'
+{"name": "rgb-linear", "r": [0, 0, 0.333333, 1], "g": [0.333333, 0, 0.666667, 1], "b": [0.666667, 0, 1, 1],
+ "contrast": {"mode": "linear"}}
+JSON
+expect_exit 0 "a layout file with linear contrast" -- "$render" "${base[@]}" --layout "$work/rgb-linear.json" \
+  -o "$work/layout-linear.png" --json
+python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['contrast']; assert c['mode'] == 'linear', c" \
+  "$work/out" || fail "a layout file's linear contrast is not the renderer's"
+expect_exit 0 "a layout file's contrast under --contrast corrected" -- "$render" "${base[@]}" \
+  --layout "$work/rgb-linear.json" --contrast corrected -o "$work/layout-corrected.png" --json
+python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['contrast']; assert c['mode'] == 'corrected', c" \
+  "$work/out" || fail "--contrast does not override a layout file's contrast"
+
 # The human summary goes to stdout, nothing to stderr.
 expect_exit 0 "render without --json" -- "$render" "${base[@]}" -o "$work/hi2.png"
 grep -q "frames" "$work/out" || fail "no summary on stdout"

@@ -100,6 +100,7 @@ struct Arguments {
     std::string backdrop = "flat";
     crisp::QuadPath path = crisp::QuadPath::raster;
     crisp::TextContrast contrast;  // the renderer's; a scene's runs may carry their own
+    bool contrast_given = false;   // some contrast option was given: a layout file's settings yield
     std::string output;
     std::string coverage_output;
     bool json = false;
@@ -326,6 +327,8 @@ Arguments parse_arguments(int argc, char** argv) {
             "--gamma, --enhanced-contrast and --stem-darkening apply to --contrast corrected only (linear "
             "blends the coverage as it is)");
     }
+    args.contrast_given = cli.given("--contrast") || cli.given("--gamma") || cli.given("--enhanced-contrast") ||
+                          cli.given("--stem-darkening");
     // The options' ranges are the model's; this names a setting they let through, should they part.
     if (crisp::Status valid = crisp::validate_text_contrast(args.contrast); !valid) cli.fail(valid.error().message);
     if (!args.coverage_output.empty() && std::filesystem::path(args.coverage_output).lexically_normal() ==
@@ -395,6 +398,9 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
 struct Job {
     crisp::Scene scene;
     crisp::SubpixelLayout subpixel_layout;
+    // The renderer's contrast settings: the options', or where none was given the layout file's
+    // (a monitor's, docs/subpixel.md), else the model's defaults.
+    crisp::TextContrast contrast;
     std::vector<crisp::Font> fonts;            // FontIds 1, 2, ... in scene order
     std::vector<crisp::GlyphInstance> glyphs;  // every run's glyphs that touch the canvas, in paint order
     // One draw() each: consecutive runs' glyphs with the same contrast settings (nullopt: the
@@ -652,7 +658,7 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
     for (uint32_t& samples : info.atlas.ramp) samples = std::min(samples, args.samples);
     report.atlas_side = atlas_side_for(job.glyphs);
     info.atlas.width = info.atlas.height = report.atlas_side;
-    info.contrast = args.contrast;
+    info.contrast = job.contrast;
 
     crisp::Result<crisp::Renderer> created = crisp::Renderer::create(info);
     if (!created) {
@@ -919,10 +925,10 @@ void print_json(const Summary& s) {
         .end_object();
     json.field("layout", job.subpixel_layout.name);
     json.key("contrast").begin_object();
-    json.field("mode", contrast_mode_name(args.contrast.mode))
-        .field("gamma", args.contrast.gamma)
-        .field("contrast", args.contrast.contrast)
-        .field("stem_darkening", args.contrast.stem_darkening)
+    json.field("mode", contrast_mode_name(job.contrast.mode))
+        .field("gamma", job.contrast.gamma)
+        .field("contrast", job.contrast.contrast)
+        .field("stem_darkening", job.contrast.stem_darkening)
         .field("own_runs", own_contrast_runs(job.scene))
         .end_object();
     json.field("scene", unless_empty(args.scene)).field("runs", job.scene.runs.size());
@@ -980,7 +986,7 @@ void print_human(const Summary& s) {
     std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)\n", static_cast<unsigned long long>(r.frames),
                 frame_total, r.frames ? frame_total / static_cast<double>(r.frames) : 0.0);
     std::printf("  blend    %s\n", human_composite(args, r.composite).c_str());
-    std::printf("  contrast %s\n", human_contrast(args.contrast, job.scene).c_str());
+    std::printf("  contrast %s\n", human_contrast(job.contrast, job.scene).c_str());
     std::printf("  atlas    %ux%u, %.1f%% occupied, %u resident, %llu allocations, %llu evictions\n", r.atlas_side,
                 r.atlas_side, 100.0 * static_cast<double>(r.atlas.occupancy), r.atlas.resident_glyphs,
                 static_cast<unsigned long long>(r.atlas.total.allocations),
@@ -1075,6 +1081,7 @@ Job load_job(const Arguments& args) {
                               subpixel_layout.error().message);
     }
     job.subpixel_layout = std::move(*subpixel_layout);
+    job.contrast = !args.contrast_given && job.subpixel_layout.contrast ? *job.subpixel_layout.contrast : args.contrast;
 
     job.fonts.reserve(job.scene.fonts.size());
     for (size_t i = 0; i < job.scene.fonts.size(); ++i) {
