@@ -6,7 +6,7 @@ float contrast_luminance(vec3 c) {
     return dot(c, vec3(0.2126, 0.7152, 0.0722));
 }
 
-// The corrected coverage of each channel of `quad` (its settings, its colour's luminance `lt`) over
+// The corrected coverage of each channel of a glyph (its settings, its colour's luminance `lt`) over
 // a background of luminance `lb`; coverage as it is where the settings are linear.
 vec3 corrected_coverage(vec3 coverage, float gamma, float k, float darkening, float lt, float lb) {
     if (gamma == 1.0 && k == 0.0 && darkening == 1.0) return coverage;

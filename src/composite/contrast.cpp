@@ -55,8 +55,8 @@ Status validate_text_contrast(const TextContrast& contrast) {
 
 float stem_darkening_factor(float strength, float size_px) {
     if (!(strength > 0.0f) || !(size_px > 0.0f)) return 1.0f;
-    const double width = std::max(0.25, double{kStemDarkeningStem} * double{size_px});
-    return static_cast<float>(1.0 + double{strength} * freetype_darkening(width) / width);
+    const double width = std::max(0.25, static_cast<double>(kStemDarkeningStem) * static_cast<double>(size_px));
+    return static_cast<float>(1.0 + static_cast<double>(strength) * freetype_darkening(width) / width);
 }
 
 GlyphContrast resolve_contrast(const TextContrast& contrast, float size_px) {
@@ -67,14 +67,14 @@ GlyphContrast resolve_contrast(const TextContrast& contrast, float size_px) {
 double corrected_coverage(double coverage, const GlyphContrast& contrast, double text_luminance,
                           double background_luminance) {
     if (contrast.linear()) return coverage;
-    const double k = double{contrast.contrast};
+    const double k = static_cast<double>(contrast.contrast);
     double c = coverage * (1.0 + k) / (1.0 + k * coverage);
-    c = std::min(1.0, c * double{contrast.darkening});
+    c = std::min(1.0, c * static_cast<double>(contrast.darkening));
     const double lt = text_luminance, lb = background_luminance;
     // No coverage and full coverage stay exact: the round trip through the gamma space would
     // leave a trace of opacity where nothing is covered.
-    if (c <= 0.0 || c >= 1.0 || std::abs(lt - lb) < double{gpu::kContrastSameLuminance}) return c;
-    const double g = double{contrast.gamma};
+    if (c <= 0.0 || c >= 1.0 || std::abs(lt - lb) < static_cast<double>(gpu::kContrastSameLuminance)) return c;
+    const double g = static_cast<double>(contrast.gamma);
     const double blended = (1.0 - c) * std::pow(lb, 1.0 / g) + c * std::pow(lt, 1.0 / g);
     return std::clamp((std::pow(blended, g) - lb) / (lt - lb), 0.0, 1.0);
 }
