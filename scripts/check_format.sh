@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Checks that every tracked C++ file is formatted as .clang-format says (clang-format 14, Debian
-# 12's). Prints the files that differ and how to fix them; exit 1 if any does. --fix formats them.
+# Checks that every C++ file git tracks or would add is formatted as .clang-format says
+# (clang-format 14, Debian 12's). Prints the files that differ and how to fix them; exit 1 if any
+# does. --fix formats them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.h')
+mapfile -t files < <(git ls-files --cached --others --exclude-standard '*.cpp' '*.hpp' '*.h')
 if [ "${1:-}" = "--fix" ]; then
   clang-format -i "${files[@]}"
   exit 0

@@ -72,7 +72,6 @@ struct LineRecord {
     bool rtl = false;
 };
 
-
 }  // namespace detail
 
 using namespace detail;
