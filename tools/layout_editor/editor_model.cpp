@@ -50,16 +50,8 @@ void shift_span(float& lo, float& hi, float delta) {
 }  // namespace
 
 float rect_coordinate(const SampleRect& rect, int coordinate) {
-    switch (coordinate) {
-        case 0:
-            return rect.x0;
-        case 1:
-            return rect.y0;
-        case 2:
-            return rect.x1;
-        default:
-            return rect.y1;
-    }
+    SampleRect copy = rect;
+    return coordinate_ref(copy, coordinate);
 }
 
 float contrast_parameter(const TextContrast& contrast, ContrastParameter parameter) {
