@@ -25,7 +25,9 @@
 
 namespace crisp {
 
-inline constexpr uint32_t kAssetVersion = 1;
+// Version 2 added colour glyphs (the COLR, LAYR, PANT, STOP, CPAL and IMAG sections); version 1
+// assets load as assets without them.
+inline constexpr uint32_t kAssetVersion = 2;
 
 // The most curves one glyph may have, in the baker and (with the pads between its contours, twice
 // as many curve slots) in the loader: the most complex glyphs of common fonts have about 550 (a CJK
@@ -41,6 +43,10 @@ struct Point {
 enum GlyphFlags : uint32_t {
     kGlyphBaked = 1u << 0,   // the glyph was requested and converted (absent glyphs have no curves)
     kGlyphFailed = 1u << 1,  // conversion failed; baked with --allow-failed as an empty glyph
+    // Not a glyph of the face: an outline the baker made for a colour glyph's layer (a layer glyph
+    // under a COLRv1 transform, a bitmap's rectangle). Synthetic records follow the face's glyphs
+    // (FontAsset::face_glyph_count()); shaping never produces them, only ColourLayer::glyph names them.
+    kGlyphSynthetic = 1u << 2,
 };
 
 // One glyph, indexed by the font's glyph index. All lengths are in em (font units / units per em),
@@ -91,15 +97,124 @@ struct FontInfo {
     friend bool operator==(const FontInfo&, const FontInfo&) = default;
 };
 
+// ---- Colour glyphs (docs/colour.md). A colour glyph (COLRv0, COLRv1, or a CBDT/sbix bitmap) is
+// baked into a list of layers in paint order, back to front: each layer is an outline glyph of the
+// asset (rasterized into the atlas like any glyph) filled with a paint. The COLRv1 paint graph is
+// flattened at bake time: transforms are folded into the layer's outline (a synthetic glyph) and
+// into its paint's mapping, groups composited src-over (and the other modes a layer list can
+// express exactly) become consecutive layers.
+
+// The palette index that means "the text's own colour" (CPAL's 0xFFFF).
+inline constexpr uint32_t kForegroundPaletteIndex = 0xFFFF;
+
+// Limits on colour glyphs (docs/limits.md): the baker refuses a glyph past them, the loader an
+// asset. Every layer is a quad the compositor sorts and a glyph the atlas holds.
+inline constexpr uint32_t kMaxColourLayers = 1024;      // layers of one colour glyph
+inline constexpr uint32_t kMaxColourStops = 256;        // stops of one colour line
+inline constexpr uint32_t kMaxPalettes = 256;           // CPAL palettes kept
+inline constexpr uint32_t kMaxPaletteSize = 4096;       // entries per palette
+inline constexpr uint32_t kMaxBitmapSide = 1024;        // pixels a side of one bitmap glyph
+inline constexpr uint32_t kMaxSyntheticGlyphs = 65536;  // synthetic outline records
+
+enum class PaintKind : uint32_t {
+    solid = 0,   // one stop: its colour
+    linear = 1,  // geometry: p0 (x, y), p1 (x, y); colour line t = 0 at p0, 1 at p1
+    radial = 2,  // geometry: c0 (x, y), r0, c1 (x, y), r1: the two-point conical gradient
+    sweep = 3,   // geometry: centre (x, y), start and end angle in turns (1 = 360 degrees, counter-clockwise)
+    image = 4,   // a bitmap (PaintBitmap::image) over the unit square [0, 1]^2 of paint space, y down
+};
+enum class PaintExtend : uint32_t { pad = 0, repeat = 1, reflect = 2 };
+
+// An affine map: x' = xx * x + xy * y + dx, y' = yx * x + yy * y + dy.
+struct Affine {
+    float xx = 1.0f;
+    float yx = 0.0f;
+    float xy = 0.0f;
+    float yy = 1.0f;
+    float dx = 0.0f;
+    float dy = 0.0f;
+    friend bool operator==(const Affine&, const Affine&) = default;
+};
+
+// A colour of a colour line: a palette entry (or kForegroundPaletteIndex) times an alpha.
+struct ColourStop {
+    float offset = 0.0f;  // position on the colour line; stops are sorted by it
+    uint32_t palette_index = 0;
+    float alpha = 1.0f;  // [0, 1]
+    friend bool operator==(const ColourStop&, const ColourStop&) = default;
+};
+
+struct Paint {
+    PaintKind kind = PaintKind::solid;
+    PaintExtend extend = PaintExtend::pad;
+    uint32_t first_stop = 0;  // in FontAsset::stops; a solid paint has exactly one stop
+    uint32_t stop_count = 0;
+    uint32_t image = 0;  // image paints: index in FontAsset::images
+    // From the glyph's em space (y up, origin at the pen) to the paint's own space, where its
+    // geometry is given.
+    Affine to_paint;
+    float geometry[6] = {};
+    friend bool operator==(const Paint&, const Paint&) = default;
+};
+
+struct ColourLayer {
+    uint32_t glyph = 0;  // the layer's outline: a glyph of the asset (a face glyph or a synthetic one)
+    uint32_t paint = 0;  // index in FontAsset::paints
+    friend bool operator==(const ColourLayer&, const ColourLayer&) = default;
+};
+
+enum ColourGlyphFlags : uint32_t {
+    kColourClipped = 1u << 0,  // the clip box holds: nothing of the glyph shows outside it
+};
+
+struct ColourGlyph {
+    uint32_t glyph = 0;        // the face glyph shaping gives; ColourGlyphs are sorted by it, once each
+    uint32_t first_layer = 0;  // in FontAsset::layers
+    uint32_t layer_count = 0;
+    uint32_t flags = 0;       // ColourGlyphFlags
+    float clip_min_x = 0.0f;  // em: the COLRv1 clip box
+    float clip_min_y = 0.0f;
+    float clip_max_x = 0.0f;
+    float clip_max_y = 0.0f;
+    friend bool operator==(const ColourGlyph&, const ColourGlyph&) = default;
+};
+
+// A bitmap glyph's pixels: premultiplied RGBA8, sRGB-encoded, rows top to bottom, compressed with
+// zlib (RFC 1950) in FontAsset::image_bytes.
+struct BitmapImage {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    uint32_t byte_offset = 0;  // in FontAsset::image_bytes
+    uint32_t byte_count = 0;
+    friend bool operator==(const BitmapImage&, const BitmapImage&) = default;
+};
+
 // A font asset in memory. `glyphs` is indexed by glyph index and holds one record for every glyph
-// of the face, baked or not.
+// of the face, baked or not, then the synthetic glyphs of colour layers.
 struct CRISP_API FontAsset {
     FontInfo info;
     std::vector<GlyphRecord> glyphs;
     std::vector<Point> points;
     std::vector<uint32_t> band_words;
     std::vector<std::byte> font_bytes;
+    // Colour glyphs; all empty for a font without any.
+    std::vector<ColourGlyph> colour_glyphs;
+    std::vector<ColourLayer> layers;
+    std::vector<Paint> paints;
+    std::vector<ColourStop> stops;
+    // CPAL: palette_count palettes of palette_size entries each, RGBA8 (red in the low byte),
+    // sRGB-encoded, straight alpha, palette-major.
+    uint32_t palette_size = 0;
+    std::vector<uint32_t> palette_colours;
+    std::vector<BitmapImage> images;
+    std::vector<std::byte> image_bytes;
     friend bool operator==(const FontAsset&, const FontAsset&) = default;
+
+    // The glyphs of the face: the records before the first synthetic one.
+    uint32_t face_glyph_count() const;
+    uint32_t palette_count() const;
+    // The colour glyph of face glyph `glyph`, or nullptr when it has none (a binary search).
+    const ColourGlyph* colour_glyph(uint32_t glyph) const;
 
     // The band holding em-space height y: with h = (bbox_max_y - bbox_min_y) / band_count,
     // clamp(floor((y - bbox_min_y) / h), 0, band_count - 1), evaluated in float in that order (as a

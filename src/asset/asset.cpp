@@ -287,6 +287,22 @@ uint32_t FontAsset::band_of(const GlyphRecord& glyph, float y) {
     return static_cast<uint32_t>(band);
 }
 
+uint32_t FontAsset::face_glyph_count() const {
+    auto synthetic = std::find_if(glyphs.begin(), glyphs.end(),
+                                  [](const GlyphRecord& glyph) { return (glyph.flags & kGlyphSynthetic) != 0; });
+    return static_cast<uint32_t>(synthetic - glyphs.begin());
+}
+
+uint32_t FontAsset::palette_count() const {
+    return palette_size == 0 ? 0 : static_cast<uint32_t>(palette_colours.size() / palette_size);
+}
+
+const ColourGlyph* FontAsset::colour_glyph(uint32_t glyph) const {
+    auto at = std::lower_bound(colour_glyphs.begin(), colour_glyphs.end(), glyph,
+                               [](const ColourGlyph& entry, uint32_t value) { return entry.glyph < value; });
+    return at != colour_glyphs.end() && at->glyph == glyph ? &*at : nullptr;
+}
+
 Result<FontAsset> load_asset(std::span<const std::byte> bytes) {
     // Cheap checks first: a truncated or foreign file fails before the checksum pass.
     if (bytes.size() < kHeaderSize)
