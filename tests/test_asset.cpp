@@ -45,7 +45,7 @@ constexpr float kInfinity = std::numeric_limits<float>::infinity();
 constexpr size_t kChecksumOffset = 24;
 constexpr size_t kSectionTableOffset = 32;
 constexpr size_t kSectionEntrySize = 24;
-constexpr size_t kSectionCount = 5;
+constexpr size_t kSectionCount = 12;
 constexpr size_t kSectionTableEnd = kSectionTableOffset + kSectionCount * kSectionEntrySize;
 constexpr size_t kGlyphRecordSize = 48;
 constexpr size_t kGlyphPointOffsetField = 28;
@@ -329,8 +329,9 @@ void expect_resealed_fault(const std::function<void(std::vector<std::byte>&)>& c
     expect_rejected(bytes, code, fragment);
 }
 
-void expect_invalid(const std::function<void(FontAsset&)>& change, std::string_view fragment) {
-    FontAsset asset = valid_asset();
+void expect_invalid(const std::function<void(FontAsset&)>& change, std::string_view fragment,
+                    const FontAsset& base = valid_asset()) {
+    FontAsset asset = base;
     change(asset);
     Status status = validate_asset(asset);
     ASSERT_FALSE(status.ok()) << "accepted; expected a message with \"" << fragment << "\"";
@@ -414,8 +415,10 @@ TEST(Asset, SerializedLayout) {
     EXPECT_EQ(peek<uint64_t>(bytes, 16), bytes.size());
     EXPECT_EQ(peek<uint32_t>(bytes, 28), 0u);
 
-    // META GLYF PNTS BAND FONT, in that order, 16-byte aligned, zero padding, nothing after FONT.
-    const char* const tags[] = {"META", "GLYF", "PNTS", "BAND", "FONT"};
+    // META GLYF PNTS BAND FONT COLR LAYR PANT STOP CPAL IMAG PIXL, in that order, 16-byte aligned, zero
+    // padding, nothing after PIXL.
+    const char* const tags[] = {"META", "GLYF", "PNTS", "BAND", "FONT", "COLR",
+                                "LAYR", "PANT", "STOP", "CPAL", "IMAG", "PIXL"};
     uint64_t end = kSectionTableEnd;
     for (size_t i = 0; i < kSectionCount; ++i) {
         size_t at = kSectionTableOffset + i * kSectionEntrySize;
@@ -452,24 +455,15 @@ TEST(Asset, SerializedLayout) {
     EXPECT_EQ(peek<uint32_t>(bytes, at + 44), glyph.flags);
 }
 
-TEST(Asset, DocumentedExample) {
-    // The worked example at the end of docs/asset-format.md, byte for byte.
-    const std::string_view hex =
-        "4352495350464e54010000000500000034010000000000003b8c04c700000000"
-        "4d45544100000000a0000000000000003300000000000000474c594600000000"
-        "e0000000000000003000000000000000504e5453000000001001000000000000"
-        "000000000000000042414e440000000010010000000000000000000000000000"
-        "464f4e5400000000100100000000000024000000000000000000000000000000"
-        "e80300002003000038ffffff5a00000000000000010000000000000000008039"
-        "0000000000000000020000000100000045785200000000000000000000000000"
-        "0000003f00000000000000000000000000000000000000000000000000000000"
-        "000000000000000000000000010000000001000000010010000000006d617870"
-        "000000000000001c000000060000500000010000";
-    std::vector<std::byte> expected;
+std::vector<std::byte> from_hex(std::string_view hex) {
+    std::vector<std::byte> bytes;
     for (size_t i = 0; i + 1 < hex.size(); i += 2)
-        expected.push_back(static_cast<std::byte>(std::stoi(std::string(hex.substr(i, 2)), nullptr, 16)));
-    ASSERT_EQ(expected.size(), 308u);
+        bytes.push_back(static_cast<std::byte>(std::stoi(std::string(hex.substr(i, 2)), nullptr, 16)));
+    return bytes;
+}
 
+// The asset of the worked examples at the end of docs/asset-format.md.
+FontAsset example_asset() {
     FontAsset asset;
     asset.font_bytes = minimal_font(1);
     asset.info.family = "Ex";
@@ -482,11 +476,51 @@ TEST(Asset, DocumentedExample) {
     asset.glyphs.resize(1);
     asset.glyphs[0].advance = 0.5f;
     asset.glyphs[0].flags = kGlyphBaked;
+    return asset;
+}
 
-    EXPECT_EQ(serialize_asset(asset), expected);
+TEST(Asset, DocumentedExample) {
+    // The worked example at the end of docs/asset-format.md, byte for byte.
+    const std::vector<std::byte> expected = from_hex(
+        "4352495350464e54020000000c000000e001000000000000f5bba9f900000000"
+        "4d4554410000000040010000000000003300000000000000474c594600000000"
+        "80010000000000003000000000000000504e545300000000b001000000000000"
+        "000000000000000042414e4400000000b0010000000000000000000000000000"
+        "464f4e5400000000b0010000000000002400000000000000434f4c5200000000"
+        "e00100000000000000000000000000004c41595200000000e001000000000000"
+        "000000000000000050414e5400000000e0010000000000000000000000000000"
+        "53544f5000000000e00100000000000000000000000000004350414c00000000"
+        "e0010000000000000000000000000000494d414700000000e001000000000000"
+        "00000000000000005049584c00000000e0010000000000000000000000000000"
+        "e80300002003000038ffffff5a00000000000000010000000000000000008039"
+        "0000000000000000020000000100000045785200000000000000000000000000"
+        "0000003f00000000000000000000000000000000000000000000000000000000"
+        "000000000000000000000000010000000001000000010010000000006d617870"
+        "000000000000001c000000060000500000010000000000000000000000000000");
+    ASSERT_EQ(expected.size(), 480u);
+    EXPECT_EQ(serialize_asset(example_asset()), expected);
     Result<FontAsset> loaded = load_asset(expected);
     ASSERT_TRUE(loaded.ok()) << loaded.error().message;
-    EXPECT_TRUE(*loaded == asset);
+    EXPECT_TRUE(*loaded == example_asset());
+}
+
+TEST(Asset, Version1FilesStillLoad) {
+    // The version 1 example of docs/asset-format.md: five sections, no colour glyphs.
+    const std::vector<std::byte> expected = from_hex(
+        "4352495350464e54010000000500000034010000000000003b8c04c700000000"
+        "4d45544100000000a0000000000000003300000000000000474c594600000000"
+        "e0000000000000003000000000000000504e5453000000001001000000000000"
+        "000000000000000042414e440000000010010000000000000000000000000000"
+        "464f4e5400000000100100000000000024000000000000000000000000000000"
+        "e80300002003000038ffffff5a00000000000000010000000000000000008039"
+        "0000000000000000020000000100000045785200000000000000000000000000"
+        "0000003f00000000000000000000000000000000000000000000000000000000"
+        "000000000000000000000000010000000001000000010010000000006d617870"
+        "000000000000001c000000060000500000010000");
+    ASSERT_EQ(expected.size(), 308u);
+    Result<FontAsset> loaded = load_asset(expected);
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    EXPECT_TRUE(*loaded == example_asset());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -609,9 +643,9 @@ TEST(AssetFault, BadMagic) {
     expect_resealed_fault([](std::vector<std::byte>& bytes) { bytes[3] = std::byte{'X'}; }, "bad magic");
 }
 
-TEST(AssetFault, VersionTwo) {
-    expect_resealed_fault([](std::vector<std::byte>& bytes) { poke<uint32_t>(bytes, 8, 2); },
-                          "version 2 is not supported", ErrorCode::asset_version);
+TEST(AssetFault, VersionThree) {
+    expect_resealed_fault([](std::vector<std::byte>& bytes) { poke<uint32_t>(bytes, 8, 3); },
+                          "version 3 is not supported (this build reads versions 1 and 2)", ErrorCode::asset_version);
 }
 
 TEST(AssetFault, ChecksumMismatch) {
@@ -627,7 +661,7 @@ TEST(AssetFault, HeaderReservedField) {
 
 TEST(AssetFault, SectionCount) {
     expect_resealed_fault([](std::vector<std::byte>& bytes) { poke<uint32_t>(bytes, 12, 4); },
-                          "4 sections, version 1 has exactly 5");
+                          "4 sections, version 2 has exactly 12");
 }
 
 TEST(AssetFault, PointRangePastEnd) {
@@ -724,7 +758,7 @@ TEST(AssetFault, GlyphCountDiffersFromRecords) {
         [](std::vector<std::byte>& bytes) {
             poke<uint32_t>(bytes, static_cast<size_t>(find_section(bytes, "META").offset) + kMetaGlyphCountField, 0);
         },
-        "asset: glyph count 0 outside 1..65536");
+        "asset: glyph count 0 outside 1..131072");
 }
 
 TEST(AssetFault, OverlappingSections) {
@@ -769,10 +803,10 @@ TEST(AssetFault, MisalignedSectionOffset) {
 TEST(AssetFault, SectionOutOfBounds) {
     expect_resealed_fault(
         [](std::vector<std::byte>& bytes) {
-            SectionEntry font = find_section(bytes, "FONT");
-            poke<uint64_t>(bytes, font.entry_at + 16, font.size + 1);
+            SectionEntry pixels = find_section(bytes, "PIXL");  // the last section
+            poke<uint64_t>(bytes, pixels.entry_at + 16, pixels.size + 1);
         },
-        "'FONT': range [");
+        "'PIXL': range [");
     // offset + size wraps around 2^64.
     expect_resealed_fault(
         [](std::vector<std::byte>& bytes) {
@@ -851,9 +885,9 @@ TEST(AssetValidate, FontInfo) {
 }
 
 TEST(AssetValidate, Glyphs) {
-    expect_invalid([](FontAsset& a) { a.glyphs.clear(); }, "glyph count 0 outside 1..65536");
+    expect_invalid([](FontAsset& a) { a.glyphs.clear(); }, "glyph count 0 outside 1..131072");
     expect_invalid([](FontAsset& a) { a.glyphs.resize(65537); }, "glyph count 65537");
-    expect_invalid([](FontAsset& a) { a.glyphs[9].flags = 4; }, "glyph 9: flags 0x00000004 hold unknown bits");
+    expect_invalid([](FontAsset& a) { a.glyphs[9].flags = 8; }, "glyph 9: flags 0x00000008 hold unknown bits");
     expect_invalid([](FontAsset& a) { a.glyphs[9].advance = kInfinity; }, "glyph 9: advance inf is not finite");
     expect_invalid([](FontAsset& a) { a.glyphs[9].bearing_y = -64.5f; },
                    "glyph 9: bearing_y -64.5 outside [-64, 64] em");
@@ -1072,6 +1106,149 @@ TEST(BandOf, MatchesTheFloatFormula) {
         uint32_t expected = band < 0.0f ? 0u : band > 6.0f ? 6u : static_cast<uint32_t>(band);
         ASSERT_EQ(FontAsset::band_of(glyph, y), expected) << "y " << y;
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Colour glyphs (version 2)
+
+// The small fixture with a synthetic glyph (a copy of the square under a transform), two palettes,
+// a paint of every kind and two colour glyphs.
+FontAsset make_colour_asset() {
+    FontAsset asset = small_asset();
+    const uint32_t synthetic = static_cast<uint32_t>(asset.glyphs.size());
+    asset.glyphs.emplace_back();
+    add_glyph(asset, synthetic, {polygon({{0.0f, 0.0f}, {0.25f, 0.0f}, {0.25f, 0.5f}, {0.0f, 0.5f}})}, 1);
+    asset.glyphs[synthetic].flags |= kGlyphSynthetic;
+
+    asset.palette_size = 2;
+    asset.palette_colours = {0xFF0000FFu, 0x8000FF00u, 0xFFFFFFFFu, 0xFF000000u};
+    asset.stops = {
+        {0.0f, 0, 1.0f},                                          // paint 0: solid
+        {0.0f, 1, 1.0f},  {1.0f, kForegroundPaletteIndex, 0.5f},  // paint 1: linear
+        {0.25f, 0, 1.0f}, {0.75f, 1, 0.25f},                      // paint 2: radial
+        {0.0f, 0, 1.0f},  {0.5f, 1, 1.0f},
+        {1.0f, 0, 1.0f},  // paint 3: sweep
+    };
+    Paint solid;
+    solid.stop_count = 1;
+    Paint linear{PaintKind::linear, PaintExtend::repeat, 1, 2, 0, {}, {0.0f, 0.0f, 0.5f, 0.5f, 0.0f, 0.0f}};
+    Paint radial{PaintKind::radial, PaintExtend::reflect, 3, 2, 0, {}, {0.2f, 0.2f, 0.0f, 0.3f, 0.3f, 0.4f}};
+    Paint sweep{PaintKind::sweep,
+                PaintExtend::pad,
+                5,
+                3,
+                0,
+                {2.0f, 0.0f, 0.0f, 2.0f, -1.0f, 0.0f},
+                {0.3f, 0.3f, 0.0f, 0.5f, 0.0f, 0.0f}};
+    Paint image{PaintKind::image, PaintExtend::pad, 0, 0, 0, {4.0f, 0.0f, 0.0f, -2.0f, 0.0f, 1.0f}, {}};
+    asset.paints = {solid, linear, radial, sweep, image};
+    asset.images = {{3, 2, 0, 5}};
+    asset.image_bytes = {std::byte{1}, std::byte{2}, std::byte{3}, std::byte{4}, std::byte{5}};
+    asset.layers = {{kSquareGlyph, 0}, {kTriangleGlyph, 1}, {kTwoContourGlyph, 2}, {synthetic, 4}, {kSquareGlyph, 3}};
+    asset.colour_glyphs = {
+        {kSquareGlyph, 0, 3, 0, 0.0f, 0.0f, 0.0f, 0.0f},
+        {kTwoContourGlyph, 3, 2, kColourClipped, -0.1f, -0.2f, 0.8f, 0.9f},
+    };
+    return asset;
+}
+
+const FontAsset& colour_asset() {
+    static const FontAsset asset = make_colour_asset();
+    return asset;
+}
+
+void expect_colour_invalid(const std::function<void(FontAsset&)>& change, std::string_view fragment) {
+    expect_invalid(change, fragment, colour_asset());
+}
+
+TEST(AssetColour, FixtureIsValidAndRoundTrips) {
+    const FontAsset& asset = colour_asset();
+    Status status = validate_asset(asset);
+    ASSERT_TRUE(status.ok()) << status.error().message;
+    EXPECT_EQ(asset.face_glyph_count(), small_asset().glyphs.size());
+    EXPECT_EQ(asset.palette_count(), 2u);
+    ASSERT_NE(asset.colour_glyph(kTwoContourGlyph), nullptr);
+    EXPECT_EQ(asset.colour_glyph(kTwoContourGlyph)->first_layer, 3u);
+    EXPECT_EQ(asset.colour_glyph(kTriangleGlyph), nullptr);
+
+    std::vector<std::byte> bytes = serialize_asset(asset);
+    Result<FontAsset> loaded = load_asset(bytes);
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    EXPECT_TRUE(*loaded == asset);
+    EXPECT_EQ(find_section(bytes, "COLR").size, 32 * asset.colour_glyphs.size());
+    EXPECT_EQ(find_section(bytes, "LAYR").size, 8 * asset.layers.size());
+    EXPECT_EQ(find_section(bytes, "PANT").size, 68 * asset.paints.size());
+    EXPECT_EQ(find_section(bytes, "STOP").size, 12 * asset.stops.size());
+    EXPECT_EQ(find_section(bytes, "CPAL").size, 8 + 4 * asset.palette_colours.size());
+    EXPECT_EQ(find_section(bytes, "IMAG").size, 16 * asset.images.size());
+    EXPECT_EQ(find_section(bytes, "PIXL").size, asset.image_bytes.size());
+    // A paint record field by field: kind, extend, first stop, stop count, image, to_paint, geometry.
+    const size_t paint = static_cast<size_t>(find_section(bytes, "PANT").offset) + 68 * 3;
+    EXPECT_EQ(peek<uint32_t>(bytes, paint + 0), 3u);
+    EXPECT_EQ(peek<uint32_t>(bytes, paint + 8), 5u);
+    EXPECT_EQ(peek<uint32_t>(bytes, paint + 12), 3u);
+    EXPECT_EQ(peek<float>(bytes, paint + 20), 2.0f);
+    EXPECT_EQ(peek<float>(bytes, paint + 36), -1.0f);
+    EXPECT_EQ(peek<float>(bytes, paint + 56), 0.5f);
+}
+
+TEST(AssetColour, CorruptedFilesAreRejectedOrValid) {
+    run_resealed_flips(serialize_asset(colour_asset()), 400, 11);
+    const std::vector<std::byte> bytes = serialize_asset(colour_asset());
+    for (size_t length = 0; length < bytes.size(); length += 7) {
+        Result<FontAsset> result = load_asset(std::span(bytes).first(length));
+        EXPECT_FALSE(result.ok()) << "a " << length << "-byte prefix loaded";
+    }
+}
+
+TEST(AssetColour, SectionsOfWholeRecords) {
+    std::vector<std::byte> bytes = serialize_asset(colour_asset());
+    SectionEntry pant = find_section(bytes, "PANT");
+    poke<uint64_t>(bytes, pant.entry_at + 16, pant.size - 4);
+    reseal(bytes);
+    expect_rejected(bytes, ErrorCode::asset_invalid, "PANT section is 336 bytes, not a multiple of 68");
+    bytes = serialize_asset(colour_asset());
+    poke<uint32_t>(bytes, static_cast<size_t>(find_section(bytes, "CPAL").offset) + 4, 9);
+    reseal(bytes);
+    expect_rejected(bytes, ErrorCode::asset_invalid, "CPAL reserved field is 0x00000009");
+}
+
+TEST(AssetColour, Rules) {
+    const uint32_t synthetic = colour_asset().face_glyph_count();
+    expect_colour_invalid([](FontAsset& a) { a.glyphs[3].flags |= kGlyphSynthetic; },
+                          "follows the synthetic glyph 3 but is not synthetic");
+    expect_colour_invalid([&](FontAsset& a) { a.glyphs[synthetic] = GlyphRecord{.flags = kGlyphSynthetic}; },
+                          "must be baked and not failed");
+    expect_colour_invalid([](FontAsset& a) { a.palette_colours.pop_back(); }, "are not whole palettes of 2");
+    expect_colour_invalid([](FontAsset& a) { a.palette_size = 0; }, "palette colours but a palette size of 0");
+    expect_colour_invalid([](FontAsset& a) { a.stops[0].palette_index = 2; },
+                          "paint 0: palette index 2 past the 2 entries");
+    expect_colour_invalid([](FontAsset& a) { a.stops[2].alpha = 1.5f; }, "paint 1: stop alpha 1.5 outside [0, 1]");
+    expect_colour_invalid([](FontAsset& a) { a.stops[4].offset = 0.1f; }, "paint 2: stop offset 0.1 after 0.25");
+    expect_colour_invalid([](FontAsset& a) { a.stops[5].offset = kNan; }, "is not a sane number");
+    expect_colour_invalid([](FontAsset& a) { a.paints[0].stop_count = 2; }, "2 stops, a solid paint wants 1..1");
+    expect_colour_invalid([](FontAsset& a) { a.paints[1].stop_count = 0; }, "0 stops, a gradient wants 1..256");
+    expect_colour_invalid([](FontAsset& a) { a.paints[3].stop_count = 4; }, "past the 8 stops");
+    expect_colour_invalid([](FontAsset& a) { a.paints[2].first_stop = 2; }, "inside an earlier paint's");
+    expect_colour_invalid([](FontAsset& a) { a.paints[1].kind = static_cast<PaintKind>(9); }, "kind 9 is unknown");
+    expect_colour_invalid([](FontAsset& a) { a.paints[1].extend = static_cast<PaintExtend>(3); },
+                          "extend 3 is unknown");
+    expect_colour_invalid([](FontAsset& a) { a.paints[2].geometry[5] = -0.5f; }, "is negative");
+    expect_colour_invalid([](FontAsset& a) { a.paints[3].to_paint.dx = kInfinity; }, "mapping value inf");
+    expect_colour_invalid([](FontAsset& a) { a.paints[4].image = 1; }, "image 1 past the 1 images");
+    expect_colour_invalid([](FontAsset& a) { a.paints[4].stop_count = 1; }, "an image paint has 1 stops");
+    expect_colour_invalid([](FontAsset& a) { a.images[0].width = kMaxBitmapSide + 1; }, "each side 1..1024");
+    expect_colour_invalid([](FontAsset& a) { a.images[0].byte_count = 6; }, "past the 5 image bytes");
+    expect_colour_invalid([](FontAsset& a) { a.colour_glyphs[1].glyph = kSquareGlyph; }, "sorted, each once");
+    expect_colour_invalid([&](FontAsset& a) { a.colour_glyphs[1].glyph = synthetic; }, "is not one of the face's");
+    expect_colour_invalid([](FontAsset& a) { a.colour_glyphs[0].layer_count = 0; }, "0 layers, 1..1024");
+    expect_colour_invalid([](FontAsset& a) { a.colour_glyphs[1].first_layer = 2; }, "inside an earlier glyph's");
+    expect_colour_invalid([](FontAsset& a) { a.colour_glyphs[1].layer_count = 3; }, "past the 5 layers");
+    expect_colour_invalid([](FontAsset& a) { a.colour_glyphs[1].clip_min_x = 1.0f; }, "clip box");
+    expect_colour_invalid([](FontAsset& a) { a.colour_glyphs[0].flags = 2; }, "flags 0x00000002 hold unknown bits");
+    expect_colour_invalid([](FontAsset& a) { a.layers[0].glyph = 0; }, "names glyph 0, which is not baked");
+    expect_colour_invalid([](FontAsset& a) { a.layers[1].paint = 5; }, "names paint 5, past the 5 paints");
+    expect_colour_invalid([](FontAsset& a) { a.colour_glyphs.clear(); }, "5 layers but no colour glyph");
 }
 
 }  // namespace

@@ -79,10 +79,12 @@ struct SectionRange {
     uint64_t size = 0;
 };
 
-Result<std::array<SectionRange, kSectionCount>> read_section_table(std::span<const std::byte> file) {
-    std::array<SectionRange, kSectionCount> sections;
+// The table of a file with `count` sections (the first `count` kinds); the others stay empty.
+Result<std::array<SectionRange, kSectionCount>> read_section_table(std::span<const std::byte> file, size_t count) {
+    std::array<SectionRange, kSectionCount> sections = {};
     std::array<bool, kSectionCount> seen = {};
-    for (size_t entry = 0; entry < kSectionCount; ++entry) {
+    const size_t table_end = section_table_end(count);
+    for (size_t entry = 0; entry < count; ++entry) {
         const std::byte* at = file.data() + kSectionTableOffset + entry * kSectionEntrySize;
         Tag tag;
         std::memcpy(tag.chars.data(), at, 4);
@@ -90,8 +92,10 @@ Result<std::array<SectionRange, kSectionCount>> read_section_table(std::span<con
         uint64_t offset = load<uint64_t>(at + 8);
         uint64_t size = load<uint64_t>(at + 16);
 
-        auto kind = std::find(kSectionTags.begin(), kSectionTags.end(), tag.chars);
-        if (kind == kSectionTags.end()) return invalid("asset: section {}: unknown section tag {}", entry, tag);
+        auto kind =
+            std::find(kSectionTags.begin(), kSectionTags.begin() + static_cast<std::ptrdiff_t>(count), tag.chars);
+        if (kind == kSectionTags.begin() + static_cast<std::ptrdiff_t>(count))
+            return invalid("asset: section {}: unknown section tag {}", entry, tag);
         size_t index = static_cast<size_t>(kind - kSectionTags.begin());
         if (seen[index]) return invalid("asset: section {}: tag {} appears twice", entry, tag);
         seen[index] = true;
@@ -100,21 +104,22 @@ Result<std::array<SectionRange, kSectionCount>> read_section_table(std::span<con
         if (offset % kSectionAlignment != 0)
             return invalid("asset: section {} {}: offset {} is not a multiple of {}", entry, tag, offset,
                            kSectionAlignment);
-        if (offset < kSectionTableEnd)
+        if (offset < table_end)
             return invalid("asset: section {} {}: offset {} is inside the header or section table (ends at {})", entry,
-                           tag, offset, kSectionTableEnd);
+                           tag, offset, table_end);
         if (offset > file.size() || size > file.size() - offset)
             return invalid("asset: section {} {}: range [{}, {} + {}) past the {}-byte file", entry, tag, offset,
                            offset, size, file.size());
         sections[index] = {offset, size};
     }
 
-    std::array<size_t, kSectionCount> by_offset = {0, 1, 2, 3, 4};
-    std::sort(by_offset.begin(), by_offset.end(), [&](size_t a, size_t b) {
+    std::array<size_t, kSectionCount> by_offset;
+    for (size_t i = 0; i < kSectionCount; ++i) by_offset[i] = i;
+    std::sort(by_offset.begin(), by_offset.begin() + static_cast<std::ptrdiff_t>(count), [&](size_t a, size_t b) {
         return sections[a].offset != sections[b].offset ? sections[a].offset < sections[b].offset
                                                         : sections[a].size < sections[b].size;
     });
-    for (size_t i = 1; i < kSectionCount; ++i) {
+    for (size_t i = 1; i < count; ++i) {
         const SectionRange& previous = sections[by_offset[i - 1]];
         const SectionRange& next = sections[by_offset[i]];
         if (previous.offset + previous.size > next.offset)
@@ -144,8 +149,8 @@ Status decode_meta(std::span<const std::byte> meta, FontAsset& asset, uint32_t& 
     uint32_t family_length = load<uint32_t>(at + 40);
     uint32_t style_length = load<uint32_t>(at + 44);
 
-    if (glyph_count < 1 || glyph_count > kMaxGlyphs)
-        return invalid("asset: glyph count {} outside 1..{}", glyph_count, kMaxGlyphs);
+    if (glyph_count < 1 || glyph_count > kMaxGlyphRecords)
+        return invalid("asset: glyph count {} outside 1..{}", glyph_count, kMaxGlyphRecords);
     if (axis_count > kMaxAxes) return invalid("asset: {} axes, at most {}", axis_count, kMaxAxes);
     if (family_length > kMaxNameBytes)
         return invalid("asset: family name is {} bytes, at most {}", family_length, kMaxNameBytes);
@@ -197,6 +202,27 @@ Status decode_glyphs(std::span<const std::byte> glyf, uint32_t glyph_count, Font
     return {};
 }
 
+// A section that is an array of fixed-size records, copied as a block.
+template <class Record>
+Status decode_records(std::span<const std::byte> section, const char* tag, std::vector<Record>& out) {
+    if (section.size() % sizeof(Record) != 0)
+        return invalid("asset: {} section is {} bytes, not a multiple of {}", tag, section.size(), sizeof(Record));
+    out.resize(section.size() / sizeof(Record));
+    if (!section.empty()) std::memcpy(out.data(), section.data(), section.size());
+    return {};
+}
+
+Status decode_palettes(std::span<const std::byte> cpal, FontAsset& asset) {
+    if (cpal.empty()) return {};
+    if (cpal.size() < kCpalHeaderSize)
+        return invalid("asset: CPAL section is {} bytes, shorter than its {}-byte header", cpal.size(),
+                       kCpalHeaderSize);
+    asset.palette_size = load<uint32_t>(cpal.data());
+    uint32_t reserved = load<uint32_t>(cpal.data() + 4);
+    if (reserved != 0) return invalid("asset: CPAL reserved field is {}, must be 0", Hex{reserved});
+    return decode_records(cpal.subspan(kCpalHeaderSize), "CPAL", asset.palette_colours);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Encoding
 
@@ -205,7 +231,10 @@ size_t serialized_capacity(const FontAsset& asset) {
     const FontInfo& info = asset.info;
     return kSectionTableEnd + kSectionCount * kSectionAlignment + kMetaFixedSize + info.axes.size() * kAxisRecordSize +
            info.family.size() + info.style.size() + asset.glyphs.size() * kGlyphRecordSize +
-           asset.points.size() * kPointSize + asset.band_words.size() * kBandWordSize + asset.font_bytes.size();
+           asset.points.size() * kPointSize + asset.band_words.size() * kBandWordSize + asset.font_bytes.size() +
+           asset.colour_glyphs.size() * sizeof(ColourGlyph) + asset.layers.size() * sizeof(ColourLayer) +
+           asset.paints.size() * sizeof(Paint) + asset.stops.size() * sizeof(ColourStop) + kCpalHeaderSize +
+           asset.palette_colours.size() * 4 + asset.images.size() * sizeof(BitmapImage) + asset.image_bytes.size();
 }
 
 // Appends the META section: the fixed part, the axis records, then the family and style names.
@@ -309,10 +338,10 @@ Result<FontAsset> load_asset(std::span<const std::byte> bytes) {
         return invalid("asset: truncated: {} bytes, shorter than the {}-byte header", bytes.size(), kHeaderSize);
     if (std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) return invalid("asset: bad magic (not a crisp asset)");
     uint32_t version = load<uint32_t>(bytes.data() + kVersionOffset);
-    if (version != kAssetVersion)
+    if (version != 1 && version != kAssetVersion)
         return Error{
             ErrorCode::asset_version,
-            format("asset: version {} is not supported (this build reads version {})", version, kAssetVersion)};
+            format("asset: version {} is not supported (this build reads versions 1 and {})", version, kAssetVersion)};
     uint64_t file_size = load<uint64_t>(bytes.data() + kFileSizeOffset);
     if (file_size > bytes.size())
         return invalid("asset: truncated: header says {} bytes, got {}", file_size, bytes.size());
@@ -326,13 +355,14 @@ Result<FontAsset> load_asset(std::span<const std::byte> bytes) {
         return invalid("asset: checksum mismatch (stored {}, computed {})", Hex{stored_checksum},
                        Hex{computed_checksum});
 
+    const size_t expected_sections = version == 1 ? kSectionCountV1 : kSectionCount;
     uint32_t section_count = load<uint32_t>(bytes.data() + kSectionCountOffset);
-    if (section_count != kSectionCount)
-        return invalid("asset: {} sections, version 1 has exactly {}", section_count, kSectionCount);
-    if (bytes.size() < kSectionTableEnd)
-        return invalid("asset: truncated: the section table ends at {}, past the {}-byte file", kSectionTableEnd,
-                       bytes.size());
-    Result<std::array<SectionRange, kSectionCount>> table = read_section_table(bytes);
+    if (section_count != expected_sections)
+        return invalid("asset: {} sections, version {} has exactly {}", section_count, version, expected_sections);
+    if (bytes.size() < section_table_end(expected_sections))
+        return invalid("asset: truncated: the section table ends at {}, past the {}-byte file",
+                       section_table_end(expected_sections), bytes.size());
+    Result<std::array<SectionRange, kSectionCount>> table = read_section_table(bytes, expected_sections);
     if (!table) return table.error();
     auto section = [&](SectionKind kind) {
         const SectionRange& range = table.value()[kind];
@@ -358,6 +388,20 @@ Result<FontAsset> load_asset(std::span<const std::byte> bytes) {
 
     std::span<const std::byte> font = section(kSectionFont);
     asset.font_bytes.assign(font.begin(), font.end());
+
+    // Colour glyphs (version 2; a version 1 file's ranges are empty).
+    const Status colour[] = {
+        decode_records(section(kSectionColr), "COLR", asset.colour_glyphs),
+        decode_records(section(kSectionLayr), "LAYR", asset.layers),
+        decode_records(section(kSectionPant), "PANT", asset.paints),
+        decode_records(section(kSectionStop), "STOP", asset.stops),
+        decode_palettes(section(kSectionCpal), asset),
+        decode_records(section(kSectionImag), "IMAG", asset.images),
+    };
+    for (const Status& status : colour)
+        if (!status) return status.error();
+    std::span<const std::byte> pixels = section(kSectionPixl);
+    asset.image_bytes.assign(pixels.begin(), pixels.end());
 
     if (Status status = validate_asset(asset); !status) return status.error();
     return asset;
@@ -393,6 +437,25 @@ std::vector<std::byte> serialize_asset(const FontAsset& asset) {
     begin_section(kSectionFont);
     append_bytes(out, asset.font_bytes.data(), asset.font_bytes.size());
     end_section(kSectionFont);
+
+    auto block = [&](SectionKind kind, const auto& records) {
+        begin_section(kind);
+        append_bytes(out, records.data(), records.size() * sizeof(records[0]));
+        end_section(kind);
+    };
+    block(kSectionColr, asset.colour_glyphs);
+    block(kSectionLayr, asset.layers);
+    block(kSectionPant, asset.paints);
+    block(kSectionStop, asset.stops);
+    begin_section(kSectionCpal);
+    if (!asset.palette_colours.empty()) {
+        append<uint32_t>(out, asset.palette_size);
+        append<uint32_t>(out, 0);
+        append_bytes(out, asset.palette_colours.data(), asset.palette_colours.size() * 4);
+    }
+    end_section(kSectionCpal);
+    block(kSectionImag, asset.images);
+    block(kSectionPixl, asset.image_bytes);
 
     store_header(sections, out);
     return out;

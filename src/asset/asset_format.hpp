@@ -23,6 +23,13 @@ static_assert(std::endian::native == std::endian::little,
 static_assert(sizeof(float) == 4 && std::numeric_limits<float>::is_iec559, "floats are stored as IEEE 754 binary32");
 static_assert(sizeof(Point) == 8 && std::is_trivially_copyable_v<Point>, "PNTS is copied as a block of Points");
 static_assert(sizeof(GlyphRecord) == 48, "a GLYF record mirrors GlyphRecord field for field");
+// The colour sections are copied as blocks of their records, as PNTS is.
+static_assert(sizeof(ColourGlyph) == 32 && std::is_trivially_copyable_v<ColourGlyph>, "a COLR record is a ColourGlyph");
+static_assert(sizeof(ColourLayer) == 8 && std::is_trivially_copyable_v<ColourLayer>, "a LAYR record is a ColourLayer");
+static_assert(sizeof(Paint) == 68 && std::is_trivially_copyable_v<Paint>, "a PANT record is a Paint");
+static_assert(sizeof(ColourStop) == 12 && std::is_trivially_copyable_v<ColourStop>, "a STOP record is a ColourStop");
+static_assert(sizeof(BitmapImage) == 16 && std::is_trivially_copyable_v<BitmapImage>,
+              "an IMAG record is a BitmapImage");
 
 // Header.
 inline constexpr char kMagic[8] = {'C', 'R', 'I', 'S', 'P', 'F', 'N', 'T'};
@@ -36,17 +43,42 @@ inline constexpr size_t kReservedOffset = 28;
 // Section table.
 inline constexpr size_t kSectionTableOffset = kHeaderSize;
 inline constexpr size_t kSectionEntrySize = 24;
-inline constexpr size_t kSectionCount = 5;
-inline constexpr size_t kSectionTableEnd = kSectionTableOffset + kSectionCount * kSectionEntrySize;
+// Version 1 has the first five sections; version 2 all twelve.
+inline constexpr size_t kSectionCountV1 = 5;
+inline constexpr size_t kSectionCount = 12;
+inline constexpr size_t section_table_end(size_t section_count) {
+    return kSectionTableOffset + section_count * kSectionEntrySize;
+}
+inline constexpr size_t kSectionTableEnd = section_table_end(kSectionCount);
 inline constexpr uint64_t kSectionAlignment = 16;  // lets a reader map sections as arrays of 16-byte-aligned data
 
-enum SectionKind : size_t { kSectionMeta, kSectionGlyf, kSectionPnts, kSectionBand, kSectionFont };
+enum SectionKind : size_t {
+    kSectionMeta,
+    kSectionGlyf,
+    kSectionPnts,
+    kSectionBand,
+    kSectionFont,
+    kSectionColr,
+    kSectionLayr,
+    kSectionPant,
+    kSectionStop,
+    kSectionCpal,
+    kSectionImag,
+    kSectionPixl,
+};
 inline constexpr std::array<std::array<char, 4>, kSectionCount> kSectionTags = {{
     {'M', 'E', 'T', 'A'},
     {'G', 'L', 'Y', 'F'},
     {'P', 'N', 'T', 'S'},
     {'B', 'A', 'N', 'D'},
     {'F', 'O', 'N', 'T'},
+    {'C', 'O', 'L', 'R'},
+    {'L', 'A', 'Y', 'R'},
+    {'P', 'A', 'N', 'T'},
+    {'S', 'T', 'O', 'P'},
+    {'C', 'P', 'A', 'L'},
+    {'I', 'M', 'A', 'G'},
+    {'P', 'I', 'X', 'L'},
 }};
 
 // Section contents.
@@ -60,7 +92,9 @@ inline constexpr size_t kBandWordSize = 4;
 // where float arithmetic in the rasterizers stays exact enough.
 inline constexpr uint32_t kMinUnitsPerEm = 16;  // the OpenType range
 inline constexpr uint32_t kMaxUnitsPerEm = 16384;
-inline constexpr uint64_t kMaxGlyphs = 65536;  // glyph indices are 16-bit
+inline constexpr uint64_t kMaxGlyphs = 65536;  // glyph indices of a face are 16-bit
+inline constexpr uint64_t kMaxGlyphRecords = kMaxGlyphs + kMaxSyntheticGlyphs;
+inline constexpr size_t kCpalHeaderSize = 8;  // palette_size, reserved
 inline constexpr uint64_t kMaxAxes = 64;
 inline constexpr uint64_t kMaxNameBytes = 1024;
 inline constexpr float kMaxCoordinateEm = 64.0f;
@@ -69,7 +103,8 @@ inline constexpr uint32_t kMaxBandsPerGlyph = 256;
 inline constexpr uint32_t kMaxCurveSlotsPerGlyph = 2 * kMaxCurvesPerGlyph;
 inline constexpr size_t kMinFontBytes = 12;  // an sfnt header
 inline constexpr uint32_t kKnownFontFlags = kFontCubic | kFontVariable;
-inline constexpr uint32_t kKnownGlyphFlags = kGlyphBaked | kGlyphFailed;
+inline constexpr uint32_t kKnownGlyphFlags = kGlyphBaked | kGlyphFailed | kGlyphSynthetic;
+inline constexpr uint32_t kKnownColourGlyphFlags = kColourClipped;
 
 // ---------------------------------------------------------------------------------------------
 // Messages
@@ -137,5 +172,8 @@ template <class... Args>
 Error invalid(std::string_view pattern, const Args&... args) {
     return Error{ErrorCode::asset_invalid, format(pattern, args...)};
 }
+
+// The rules on the colour sections (validate_colour.cpp), run by validate_asset after the glyphs'.
+Status check_colour(const FontAsset& asset);
 
 }  // namespace crisp::asset_format

@@ -196,9 +196,9 @@ Status check_font_bytes(const FontAsset& asset) {
     } else {
         hb_face_t* face = hb_face_create(blob, asset.info.face_index);
         unsigned glyph_count = hb_face_get_glyph_count(face);
-        if (glyph_count != asset.glyphs.size())
+        if (glyph_count != asset.face_glyph_count())
             status = invalid("asset: font bytes hold {} glyphs in face {}, records say {}", glyph_count,
-                             asset.info.face_index, asset.glyphs.size());
+                             asset.info.face_index, asset.face_glyph_count());
         hb_face_destroy(face);
     }
     hb_blob_destroy(blob);
@@ -208,8 +208,10 @@ Status check_font_bytes(const FontAsset& asset) {
 
 Status validate_asset(const FontAsset& asset) {
     if (Status status = check_info(asset.info); !status) return status;
-    if (asset.glyphs.empty() || asset.glyphs.size() > kMaxGlyphs)
-        return invalid("asset: glyph count {} outside 1..{}", asset.glyphs.size(), kMaxGlyphs);
+    if (asset.glyphs.empty() || asset.glyphs.size() > kMaxGlyphRecords)
+        return invalid("asset: glyph count {} outside 1..{}", asset.glyphs.size(), kMaxGlyphRecords);
+    if (asset.face_glyph_count() > kMaxGlyphs)
+        return invalid("asset: glyph count {} of the face outside 1..{}", asset.face_glyph_count(), kMaxGlyphs);
 
     // Every point, referenced or not: a reader may upload PNTS as a whole.
     for (size_t i = 0; i < asset.points.size(); ++i) {
@@ -240,6 +242,7 @@ Status validate_asset(const FontAsset& asset) {
         words_end = uint64_t{glyph.band_offset} + uint64_t{glyph.band_count} * glyph.band_words;
     }
 
+    if (Status status = check_colour(asset); !status) return status;
     return check_font_bytes(asset);
 }
 

@@ -102,9 +102,9 @@ Result<Font> Font::create(FontAsset asset, FontId id) {
         return invalid("font: HarfBuzz finds no face " + std::to_string(owned.info.face_index) + " in the font bytes");
     state->face = hb_face_create(state->blob, owned.info.face_index);
     const unsigned glyph_count = hb_face_get_glyph_count(state->face);
-    if (glyph_count == 0 || glyph_count != owned.glyphs.size())
+    if (glyph_count == 0 || glyph_count != owned.face_glyph_count())
         return invalid("font: HarfBuzz reads " + std::to_string(glyph_count) + " glyphs, the asset has " +
-                       std::to_string(owned.glyphs.size()));
+                       std::to_string(owned.face_glyph_count()));
     const unsigned upem = hb_face_get_upem(state->face);
     if (upem != owned.info.units_per_em)
         return invalid("font: HarfBuzz reads " + std::to_string(upem) + " units per em, the asset says " +
