@@ -120,6 +120,9 @@ CRISP_CONSTANT(uint, kCompositeBindNodes, 4u);         // exact: the node pool
 CRISP_CONSTANT(uint, kCompositeBindStats, 5u);         // counters read back after the frame
 CRISP_CONSTANT(uint, kCompositeBindTarget, 6u);        // the reference target, storage image
 CRISP_CONSTANT(uint, kCompositeBindTiles, 7u);         // the compute quad passes' tile list
+CRISP_CONSTANT(uint, kCompositeBindPaints, 8u);        // QuadPaint[]: colour layers' fills
+CRISP_CONSTANT(uint, kCompositeBindStops, 9u);         // PaintStop[]: their colour lines
+CRISP_CONSTANT(uint, kCompositeBindImages, 10u);       // bitmap glyphs' images, sampled 2D array
 
 // The tile path's layered way keeps at most this many layers per pixel.
 CRISP_CONSTANT(uint, kCompositeMaxLayers, 8u);
@@ -172,6 +175,46 @@ struct CompositeQuad {
     float contrast_k;
     float contrast_darkening;
     vec4 color;  // linear, straight alpha
+    uint paint;  // a colour layer's fill: an index in the QuadPaint buffer; kNoQuadPaint: `color`
+    uint padding0;
+    uint padding1;
+    uint padding2;
+};
+
+// ---- Colour layers' fills (paint.glsl; include/crisp/renderer.hpp, FramePaint, says what each
+// field means; docs/colour.md the paints).
+CRISP_CONSTANT(uint, kNoQuadPaint, 0xFFFFFFFFu);
+CRISP_CONSTANT(uint, kPaintSolid, 0u);
+CRISP_CONSTANT(uint, kPaintLinear, 1u);
+CRISP_CONSTANT(uint, kPaintRadial, 2u);
+CRISP_CONSTANT(uint, kPaintSweep, 3u);
+CRISP_CONSTANT(uint, kPaintImage, 4u);
+CRISP_CONSTANT(uint, kExtendPad, 0u);
+CRISP_CONSTANT(uint, kExtendRepeat, 1u);
+CRISP_CONSTANT(uint, kExtendReflect, 2u);
+
+struct QuadPaint {
+    uint kind;  // kPaint*
+    uint extend;
+    uint first_stop;
+    uint stop_count;
+    vec4 to_paint_x;  // paint x = dot(xyz, (pixel.x, pixel.y, 1)); w unused
+    vec4 to_paint_y;
+    vec4 geometry0;  // Paint::geometry[0..3]
+    vec4 geometry1;  // [4..5], unused, unused
+    vec4 clip;       // pixels: x0, y0, x1, y1
+    uint image_layer;
+    float image_u;  // the part of the layer the image fills
+    float image_v;
+    float opacity;
+};
+
+struct PaintStop {
+    vec4 colour;  // premultiplied, sRGB-encoded
+    float offset;
+    float padding0;
+    float padding1;
+    float padding2;
 };
 
 // Text and background luminances closer than this blend the corrected coverage as it is (the
@@ -231,7 +274,10 @@ CRISP_CONSTANT(uint, kTileBindTiles, 2u);   // per tile: count, start, cursor (p
 CRISP_CONSTANT(uint, kTileBindBins, 3u);    // TileBinEntry[], each tile's at its start
 CRISP_CONSTANT(uint, kTileBindHeader, 4u);  // TileHeader, then the non-empty tiles' indices
 CRISP_CONSTANT(uint, kTileBindTarget, 5u);  // the caller's image, storage image
-CRISP_CONSTANT(uint, kTileBindingCount, 6u);
+CRISP_CONSTANT(uint, kTileBindPaints, 6u);  // QuadPaint[]
+CRISP_CONSTANT(uint, kTileBindStops, 7u);   // PaintStop[]
+CRISP_CONSTANT(uint, kTileBindImages, 8u);  // bitmap images, sampled 2D array
+CRISP_CONSTANT(uint, kTileBindingCount, 9u);
 
 // Target encodings of the tile pass (specialization constant 1).
 CRISP_CONSTANT(uint, kTileEncodeLinear, 0u);  // float formats: the image holds linear colour
@@ -298,8 +344,12 @@ static_assert(kTileScanBlock * kTileScanBlock <= 1u << kTileBusyIndexBits);
 static_assert(kTileMaxCapacity < kTileBusyCountMax && kTileBusyCountMax < 1u << (32 - kTileBusyIndexBits));
 static_assert(kTileScanBlock * kTileScanBlock * kTileSide * kTileSide >= 16384u * 16384u);
 static_assert(sizeof(TilePushConstants) == 32);
-static_assert(sizeof(CompositeQuad) == 64);
+static_assert(sizeof(CompositeQuad) == 80);
 static_assert(offsetof(CompositeQuad, color) == 48);
+static_assert(offsetof(CompositeQuad, paint) == 64);
+static_assert(sizeof(QuadPaint) == 112);
+static_assert(offsetof(QuadPaint, clip) == 80);
+static_assert(sizeof(PaintStop) == 32);
 static_assert(sizeof(CompositePushConstants) == 64);
 static_assert(offsetof(CompositePushConstants, width) == 16);
 static_assert(offsetof(RasterItem, first_workgroup) == 84);

@@ -118,7 +118,7 @@ std::vector<float> composite(Compositor& compositor, const Scene& scene, std::sp
     params.path = path;
     std::copy(kBackground, kBackground + 4, params.background);
     EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) {
-        EXPECT_TRUE(compositor.record_reference(cb, crisp::DrawnFrame{glyphs, scene.renderer->atlas_view()}, params));
+        EXPECT_TRUE(compositor.record_reference(cb, scene.renderer->drawn_frame().with_glyphs(glyphs), params));
         compositor.record_target_readback(cb, readback->handle());
     }));
     std::vector<float> image(size_t{kWidth} * kHeight * 4);

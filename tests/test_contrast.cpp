@@ -386,7 +386,7 @@ std::vector<Rgba> composite(Compositor& compositor, const Frame& frame, std::spa
     std::vector<std::byte> bytes(background.size() * sizeof(Rgba));
     std::memcpy(bytes.data(), background.data(), bytes.size());
     EXPECT_TRUE(context.upload(t.image, bytes, VK_IMAGE_LAYOUT_GENERAL));
-    const crisp::DrawnFrame drawn{glyphs, frame.renderer->atlas_view()};
+    const crisp::DrawnFrame drawn = frame.renderer->drawn_frame().with_glyphs(glyphs);
     EXPECT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) {
         Status s;
         if (t.draw) {

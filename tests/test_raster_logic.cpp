@@ -2,6 +2,7 @@
 // motion), the subpixel-step controller, and the rasterizer's work items.
 #include "raster/coarsening.hpp"
 #include "raster/held_fonts.hpp"
+#include "raster/paints.hpp"
 #include "raster/raster.hpp"
 #include "raster/requests.hpp"
 #include "test_support.hpp"
@@ -413,6 +414,98 @@ TEST(RasterWorkItems, ItemsAddressTheirFontsRangesAndTileTheWorkgroups) {
     EXPECT_EQ(raster::build_work_items({}, fonts, items, table), 0u);
     EXPECT_TRUE(items.empty());
     EXPECT_TRUE(table.empty());
+}
+
+// ---- Colour layers' fills (raster/paints)
+
+// The test font's asset with a palette and one paint of each kind the resolver treats apart.
+FontAsset painted_asset() {
+    FontAsset asset = test_font().asset();
+    asset.palette_size = 2;
+    asset.palette_colours = {0x80FF0000u, 0xFF00FF00u, 0xFFFFFFFFu, 0xFF000000u};  // 0: blue at alpha 0.5
+    asset.stops = {{0.0f, 0, 1.0f}, {0.0f, 1, 1.0f}, {1.0f, kForegroundPaletteIndex, 0.5f}};
+    Paint solid;
+    solid.stop_count = 1;
+    Paint linear{PaintKind::linear, PaintExtend::repeat, 1, 2, 0, {2.0f, 0.0f, 0.0f, 3.0f, 0.5f, -0.25f},
+                 {0, 0, 1, 0, 0, 0}};
+    Paint image{PaintKind::image, PaintExtend::pad, 0, 0, 0, {}, {}};
+    asset.paints = {solid, linear, image};
+    asset.colour_glyphs = {{0, 0, 1, kColourClipped, -0.5f, -0.25f, 1.0f, 0.75f}};
+    return asset;
+}
+
+TEST(FramePaints, SolidFillsBecomeColoursAndGradientsMapPixelsToTheirSpace) {
+    const FontAsset asset = painted_asset();
+    TestFonts fonts;
+    fonts.fonts[kFontId] = {&asset, 0, 0, 0};
+    const GlyphInstance base = glyph_at(32.0f, 10.3f, 40.6f);
+    auto layer = [&](uint32_t paint, uint32_t palette, uint32_t colour_glyph) {
+        DrawnGlyph drawn;
+        drawn.instance = base;
+        drawn.instance.paint = paint;
+        drawn.instance.palette = palette;
+        drawn.instance.colour_glyph = colour_glyph;
+        drawn.instance.color[0] = 0.5f;  // linear grey text at alpha 0.8
+        drawn.instance.color[1] = 0.5f;
+        drawn.instance.color[2] = 0.5f;
+        drawn.instance.color[3] = 0.8f;
+        return drawn;
+    };
+    std::vector<DrawnGlyph> drawn = {layer(0, 0, kNoColourGlyph), layer(0, 1, 0),
+                                     layer(1, 7, kNoColourGlyph), layer(2, 0, kNoColourGlyph),
+                                     layer(9, 0, kNoColourGlyph), layer(kNoPaint, 0, 0)};
+    raster::FramePaints paints;
+    RendererStats stats;
+    paints.resolve(drawn, fonts, nullptr, stats);
+
+    // Palette 0's entry 0, blue at alpha 0.5, times the text's 0.8: a colour, no fill.
+    EXPECT_EQ(drawn[0].paint, kNoPaint);
+    EXPECT_FLOAT_EQ(drawn[0].instance.color[2], 1.0f);
+    EXPECT_FLOAT_EQ(drawn[0].instance.color[0], 0.0f);
+    EXPECT_NEAR(drawn[0].instance.color[3], 128.0f / 255.0f * 0.8f, 1e-6f);
+    // Palette 1 (white) with the colour glyph's clip box: a solid fill whose clip is in pixels.
+    ASSERT_EQ(drawn[1].paint, 0u);
+    const FramePaint& clipped = paints.paints()[0];
+    EXPECT_EQ(clipped.kind, PaintKind::solid);
+    EXPECT_FLOAT_EQ(drawn[1].instance.color[0], 1.0f);
+    const GlyphRect rect = glyph_rect(record_of(base), base.key);
+    const double pen_x = base.x - rect.x + base.key.subpixel_x / 256.0,
+                 pen_y = base.y - rect.y + base.key.subpixel_y / 256.0;
+    EXPECT_NEAR(clipped.clip[0], pen_x - 0.5 * 32.0, 1e-4);
+    EXPECT_NEAR(clipped.clip[1], pen_y - 0.75 * 32.0, 1e-4);
+    EXPECT_NEAR(clipped.clip[2], pen_x + 1.0 * 32.0, 1e-4);
+    EXPECT_NEAR(clipped.clip[3], pen_y + 0.25 * 32.0, 1e-4);
+    // The gradient (palette 7 is past the two: palette 0): its stops premultiplied and sRGB-encoded,
+    // the foreground stop the text's colour at alpha 1 times the stop's 0.5; pixels mapped through em.
+    ASSERT_EQ(drawn[2].paint, 1u);
+    const FramePaint& linear = paints.paints()[1];
+    ASSERT_EQ(linear.stop_count, 2u);
+    const FrameStop& green = paints.stops()[linear.first_stop];
+    EXPECT_FLOAT_EQ(green.colour[1], 1.0f);
+    EXPECT_FLOAT_EQ(green.colour[3], 1.0f);
+    const FrameStop& text = paints.stops()[linear.first_stop + 1];
+    EXPECT_NEAR(text.colour[0], 0.5 * (1.055 * std::pow(0.5, 1 / 2.4) - 0.055), 1e-5);
+    EXPECT_FLOAT_EQ(text.colour[3], 0.5f);
+    EXPECT_FLOAT_EQ(text.offset, 1.0f);
+    EXPECT_FLOAT_EQ(linear.opacity, 0.8f);
+    // The pixel point at em (0.25, 0.5) lands at to_paint(0.25, 0.5) = (2 * 0.25 + 0.5, 3 * 0.5 - 0.25).
+    const double px = pen_x + 0.25 * 32.0, py = pen_y - 0.5 * 32.0;
+    auto mapped = [&](int row) {
+        const float* m = linear.to_paint + 3 * row;
+        return static_cast<double>(m[0]) * px + static_cast<double>(m[1]) * py + static_cast<double>(m[2]);
+    };
+    EXPECT_NEAR(mapped(0), 1.0, 1e-4);
+    EXPECT_NEAR(mapped(1), 1.25, 1e-4);
+    // An image without a place draws nothing; an unknown paint keeps its colour; plain text is untouched.
+    EXPECT_EQ(drawn[3].paint, kNoPaint);
+    EXPECT_EQ(drawn[3].instance.color[3], 0.0f);
+    EXPECT_EQ(drawn[4].paint, kNoPaint);
+    EXPECT_EQ(drawn[4].instance.color[3], 0.8f);
+    EXPECT_EQ(drawn[5].paint, kNoPaint);
+    EXPECT_EQ(drawn[5].instance.color[0], 0.5f);
+    EXPECT_EQ(stats.colour_layers, 4u);
+    EXPECT_EQ(stats.frame_paints, 2u);
+    EXPECT_EQ(stats.bitmap_misses, 1u);
 }
 
 }  // namespace

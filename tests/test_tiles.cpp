@@ -179,7 +179,7 @@ void composite_tiles(Compositor& compositor, const Scene& scene, std::span<const
     target.extent = {t.width, t.height};
     target.rect = {origin, {kWidth, kHeight}};
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
-        const Status s = compositor.record(cb, crisp::DrawnFrame{glyphs, scene.renderer->atlas_view()}, target);
+        const Status s = compositor.record(cb, scene.renderer->drawn_frame().with_glyphs(glyphs), target);
         EXPECT_TRUE(s) << (s ? "" : s.error().message);
     }));
 }
@@ -188,8 +188,8 @@ void composite_tiles(Compositor& compositor, const Scene& scene, std::span<const
 void composite_draw(Compositor& compositor, const Scene& scene, std::span<const DrawnGlyph> glyphs, Target& t) {
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
         tools::begin_rendering_over(cb, t.image.view(), {{0, 0}, {t.width, t.height}});
-        const Status s = compositor.record_draw(cb, crisp::DrawnFrame{glyphs, scene.renderer->atlas_view()},
-                                                {{0, 0}, {kWidth, kHeight}});
+        const Status s =
+            compositor.record_draw(cb, scene.renderer->drawn_frame().with_glyphs(glyphs), {{0, 0}, {kWidth, kHeight}});
         EXPECT_TRUE(s) << (s ? "" : s.error().message);
         vkCmdEndRendering(cb);
     }));
@@ -460,7 +460,7 @@ TEST(TileCompositor, DrawPathTestsGlyphsAgainstTheCallersDepth) {
         clear.clearValue.depthStencil = {kWall, 0};
         const VkClearRect rect{{{0, 0}, {half, kHeight}}, 0, 1};
         vkCmdClearAttachments(cb, 1, &clear, 1, &rect);
-        const Status s = tested->record_draw(cb, crisp::DrawnFrame{scene.drawn, scene.renderer->atlas_view()},
+        const Status s = tested->record_draw(cb, scene.renderer->drawn_frame().with_glyphs(scene.drawn),
                                              {{0, 0}, {kWidth, kHeight}});
         EXPECT_TRUE(s) << (s ? "" : s.error().message);
         vkCmdEndRendering(cb);
@@ -740,7 +740,7 @@ TEST(TileCompositor, ScansTileCountsAcrossBlocks) {
     Target t = make_target(VK_FORMAT_R16G16B16A16_SFLOAT, width, height, VK_IMAGE_USAGE_STORAGE_BIT);
     CompositeTarget target{t.image.view(), t.format, VK_FORMAT_UNDEFINED, {width, height}, {}};
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
-        EXPECT_TRUE(compositor->record(cb, crisp::DrawnFrame{copies, scene.renderer->atlas_view()}, target));
+        EXPECT_TRUE(compositor->record(cb, scene.renderer->drawn_frame().with_glyphs(copies), target));
     }));
     const std::vector<std::byte> bytes = read_target(t);
     // Each copy's kWidth x kHeight region is what scene.pixels describes (glyph rects reach a
@@ -791,13 +791,14 @@ TEST(TileCompositor, RefusesWhatItCannotDraw) {
     EXPECT_FALSE(compositor->supports_target_format(VK_FORMAT_R8G8B8A8_SRGB));
     Target t = make_target(VK_FORMAT_R8G8B8A8_UNORM, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
     CompositeTarget target{t.image.view(), VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_UNDEFINED, {kWidth, kHeight}, {}};
-    const crisp::DrawnFrame frame{scene.drawn, scene.renderer->atlas_view()};
+    const crisp::DrawnFrame frame = scene.renderer->drawn_frame().with_glyphs(scene.drawn);
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
         const Status wrong_format = compositor->record(cb, frame, target);
         ASSERT_FALSE(wrong_format);
         EXPECT_NE(wrong_format.error().message.find("storage_without_format"), std::string::npos);
         target.format = VK_FORMAT_R8G8B8A8_UNORM;
-        const crisp::DrawnFrame no_atlas{scene.drawn, VK_NULL_HANDLE};
+        crisp::DrawnFrame no_atlas = frame;
+        no_atlas.atlas = VK_NULL_HANDLE;
         EXPECT_EQ(compositor->record(cb, no_atlas, target).error().code, ErrorCode::invalid_argument);
         target.rect = {{10, 0}, {kWidth, kHeight}};  // past the right edge
         EXPECT_EQ(compositor->record(cb, frame, target).error().code, ErrorCode::invalid_argument);
@@ -833,7 +834,7 @@ TEST(TileCompositor, RefusesBinsPastTheStorageBufferRange) {
     Target t = make_target(VK_FORMAT_R8G8B8A8_UNORM, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
     const CompositeTarget target{t.image.view(), t.format, VK_FORMAT_UNDEFINED, {kWidth, kHeight}, {}};
     EXPECT_TRUE(fixture().context->submit_and_wait([&](VkCommandBuffer cb) {
-        const Status too_many = compositor->record(cb, {many, scene.renderer->atlas_view()}, target);
+        const Status too_many = compositor->record(cb, scene.renderer->drawn_frame().with_glyphs(many), target);
         ASSERT_FALSE(too_many);
         EXPECT_EQ(too_many.error().code, ErrorCode::invalid_argument);
         EXPECT_NE(too_many.error().message.find("maxStorageBufferRange"), std::string::npos);
@@ -844,7 +845,7 @@ TEST(TileCompositor, RefusesBinsPastTheStorageBufferRange) {
     ASSERT_TRUE(dropped.ok());
     const std::span<const DrawnGlyph> fitting(many.data(), glyphs - 1);
     EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) {
-        EXPECT_TRUE(compositor->record(cb, {fitting, scene.renderer->atlas_view()}, target));
+        EXPECT_TRUE(compositor->record(cb, scene.renderer->drawn_frame().with_glyphs(fitting), target));
     }));
     compositor->abandon_frame();
     expect_no_validation_messages();

@@ -98,6 +98,9 @@ struct LayoutOptions {
     const char* language = nullptr;
 };
 
+inline constexpr uint32_t kNoPaint = 0xFFFFFFFFu;
+inline constexpr uint32_t kNoColourGlyph = 0xFFFFFFFFu;
+
 struct GlyphInstance {
     GlyphKey key;        // font id, glyph index, size (u24.8), subpixel offset (u0.8)
     int32_t x = 0;       // top-left of the glyph's atlas rect on the target, whole pixels:
@@ -111,6 +114,11 @@ struct GlyphInstance {
     uint32_t paint_order = 0;  // consecutive from first_paint_order, in logical order
     uint32_t cluster = 0;      // byte offset in the UTF-8 text of the first character it shows
     uint32_t line = 0;         // index into TextLayout::lines
+    // A layer of a colour glyph (asset.hpp, "Colour glyphs"): the paint it is filled with, an index
+    // in its font's FontAsset::paints; kNoPaint: the instance's own colour (monochrome text).
+    uint32_t paint = kNoPaint;
+    uint32_t colour_glyph = kNoColourGlyph;  // index in FontAsset::colour_glyphs of the glyph it is a layer of
+    uint32_t palette = 0;                    // CPAL palette (TextStyle::palette)
 };
 
 struct TextLine {

@@ -110,6 +110,12 @@ struct RendererCreateInfo {
     // contrast model by default, ContrastMode::linear for coverage as it is. It changes no atlas
     // texel. A setting validate_text_contrast() refuses fails create() (invalid_argument).
     TextContrast contrast;
+    // Bitmap glyphs (CBDT, sbix): each image drawn is box-filtered into one layer of an array image of
+    // bitmap_layers layers of bitmap_layer_side texels a side (a power of two, 16..1024), with its
+    // mips, made at the first bitmap glyph drawn. A frame that draws more images than there are
+    // layers draws the rest without their image (RendererStats::bitmap_misses). 1..4096 layers.
+    uint32_t bitmap_layers = 256;
+    uint32_t bitmap_layer_side = 128;
 };
 
 // How one draw() call shows its glyphs, without a new layout: where, in which colour, at which depth,
@@ -141,12 +147,42 @@ struct DrawOptions {
     // Contrast settings for these glyphs instead of the renderer's (set_contrast()). A setting
     // validate_text_contrast() refuses draws nothing (skipped_glyphs).
     std::optional<TextContrast> contrast;
+    // The CPAL palette of colour glyphs instead of their layout's (TextStyle::palette). A palette
+    // past a font's palettes draws with its palette 0.
+    std::optional<uint32_t> palette;
 };
 
 // Subpixel steps per pixel of moving text (DrawOptions::id).
 inline constexpr uint32_t kMovingSubpixelSteps = 4;
 // Frames a named draw must rest before its text counts as static again.
 inline constexpr uint32_t kMotionSettleFrames = 8;
+
+// How a layer of a colour glyph is filled this frame (the renderer resolves each layer's Paint of
+// the asset for the draw's palette, colour and the glyph's place): DrawnFrame::paints. Layers filled
+// with one solid colour and no clip box need none: their instance's colour is that colour.
+struct FramePaint {
+    PaintKind kind = PaintKind::solid;
+    PaintExtend extend = PaintExtend::pad;
+    uint32_t first_stop = 0;  // in DrawnFrame::stops
+    uint32_t stop_count = 0;
+    // From the target's pixels (x right, y down, pixel centres at + 0.5, the glyphs' pixel space) to
+    // the paint's own space: q.x = to_paint[0] x + to_paint[1] y + to_paint[2], q.y = to_paint[3] x +
+    // to_paint[4] y + to_paint[5].
+    float to_paint[6] = {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+    float geometry[6] = {};  // as Paint::geometry
+    // The clip box in pixels (x0, y0, x1, y1): coverage is multiplied by the part of each pixel inside.
+    float clip[4] = {-1.0e30f, -1.0e30f, 1.0e30f, 1.0e30f};
+    uint32_t image_layer = 0;              // image paints: the layer of DrawnFrame::images
+    float image_extent[2] = {1.0f, 1.0f};  // the part of the layer (u, v) the image fills
+    float opacity = 1.0f;                  // the text colour's alpha, times every stop's colour
+};
+
+// A stop of a FramePaint's colour line: its colour premultiplied and sRGB-encoded (gradients
+// interpolate in that space, then decode), and its offset.
+struct FrameStop {
+    float colour[4] = {};
+    float offset = 0.0f;
+};
 
 // A glyph drawn this frame whose rect holds samples: where its texels are in the atlas.
 // A glyph drawn clipped (draw() with a visible rect) shows only the texels inside that rect:
@@ -165,6 +201,8 @@ struct DrawnGlyph {
     // How the compositor blends its coverage (RendererCreateInfo::contrast, DrawOptions::contrast),
     // resolved for its size; a DrawnGlyph made by hand is linear unless it says otherwise.
     GlyphContrast contrast;
+    // A colour layer's fill: an index in DrawnFrame::paints; kNoPaint: instance.color.
+    uint32_t paint = kNoPaint;
 };
 
 // What a recorded frame hands the compositor (Renderer::drawn_frame(), Compositor::record()): the
@@ -176,6 +214,21 @@ struct DrawnFrame {
     // VK_IMAGE_LAYOUT_GENERAL. The barrier at the end of Renderer::record() makes this frame's
     // writes to it readable by compute and fragment shaders; the compositor records none on it.
     VkImageView atlas = VK_NULL_HANDLE;
+    // The fills of colour layers (DrawnGlyph::paint) and their stops.
+    std::span<const FramePaint> paints;
+    std::span<const FrameStop> stops;
+    // Bitmap glyphs' images: a 2D array view of R8G8B8A8_SRGB layers with their mips (premultiplied),
+    // in VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL once Renderer::record()'s commands have run.
+    // Required by the compositor (a renderer always has one, a single blank layer until it draws a
+    // bitmap glyph).
+    VkImageView images = VK_NULL_HANDLE;
+
+    // The same frame with other glyphs (a subset of these, say): the atlas, paints and images kept.
+    DrawnFrame with_glyphs(std::span<const DrawnGlyph> other) const {
+        DrawnFrame frame = *this;
+        frame.glyphs = other;
+        return frame;
+    }
 };
 
 struct RendererStats {
@@ -202,6 +255,11 @@ struct RendererStats {
     uint32_t unknown_fonts = 0;   // instances whose FontId was never added
     uint32_t culled_glyphs = 0;   // instances wholly outside draw()'s visible rect
     uint32_t clipped_glyphs = 0;  // instances partly outside it: only their visible part is rasterized
+    uint32_t colour_layers =
+        0;                      // drawn glyphs that are layers of colour glyphs (DrawnGlyph::paint or a palette colour)
+    uint32_t frame_paints = 0;  // DrawnFrame::paints this frame
+    uint32_t bitmap_uploads = 0;  // bitmap glyph images decoded and uploaded this frame
+    uint32_t bitmap_misses = 0;   // image layers drawn without their image (no room, or a bad image)
     uint32_t work_items = 0;      // glyphs given samples this frame
     uint32_t workgroups = 0;      // compute workgroups dispatched
     uint64_t samples = 0;         // samples scheduled this frame (all channels count once)

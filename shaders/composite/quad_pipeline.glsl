@@ -22,6 +22,10 @@ layout(std430, set = 0, binding = kCompositeBindQuads) readonly buffer Quads {
 
 #include "atlas/atlas_texel.glsl"
 #include "contrast.glsl"
+#define CRISP_BIND_PAINTS kCompositeBindPaints
+#define CRISP_BIND_STOPS kCompositeBindStops
+#define CRISP_BIND_IMAGES kCompositeBindImages
+#include "paint.glsl"
 
 #ifdef CRISP_COMPUTE
 // Per tile: the quad's index, and the tile's top-left texel in the quad's rect (x | y << 16).
@@ -62,13 +66,15 @@ bool load_fragment(out GlyphFragment f) {
     // A rect that does not lie in the atlas (not from Renderer::drawn()) draws nothing there.
     vec3 coverage;
     if (!glyph_texel_coverage(f.quad, pixel, coverage)) return false;
+    // A colour layer's fill at the pixel (paint.glsl), or the glyph's colour.
+    const vec4 fill = quad_fill(f.quad, pixel);
     // The contrast model against the background these passes cannot read (contrast.glsl).
-    const float lt = contrast_luminance(f.quad.color.rgb);
+    const float lt = contrast_luminance(fill.rgb);
     coverage = corrected_coverage(coverage, f.quad.contrast_gamma, f.quad.contrast_k, f.quad.contrast_darkening, lt,
                                   assumed_background_luminance(lt));
-    f.opacity = f.quad.color.a * coverage;
+    f.opacity = fill.a * coverage;
     f.transmittance = 1.0 - f.opacity;
-    f.light = f.quad.color.rgb * f.opacity;
+    f.light = fill.rgb * f.opacity;
     return true;
 }
 

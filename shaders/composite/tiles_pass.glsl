@@ -35,6 +35,9 @@ layout(constant_id = 4) const uint kLayeredPass = 0u;
 // 1: some quad's coverage is corrected (contrast.glsl) against the luminance of the caller's pixel.
 // Linear frames use the pipelines made with 0, which carry none of its registers.
 layout(constant_id = 5) const uint kContrast = 0u;
+// 1: some quad is a colour layer with a fill of its own (paint.glsl). Frames of plain text use the
+// pipelines made with 0.
+layout(constant_id = 6) const uint kPaints = 0u;
 
 layout(set = 0, binding = kTileBindAtlas, rgba16ui) uniform readonly uimage2D atlas;
 #ifdef CRISP_TARGET_FORMAT
@@ -45,6 +48,10 @@ layout(set = 0, binding = kTileBindTarget) uniform image2D target;
 
 #include "atlas/atlas_texel.glsl"
 #include "contrast.glsl"
+#define CRISP_BIND_PAINTS kTileBindPaints
+#define CRISP_BIND_STOPS kTileBindStops
+#define CRISP_BIND_IMAGES kTileBindImages
+#include "paint.glsl"
 
 shared uint unsorted[kCapacity];  // the keys of the tile's list as the scatter left it
 shared uint list[kCapacity];      // ... sorted, as positions in that list
@@ -55,6 +62,8 @@ shared ivec2 chunk_texel[kTileChunk];
 shared vec4 chunk_colour[kTileChunk];
 // With kContrast: per staged quad its gamma, contrast and darkening, and its colour's luminance.
 shared vec4 chunk_contrast[kTileChunk];
+// With kPaints: per staged quad its fill (kNoQuadPaint: its colour).
+shared uint chunk_paint[kTileChunk];
 shared uint tile_overlap;
 shared uint tile_tail_pixels;
 shared uint tile_busy_pixels;  // pixels of the tile still walking
@@ -77,6 +86,7 @@ void stage_entry(uint slot, TileBinEntry e) {
         chunk_contrast[slot] =
             vec4(q.contrast_gamma, q.contrast_k, q.contrast_darkening, contrast_luminance(e.color.rgb));
     }
+    if (kPaints != 0u) chunk_paint[slot] = quads[e.quad].paint;
 }
 
 // Entry i's place in the sorted list: the number of keys smaller than its own (a quad is in a
@@ -120,16 +130,20 @@ bool quad_opacity(uint index, ivec2 pixel, float background_luminance, out vec3 
     if (pixel.x < q.x || pixel.y < q.y || pixel.x - q.x >= int(q.width) || pixel.y - q.y >= int(q.height)) {
         return false;
     }
-    if (kContrast == 0u) {
+    if (kContrast == 0u && kPaints == 0u) {
         if (!glyph_texel_opacity(q, pixel, opacity)) return false;
+        colour = q.color.rgb;
     } else {
         vec3 coverage;
         if (!glyph_texel_coverage(q, pixel, coverage)) return false;
-        coverage = corrected_coverage(coverage, q.contrast_gamma, q.contrast_k, q.contrast_darkening,
-                                      contrast_luminance(q.color.rgb), background_luminance);
-        opacity = q.color.a * coverage;
+        const vec4 fill = kPaints != 0u ? quad_fill(q, pixel) : q.color;
+        if (kContrast != 0u) {
+            coverage = corrected_coverage(coverage, q.contrast_gamma, q.contrast_k, q.contrast_darkening,
+                                          contrast_luminance(fill.rgb), background_luminance);
+        }
+        opacity = fill.a * coverage;
+        colour = fill.rgb;
     }
-    colour = q.color.rgb;
     return any(greaterThan(opacity, vec3(0.0)));
 }
 
@@ -178,11 +192,17 @@ Blend exact_way(uint start, uint count, ivec2 corner, ivec2 pixel, bool inside, 
                 if (any(lessThan(texel, ivec2(0))) || any(greaterThanEqual(texel, atlas_size))) continue;
                 const uvec4 sums = imageLoad(atlas, texel);
                 if (sums.a == 0u) continue;
-                const vec4 colour = chunk_colour[j];
+                vec4 colour = chunk_colour[j];
+                float luminance = 0.0;
+                if (kContrast != 0u) luminance = chunk_contrast[j].w;
+                if (kPaints != 0u && chunk_paint[j] != kNoQuadPaint) {
+                    colour = paint_fill(chunk_paint[j], colour, pixel);
+                    if (kContrast != 0u) luminance = contrast_luminance(colour.rgb);
+                }
                 vec3 coverage = min(vec3(sums.rgb) / (float(kRasterCoverageOne) * float(sums.a)), vec3(1.0));
                 if (kContrast != 0u) {
                     const vec4 c = chunk_contrast[j];
-                    coverage = corrected_coverage(coverage, c.x, c.y, c.z, c.w, background_luminance);
+                    coverage = corrected_coverage(coverage, c.x, c.y, c.z, luminance, background_luminance);
                 }
                 const vec3 opacity = colour.a * coverage;
                 if (!any(greaterThan(opacity, vec3(0.0)))) continue;

@@ -1,6 +1,7 @@
 // The GPU compositor's public face (docs/compositing.md): the tile path (tiles.cpp), the draw path
 // (draw.cpp) and the reference modes (reference.cpp) over one set of quads (quads.cpp).
 #include "composite/draw.hpp"
+#include "composite/paints.hpp"
 #include "composite/quads.hpp"
 #include "composite/reference.hpp"
 #include "composite/tiles.hpp"
@@ -73,6 +74,10 @@ Status no_reference_modes() {
 
 Status check_frame(const DrawnFrame& frame) {
     if (!frame.atlas) return Error{ErrorCode::invalid_argument, "compositor: the frame has no atlas view"};
+    if (!frame.images) {
+        return Error{ErrorCode::invalid_argument,
+                     "compositor: the frame has no bitmap images view (Renderer::drawn_frame() gives one)"};
+    }
     return {};
 }
 
@@ -134,6 +139,7 @@ struct CRISP_HIDDEN Compositor::State {
     // buffer's memory; outlives the paths below.
     std::unique_ptr<vk::Context> context;
     bool storage_without_format = false;
+    composite::PaintInputs paints;  // every path's colour-layer fills
     composite::TileCompositor tiles;
     std::unique_ptr<composite::DrawCompositor> draw;            // with draw_format
     std::unique_ptr<composite::ReferenceCompositor> reference;  // with reference_modes
@@ -200,6 +206,7 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     tiles.capacity = info.tile_capacity;
     tiles.storage_without_format = storage_without_format;
     tiles.reuse_static_bins = info.reuse_static_bins;
+    if (Status s = state->paints.create(ref, info.frames_in_flight); !s) return s.error();
     if (Status s = state->tiles.create(ref, tiles); !s) return s.error();
     if (!std::any_of(std::begin(kTileTargetFormats), std::end(kTileTargetFormats),
                      [&](VkFormat format) { return state->tiles.supports(format, format); })) {
@@ -240,14 +247,18 @@ Status Compositor::record(VkCommandBuffer command_buffer, const DrawnFrame& fram
     }
     Result<VkRect2D> rect = checked_rect(target.rect, target.extent);
     if (!rect) return rect.error();
-    composite::sort_front_to_back(frame.glyphs, rect->extent.width, rect->extent.height, s.quads);
+    composite::sort_front_to_back(frame.glyphs, frame.paints.size(), rect->extent.width, rect->extent.height, s.quads);
     composite::TileCounts counts;
     uint64_t measured_frame = 0;
     bool reused = false;
     const composite::TileTarget tile_target{target.view, target.format, view_format, rect->offset, rect->extent};
+    if (Status p = s.paints.upload(frame); !p) return p;
     Result<uint64_t> bytes =
-        s.tiles.record(command_buffer, s.quads, frame.atlas, tile_target, counts, measured_frame, reused);
-    if (!bytes) return bytes.error();
+        s.tiles.record(command_buffer, s.quads, frame.atlas, s.paints, tile_target, counts, measured_frame, reused);
+    if (!bytes) {
+        s.paints.abandon_frame();
+        return bytes.error();
+    }
     if (measured_frame != 0) s.take(counts, measured_frame);
     s.last = State::Last::tiles;
     s.stats.mode = CompositeMode::tiled;
@@ -274,6 +285,7 @@ void Compositor::abandon_frame() {
         case State::Last::none:
             break;
     }
+    if (s.last != State::Last::none) s.paints.abandon_frame();
     s.last = State::Last::none;
 }
 
@@ -288,9 +300,13 @@ Status Compositor::record_draw(VkCommandBuffer command_buffer, const DrawnFrame&
         return Error{ErrorCode::invalid_argument, "compositor: the draw rect " + rect_string(rect) +
                                                       " is empty, above 16384 a side or at a negative offset"};
     }
-    composite::sort_front_to_back(frame.glyphs, rect.extent.width, rect.extent.height, s.quads);
-    Result<uint64_t> bytes = s.draw->record(command_buffer, s.quads, frame.atlas, rect);
-    if (!bytes) return bytes.error();
+    composite::sort_front_to_back(frame.glyphs, frame.paints.size(), rect.extent.width, rect.extent.height, s.quads);
+    if (Status p = s.paints.upload(frame); !p) return p;
+    Result<uint64_t> bytes = s.draw->record(command_buffer, s.quads, frame.atlas, s.paints, rect);
+    if (!bytes) {
+        s.paints.abandon_frame();
+        return bytes.error();
+    }
     s.last = State::Last::draw;
     s.stats.mode = CompositeMode::draw;
     s.stats.path = QuadPath::raster;
@@ -303,8 +319,14 @@ Status Compositor::record_reference(VkCommandBuffer command_buffer, const DrawnF
                                     const CompositeParams& params) {
     if (!state_->reference) return no_reference_modes();
     if (Status checked = check_frame(frame); !checked) return checked;
-    Status status = state_->reference->record(command_buffer, frame.glyphs, frame.atlas, params, state_->stats);
-    if (status) state_->last = State::Last::reference;
+    State& s = *state_;
+    if (Status p = s.paints.upload(frame); !p) return p;
+    Status status = s.reference->record(command_buffer, frame, s.paints, params, s.stats);
+    if (status) {
+        s.last = State::Last::reference;
+    } else {
+        s.paints.abandon_frame();
+    }
     return status;
 }
 

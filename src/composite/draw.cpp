@@ -13,10 +13,14 @@ namespace crisp::composite {
 namespace {
 
 constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-// The bindings quad_pipeline.glsl declares for a rasterized quad: the atlas and the quads.
+// The bindings quad_pipeline.glsl declares for a rasterized quad: the atlas, the quads and their
+// fills.
 constexpr vk::Binding kBindings[] = {
     {gpu::kCompositeBindAtlas, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
     {gpu::kCompositeBindQuads, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindPaints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindStops, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindImages, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
 };
 constexpr vk::BindingTable kTable{kBindings, kStages};
 
@@ -70,7 +74,7 @@ Status DrawCompositor::create(const vk::DeviceRef& device, VkPhysicalDevice phys
 }
 
 Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
-                                        VkImageView atlas_view, const VkRect2D& rect) {
+                                        VkImageView atlas_view, const PaintInputs& paints, const VkRect2D& rect) {
     Slot& slot = slots_[frame_ % slots_.size()];
     const VkDeviceSize bytes = quads.size_bytes();
     if (!slot.quads.buffer || slot.quads.size < bytes) {
@@ -83,10 +87,11 @@ Result<uint64_t> DrawCompositor::record(VkCommandBuffer command_buffer, std::spa
         }
     }
     if (bytes > 0) std::memcpy(slot.quads.mapped, quads.data(), bytes);
-    vk::DescriptorWrites(kTable, slot.set)
-        .storage_image(gpu::kCompositeBindAtlas, atlas_view)
-        .storage_buffer(gpu::kCompositeBindQuads, slot.quads.buffer)
-        .update(ref_);
+    vk::DescriptorWrites writes(kTable, slot.set);
+    writes.storage_image(gpu::kCompositeBindAtlas, atlas_view)
+        .storage_buffer(gpu::kCompositeBindQuads, slot.quads.buffer);
+    paints.write(writes, gpu::kCompositeBindPaints, gpu::kCompositeBindStops, gpu::kCompositeBindImages);
+    writes.update(ref_);
     ++frame_;
     recorded_ = true;
     if (quads.empty()) return uint64_t{0};

@@ -3,6 +3,8 @@
 // channel, dst = L + T * dst, for targets that cannot be storage images.
 #pragma once
 
+#include "composite/paints.hpp"
+
 #include "shared.h"
 #include "vk/resources.hpp"
 
@@ -31,7 +33,7 @@ public:
     // Records the draws into the active render pass; `quads` sorted front to back for rect's size.
     // Returns the bytes of quads uploaded.
     Result<uint64_t> record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
-                            VkImageView atlas_view, const VkRect2D& rect);
+                            VkImageView atlas_view, const PaintInputs& paints, const VkRect2D& rect);
     // Takes back the last record() (its command buffer will not be submitted): the frame does
     // not count towards frames in flight.
     void abandon_frame() {

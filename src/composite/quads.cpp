@@ -19,7 +19,7 @@ uint32_t depth_bits(float depth, int bits) {
     return scaled >= saturate ? static_cast<uint32_t>(saturate) : static_cast<uint32_t>(scaled);
 }
 
-gpu::CompositeQuad make_quad(const DrawnGlyph& glyph) {
+gpu::CompositeQuad make_quad(const DrawnGlyph& glyph, size_t paint_count) {
     const GlyphInstance& instance = glyph.instance;
     gpu::CompositeQuad q{};
     q.x = instance.x;
@@ -39,6 +39,8 @@ gpu::CompositeQuad make_quad(const DrawnGlyph& glyph) {
     q.contrast_gamma = used.gamma;
     q.contrast_k = used.contrast;
     q.contrast_darkening = used.darkening;
+    // A paint index past the frame's paints (a DrawnGlyph made by hand) fills with the colour.
+    q.paint = glyph.paint < paint_count ? glyph.paint : gpu::kNoQuadPaint;
     return q;
 }
 
@@ -55,19 +57,19 @@ bool reaches(const GlyphInstance& g, uint32_t width, uint32_t height) {
 // Everything a quad's fragments depend on, most significant first: the sort key.
 auto content(const gpu::CompositeQuad& q) {
     return std::make_tuple(q.key_depth, ~q.rank, q.y, q.x, q.height, q.width, q.atlas_y, q.atlas_x, q.color.w,
-                           q.color.x, q.color.y, q.color.z);
+                           q.color.x, q.color.y, q.color.z, q.paint);
 }
 
 }  // namespace
 
-void sort_front_to_back(std::span<const DrawnGlyph> glyphs, uint32_t width, uint32_t height,
+void sort_front_to_back(std::span<const DrawnGlyph> glyphs, size_t paint_count, uint32_t width, uint32_t height,
                         std::vector<gpu::CompositeQuad>& out) {
     // Built in `out` itself (the rank holds the paint order), so that a frame allocates nothing
     // once `out` has grown to the frame's glyphs.
     out.clear();
     for (const DrawnGlyph& glyph : glyphs) {
         if (!reaches(glyph.instance, width, height)) continue;
-        gpu::CompositeQuad quad = make_quad(glyph);
+        gpu::CompositeQuad quad = make_quad(glyph, paint_count);
         quad.key_depth = depth_bits(glyph.instance.depth, 32);
         quad.rank = glyph.instance.paint_order;
         out.push_back(quad);
@@ -91,7 +93,7 @@ uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t wi
     return pairs;
 }
 
-void rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::CompositeQuad>& out) {
+void rank_quads(std::span<const DrawnGlyph> glyphs, size_t paint_count, std::vector<gpu::CompositeQuad>& out) {
     out.clear();
     struct Order {
         uint32_t depth;
@@ -104,7 +106,7 @@ void rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::CompositeQu
         const GlyphInstance& instance = glyph.instance;
         if (instance.width == 0 || instance.height == 0) continue;
         orders.push_back({depth_bits(instance.depth, 32), instance.paint_order, static_cast<uint32_t>(out.size())});
-        out.push_back(make_quad(glyph));
+        out.push_back(make_quad(glyph, paint_count));
     }
     // Paint orders become dense ranks within each depth plane; each block of 256 ranks is also one
     // depth step nearer, as the first compositor's 8-bit paint-order keys needed.

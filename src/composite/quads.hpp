@@ -18,15 +18,16 @@ float clamp01(float value);
 // key equals an empty slot (oit::pack_layer_key).
 uint32_t depth_bits(float depth, int bits);
 
-// One quad per drawn glyph with a non-empty rect, its colour and depth clamped into [0, 1].
-gpu::CompositeQuad make_quad(const DrawnGlyph& glyph);
+// One quad per drawn glyph with a non-empty rect, its colour and depth clamped into [0, 1], its
+// paint kept where it is one of the frame's `paint_count` paints.
+gpu::CompositeQuad make_quad(const DrawnGlyph& glyph, size_t paint_count);
 
 // The glyphs whose rects reach [0, width) x [0, height), as quads sorted front to back: depth
 // ascending, then paint order descending (later in front), then by content (rect, atlas position,
-// colour), so that the order, and with it a quad's index, depends only on the set of glyphs and
+// colour, paint), so that the order, and with it a quad's index, depends only on the set of glyphs and
 // never on their submission order. A quad's index in `out` is then its compositing key. Rects
 // wider or taller than 65535 are left out (the renderer's are at most a few thousand).
-void sort_front_to_back(std::span<const DrawnGlyph> glyphs, uint32_t width, uint32_t height,
+void sort_front_to_back(std::span<const DrawnGlyph> glyphs, size_t paint_count, uint32_t width, uint32_t height,
                         std::vector<gpu::CompositeQuad>& out);
 
 // How many (quad, tile) pairs the tile compositor's binning makes for `quads` in a rect of
@@ -35,6 +36,6 @@ uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t wi
 
 // The reference modes' quads, in submission order, with the exact mode's key: paint orders become
 // dense ranks per depth plane.
-void rank_quads(std::span<const DrawnGlyph> glyphs, std::vector<gpu::CompositeQuad>& out);
+void rank_quads(std::span<const DrawnGlyph> glyphs, size_t paint_count, std::vector<gpu::CompositeQuad>& out);
 
 }  // namespace crisp::composite

@@ -42,6 +42,9 @@ constexpr vk::Binding kBindings[] = {
     {gpu::kCompositeBindStats, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
     {gpu::kCompositeBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
     {gpu::kCompositeBindTiles, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindPaints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindStops, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kCompositeBindImages, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
 };
 constexpr vk::BindingTable kTable{kBindings, kPushStages};
 
@@ -319,9 +322,10 @@ Status ReferenceCompositor::upload(vk::DeviceBuffer& buffer, uint32_t& capacity,
     return {};
 }
 
-void ReferenceCompositor::write_descriptors(const FrameSlot& slot, VkImageView atlas_view) {
-    vk::DescriptorWrites(kTable, slot.set)
-        .storage_image(gpu::kCompositeBindAtlas, atlas_view)
+void ReferenceCompositor::write_descriptors(const FrameSlot& slot, VkImageView atlas_view, const PaintInputs& paints) {
+    vk::DescriptorWrites writes(kTable, slot.set);
+    paints.write(writes, gpu::kCompositeBindPaints, gpu::kCompositeBindStops, gpu::kCompositeBindImages);
+    writes.storage_image(gpu::kCompositeBindAtlas, atlas_view)
         .storage_buffer(gpu::kCompositeBindQuads, slot.quads.buffer)
         .storage_buffer(gpu::kCompositeBindAccumulators, accumulators.buffer)
         .storage_buffer(gpu::kCompositeBindNodes, nodes.buffer)
@@ -506,15 +510,15 @@ void ReferenceCompositor::record_passes(VkCommandBuffer command_buffer, const Fr
                    VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
-Status ReferenceCompositor::record(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs,
-                                   VkImageView atlas_view, const CompositeParams& params, CompositorStats& stats) {
+Status ReferenceCompositor::record(VkCommandBuffer command_buffer, const DrawnFrame& drawn, const PaintInputs& paints,
+                                   const CompositeParams& params, CompositorStats& stats) {
     if (Status s = check(params); !s) return s;
     FrameSlot& slot = slots[frame % frames_in_flight];
     read_back_stats(slot, stats);
     Result<bool> compute = compute_pass_for(params);
     if (!compute) return compute.error();
 
-    rank_quads(glyphs, quad_data);
+    rank_quads(drawn.glyphs, drawn.paints.size(), quad_data);
     if (*compute) {
         build_tiles();
     } else {
@@ -529,7 +533,7 @@ Status ReferenceCompositor::record(VkCommandBuffer command_buffer, std::span<con
     if (Status s = upload(slot.tiles, slot.tile_capacity, tile_data.data(), tile_count, 2 * sizeof(uint32_t)); !s) {
         return s;
     }
-    write_descriptors(slot, atlas_view);
+    write_descriptors(slot, drawn.atlas, paints);
 
     const gpu::CompositePushConstants push = push_constants(params);
     target_was_initialized = target_initialized;

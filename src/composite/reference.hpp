@@ -2,6 +2,8 @@
 // into the compositor's own RGBA32F target over a flat background (docs/compositing.md).
 #pragma once
 
+#include "composite/paints.hpp"
+
 #include "shared.h"
 #include "vk/resources.hpp"
 
@@ -25,7 +27,7 @@ public:
     // The target, per-pixel buffers and fixed pipelines for `info` (already checked by
     // Compositor::create). Warnings go to `warnings`.
     Status create(const vk::DeviceRef& device, const CompositorCreateInfo& info, std::vector<std::string>& warnings);
-    Status record(VkCommandBuffer command_buffer, std::span<const DrawnGlyph> glyphs, VkImageView atlas_view,
+    Status record(VkCommandBuffer command_buffer, const DrawnFrame& drawn, const PaintInputs& paints,
                   const CompositeParams& params, CompositorStats& stats);
     void record_target_readback(VkCommandBuffer command_buffer, VkBuffer buffer) const;
     const vk::DeviceImage& target() const { return target_; }
@@ -58,7 +60,7 @@ private:
     void read_back_stats(FrameSlot& slot, CompositorStats& stats);
     void build_tiles();
     Status upload(vk::DeviceBuffer& buffer, uint32_t& capacity, const void* data, uint32_t count, size_t size);
-    void write_descriptors(const FrameSlot& slot, VkImageView atlas_view);
+    void write_descriptors(const FrameSlot& slot, VkImageView atlas_view, const PaintInputs& paints);
     gpu::CompositePushConstants push_constants(const CompositeParams& params) const;
     void record_target_init(VkCommandBuffer command_buffer);
     uint64_t record_clears(VkCommandBuffer command_buffer, CompositeMode mode);

@@ -25,6 +25,9 @@ constexpr vk::Binding kBindings[] = {
     {gpu::kTileBindBins, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
     {gpu::kTileBindHeader, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
     {gpu::kTileBindTarget, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+    {gpu::kTileBindPaints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kTileBindStops, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kTileBindImages, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
 };
 static_assert(std::size(kBindings) == gpu::kTileBindingCount);
 constexpr vk::BindingTable kTable{kBindings, VK_SHADER_STAGE_COMPUTE_BIT};
@@ -101,7 +104,7 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
         ref_.fn->vkGetPhysicalDeviceFormatProperties(config.physical_device, variant.view, &properties);
         if ((properties.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT) == 0) continue;
         if (std::string_view(variant.shader) == "tiles_pass_any.comp" && !config.storage_without_format) continue;
-        if (Status s = make_tile_passes(i, 0, tile_pipelines_[i]); !s) return s;
+        if (Status s = make_tile_passes(i, 0, tile_pipelines_[i][0]); !s) return s;
     }
     return {};
 }
@@ -118,23 +121,26 @@ Status TileCompositor::make_pipeline(const char* shader, const VkSpecializationI
     return {};
 }
 
-Status TileCompositor::make_tile_passes(size_t index, uint32_t contrast, std::array<VkPipeline, 2>& out) {
+Status TileCompositor::make_tile_passes(size_t index, uint32_t features, std::array<VkPipeline, 2>& out) {
     const TileVariant& variant = kTileVariants[index];
     // constant_id 0: K; 1: the target's encoding; 2: the list capacity; 3: red and blue swap;
-    // 4: the pass (exact, layered); 5: the contrast model.
+    // 4: the pass (exact, layered); 5: the contrast model; 6: colour layers' fills.
+    const uint32_t contrast = (features & kTileContrast) != 0 ? 1u : 0u;
+    const uint32_t paints = (features & kTilePaints) != 0 ? 1u : 0u;
     for (uint32_t pass = 0; pass < 2; ++pass) {
-        const uint32_t constants[6] = {config_.layers,
+        const uint32_t constants[7] = {config_.layers,
                                        is_srgb_encoded(variant.image) ? gpu::kTileEncodeSrgb : gpu::kTileEncodeLinear,
                                        config_.capacity,
                                        variant.image != variant.view ? 1u : 0u,
                                        pass,
-                                       contrast};
-        const VkSpecializationMapEntry entries[6] = {{0, 0, 4},  {1, 4, 4},  {2, 8, 4},
-                                                     {3, 12, 4}, {4, 16, 4}, {5, 20, 4}};
-        const VkSpecializationInfo specialization{6, entries, sizeof(constants), constants};
+                                       contrast,
+                                       paints};
+        const VkSpecializationMapEntry entries[7] = {{0, 0, 4},  {1, 4, 4},  {2, 8, 4}, {3, 12, 4},
+                                                     {4, 16, 4}, {5, 20, 4}, {6, 24, 4}};
+        const VkSpecializationInfo specialization{7, entries, sizeof(constants), constants};
         const std::string label = std::string(variant.shader) + (pass == 0 ? " (exact pass)" : " (layered pass)") +
                                   (variant.image != variant.view ? ", red and blue swapped" : "") +
-                                  (contrast != 0 ? ", contrast" : "");
+                                  (contrast != 0 ? ", contrast" : "") + (paints != 0 ? ", paints" : "");
         if (Status s = make_pipeline(variant.shader, &specialization, label, out[pass]); !s) return s;
     }
     return {};
@@ -142,7 +148,7 @@ Status TileCompositor::make_tile_passes(size_t index, uint32_t contrast, std::ar
 
 bool TileCompositor::supports(VkFormat format, VkFormat view_format) const {
     const size_t i = variant_index(format, view_format);
-    return i < kTileVariants.size() && tile_pipelines_[i][0] != VK_NULL_HANDLE;
+    return i < kTileVariants.size() && tile_pipelines_[i][0][0] != VK_NULL_HANDLE;
 }
 
 Status TileCompositor::grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
@@ -174,9 +180,11 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
     return {};
 }
 
-void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view) {
-    vk::DescriptorWrites(kTable, slot.set)
-        .storage_image(gpu::kTileBindAtlas, atlas_view)
+void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view, const PaintInputs& paints,
+                                       VkImageView target_view) {
+    vk::DescriptorWrites writes(kTable, slot.set);
+    paints.write(writes, gpu::kTileBindPaints, gpu::kTileBindStops, gpu::kTileBindImages);
+    writes.storage_image(gpu::kTileBindAtlas, atlas_view)
         .storage_buffer(gpu::kTileBindQuads, slot.quads.buffer)
         .storage_buffer(gpu::kTileBindTiles, slot.tiles.buffer)
         .storage_buffer(gpu::kTileBindBins, slot.bins.buffer)
@@ -279,8 +287,8 @@ void TileCompositor::abandon_frame() {
 }
 
 Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
-                                        VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
-                                        uint64_t& measured_frame, bool& reused) {
+                                        VkImageView atlas_view, const PaintInputs& paints, const TileTarget& target,
+                                        TileCounts& measured, uint64_t& measured_frame, bool& reused) {
     Slot& slot = slots_[frame_ % slots_.size()];
     if (slot.pending) {
         gpu::TileHeader header{};
@@ -322,18 +330,21 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
         slot.binned_height = push.height;
         slot.bins_valid = true;
     }
-    // The contrast model's passes only for frames that correct some glyph: linear frames keep the
-    // passes, registers and speed they had without it.
+    // The contrast model's passes only for frames that correct some glyph, the fills' only for
+    // frames with colour layers: plain linear text keeps the passes, registers and speed it had
+    // without them.
     const size_t variant = variant_index(target.format, target.view_format);
-    const bool corrected = std::any_of(quads.begin(), quads.end(), [](const gpu::CompositeQuad& q) {
-        return q.contrast_gamma != 1.0f || q.contrast_k != 0.0f || q.contrast_darkening != 1.0f;
-    });
-    if (corrected && contrast_pipelines_[variant][0] == VK_NULL_HANDLE) {
-        if (Status s = make_tile_passes(variant, 1, contrast_pipelines_[variant]); !s) return s.error();
+    uint32_t features = 0;
+    for (const gpu::CompositeQuad& q : quads) {
+        if (q.contrast_gamma != 1.0f || q.contrast_k != 0.0f || q.contrast_darkening != 1.0f) features |= kTileContrast;
+        if (q.paint != gpu::kNoQuadPaint) features |= kTilePaints;
     }
-    write_descriptors(slot, atlas_view, target.view);
-    record_passes(command_buffer, slot, corrected ? contrast_pipelines_[variant] : tile_pipelines_[variant], push,
-                  reused);
+    std::array<VkPipeline, 2>& passes = tile_pipelines_[variant][features];
+    if (passes[0] == VK_NULL_HANDLE) {
+        if (Status s = make_tile_passes(variant, features, passes); !s) return s.error();
+    }
+    write_descriptors(slot, atlas_view, paints, target.view);
+    record_passes(command_buffer, slot, passes, push, reused);
     ++frame_;
     slot.pending = true;
     slot.frame = frame_;

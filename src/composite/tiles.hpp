@@ -5,6 +5,8 @@
 // Nothing per pixel lives in global memory.
 #pragma once
 
+#include "composite/paints.hpp"
+
 #include "shared.h"
 #include "vk/resources.hpp"
 
@@ -82,8 +84,8 @@ public:
     // says whether the slot's bins already held these quads (static text), so that the frame
     // skipped the upload and the binning passes.
     Result<uint64_t> record(VkCommandBuffer command_buffer, std::span<const gpu::CompositeQuad> quads,
-                            VkImageView atlas_view, const TileTarget& target, TileCounts& measured,
-                            uint64_t& measured_frame, bool& reused);
+                            VkImageView atlas_view, const PaintInputs& paints, const TileTarget& target,
+                            TileCounts& measured, uint64_t& measured_frame, bool& reused);
     // Takes back the last record() (its command buffer will not be submitted): the slot's bins,
     // if that record() binned, no longer count as holding its quads, its counts are not read,
     // and the frame does not count towards frames in flight.
@@ -107,7 +109,8 @@ private:
     Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
                 const char* what);
     Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
-    void write_descriptors(const Slot& slot, VkImageView atlas_view, VkImageView target_view);
+    void write_descriptors(const Slot& slot, VkImageView atlas_view, const PaintInputs& paints,
+                           VkImageView target_view);
     void record_binning(VkCommandBuffer command_buffer, const gpu::TilePushConstants& push);
     void reset_header(const Slot& slot, bool reuse_bins);
     void record_passes(VkCommandBuffer command_buffer, const Slot& slot, const std::array<VkPipeline, 2>& tile_passes,
@@ -116,9 +119,11 @@ private:
     // specializations where it has several.
     Status make_pipeline(const char* shader, const VkSpecializationInfo* specialization, const std::string& label,
                          VkPipeline& out);
-    // The exact and layered passes of variant `variant`, with the contrast model (contrast 1) or
-    // without it (0).
-    Status make_tile_passes(size_t variant, uint32_t contrast, std::array<VkPipeline, 2>& out);
+    // What a frame's tile passes are specialized for (a set of these bits).
+    static constexpr uint32_t kTileContrast = 1;  // some quad's coverage is corrected
+    static constexpr uint32_t kTilePaints = 2;    // some quad is a colour layer with a fill
+    // The exact and layered passes of variant `variant`, for `features`.
+    Status make_tile_passes(size_t variant, uint32_t features, std::array<VkPipeline, 2>& out);
 
     vk::DeviceRef ref_;
     TileConfig config_;
@@ -126,10 +131,10 @@ private:
     vk::DescriptorSets descriptors_;
     vk::DeviceObjects objects_;  // shader modules and pipelines
     VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
-    std::array<VkPipeline, 3> scan_{};                                              // reduce, blocks, down
-    std::array<std::array<VkPipeline, 2>, kTileVariants.size()> tile_pipelines_{};  // exact, layered pass
-    // The same with the contrast model, made at the first frame that has a corrected glyph.
-    std::array<std::array<VkPipeline, 2>, kTileVariants.size()> contrast_pipelines_{};
+    std::array<VkPipeline, 3> scan_{};  // reduce, blocks, down
+    // Per variant and features, the exact and layered passes: those without features made by
+    // create(), the others at the first frame that needs them.
+    std::array<std::array<std::array<VkPipeline, 2>, 4>, kTileVariants.size()> tile_pipelines_{};
     std::vector<Slot> slots_;
     uint64_t frame_ = 0;
     bool recorded_ = false;     // record() since the last abandon_frame()

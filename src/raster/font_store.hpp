@@ -56,6 +56,8 @@ public:
     Status remove(FontId id);
     // The fonts remove() named leave: their atlas entries go, their staging buffers and page
     // ranges are freed once the frames that may read them are done, and their ids are free.
+    // The fonts the next apply_removals() removes.
+    const std::vector<FontId>& pending_removals() const { return removals_; }
     void apply_removals(GlyphAtlas& atlas, RetireLists& retired, uint64_t frame);
     // Copies every font added since the last frame from its staging buffer into its page; the
     // staging buffer is retired. True when something was copied.

@@ -3,8 +3,10 @@
 // subpixel steps (raster/coarsening), the atlas image (raster/atlas_image), the rasterizer's work
 // items and dispatch (raster/raster), and what waits for the GPU to finish (raster/retired).
 #include "raster/atlas_image.hpp"
+#include "raster/bitmaps.hpp"
 #include "raster/coarsening.hpp"
 #include "raster/font_store.hpp"
+#include "raster/paints.hpp"
 #include "raster/raster.hpp"
 #include "raster/requests.hpp"
 #include "raster/retired.hpp"
@@ -12,6 +14,7 @@
 
 #include <crisp/renderer.hpp>
 
+#include <bit>
 #include <memory>
 #include <string>
 #include <utility>
@@ -35,6 +38,8 @@ struct CRISP_HIDDEN Renderer::State {
     raster::RetireLists retired;
     raster::AtlasImage image;
     raster::RasterPass raster;
+    raster::FramePaints paints;
+    raster::BitmapLayers bitmaps;
 
     uint64_t frame = 0;
     bool recorded = false;  // record() since begin_frame(): abandon_frame() has a frame to take back
@@ -50,7 +55,8 @@ struct CRISP_HIDDEN Renderer::State {
           fonts(context->ref, context->properties.limits.maxStorageBufferRange),
           requests(atlas, fonts, coarsening, stats),
           image(context->ref),
-          raster(context->ref, {info.frames_in_flight, info.shared_row_roots, info.sample_kind}) {
+          raster(context->ref, {info.frames_in_flight, info.shared_row_roots, info.sample_kind}),
+          bitmaps(context->ref, info.bitmap_layers, info.bitmap_layer_side, info.frames_in_flight) {
         requests.set_contrast(info.contrast);
     }
 
@@ -76,6 +82,13 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     }
     if (Status s = validate_text_contrast(info.contrast); !s) {
         return Error{ErrorCode::invalid_argument, "renderer: " + s.error().message};
+    }
+    if (info.bitmap_layers < 1 || info.bitmap_layers > 4096 || info.bitmap_layer_side < 16 ||
+        info.bitmap_layer_side > 1024 || !std::has_single_bit(info.bitmap_layer_side)) {
+        return Error{ErrorCode::invalid_argument, "renderer: bitmap_layers " + std::to_string(info.bitmap_layers) +
+                                                      " (1..4096) or bitmap_layer_side " +
+                                                      std::to_string(info.bitmap_layer_side) +
+                                                      " (a power of two, 16..1024) is out of range"};
     }
     SubpixelLayout subpixel = info.layout;
     if (subpixel.name.empty() && subpixel == SubpixelLayout{}) subpixel = *subpixel_preset("rgb");
@@ -111,6 +124,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     auto state = std::make_unique<State>(std::move(*context), std::move(*atlas), std::move(subpixel), info);
     const AtlasConfig& config = state->atlas.config();
     if (Status s = state->image.create(config); !s) return s.error();
+    if (Status s = state->bitmaps.create(); !s) return s.error();
     if (Status s = state->raster.create(state->atlas.stats().usable_cells, uint64_t{config.width} * config.height,
                                         state->retired);
         !s) {
@@ -163,6 +177,7 @@ void Renderer::abandon_frame() {
     s.recorded = false;
     s.atlas.abandon_frame();
     s.image.abandon_frame(s.retired);
+    s.bitmaps.abandon_frame();
     // Motion and the subpixel-step level go back to what they were, as if the frame never began.
     s.motion.abandon_frame();
     s.coarsening = s.coarsening_begun;
@@ -178,7 +193,9 @@ void Renderer::begin_frame() {
     s.recorded = false;
     s.coarsening_begun = s.coarsening;
     s.atlas.begin_frame();  // unpins last frame's glyphs, so that removed fonts' entries can go
+    for (FontId id : s.fonts.pending_removals()) s.bitmaps.forget_font(id);
     s.fonts.apply_removals(s.atlas, s.retired, s.frame);
+    s.bitmaps.begin_frame(s.frame);
     s.requests.begin_frame();
     s.stats = {};
 }
@@ -217,12 +234,14 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     s.requests.settle(s.limits);
     const std::span<const RasterWork> work = s.atlas.schedule();
     s.requests.collect_drawn();
+    s.paints.resolve(s.requests.drawn_to_fill(), s.fonts, &s.bitmaps, s.stats);
 
     s.recorded = true;
     const uint64_t frame = s.frame++;
     s.retired.release_finished(frame, s.frames_in_flight, s.fonts);
     const bool fonts_uploaded = s.fonts.record_uploads(command_buffer, frame, s.retired, s.stats);
     if (Status prepared = s.prepare_atlas_image(command_buffer, frame); !prepared) return prepared;
+    if (Status images = s.bitmaps.record(command_buffer, frame, s.retired, s.stats); !images) return images;
     const uint32_t workgroups = s.raster.build(work, s.fonts, s.atlas, s.stats);
     s.raster.record_upload(command_buffer, frame, fonts_uploaded, s.stats);
     if (s.raster.has_items()) {
@@ -239,7 +258,7 @@ std::span<const DrawnGlyph> Renderer::drawn() const {
     return state_->requests.drawn();
 }
 DrawnFrame Renderer::drawn_frame() const {
-    return DrawnFrame{drawn(), atlas_view()};
+    return DrawnFrame{drawn(), atlas_view(), state_->paints.paints(), state_->paints.stops(), state_->bitmaps.view()};
 }
 bool Renderer::converged() const {
     return state_->requests.converged();
@@ -253,6 +272,9 @@ const std::vector<ShaderStatistic>& Renderer::shader_statistics() const {
 DeviceMemoryUse Renderer::device_memory() const {
     const State& s = *state_;
     DeviceMemoryUse use{s.context->arena.block_count(), s.context->arena.block_bytes()};
+    const DeviceMemoryUse images = s.bitmaps.memory();
+    use.allocations += images.allocations;
+    use.bytes += images.bytes;
     for (const vk::DeviceImage* image : {&s.image.image()}) {
         use.allocations += image->memory != VK_NULL_HANDLE ? 1 : 0;
         use.bytes += image->memory_size;

@@ -135,6 +135,7 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
         }
         if (options.color) std::copy(std::begin(color), std::end(color), std::begin(glyph.color));
         if (options.depth) glyph.depth = *options.depth;
+        if (options.palette) glyph.palette = *options.palette;
         add(glyph, visible, steps, options.contrast ? *options.contrast : contrast_);
     }
 }

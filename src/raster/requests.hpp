@@ -76,6 +76,8 @@ public:
     const TextContrast& contrast() const { return contrast_; }
 
     std::span<const DrawnGlyph> drawn() const { return drawn_; }
+    // The same, for the pass that resolves colour layers' fills in place (raster/paints).
+    std::span<DrawnGlyph> drawn_to_fill() { return drawn_; }
     bool converged() const { return converged_; }
 
 private:

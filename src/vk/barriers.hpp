@@ -23,8 +23,8 @@ inline void memory_barrier(const Functions& fn, VkCommandBuffer command_buffer, 
     fn.vkCmdPipelineBarrier(command_buffer, source, destination, 0, 1, &barrier, 0, nullptr, 0, nullptr);
 }
 
-// A layout change of a whole single-level, single-layer colour image, with the same access
-// ordering as memory_barrier.
+// A layout change of a whole colour image (every level and layer), with the same access ordering as
+// memory_barrier.
 inline void image_barrier(const Functions& fn, VkCommandBuffer command_buffer, VkImage image, VkImageLayout from,
                           VkImageLayout to, VkPipelineStageFlags source, VkAccessFlags source_access,
                           VkPipelineStageFlags destination, VkAccessFlags destination_access) {
@@ -37,7 +37,7 @@ inline void image_barrier(const Functions& fn, VkCommandBuffer command_buffer, V
     barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     barrier.image = image;
-    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
     fn.vkCmdPipelineBarrier(command_buffer, source, destination, 0, 0, nullptr, 0, nullptr, 1, &barrier);
 }
 

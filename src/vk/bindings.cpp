@@ -57,6 +57,14 @@ DescriptorWrites& DescriptorWrites::storage_image(uint32_t binding, VkImageView 
     return *this;
 }
 
+DescriptorWrites& DescriptorWrites::sampled_image(uint32_t binding, VkImageView view, VkSampler sampler,
+                                                  VkImageLayout layout) {
+    const size_t i = write(binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1);
+    images_[i] = {sampler, view, layout};
+    writes_[i].pImageInfo = &images_[i];
+    return *this;
+}
+
 DescriptorWrites& DescriptorWrites::storage_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset,
                                                    VkDeviceSize range) {
     const size_t i = write(binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1);

@@ -24,7 +24,7 @@ struct Binding {
 };
 
 // The most bindings a table holds: DescriptorWrites keeps room for every one on the stack.
-inline constexpr size_t kMaxBindings = 8;
+inline constexpr size_t kMaxBindings = 12;
 
 // A pass's descriptor set: its bindings (a constant array in the pass's file, which must outlive
 // the table), all visible to `stages`.
@@ -59,6 +59,9 @@ public:
     // `range` bytes of `buffer` from `offset` as the one storage buffer of `binding`.
     DescriptorWrites& storage_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0,
                                      VkDeviceSize range = VK_WHOLE_SIZE);
+    // `view` and `sampler` as the one combined image sampler of `binding`, in `layout`.
+    DescriptorWrites& sampled_image(uint32_t binding, VkImageView view, VkSampler sampler,
+                                    VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     // Every element of an array binding: `infos` (one per descriptor the table declares) stay the
     // caller's, and must live until update().
     DescriptorWrites& storage_buffers(uint32_t binding, std::span<const VkDescriptorBufferInfo> infos);

@@ -81,6 +81,8 @@ namespace crisp::vk {
     X(vkDestroyRenderPass)           \
     X(vkCreateFramebuffer)           \
     X(vkDestroyFramebuffer)          \
+    X(vkCreateSampler)               \
+    X(vkDestroySampler)              \
     X(vkCmdPipelineBarrier)          \
     X(vkCmdBindPipeline)             \
     X(vkCmdBindDescriptorSets)       \
@@ -93,6 +95,7 @@ namespace crisp::vk {
     X(vkCmdBeginRenderPass)          \
     X(vkCmdEndRenderPass)            \
     X(vkCmdFillBuffer)               \
+    X(vkCmdClearColorImage)          \
     X(vkCmdUpdateBuffer)             \
     X(vkCmdCopyBuffer)               \
     X(vkCmdCopyImage)                \

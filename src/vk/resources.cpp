@@ -166,7 +166,7 @@ void free_buffer(const DeviceRef& device, BufferFields& buffer) {
 }
 
 Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height, VkImageUsageFlags usage,
-                    const char* what, DeviceImage& out) {
+                    const char* what, DeviceImage& out, uint32_t array_layers, uint32_t mip_levels) {
     out.reset();
     out.adopt(device);  // what is made below is given back by out.reset() on failure
     VkImageCreateInfo image{};
@@ -174,8 +174,8 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     image.imageType = VK_IMAGE_TYPE_2D;
     image.format = format;
     image.extent = {width, height, 1};
-    image.mipLevels = 1;
-    image.arrayLayers = 1;
+    image.mipLevels = mip_levels;
+    image.arrayLayers = std::max(array_layers, 1u);
     image.samples = VK_SAMPLE_COUNT_1_BIT;
     image.tiling = VK_IMAGE_TILING_OPTIMAL;
     image.usage = usage;
@@ -201,9 +201,9 @@ Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, ui
     VkImageViewCreateInfo view{};
     view.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
     view.image = out.image;
-    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view.viewType = array_layers > 0 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
     view.format = format;
-    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mip_levels, 0, image.arrayLayers};
     if (VkResult r = device.fn->vkCreateImageView(device.device, &view, device.allocator, &out.view); r != VK_SUCCESS) {
         out.reset();
         return vulkan_error("vkCreateImageView" + suffix, r);
@@ -323,6 +323,9 @@ void DeviceObjects::reset() {
                 break;
             case VK_OBJECT_TYPE_FRAMEBUFFER:
                 d.fn->vkDestroyFramebuffer(d.device, reinterpret_cast<VkFramebuffer>(it->second), d.allocator);
+                break;
+            case VK_OBJECT_TYPE_SAMPLER:
+                d.fn->vkDestroySampler(d.device, reinterpret_cast<VkSampler>(it->second), d.allocator);
                 break;
             default:
                 assert(false && "DeviceObjects keeps no other type");

@@ -131,7 +131,8 @@ void name_object(const DeviceRef& device, VkObjectType type, Handle handle, std:
 Status create_buffer(const DeviceRef& device, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible,
                      const char* what, DeviceBuffer& out);
 
-// A 2D colour image (one mip level, one layer, optimal tiling) in device-local memory, with a view.
+// A 2D colour image (optimal tiling, `mip_levels` levels) in device-local memory, with a view of all
+// of it: a 2D image and view, or with array_layers > 0 an array of that many layers and a 2D array view.
 struct ImageFields {
     VkImage image = VK_NULL_HANDLE;
     VkDeviceMemory memory = VK_NULL_HANDLE;  // its own
@@ -144,7 +145,7 @@ using DeviceImage = Owner<ImageFields, free_image>;
 // Makes `out` in VK_IMAGE_LAYOUT_UNDEFINED. On failure what was made is destroyed and the error
 // names the call and `what` ("atlas").
 Status create_image(const DeviceRef& device, VkFormat format, uint32_t width, uint32_t height, VkImageUsageFlags usage,
-                    const char* what, DeviceImage& out);
+                    const char* what, DeviceImage& out, uint32_t array_layers = 0, uint32_t mip_levels = 1);
 
 // One descriptor set layout, a pipeline layout over it with one push-constant range at offset 0,
 // and a pool holding `sets.size()` sets of it (one per frame in flight, typically).
@@ -162,7 +163,7 @@ Status create_descriptor_sets(const DeviceRef& device, std::span<const VkDescrip
                               VkShaderStageFlags push_stages, uint32_t push_bytes, uint32_t set_count, const char* what,
                               DescriptorSets& out);
 
-// The pipelines, shader modules, render passes and framebuffers an object made, destroyed with it
+// The pipelines, shader modules, render passes, framebuffers and samplers an object made, destroyed with it
 // (newest first) through the DeviceRef they were made with, which must outlive it. keep() takes
 // ownership of a handle and returns it, so that a part keeps using plain handles.
 class DeviceObjects {
@@ -189,6 +190,7 @@ private:
         if constexpr (std::is_same_v<Handle, VkShaderModule>) return VK_OBJECT_TYPE_SHADER_MODULE;
         if constexpr (std::is_same_v<Handle, VkRenderPass>) return VK_OBJECT_TYPE_RENDER_PASS;
         if constexpr (std::is_same_v<Handle, VkFramebuffer>) return VK_OBJECT_TYPE_FRAMEBUFFER;
+        if constexpr (std::is_same_v<Handle, VkSampler>) return VK_OBJECT_TYPE_SAMPLER;
         return VK_OBJECT_TYPE_UNKNOWN;
     }
     void keep(const DeviceRef& device, VkObjectType type, uint64_t handle);
