@@ -35,11 +35,6 @@ struct FaceDeleter {
 using LibraryHandle = std::unique_ptr<FT_LibraryRec_, LibraryDeleter>;
 using FaceHandle = std::unique_ptr<FT_FaceRec_, FaceDeleter>;
 
-std::string freetype_error(FT_Error error) {
-    const char* text = FT_Error_String(error);
-    return "FreeType error " + std::to_string(error) + (text ? std::string(" (") + text + ")" : std::string());
-}
-
 double fixed_to_double(FT_Fixed value) {
     return static_cast<double>(value) / 65536.0;
 }
@@ -194,17 +189,7 @@ GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em,
         return {};
     }
     const GlyphBands bands = build_bands(packed, kTargetCurvesPerBand, kMaxBands, kBandOverlap);
-    record.bbox_min_x = packed.min_x;
-    record.bbox_min_y = packed.min_y;
-    record.bbox_max_x = packed.max_x;
-    record.bbox_max_y = packed.max_y;
-    record.point_offset = static_cast<uint32_t>(asset.points.size());
-    record.curve_count = packed.curve_count;
-    record.band_offset = static_cast<uint32_t>(asset.band_words.size());
-    record.band_count = bands.band_count;
-    record.band_words = bands.band_words;
-    asset.points.insert(asset.points.end(), packed.points.begin(), packed.points.end());
-    asset.band_words.insert(asset.band_words.end(), bands.words.begin(), bands.words.end());
+    append_glyph(packed, bands, record, asset);
 
     report.curve_count += packed.real_curves;
     report.max_curves_per_glyph = std::max(report.max_curves_per_glyph, packed.real_curves);
