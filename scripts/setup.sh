@@ -14,6 +14,7 @@ packages=(
   glslang-tools                          # glslangValidator: GLSL to SPIR-V at build time
   libglm-dev                             # vector math shared by tools and tests
   libpng-dev                             # PNG output of crisp-render
+  zlib1g-dev                             # the asset's bitmap glyphs are zlib streams
   libgtest-dev                           # GoogleTest
   clang libclang-rt-14-dev               # libFuzzer for the fuzz targets
   clang-format                           # the format check (scripts/check_format.sh)
