@@ -1,5 +1,8 @@
-// Bitmap glyphs: the core's decoding and filtering of their pixels for the GPU.
+// Bitmap glyphs: CBDT colour bitmaps baked from Noto Color Emoji (their images, rectangles, paints
+// and advances against FreeType and HarfBuzz; a truncated CBDT), and the core's decoding and
+// filtering of their pixels for the GPU.
 #include "test_support.hpp"
+#include "bake/bitmap.hpp"
 #include "raster/bitmap_pixels.hpp"
 
 #include <crisp/asset.hpp>
@@ -8,6 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include <ft2build.h>
+#include FT_FREETYPE_H
+#include <hb.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -17,6 +23,16 @@
 
 namespace crisp {
 namespace {
+
+// fonts-noto-color-emoji (scripts/setup.sh): one CBDT strike of 109 pixels per em, no outlines.
+const std::string kNotoColorEmoji = "/usr/share/fonts/truetype/noto/NotoColorEmoji.ttf";
+
+#define SKIP_WITHOUT_NOTO_COLOR_EMOJI()            \
+    if (!std::filesystem::exists(kNotoColorEmoji)) \
+    GTEST_SKIP() << kNotoColorEmoji << " is missing (Debian: apt install fonts-noto-color-emoji; scripts/setup.sh)"
+
+// 👨‍👩‍👧‍👦: four people joined by ZWJ, one ligature glyph in Noto Color Emoji.
+const std::vector<uint32_t> kFamily = {0x1F468, 0x200D, 0x1F469, 0x200D, 0x1F467, 0x200D, 0x1F466};
 
 std::vector<std::byte> zlib_compress(std::span<const uint8_t> bytes) {
     uLongf size = compressBound(static_cast<uLong>(bytes.size()));
@@ -233,6 +249,285 @@ TEST(BitmapPixels, LayerRefusesBadArguments) {
     auto short_pixels = raster::make_bitmap_layer(pixels, 4, 5, 64);
     ASSERT_FALSE(short_pixels);
     EXPECT_NE(short_pixels.error().message.find("4 x 5 pixels given 64 bytes"), std::string::npos);
+}
+
+// ---- The baker on Noto Color Emoji
+
+struct FreeTypeFace {
+    FT_Library library = nullptr;
+    FT_Face face = nullptr;
+    explicit FreeTypeFace(const std::vector<std::byte>& bytes) {
+        FT_Init_FreeType(&library);
+        FT_New_Memory_Face(library, reinterpret_cast<const FT_Byte*>(bytes.data()), static_cast<FT_Long>(bytes.size()),
+                           0, &face);
+        FT_Select_Size(face, face->num_fixed_sizes - 1);
+    }
+    FreeTypeFace(const FreeTypeFace&) = delete;
+    FreeTypeFace& operator=(const FreeTypeFace&) = delete;
+    ~FreeTypeFace() {
+        FT_Done_Face(face);
+        FT_Done_FreeType(library);
+    }
+};
+
+struct HarfBuzzFont {
+    hb_blob_t* blob = nullptr;
+    hb_face_t* face = nullptr;
+    hb_font_t* font = nullptr;
+    explicit HarfBuzzFont(const std::vector<std::byte>& bytes) {
+        blob = hb_blob_create(reinterpret_cast<const char*>(bytes.data()), static_cast<unsigned>(bytes.size()),
+                              HB_MEMORY_MODE_READONLY, nullptr, nullptr);
+        face = hb_face_create(blob, 0);
+        font = hb_font_create(face);  // scaled to units per em
+    }
+    HarfBuzzFont(const HarfBuzzFont&) = delete;
+    HarfBuzzFont& operator=(const HarfBuzzFont&) = delete;
+    ~HarfBuzzFont() {
+        hb_font_destroy(font);
+        hb_face_destroy(face);
+        hb_blob_destroy(blob);
+    }
+    uint32_t glyph(uint32_t codepoint) const {
+        hb_codepoint_t glyph = 0;
+        hb_font_get_nominal_glyph(font, codepoint, &glyph);
+        return glyph;
+    }
+    std::vector<uint32_t> shape(const std::vector<uint32_t>& codepoints) const {
+        hb_buffer_t* buffer = hb_buffer_create();
+        hb_buffer_add_utf32(buffer, codepoints.data(), static_cast<int>(codepoints.size()), 0, -1);
+        hb_buffer_guess_segment_properties(buffer);
+        hb_shape(font, buffer, nullptr, 0);
+        unsigned count = 0;
+        const hb_glyph_info_t* infos = hb_buffer_get_glyph_infos(buffer, &count);
+        std::vector<uint32_t> glyphs;
+        for (unsigned i = 0; i < count; ++i) glyphs.push_back(infos[i].codepoint);
+        hb_buffer_destroy(buffer);
+        return glyphs;
+    }
+};
+
+BakeOptions emoji_options(std::vector<uint32_t> codepoints) {
+    BakeOptions options;
+    options.all_glyphs = false;
+    options.codepoints = std::move(codepoints);
+    std::sort(options.codepoints.begin(), options.codepoints.end());
+    options.codepoints.erase(std::unique(options.codepoints.begin(), options.codepoints.end()),
+                             options.codepoints.end());
+    return options;
+}
+
+std::vector<uint32_t> emoji_codepoints() {
+    std::vector<uint32_t> codepoints = {0x1F600, 0x1F44D, 0x1F3FD};
+    codepoints.insert(codepoints.end(), kFamily.begin(), kFamily.end());
+    return codepoints;
+}
+
+TEST(BitmapBake, NotoColorEmojiBakesItsBitmapsAsImageLayers) {
+    SKIP_WITHOUT_NOTO_COLOR_EMOJI();
+    const std::vector<std::byte> font = test::read_file(kNotoColorEmoji);
+    auto baked = bake_font(font, emoji_options(emoji_codepoints()));
+    ASSERT_TRUE(baked) << baked.error().message;
+    const FontAsset& asset = baked->asset;
+    const HarfBuzzFont hb(font);
+    // FreeType gives this face (no outlines) no units per em; head, and HarfBuzz, say 2048.
+    EXPECT_EQ(asset.info.units_per_em, 2048u);
+    EXPECT_EQ(asset.info.units_per_em, hb_face_get_upem(hb.face));
+    EXPECT_EQ(asset.info.ascender, 1900);
+    EXPECT_EQ(asset.info.descender, -500);
+    EXPECT_EQ(asset.info.line_gap, 0);
+    EXPECT_EQ(baked->report.failed_glyphs, 0u);
+    auto loaded = load_asset(serialize_asset(asset));
+    ASSERT_TRUE(loaded) << loaded.error().message;
+    EXPECT_TRUE(*loaded == asset);
+
+    const std::vector<uint32_t> family = hb.shape(kFamily);
+    ASSERT_EQ(family.size(), 1u) << "the ZWJ sequence shapes to one ligature";
+    const std::vector<uint32_t> glyphs = {hb.glyph(0x1F600), hb.glyph(0x1F44D), hb.glyph(0x1F3FD), family[0]};
+    // One rectangle for all: every image of the strike is 136 x 128 pixels at the same place.
+    const uint32_t faces = static_cast<uint32_t>(hb_face_get_glyph_count(hb.face));
+    EXPECT_EQ(asset.face_glyph_count(), faces);
+    ASSERT_EQ(asset.glyphs.size(), faces + 1u);
+    const GlyphRecord& rect = asset.glyphs[faces];
+    EXPECT_EQ(rect.flags, kGlyphBaked | kGlyphSynthetic);
+    EXPECT_FLOAT_EQ(rect.bbox_min_x, 0.0f);
+    EXPECT_FLOAT_EQ(rect.bbox_max_x, 136.0f / 109.0f);
+    EXPECT_FLOAT_EQ(rect.bbox_min_y, (101.0f - 128.0f) / 109.0f);
+    EXPECT_FLOAT_EQ(rect.bbox_max_y, 101.0f / 109.0f);
+    EXPECT_EQ(rect.curve_count, 4u);  // four lines, one contour
+
+    EXPECT_EQ(asset.colour_glyphs.size(), asset.images.size());
+    for (uint32_t glyph : glyphs) {
+        SCOPED_TRACE("glyph " + std::to_string(glyph));
+        const GlyphRecord& record = asset.glyphs[glyph];
+        EXPECT_EQ(record.flags, kGlyphBaked);
+        EXPECT_EQ(record.curve_count, 0u);
+        // hmtx, as HarfBuzz advances: 2550 font units.
+        EXPECT_EQ(record.advance, static_cast<float>(hb_font_get_glyph_h_advance(hb.font, glyph) / 2048.0));
+        const ColourGlyph* colour = asset.colour_glyph(glyph);
+        ASSERT_NE(colour, nullptr);
+        ASSERT_EQ(colour->layer_count, 1u);
+        const ColourLayer& layer = asset.layers[colour->first_layer];
+        EXPECT_EQ(layer.glyph, faces);
+        const Paint& paint = asset.paints[layer.paint];
+        EXPECT_EQ(paint.kind, PaintKind::image);
+        EXPECT_EQ(paint.stop_count, 0u);
+        const BitmapImage& image = asset.images[paint.image];
+        EXPECT_EQ(image.width, 136u);
+        EXPECT_EQ(image.height, 128u);
+        // The rectangle's top-left corner to (0, 0) of the image, its bottom-right to (1, 1).
+        const Affine& m = paint.to_paint;
+        EXPECT_NEAR(m.xx * rect.bbox_min_x + m.xy * rect.bbox_max_y + m.dx, 0.0f, 1e-6f);
+        EXPECT_NEAR(m.yx * rect.bbox_min_x + m.yy * rect.bbox_max_y + m.dy, 0.0f, 1e-6f);
+        EXPECT_NEAR(m.xx * rect.bbox_max_x + m.xy * rect.bbox_min_y + m.dx, 1.0f, 1e-6f);
+        EXPECT_NEAR(m.yx * rect.bbox_max_x + m.yy * rect.bbox_min_y + m.dy, 1.0f, 1e-6f);
+    }
+}
+
+TEST(BitmapBake, ImagesHoldFreeTypesPixelsByteForByte) {
+    SKIP_WITHOUT_NOTO_COLOR_EMOJI();
+    const std::vector<std::byte> font = test::read_file(kNotoColorEmoji);
+    auto baked = bake_font(font, emoji_options({0x1F600, 0x1F3FD}));
+    ASSERT_TRUE(baked) << baked.error().message;
+    const FreeTypeFace ft(font);
+    for (uint32_t codepoint : {0x1F600u, 0x1F3FDu}) {
+        const uint32_t glyph = FT_Get_Char_Index(ft.face, codepoint);
+        ASSERT_EQ(FT_Load_Glyph(ft.face, glyph, FT_LOAD_COLOR), 0);
+        const FT_Bitmap& bitmap = ft.face->glyph->bitmap;
+        ASSERT_EQ(bitmap.pixel_mode, FT_PIXEL_MODE_BGRA);
+        const ColourGlyph* colour = baked->asset.colour_glyph(glyph);
+        ASSERT_NE(colour, nullptr);
+        const uint32_t image = baked->asset.paints[baked->asset.layers[colour->first_layer].paint].image;
+        auto pixels = raster::decode_bitmap(baked->asset, image);
+        ASSERT_TRUE(pixels) << pixels.error().message;
+        ASSERT_EQ(pixels->size(), size_t{bitmap.width} * bitmap.rows * 4);
+        size_t differing = 0, translucent = 0;
+        for (uint32_t y = 0; y < bitmap.rows; ++y) {
+            for (uint32_t x = 0; x < bitmap.width; ++x) {
+                const uint8_t* bgra = bitmap.buffer + ptrdiff_t(y) * bitmap.pitch + x * 4;
+                const uint8_t* rgba = pixels->data() + (size_t{y} * bitmap.width + x) * 4;
+                differing += rgba[0] != bgra[2] || rgba[1] != bgra[1] || rgba[2] != bgra[0] || rgba[3] != bgra[3];
+                translucent += bgra[3] != 0 && bgra[3] != 255;
+            }
+        }
+        EXPECT_EQ(differing, 0u) << "U+" << std::hex << codepoint;
+        EXPECT_GT(translucent, 0u);  // antialiased edges: premultiplied pixels were compared
+    }
+}
+
+// The font with its CBDT table cut to its first half, the tables after it moved up to follow.
+std::vector<std::byte> with_cbdt_halved(const std::vector<std::byte>& font) {
+    const auto u16 = [&](size_t at) { return uint32_t(font[at]) << 8 | uint32_t(font[at + 1]); };
+    const auto u32 = [&](size_t at) { return u16(at) << 16 | u16(at + 2); };
+    const auto put32 = [](std::vector<std::byte>& out, size_t at, uint32_t value) {
+        for (size_t i = 0; i < 4; ++i) out[at + i] = std::byte(value >> (24 - 8 * i));
+    };
+    const uint32_t tables = u16(4);
+    std::vector<size_t> order(tables);
+    for (size_t i = 0; i < tables; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return u32(12 + 16 * a + 8) < u32(12 + 16 * b + 8); });
+    std::vector<std::byte> out(font.begin(), font.begin() + 12 + 16 * ptrdiff_t(tables));
+    for (size_t i : order) {
+        const size_t entry = 12 + 16 * i;
+        const uint32_t offset = u32(entry + 8);
+        uint32_t length = u32(entry + 12);
+        if (u32(entry) == make_tag("CBDT")) length /= 2;
+        out.resize((out.size() + 3) & ~size_t{3});
+        put32(out, entry + 8, static_cast<uint32_t>(out.size()));
+        put32(out, entry + 12, length);
+        out.insert(out.end(), font.begin() + offset, font.begin() + offset + length);
+    }
+    return out;
+}
+
+TEST(BitmapBake, ATruncatedCbdtFailsItsGlyphsByName) {
+    SKIP_WITHOUT_NOTO_COLOR_EMOJI();
+    const std::vector<std::byte> font = with_cbdt_halved(test::read_file(kNotoColorEmoji));
+    // The strike's first half holds the bitmaps of the code points' own glyphs, the second most
+    // ligatures': that of 👩🏽‍💻 (woman, skin tone, ZWJ, laptop) is cut off, U+1F600's is whole.
+    const std::vector<uint32_t> coder = {0x1F469, 0x1F3FD, 0x200D, 0x1F4BB};
+    const FreeTypeFace ft(font);
+    const HarfBuzzFont hb(font);
+    const uint32_t smile = hb.glyph(0x1F600), ligature = hb.shape(coder).at(0);
+    ASSERT_EQ(FT_Load_Glyph(ft.face, smile, FT_LOAD_COLOR), 0);
+    ASSERT_NE(FT_Load_Glyph(ft.face, ligature, FT_LOAD_COLOR), 0);
+    std::vector<uint32_t> codepoints = coder;
+    codepoints.push_back(0x1F600);
+
+    BakeOptions options = emoji_options(codepoints);
+    options.allow_failed = true;
+    auto baked = bake_font(font, options);
+    ASSERT_TRUE(baked) << baked.error().message;
+    const BakeReport& report = baked->report;
+    EXPECT_GE(report.failed_glyphs, 1u);
+    EXPECT_EQ(baked->asset.glyphs[ligature].flags, kGlyphBaked | kGlyphFailed);
+    EXPECT_EQ(report.first_failure.find("glyph " + std::to_string(report.failed_glyph_ids[0]) +
+                                        ": its bitmap: FreeType error 6"),
+              0u)
+        << report.first_failure;
+    EXPECT_EQ(baked->asset.colour_glyph(ligature), nullptr);
+    EXPECT_NE(baked->asset.colour_glyph(smile), nullptr);
+    // Every glyph that baked and has a bitmap has its colour glyph; no other does.
+    for (uint32_t glyph = 0; glyph < baked->asset.face_glyph_count(); ++glyph) {
+        const bool has_bitmap = baked->asset.glyphs[glyph].flags == kGlyphBaked &&
+                                FT_Load_Glyph(ft.face, glyph, FT_LOAD_COLOR) == 0 && ft.face->glyph->bitmap.width > 0;
+        EXPECT_EQ(baked->asset.colour_glyph(glyph) != nullptr, has_bitmap) << "glyph " << glyph;
+    }
+    EXPECT_TRUE(validate_asset(baked->asset));
+
+    auto refused = bake_font(font, emoji_options(codepoints));
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::glyph_failed);
+    EXPECT_NE(refused.error().message.find("glyphs failed; first: " + report.first_failure), std::string::npos)
+        << refused.error().message;
+}
+
+TEST(BitmapBake, AColrGlyphKeepsItsLayersAndBitmapsFallIntoOrder) {
+    SKIP_WITHOUT_NOTO_COLOR_EMOJI();
+    const std::vector<std::byte> font = test::read_file(kNotoColorEmoji);
+    const FreeTypeFace ft(font);
+    const HarfBuzzFont hb(font);
+    const uint32_t thumbs = hb.glyph(0x1F44D), smile = hb.glyph(0x1F600), family = hb.shape(kFamily).at(0);
+    ASSERT_LT(thumbs, smile);
+    ASSERT_LT(smile, family);
+    // As the COLR reader leaves them: the smile has a colour glyph of two layers already.
+    FontAsset asset;
+    asset.glyphs.assign(static_cast<size_t>(ft.face->num_glyphs), GlyphRecord{});
+    asset.paints.resize(1);
+    asset.layers = {{1, 0}, {2, 0}};
+    ColourGlyph colr;
+    colr.glyph = smile;
+    colr.layer_count = 2;
+    asset.colour_glyphs.push_back(colr);
+
+    auto bitmaps = BitmapGlyphs::open(ft.face, 2048);
+    ASSERT_TRUE(bitmaps) << bitmaps.error().message;
+    EXPECT_TRUE(bitmaps->bitmap_only());
+    BakeReport report;
+    for (uint32_t glyph : {thumbs, smile, family}) EXPECT_FALSE(bitmaps->bake(glyph, asset, report));
+    ASSERT_TRUE(bitmaps->finish(asset));
+
+    ASSERT_EQ(asset.colour_glyphs.size(), 3u);
+    EXPECT_EQ(asset.images.size(), 2u);  // the smile's bitmap is not used
+    const uint32_t glyphs[] = {thumbs, smile, family}, counts[] = {1, 2, 1}, firsts[] = {0, 1, 3};
+    for (size_t i = 0; i < 3; ++i) {
+        EXPECT_EQ(asset.colour_glyphs[i].glyph, glyphs[i]);
+        EXPECT_EQ(asset.colour_glyphs[i].layer_count, counts[i]);
+        EXPECT_EQ(asset.colour_glyphs[i].first_layer, firsts[i]);
+    }
+    EXPECT_EQ(asset.layers[1].glyph, 1u);
+    EXPECT_EQ(asset.layers[2].glyph, 2u);
+    EXPECT_EQ(asset.paints[asset.layers[3].paint].kind, PaintKind::image);
+    EXPECT_EQ(asset.paints[asset.layers[3].paint].image, 1u);
+    EXPECT_EQ(asset.layers[0].glyph, asset.layers[3].glyph);  // one rectangle for both
+}
+
+TEST(BitmapBake, AFontWithoutColourHasNoColourGlyphs) {
+    auto baked = bake_font_file(test::kDejaVuSans, emoji_options({'A', 0x263A}));
+    ASSERT_TRUE(baked) << baked.error().message;
+    EXPECT_TRUE(baked->asset.colour_glyphs.empty());
+    EXPECT_TRUE(baked->asset.images.empty());
+    EXPECT_EQ(baked->asset.face_glyph_count(), baked->asset.glyphs.size());
 }
 
 }  // namespace
