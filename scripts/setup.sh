@@ -14,6 +14,7 @@ packages=(
   glslang-tools                          # glslangValidator: GLSL to SPIR-V at build time
   libglm-dev                             # vector math shared by tools and tests
   libpng-dev                             # PNG output of crisp-render
+  zlib1g-dev                             # the asset's bitmap glyphs are zlib streams
   libgtest-dev                           # GoogleTest
   clang libclang-rt-14-dev               # libFuzzer for the fuzz targets
   clang-format                           # the format check (scripts/check_format.sh)
@@ -22,6 +23,7 @@ packages=(
   python3-fonttools                      # tests derive a 16384 units-per-em font from DejaVu Sans
   fonts-noto-cjk                         # tests: a CJK collection (.ttc, CFF, 1000 units per em)
   fonts-cantarell                        # tests: a CFF face with 1000 units per em
+  fonts-noto-color-emoji                 # tests: colour bitmap glyphs (CBDT), no outlines
   fonts-dejavu-extra                     # crisp-bench's coverage suite: an italic face
   libglfw3-dev                           # the layout editor's and the engine example's window and input
   libvulkan-volk-dev                     # the engine example loads Vulkan with volk, as engines do

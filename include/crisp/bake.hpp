@@ -96,8 +96,8 @@ struct BakeResult {
 
 // Bakes a font held in memory. Errors: ErrorCode::font_unreadable (FreeType cannot open the
 // bytes, or face_index is past the collection), font_unsupported (a WOFF, WOFF2 or Type 1 font, as
-// check_font_container says; no scalable outlines; a variation on a face without axes or an
-// unknown axis tag), invalid_argument (a tolerance outside
+// check_font_container says; neither scalable outlines nor colour bitmaps; a variation on a face
+// without axes or an unknown axis tag), invalid_argument (a tolerance outside
 // (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be converted and
 // allow_failed is false; the report inside the message names them). Hostile font bytes never
 // crash the baker.

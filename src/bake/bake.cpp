@@ -1,4 +1,5 @@
 #include "bake/bands.hpp"
+#include "bake/bitmap.hpp"
 #include "core/file_io.hpp"
 #include "core/limits.hpp"
 #include "bake/outline.hpp"
@@ -34,11 +35,6 @@ struct FaceDeleter {
 };
 using LibraryHandle = std::unique_ptr<FT_LibraryRec_, LibraryDeleter>;
 using FaceHandle = std::unique_ptr<FT_FaceRec_, FaceDeleter>;
-
-std::string freetype_error(FT_Error error) {
-    const char* text = FT_Error_String(error);
-    return "FreeType error " + std::to_string(error) + (text ? std::string(" (") + text + ")" : std::string());
-}
 
 double fixed_to_double(FT_Fixed value) {
     return static_cast<double>(value) / 65536.0;
@@ -194,17 +190,7 @@ GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em,
         return {};
     }
     const GlyphBands bands = build_bands(packed, kTargetCurvesPerBand, kMaxBands, kBandOverlap);
-    record.bbox_min_x = packed.min_x;
-    record.bbox_min_y = packed.min_y;
-    record.bbox_max_x = packed.max_x;
-    record.bbox_max_y = packed.max_y;
-    record.point_offset = static_cast<uint32_t>(asset.points.size());
-    record.curve_count = packed.curve_count;
-    record.band_offset = static_cast<uint32_t>(asset.band_words.size());
-    record.band_count = bands.band_count;
-    record.band_words = bands.band_words;
-    asset.points.insert(asset.points.end(), packed.points.begin(), packed.points.end());
-    asset.band_words.insert(asset.band_words.end(), bands.words.begin(), bands.words.end());
+    append_glyph(packed, bands, record, asset);
 
     report.curve_count += packed.real_curves;
     report.max_curves_per_glyph = std::max(report.max_curves_per_glyph, packed.real_curves);
@@ -308,12 +294,14 @@ Result<OpenedFace> open_face(std::span<const std::byte> font_bytes, const BakeOp
     return OpenedFace{std::move(library), std::move(face)};
 }
 
-// Refuses a face without outlines, or with units per em or a glyph count outside what OpenType allows.
+// Refuses a face without outlines or colour bitmaps, or with units per em or a glyph count outside
+// what OpenType allows.
 Status check_face(FT_Face face) {
-    if (!FT_IS_SCALABLE(face)) {
-        return Error{ErrorCode::font_unsupported, "the face has no scalable outlines (bitmap-only font)"};
+    if (!FT_IS_SCALABLE(face) && !is_colour_bitmap_face(face)) {
+        return Error{ErrorCode::font_unsupported,
+                     "the face has no scalable outlines and no colour bitmaps (bitmap-only font)"};
     }
-    const uint32_t units_per_em = face->units_per_EM;
+    const uint32_t units_per_em = face_metrics(face).units_per_em;
     if (units_per_em < 16 || units_per_em > 16384) {
         return Error{ErrorCode::font_unsupported,
                      "units per em is " + std::to_string(units_per_em) + ", outside the 16 to 16384 OpenType allows"};
@@ -329,15 +317,18 @@ Status check_face(FT_Face face) {
 Status read_font_info(FT_Library library, FT_Face face, const BakeOptions& options, FontInfo& info) {
     info.family = face->family_name ? face->family_name : "";
     info.style = face->style_name ? face->style_name : "";
-    info.units_per_em = face->units_per_EM;
+    info.units_per_em = face_metrics(face).units_per_em;
     info.face_index = options.face_index;
     info.tolerance_em = options.tolerance_em;
     if (Status status = apply_variations(library, face, options, info); !status) return status;
     // After the variation: FreeType applies MVAR to these.
-    info.ascender = face->ascender;
-    info.descender = face->descender;
-    info.line_gap = std::max(0, face->height - (face->ascender - face->descender));
+    const FaceMetrics metrics = face_metrics(face);
+    info.ascender = metrics.ascender;
+    info.descender = metrics.descender;
+    info.line_gap = std::max(0, metrics.height - (metrics.ascender - metrics.descender));
 
+    // Its strikes are a bitmap-only face's only sizes; BitmapGlyphs selects one.
+    if (is_colour_bitmap_face(face)) return {};
     // One pixel per font unit; see bake_glyph.
     if (const FT_Error error = FT_Set_Char_Size(face, 0, static_cast<FT_F26Dot6>(info.units_per_em) * 64, 72, 72);
         error != 0) {
@@ -346,12 +337,12 @@ Status read_font_info(FT_Library library, FT_Face face, const BakeOptions& optio
     return {};
 }
 
-// Bakes every requested glyph into the asset, a failed one as an empty record flagged failed, and
-// reports progress; returns how many glyphs were requested.
+// Bakes every requested glyph into the asset (its colour bitmap, its outline), a failed one as an
+// empty record flagged failed, and reports progress; returns how many glyphs were requested.
 uint32_t bake_glyphs(std::span<const std::byte> font_bytes, FT_Face face, const BakeOptions& options,
-                     OutlineCounters& counters, FontAsset& asset, BakeReport& report) {
+                     BitmapGlyphs& bitmaps, OutlineCounters& counters, FontAsset& asset, BakeReport& report) {
     const auto glyph_count = static_cast<uint32_t>(face->num_glyphs);
-    const uint32_t units_per_em = face->units_per_EM;
+    const uint32_t units_per_em = asset.info.units_per_em;
     std::vector<uint8_t> wanted;
     if (!options.all_glyphs) wanted = requested_glyphs(font_bytes, options.face_index, options.codepoints, glyph_count);
     const uint32_t to_do =
@@ -362,7 +353,11 @@ uint32_t bake_glyphs(std::span<const std::byte> font_bytes, FT_Face face, const 
     uint32_t done = 0;
     for (uint32_t glyph = 0; glyph < glyph_count; ++glyph) {
         if (!options.all_glyphs && !wanted[glyph]) continue;
-        const GlyphOutcome outcome = bake_glyph(face, glyph, units_per_em, options, counters, asset, report);
+        GlyphOutcome outcome;
+        if (std::optional<std::string> reason = bitmaps.bake(glyph, asset, report))
+            outcome = {true, std::move(*reason)};
+        else if (!bitmaps.bitmap_only())
+            outcome = bake_glyph(face, glyph, units_per_em, options, counters, asset, report);
         if (outcome.failed) {
             asset.glyphs[glyph] = GlyphRecord{};
             asset.glyphs[glyph].flags = kGlyphBaked | kGlyphFailed;
@@ -416,8 +411,11 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     FontInfo& info = asset.info;
     if (Status status = read_font_info(opened->library.get(), face, options, info); !status) return status.error();
 
+    Result<BitmapGlyphs> bitmaps = BitmapGlyphs::open(face, info.units_per_em);
+    if (!bitmaps) return bitmaps.error();
     OutlineCounters counters;
-    const uint32_t to_do = bake_glyphs(font_bytes, face, options, counters, asset, report);
+    const uint32_t to_do = bake_glyphs(font_bytes, face, options, *bitmaps, counters, asset, report);
+    if (Status status = bitmaps->finish(asset); !status) return status.error();
     if (counters.cubics > 0) info.flags |= kFontCubic;
     info.max_deviation_em = static_cast<float>(counters.max_deviation);
     asset.font_bytes.assign(font_bytes.begin(), font_bytes.end());

@@ -141,4 +141,18 @@ GlyphBands build_bands(const PackedGlyph& glyph, uint32_t target_per_band, uint3
     return bands;
 }
 
+void append_glyph(const PackedGlyph& glyph, const GlyphBands& bands, GlyphRecord& record, FontAsset& asset) {
+    record.bbox_min_x = glyph.min_x;
+    record.bbox_min_y = glyph.min_y;
+    record.bbox_max_x = glyph.max_x;
+    record.bbox_max_y = glyph.max_y;
+    record.point_offset = static_cast<uint32_t>(asset.points.size());
+    record.curve_count = glyph.curve_count;
+    record.band_offset = static_cast<uint32_t>(asset.band_words.size());
+    record.band_count = bands.band_count;
+    record.band_words = bands.band_words;
+    asset.points.insert(asset.points.end(), glyph.points.begin(), glyph.points.end());
+    asset.band_words.insert(asset.band_words.end(), bands.words.begin(), bands.words.end());
+}
+
 }  // namespace crisp

@@ -45,4 +45,8 @@ void curve_y_extent(std::span<const Point> points, uint32_t slot, float& min_y, 
 // their end points from the neighbouring curves.
 GlyphBands build_bands(const PackedGlyph& glyph, uint32_t target_per_band, uint32_t max_bands, float overlap);
 
+// Appends the glyph's points and band words to the asset and points `record` at them: its bbox,
+// offsets and counts. The glyph's other fields (advance, bearings, flags) are the caller's.
+void append_glyph(const PackedGlyph& glyph, const GlyphBands& bands, GlyphRecord& record, FontAsset& asset);
+
 }  // namespace crisp

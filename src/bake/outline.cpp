@@ -133,4 +133,9 @@ bool decompose_outline(const FT_Outline_& outline, OutlineBuilder& builder, std:
     return true;
 }
 
+std::string freetype_error(int error) {
+    const char* text = FT_Error_String(error);
+    return "FreeType error " + std::to_string(error) + (text ? std::string(" (") + text + ")" : std::string());
+}
+
 }  // namespace crisp

@@ -67,4 +67,7 @@ private:
 // rejects the outline.
 bool decompose_outline(const FT_Outline_& outline, OutlineBuilder& builder, std::string& error);
 
+// "FreeType error N (its text)", for the baker's messages.
+std::string freetype_error(int error);
+
 }  // namespace crisp

@@ -101,10 +101,10 @@ std::vector<float> filtered_level(std::span<const uint8_t> pixels, uint32_t widt
         for (uint32_t i = 0; i < columns; ++i) {
             double sum[4] = {};
             for_each_tap(j / scale, hi, [&](uint32_t y, double weight) {
-                for (int c = 0; c < 4; ++c) sum[c] += weight * across[(size_t{y} * columns + i) * 4 + size_t(c)];
+                for (size_t c = 0; c < 4; ++c) sum[c] += weight * across[(size_t{y} * columns + i) * 4 + c];
             });
-            for (int c = 0; c < 4; ++c)
-                level[(size_t{j} * side + i) * 4 + size_t(c)] = static_cast<float>(sum[c] * scale * scale);
+            for (size_t c = 0; c < 4; ++c)
+                level[(size_t{j} * side + i) * 4 + c] = static_cast<float>(sum[c] * scale * scale);
         }
     }
     return level;
