@@ -344,7 +344,7 @@ def colrv1_glyphs():
 CLIP_BOXES = {"v1_clipped": (200, 100, 800, 700), "v1_clipped_var": (0, 0, 500, 400, NO_VAR)}
 # COLRv0 layers beside the COLRv1 paint: v1_with_v0 shows that COLRv1 wins; the multiply composite
 # falls back to its COLRv0 layers; the nested clip has none and falls back to its plain outline.
-V0_IN_V1 = {"v1_with_v0": [("circle", 0)], "v1_composite_multiply": [("square", 0), ("circle", 2)]}
+V0_IN_V1 = {"v1_with_v0": [("circle", 0)], "v1_composite_multiply": [("ring", 1), ("bar", 3)]}
 
 
 def add_v0_layers(colr, font, glyphs):
