@@ -2,7 +2,9 @@
 //
 // The baker reads outlines with FreeType, unhinted and in font units, normalises them to em, turns
 // lines into quadratics, lowers cubics to quadratics within a tolerance, drops zero-length curves,
-// closes open contours, and cuts each glyph into bands. It needs no GPU.
+// closes open contours, and cuts each glyph into bands. It needs no GPU. Colour glyphs (COLRv0
+// layers, the COLRv1 paint graph, CPAL palettes) are read by crisp's own COLR reader and flattened
+// into layers (docs/colour.md).
 //
 // The baker is its own library, crisp::bake (CMake target crisp_bake), which links crisp::crisp
 // and FreeType: an engine that loads assets baked offline links crisp::crisp alone
@@ -37,6 +39,12 @@ inline constexpr uint32_t kMaxBands = 32;
 // ends exactly on an edge (or within float rounding of it) is listed in both bands.
 inline constexpr float kBandOverlap = 1.0f / 256.0f;
 
+// Limits on one colour glyph's COLRv1 paint graph (docs/limits.md): a glyph whose graph nests
+// deeper, or that visits more paints (a shared subgraph counts each time it is reached), fails as
+// a malformed glyph; so does a cycle, which is refused rather than followed.
+inline constexpr uint32_t kMaxPaintDepth = 64;
+inline constexpr uint32_t kMaxPaintNodes = 16384;
+
 struct Variation {
     uint32_t tag = 0;  // OpenType axis tag
     float value = 0.0f;
@@ -53,14 +61,17 @@ struct BakeOptions {
     bool split_y_extrema = false;              // split quadratics at y-extrema (docs/cubic-lowering.md)
     // A glyph with more curves fails; at most kMaxCurvesPerGlyph (asset.hpp).
     uint32_t max_curves_per_glyph = kMaxCurvesPerGlyph;
-    bool allow_failed = false;  // keep going past failed glyphs, baking them empty
+    // Keep going past failed glyphs, baking them empty; past malformed colour glyphs, drawing
+    // them as their COLRv0 layers or plain outline; past a COLR or CPAL table that cannot be
+    // read, baking no colour glyphs. Each is counted in the report.
+    bool allow_failed = false;
     // Called now and then with (glyphs done, glyphs to do); may be empty.
     std::function<void(uint32_t, uint32_t)> progress;
 };
 
 struct BakeReport {
     uint32_t glyph_count = 0;   // glyphs in the face
-    uint32_t baked_glyphs = 0;  // glyphs converted (requested and not failed)
+    uint32_t baked_glyphs = 0;  // glyphs converted (requested and not failed), synthetic ones included
     uint32_t empty_glyphs = 0;  // baked glyphs without an outline (space, ...)
     uint32_t failed_glyphs = 0;
     std::vector<uint32_t> failed_glyph_ids;  // the first few failed glyph indices
@@ -86,6 +97,18 @@ struct BakeReport {
     double seed_max_deviation_em = 0.0;  // the same for the seed's fixed split in two
     uint64_t seed_cubic_pieces = 0;      // 2 per cubic
     uint64_t asset_bytes = 0;            // size of the serialized asset
+    // Colour glyphs (COLR/CPAL), among the requested glyphs.
+    uint32_t colour_glyphs = 0;     // base glyphs drawn as colour layers
+    uint32_t colour_layers = 0;     // their layers in all
+    uint32_t synthetic_glyphs = 0;  // outlines made for transformed layers (kGlyphSynthetic records)
+    // Base glyphs whose COLRv1 paint (or COLRv0 layers) was refused and that fell back to their
+    // COLRv0 layers or their plain outline: an unsupported feature (a composite mode, a nested
+    // clip), or with allow_failed a malformed graph (a cycle, a limit, a bad offset or palette index).
+    uint32_t colour_fallbacks = 0;
+    std::string first_colour_fallback;  // "glyph N: " and why, for the first of them
+    // What else the reader had to say: palettes past kMaxPalettes dropped, variation deltas not
+    // applied, with allow_failed a COLR or CPAL table it could not read.
+    std::vector<std::string> colour_notes;
     double seconds = 0.0;
 };
 
@@ -98,9 +121,12 @@ struct BakeResult {
 // bytes, or face_index is past the collection), font_unsupported (a WOFF, WOFF2 or Type 1 font, as
 // check_font_container says; neither scalable outlines nor colour bitmaps; a variation on a face
 // without axes or an unknown axis tag), invalid_argument (a tolerance outside
-// (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be converted and
-// allow_failed is false; the report inside the message names them). Hostile font bytes never
-// crash the baker.
+// (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be converted, or a colour
+// glyph's paint graph is malformed: a cycle, a limit passed, a bad offset or palette index; with
+// allow_failed false, the message names the first glyph and why). A COLR or CPAL table that
+// cannot be read at all is font_unreadable naming the table, unless allow_failed. Layers of the
+// requested colour glyphs are baked even when `codepoints` does not reach them. Hostile font
+// bytes never crash the baker.
 CRISP_API Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options);
 
 // font_unsupported, with what to do instead, for the font containers crisp does not bake though
