@@ -248,6 +248,11 @@ int run_check(const Arguments& args) {
     return kExitOk;
 }
 
+// Colour glyphs, or something said about them: only then do the reports speak of colour.
+bool has_colour(const crisp::BakeReport& r) {
+    return r.colour_glyphs > 0 || r.colour_fallbacks > 0 || !r.colour_notes.empty();
+}
+
 crisp::JsonWriter report_json(const Arguments& args, const crisp::FontInfo& info, const crisp::BakeReport& r) {
     const double px16 = 16.0;
     crisp::JsonWriter json;
@@ -289,6 +294,16 @@ crisp::JsonWriter report_json(const Arguments& args, const crisp::FontInfo& info
         .field("seed_split_max_deviation_px_at_16px", r.seed_max_deviation_em * px16)
         .field("seed_split_pieces", r.seed_cubic_pieces)
         .end_object();
+    if (has_colour(r)) {
+        json.key("colour").begin_object();
+        json.field("glyphs", r.colour_glyphs)
+            .field("layers", r.colour_layers)
+            .field("synthetic_glyphs", r.synthetic_glyphs)
+            .field("fallbacks", r.colour_fallbacks)
+            .field("first_fallback", r.first_colour_fallback)
+            .field("notes", r.colour_notes)
+            .end_object();
+    }
     json.field("asset_bytes", r.asset_bytes)
         .field("seconds", r.seconds)
         .field("peak_rss_bytes", peak_rss_bytes())
@@ -327,6 +342,13 @@ void print_report(const Arguments& args, const crisp::FontInfo& info, const cris
         std::printf("                the seed's split in two: %.3g em (%.4f px at 16 px) in %llu pieces\n",
                     r.seed_max_deviation_em, r.seed_max_deviation_em * px16,
                     static_cast<unsigned long long>(r.seed_cubic_pieces));
+    }
+    if (has_colour(r)) {
+        std::printf("  colour        %u glyphs, %u layers, %u synthetic outlines; %u fell back%s%s\n", r.colour_glyphs,
+                    r.colour_layers, r.synthetic_glyphs, r.colour_fallbacks, r.colour_fallbacks ? ", first: " : "",
+                    crisp::cli::printable(r.first_colour_fallback).c_str());
+        for (const std::string& note : r.colour_notes)
+            std::printf("                %s\n", crisp::cli::printable(note).c_str());
     }
     std::printf("  asset         %s\n", human_bytes(static_cast<double>(r.asset_bytes)).c_str());
     std::printf("  time          %.2f s, peak memory %s\n", r.seconds, human_bytes(peak_rss_bytes()).c_str());

@@ -97,10 +97,11 @@ struct BakeReport {
     double seed_max_deviation_em = 0.0;  // the same for the seed's fixed split in two
     uint64_t seed_cubic_pieces = 0;      // 2 per cubic
     uint64_t asset_bytes = 0;            // size of the serialized asset
-    // Colour glyphs (COLR/CPAL), among the requested glyphs.
-    uint32_t colour_glyphs = 0;     // base glyphs drawn as colour layers
-    uint32_t colour_layers = 0;     // their layers in all
-    uint32_t synthetic_glyphs = 0;  // outlines made for transformed layers (kGlyphSynthetic records)
+    // Colour glyphs (COLR/CPAL layers, colour bitmaps), among the requested glyphs.
+    uint32_t colour_glyphs = 0;  // base glyphs drawn as colour layers
+    uint32_t colour_layers = 0;  // their layers in all
+    // Outlines made for transformed COLRv1 layers and bitmaps' rectangles (kGlyphSynthetic records).
+    uint32_t synthetic_glyphs = 0;
     // Base glyphs whose COLRv1 paint (or COLRv0 layers) was refused and that fell back to their
     // COLRv0 layers or their plain outline: an unsupported feature (a composite mode, a nested
     // clip), or with allow_failed a malformed graph (a cycle, a limit, a bad offset or palette index).

@@ -1,5 +1,6 @@
 #include "bake/bands.hpp"
 #include "bake/bitmap.hpp"
+#include "bake/colr.hpp"
 #include "core/file_io.hpp"
 #include "core/limits.hpp"
 #include "bake/outline.hpp"
@@ -134,10 +135,51 @@ struct GlyphOutcome {
     std::string reason;
 };
 
-// Converts one glyph and appends it to the asset.
+// The largest factor by which the linear part of `t` stretches a length (its largest singular value).
+double stretch(const Affine& t) {
+    const auto a = static_cast<double>(t.xx), b = static_cast<double>(t.xy);
+    const auto c = static_cast<double>(t.yx), d = static_cast<double>(t.yy);
+    const double sum = a * a + b * b + c * c + d * d, det = a * d - b * c;
+    return std::sqrt((sum + std::sqrt(std::max(0.0, sum * sum - 4.0 * det * det))) / 2.0);
+}
+
+// A synthetic glyph's contours: the face glyph's under `t`, exact for quadratics (an affine map of
+// a quadratic is the quadratic of the mapped points). The y-extrema move under a rotation or skew,
+// so they are split here, after the map, rather than by the builder.
+std::vector<Contour> transform_contours(const std::vector<Contour>& contours, const Affine& t, bool split_y_extrema,
+                                        OutlineCounters& counters) {
+    const auto xx = static_cast<double>(t.xx), yx = static_cast<double>(t.yx), xy = static_cast<double>(t.xy);
+    const auto yy = static_cast<double>(t.yy), dx = static_cast<double>(t.dx), dy = static_cast<double>(t.dy);
+    const auto map = [=](Vec2 p) { return Vec2{xx * p.x + xy * p.y + dx, yx * p.x + yy * p.y + dy}; };
+    std::vector<Contour> mapped;
+    for (const Contour& contour : contours) {
+        Contour& out = mapped.emplace_back();
+        for (const Quad& q : contour) {
+            const Quad m{map(q.p0), map(q.p1), map(q.p2)};
+            if (is_zero_length(m)) {
+                ++counters.dropped_zero_length;
+                continue;
+            }
+            if (!split_y_extrema) {
+                out.push_back(m);
+                continue;
+            }
+            Quad halves[2];
+            const int count = split_at_y_extremum(m, halves);
+            counters.y_splits += static_cast<uint64_t>(count - 1);
+            out.insert(out.end(), halves, halves + count);
+        }
+        if (out.empty()) mapped.pop_back();
+    }
+    return mapped;
+}
+
+// Converts one glyph into record `record_index` of the asset: its own record, or with `transform`
+// a synthetic record of its outline under that map (em to em).
 GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em, const BakeOptions& options,
-                        OutlineCounters& counters, FontAsset& asset, BakeReport& report) {
-    GlyphRecord& record = asset.glyphs[glyph_index];
+                        OutlineCounters& counters, FontAsset& asset, BakeReport& report, uint32_t record_index,
+                        const Affine* transform = nullptr) {
+    GlyphRecord& record = asset.glyphs[record_index];
     const FT_Error error = FT_Load_Glyph(face, glyph_index, FT_LOAD_NO_HINTING | FT_LOAD_NO_BITMAP);
     if (error != 0) return {true, freetype_error(error)};
     const FT_GlyphSlot slot = face->glyph;
@@ -159,11 +201,30 @@ GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em,
     outline_options.scale = to_em_26_6;
     outline_options.tolerance = static_cast<double>(options.tolerance_em);
     outline_options.split_y_extrema = options.split_y_extrema;
+    // Under a transform that stretches, the cubics are lowered finer, so that the deviation after
+    // it is still within the tolerance.
+    const double stretched = transform ? std::max(1.0, stretch(*transform)) : 1.0;
+    if (transform) {
+        outline_options.tolerance /= stretched;
+        outline_options.split_y_extrema = false;
+    }
     OutlineCounters glyph_counters;
     OutlineBuilder builder(outline_options, glyph_counters);
     std::string reason;
     if (!decompose_outline(slot->outline, builder, reason)) return {true, reason};
-    const PackedGlyph packed = pack_contours(builder.finish());
+    std::vector<Contour> contours = builder.finish();
+    if (transform) {
+        contours = transform_contours(contours, *transform, options.split_y_extrema, glyph_counters);
+        glyph_counters.max_deviation *= stretched;
+        glyph_counters.seed_max_deviation *= stretched;
+    }
+    const PackedGlyph packed = pack_contours(contours);
+    if (transform) {
+        // A layer's outline, drawn at its colour glyph's pen: it has no advance of its own.
+        record.advance = 0.0f;
+        record.bearing_x = packed.curve_count > 0 ? packed.min_x : 0.0f;
+        record.bearing_y = packed.curve_count > 0 ? packed.max_y : 0.0f;
+    }
     if (packed.real_curves > options.max_curves_per_glyph) {
         return {true, std::to_string(packed.real_curves) + " curves, more than the limit of " +
                           std::to_string(options.max_curves_per_glyph)};
@@ -184,7 +245,7 @@ GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em,
     counters.max_deviation = std::max(counters.max_deviation, glyph_counters.max_deviation);
     counters.seed_max_deviation = std::max(counters.seed_max_deviation, glyph_counters.seed_max_deviation);
 
-    record.flags = kGlyphBaked;
+    record.flags = kGlyphBaked | (transform ? kGlyphSynthetic : 0u);
     if (packed.curve_count == 0) {
         ++report.empty_glyphs;
         return {};
@@ -337,27 +398,26 @@ Status read_font_info(FT_Library library, FT_Face face, const BakeOptions& optio
     return {};
 }
 
-// Bakes every requested glyph into the asset (its colour bitmap, its outline), a failed one as an
-// empty record flagged failed, and reports progress; returns how many glyphs were requested.
-uint32_t bake_glyphs(std::span<const std::byte> font_bytes, FT_Face face, const BakeOptions& options,
+// Bakes every wanted glyph (every glyph when `wanted` is empty) into the asset (its colour bitmap,
+// its outline), a failed one as an empty record flagged failed, and reports progress; returns how
+// many glyphs were requested.
+uint32_t bake_glyphs(FT_Face face, const BakeOptions& options, const std::vector<uint8_t>& wanted,
                      BitmapGlyphs& bitmaps, OutlineCounters& counters, FontAsset& asset, BakeReport& report) {
     const auto glyph_count = static_cast<uint32_t>(face->num_glyphs);
     const uint32_t units_per_em = asset.info.units_per_em;
-    std::vector<uint8_t> wanted;
-    if (!options.all_glyphs) wanted = requested_glyphs(font_bytes, options.face_index, options.codepoints, glyph_count);
-    const uint32_t to_do =
-        options.all_glyphs ? glyph_count : static_cast<uint32_t>(std::count(wanted.begin(), wanted.end(), 1));
+    const bool all = wanted.empty();
+    const uint32_t to_do = all ? glyph_count : static_cast<uint32_t>(std::count(wanted.begin(), wanted.end(), 1));
 
     asset.glyphs.assign(glyph_count, GlyphRecord{});
     report.glyph_count = glyph_count;
     uint32_t done = 0;
     for (uint32_t glyph = 0; glyph < glyph_count; ++glyph) {
-        if (!options.all_glyphs && !wanted[glyph]) continue;
+        if (!all && !wanted[glyph]) continue;
         GlyphOutcome outcome;
         if (std::optional<std::string> reason = bitmaps.bake(glyph, asset, report))
             outcome = {true, std::move(*reason)};
         else if (!bitmaps.bitmap_only())
-            outcome = bake_glyph(face, glyph, units_per_em, options, counters, asset, report);
+            outcome = bake_glyph(face, glyph, units_per_em, options, counters, asset, report, glyph);
         if (outcome.failed) {
             asset.glyphs[glyph] = GlyphRecord{};
             asset.glyphs[glyph].flags = kGlyphBaked | kGlyphFailed;
@@ -372,6 +432,30 @@ uint32_t bake_glyphs(std::span<const std::byte> font_bytes, FT_Face face, const 
         if (options.progress && (done % 256 == 0 || done == to_do)) options.progress(done, to_do);
     }
     return to_do;
+}
+
+// Appends the outlines of transformed colour layers after the face's glyphs, each its face
+// glyph's outline under the layer's transform, converted and banded as any glyph is. Returns why
+// each failed (empty where it did not): an asset holds no failed synthetic glyph, so the colour
+// glyphs on a failed one are dropped (ColourAssembler::drop_failed_outlines).
+std::vector<std::string> bake_synthetic_glyphs(FT_Face face, const BakeOptions& options,
+                                               const std::vector<SyntheticOutline>& outlines, OutlineCounters& counters,
+                                               FontAsset& asset, BakeReport& report) {
+    std::vector<std::string> failures;
+    for (const SyntheticOutline& outline : outlines) {
+        const auto record = static_cast<uint32_t>(asset.glyphs.size());
+        asset.glyphs.emplace_back();
+        const GlyphOutcome outcome = bake_glyph(face, outline.glyph, asset.info.units_per_em, options, counters, asset,
+                                                report, record, &outline.transform);
+        if (outcome.failed) {
+            asset.glyphs[record] = GlyphRecord{};
+            asset.glyphs[record].flags = kGlyphSynthetic;
+        } else {
+            ++report.baked_glyphs;
+        }
+        failures.push_back(outcome.reason);
+    }
+    return failures;
 }
 
 // Copies the outline counters into the report, and divides its summed means by what they average over.
@@ -411,11 +495,28 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     FontInfo& info = asset.info;
     if (Status status = read_font_info(opened->library.get(), face, options, info); !status) return status.error();
 
+    std::vector<uint8_t> wanted;  // empty: every glyph
+    const auto glyph_count = static_cast<uint32_t>(face->num_glyphs);
+    if (!options.all_glyphs) wanted = requested_glyphs(font_bytes, options.face_index, options.codepoints, glyph_count);
+    Result<ColourAssembler> colour = read_colour_glyphs(font_bytes, info, glyph_count, options, wanted, asset, report);
+    if (!colour) return colour.error();
+    if (!options.all_glyphs) colour->mark_layer_glyphs(wanted);
+
     Result<BitmapGlyphs> bitmaps = BitmapGlyphs::open(face, info.units_per_em);
     if (!bitmaps) return bitmaps.error();
     OutlineCounters counters;
-    const uint32_t to_do = bake_glyphs(font_bytes, face, options, *bitmaps, counters, asset, report);
+    const uint32_t to_do = bake_glyphs(face, options, wanted, *bitmaps, counters, asset, report);
+    const std::vector<std::string> failures =
+        bake_synthetic_glyphs(face, options, colour->synthetic(), counters, asset, report);
+    if (Status status = colour->drop_failed_outlines(failures, options.allow_failed, asset, report); !status) {
+        return status.error();
+    }
+    // COLR's colour glyphs first: a bitmap gives way to them, and its rectangles follow their outlines.
+    colour->finish(asset);
     if (Status status = bitmaps->finish(asset); !status) return status.error();
+    report.colour_glyphs = static_cast<uint32_t>(asset.colour_glyphs.size());
+    report.colour_layers = static_cast<uint32_t>(asset.layers.size());
+    report.synthetic_glyphs = static_cast<uint32_t>(asset.glyphs.size() - asset.face_glyph_count());
     if (counters.cubics > 0) info.flags |= kFontCubic;
     info.max_deviation_em = static_cast<float>(counters.max_deviation);
     asset.font_bytes.assign(font_bytes.begin(), font_bytes.end());

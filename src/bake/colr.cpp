@@ -440,13 +440,10 @@ Status ColourAssembler::drop_failed_outlines(const std::vector<std::string>& fai
     }
     colour_glyphs_ = std::move(kept);
     layers_ = std::move(kept_layers);
-    report.synthetic_glyphs = static_cast<uint32_t>(synthetic_.size());
     return {};
 }
 
-void ColourAssembler::finish(FontAsset& asset, BakeReport& report) {
-    report.colour_glyphs = static_cast<uint32_t>(colour_glyphs_.size());
-    report.colour_layers = static_cast<uint32_t>(layers_.size());
+void ColourAssembler::finish(FontAsset& asset) {
     asset.colour_glyphs = std::move(colour_glyphs_);
     asset.layers = std::move(layers_);
     asset.paints = std::move(paints_);

@@ -167,8 +167,9 @@ public:
     Status drop_failed_outlines(const std::vector<std::string>& failures, bool allow_failed, FontAsset& asset,
                                 BakeReport& report);
 
-    // Moves the colour glyphs, layers, paints and stops into the asset, and counts them in the report.
-    void finish(FontAsset& asset, BakeReport& report);
+    // Moves the colour glyphs, layers, paints and stops into the asset (before any other source of
+    // colour glyphs adds its own).
+    void finish(FontAsset& asset);
 
 private:
     uint32_t paint_index(const ColrLayer& layer);
