@@ -3,7 +3,9 @@
 small TrueType fonts whose colour glyphs cover COLRv0 layers, every COLRv1 paint format crisp
 reads, and hostile tables. tests/fonts/colour/README.md lists each font's glyphs and code points.
 
-    make_colour_fonts.py OUT_DIR
+    make_colour_fonts.py OUT_DIR [CORPUS_DIR]
+
+With CORPUS_DIR, also writes each font's COLR table there as a seed for fuzz/fuzz_colr.cpp.
 
 The output is byte for byte the same on every run (fixed timestamps, no names from the system), so
 a CTest can regenerate the fonts and compare them with the committed copies.
@@ -444,6 +446,15 @@ def colr_bad_palette(out):
     fb.save(out)
 
 
+def colr_far(out):
+    # A PaintTransform that scales the square 100 times: its outline reaches past 64 em and cannot
+    # be baked. The next glyph's transform is fine.
+    big = {"xx": 100.0, "yx": 0.0, "xy": 0.0, "yy": 100.0, "dx": 0, "dy": 0}
+    colour = {"far": transform(ot.PaintFormat.PaintTransform, glyph("square", solid(0)), Transform=big),
+              "near": transform(ot.PaintFormat.PaintTranslate, glyph("circle", solid(1)), dx=10, dy=20)}
+    colrv1_font("crisp COLR far test", colour, list(colour)).save(out)
+
+
 def colr_truncated(out, colrv1_path):
     # colrv1.ttf with its COLR table cut to its first 40%: the header and the base glyph list
     # are whole, the layer list and the clip list lie past the end. Written as raw bytes, which
@@ -456,8 +467,16 @@ def colr_truncated(out, colrv1_path):
     font.save(out)
 
 
+def write_corpus(fonts, corpus):
+    os.makedirs(corpus, exist_ok=True)
+    for name in sorted(os.listdir(fonts)):
+        if name.endswith(".ttf"):
+            with open(os.path.join(corpus, name[:-4] + ".colr"), "wb") as seed:
+                seed.write(TTFont(os.path.join(fonts, name)).getTableData("COLR"))
+
+
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) not in (2, 3):
         sys.exit(__doc__)
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -469,7 +488,10 @@ def main():
     colr_deep(path("colr_deep.ttf"))
     colr_wide(path("colr_wide.ttf"))
     colr_bad_palette(path("colr_bad_palette.ttf"))
+    colr_far(path("colr_far.ttf"))
     colr_truncated(path("colr_truncated.ttf"), path("colrv1.ttf"))
+    if len(sys.argv) == 3:
+        write_corpus(out, sys.argv[2])
 
 
 if __name__ == "__main__":
