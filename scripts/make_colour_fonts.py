@@ -18,7 +18,7 @@ import sys
 from fontTools.colorLib.builder import buildCOLR
 from fontTools.fontBuilder import FontBuilder
 from fontTools.pens.ttGlyphPen import TTGlyphPen
-from fontTools.ttLib import TTFont
+from fontTools.ttLib import TTCollection, TTFont
 from fontTools.ttLib.tables import otTables as ot
 from fontTools.ttLib.tables.DefaultTable import DefaultTable
 
@@ -455,6 +455,31 @@ def colr_far(out):
     colrv1_font("crisp COLR far test", colour, list(colour)).save(out)
 
 
+def colrv1_variable(out):
+    # A wght axis and a COLR whose one delta moves the solid's alpha: crisp bakes the default
+    # instance's paint and says that the deltas were not applied.
+    from fontTools.varLib import builder as varlib
+    regions = varlib.buildVarRegionList([{"wght": (0.0, 1.0, 1.0)}], ["wght"])
+    store = varlib.buildVarStore(regions, [varlib.buildVarData([0], [[-8192]])])
+    colour = {"var_alpha": glyph("square", {"Format": ot.PaintFormat.PaintVarSolid, "PaletteIndex": 0, "Alpha": 1.0,
+                                            "VarIndexBase": 0})}
+    font = Font("crisp COLRv1 variable test")
+    font.add("var_alpha", 0xE000)
+    fb = font.build()
+    fb.setupFvar([("wght", 400, 400, 700, "Weight")], [])
+    fb.setupGvar({})  # FreeType reads a TrueType fvar only beside a gvar
+    fb.font["COLR"] = buildCOLR(colour, version=1, glyphMap=fb.font.getReverseGlyphMap(), varStore=store)
+    fb.setupCPAL([PALETTE_0])
+    fb.save(out)
+
+
+def collection(out, paths):
+    # colrv0.ttf and colrv1.ttf as faces 0 and 1 of one collection.
+    ttc = TTCollection()
+    ttc.fonts = [TTFont(path, recalcTimestamp=False) for path in paths]
+    ttc.save(out)
+
+
 def colr_truncated(out, colrv1_path):
     # colrv1.ttf with its COLR table cut to its first 40%: the header and the base glyph list
     # are whole, the layer list and the clip list lie past the end. Written as raw bytes, which
@@ -470,7 +495,7 @@ def colr_truncated(out, colrv1_path):
 def write_corpus(fonts, corpus):
     os.makedirs(corpus, exist_ok=True)
     for name in sorted(os.listdir(fonts)):
-        if name.endswith(".ttf"):
+        if name.endswith(".ttf"):  # the collection's faces are colrv0.ttf and colrv1.ttf
             with open(os.path.join(corpus, name[:-4] + ".colr"), "wb") as seed:
                 seed.write(TTFont(os.path.join(fonts, name)).getTableData("COLR"))
 
@@ -489,6 +514,8 @@ def main():
     colr_wide(path("colr_wide.ttf"))
     colr_bad_palette(path("colr_bad_palette.ttf"))
     colr_far(path("colr_far.ttf"))
+    colrv1_variable(path("colrv1_variable.ttf"))
+    collection(path("colr_collection.ttc"), [path("colrv0.ttf"), path("colrv1.ttf")])
     colr_truncated(path("colr_truncated.ttf"), path("colrv1.ttf"))
     if len(sys.argv) == 3:
         write_corpus(out, sys.argv[2])

@@ -379,6 +379,35 @@ TEST(Colr, V1CompositeModesClipBoxesAndFallbacks) {
     EXPECT_EQ(asset.colour_glyph(glyph_of(asset, 0xE000))->flags, 0u);
 }
 
+TEST(Colr, ACollectionsFaceAndAVariableFontsDefaultInstance) {
+    BakeOptions second;
+    second.face_index = 1;
+    auto collection = bake_colour("colr_collection.ttc", second);
+    auto single = bake_colour("colrv1.ttf");
+    ASSERT_TRUE(collection) << collection.error().message;
+    ASSERT_TRUE(single) << single.error().message;
+    EXPECT_EQ(collection->asset.colour_glyphs, single->asset.colour_glyphs);
+    EXPECT_EQ(collection->asset.layers, single->asset.layers);
+    EXPECT_EQ(collection->asset.paints, single->asset.paints);
+    EXPECT_EQ(collection->asset.palette_colours, single->asset.palette_colours);
+    auto first = bake_colour("colr_collection.ttc");
+    ASSERT_TRUE(first) << first.error().message;
+    EXPECT_EQ(first->asset.colour_glyphs.size(), 13u);  // colrv0.ttf's
+
+    // The delta is not applied at wght 700, and the report says so; at the default it has nothing to say.
+    BakeOptions heavy;
+    heavy.variations = {{make_tag("wght"), 700.0f}};
+    auto varied = bake_colour("colrv1_variable.ttf", heavy);
+    ASSERT_TRUE(varied) << varied.error().message;
+    expect_solids(varied->asset, 0xE000, {{kSquare, 0, 1.0f}});
+    ASSERT_EQ(varied->report.colour_notes.size(), 1u);
+    EXPECT_EQ(varied->report.colour_notes[0],
+              "COLR varies, but its deltas are not applied: the colour glyphs are those of the default instance");
+    auto plain = bake_colour("colrv1_variable.ttf");
+    ASSERT_TRUE(plain) << plain.error().message;
+    EXPECT_TRUE(plain->report.colour_notes.empty());
+}
+
 TEST(Colr, HostileGraphsAreRefusedNamingTheReason) {
     struct Case {
         const char* font;
