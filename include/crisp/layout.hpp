@@ -18,7 +18,8 @@
 // 5. Each line is reordered into visual order (UAX #9 L1, L2), aligned, and placed on its
 //    baseline; pen positions are fractional pixels unless snapping is asked for.
 // 6. Each glyph's pen position is split into a whole pixel and a subpixel offset quantized to
-//    `subpixel_steps`; its GlyphKey and glyph_rect() give the rect on the target.
+//    `subpixel_steps`; its GlyphKey and glyph_rect() give the rect on the target. A colour glyph
+//    becomes one instance per layer, back to front, all at the glyph's pen.
 #pragma once
 
 #include <crisp/export.hpp>
@@ -50,6 +51,13 @@ inline constexpr size_t kMaxTextBytes = size_t{16} << 20;
 // marks in time quadratic in their number: 'a' and 100,000 marks took 21 s. Real text stacks a
 // handful (Vietnamese, Tibetan, Indic up to about 10); "Zalgo" text dozens.
 inline constexpr uint32_t kMaxMarksPerCluster = 64;
+// Layer instances one layout expands colour glyphs into: past this many, further colour glyphs
+// are drawn as their plain outline (as with LayoutOptions::colour_glyphs off), so that a long text
+// in a font of many-layered glyphs (up to kMaxColourLayers each) stays within memory.
+inline constexpr uint32_t kMaxColourLayerInstances = 1u << 24;
+// GlyphInstance::paint and ::colour_glyph of an instance that is not a colour glyph's layer.
+inline constexpr uint32_t kNoPaint = 0xFFFFFFFF;
+inline constexpr uint32_t kNoColourGlyph = 0xFFFFFFFF;
 
 enum class Align : uint8_t {
     left,
@@ -70,6 +78,8 @@ struct TextStyle {
     float size_y = 0.0f;                        // pixels per em, vertically; 0: same as size
     float color[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // sRGB, straight (not premultiplied) alpha; clamped to [0, 1]
     float depth = 0.0f;                         // copied to every instance, for the compositor
+    // CPAL palette of colour glyphs; past a font's palettes (or in a font without any), palette 0.
+    uint32_t palette = 0;
 };
 
 struct LayoutOptions {
@@ -96,6 +106,9 @@ struct LayoutOptions {
     // BCP 47 language for shaping ("tr", "sr", "ar", ...), or nullptr for the OpenType default
     // language system. Read during the call only.
     const char* language = nullptr;
+    // Colour glyphs (FontAsset::colour_glyphs) become their layers; false draws each as its plain
+    // outline, one instance with kNoPaint. Fonts are chosen the same either way.
+    bool colour_glyphs = true;
 };
 
 struct GlyphInstance {
@@ -111,6 +124,12 @@ struct GlyphInstance {
     uint32_t paint_order = 0;  // consecutive from first_paint_order, in logical order
     uint32_t cluster = 0;      // byte offset in the UTF-8 text of the first character it shows
     uint32_t line = 0;         // index into TextLayout::lines
+    // A colour glyph's layer: key.glyph is the layer's outline (a face glyph or a synthetic one) and
+    // the rect is that outline's at the colour glyph's pen. A glyph's layers follow each other, back
+    // to front, in consecutive paint orders, with its cluster, line, depth and colour.
+    uint32_t paint = kNoPaint;               // index in the font's FontAsset::paints; kNoPaint: `color`
+    uint32_t colour_glyph = kNoColourGlyph;  // index in FontAsset::colour_glyphs of the glyph it is a layer of
+    uint32_t palette = 0;                    // CPAL palette: TextStyle::palette where the font has it, else 0
 };
 
 struct TextLine {
@@ -139,6 +158,8 @@ struct TextLayout {
     uint32_t blank_glyphs = 0;         // glyphs without an outline (dropped unless keep_blank_glyphs)
     uint32_t out_of_range_glyphs = 0;  // not emitted: pen beyond kMaxCoordinate
     uint32_t mark_splits = 0;          // clusters cut after kMaxMarksPerCluster combining marks
+    uint32_t colour_glyphs = 0;        // shaped glyphs drawn in colour (as layers)
+    uint32_t colour_layers = 0;        // the instances they became
     uint32_t next_paint_order = 0;     // first_paint_order + glyphs.size()
 };
 
