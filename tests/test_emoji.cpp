@@ -1,5 +1,7 @@
-// Colour glyphs and emoji in layout: the emoji data and sequences, and the expansion of a colour
-// glyph into its layers. The colour font is DejaVu Sans baked, with colour glyphs added by hand.
+// Colour glyphs and emoji in layout: the emoji data and sequences, the expansion of a colour glyph
+// into its layers, and font choice by emoji presentation. The colour fonts are baked assets with
+// colour glyphs added by hand (DejaVu Sans, and a test font of emoji ligatures that
+// tests/make_emoji_font.py makes); Noto Color Emoji where the baker reads it.
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
@@ -11,6 +13,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <random>
 #include <set>
 #include <string>
 #include <tuple>
@@ -24,8 +27,13 @@ using detail::emoji_properties;
 using detail::emoji_sequence_end;
 using detail::Presentation;
 
+const std::string kNotoEmojiPath = "/usr/share/fonts/truetype/noto/NotoColorEmoji.ttf";
+
 constexpr FontId kPlainId = 21;
 constexpr FontId kColourId = 22;
+constexpr FontId kEmojiId = 23;
+constexpr FontId kNotoId = 24;
+constexpr FontId kEmojiPlainId = 25;
 
 size_t sequence_length(std::string_view utf8) {
     return emoji_sequence_end(decode_utf8(utf8), 0);
@@ -160,14 +168,30 @@ class Emoji : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
         make_fonts(bake(test::kDejaVuSans, {}), kPlainId, kColourId, {"\u2764", "\u26A1", "\u263A"}, plain_, colour_);
+        // The emoji font has no 'o': its top layer is U+1F469's box.
+        Result<FontAsset> emoji = bake(CRISP_EMOJI_TEST_FONT, {});
+        ASSERT_TRUE(emoji) << emoji.error().message;
+        std::unique_ptr<Font> plain_emoji = make_font(emoji.value(), kEmojiPlainId);
+        ASSERT_NE(plain_emoji, nullptr);
+        const std::set<uint32_t> coloured =
+            shaped_glyphs(*plain_emoji, {"\U0001F600", "\U0001F468", "1", "\U0001F468\u200D\U0001F469\u200D\U0001F467",
+                                         "\U0001F44D\U0001F3FD", "\U0001F1FA\U0001F1F8", "1\uFE0F\u20E3",
+                                         "\U0001F3F4\U000E0067\U000E0062\U000E0065\U000E006E\U000E0067\U000E007F"});
+        FontAsset asset = std::move(emoji).value();
+        add_colour_glyphs(asset, coloured, plain_emoji->nominal_glyph(' '), plain_emoji->nominal_glyph(0x1F469));
+        emoji_ = make_font(std::move(asset), kEmojiId);
+        emoji_plain_ = std::move(plain_emoji);
     }
     static void TearDownTestSuite() {
         plain_.reset();
         colour_.reset();
+        emoji_.reset();
+        emoji_plain_.reset();
     }
     void SetUp() override {
         ASSERT_NE(plain_, nullptr);
         ASSERT_NE(colour_, nullptr);
+        ASSERT_NE(emoji_, nullptr);
     }
 
     static TextLayout lay(std::vector<const Font*> fonts, std::string_view text, const TextStyle& style = {},
@@ -175,8 +199,14 @@ protected:
         return test::layout_or_fail(fonts, text, style, options);
     }
 
-    static inline std::unique_ptr<Font> plain_, colour_;
+    static inline std::unique_ptr<Font> plain_, colour_, emoji_, emoji_plain_;
 };
+
+std::vector<FontId> font_ids(const TextLayout& layout) {
+    std::vector<FontId> ids;
+    for (const GlyphInstance& glyph : layout.glyphs) ids.push_back(glyph.key.font);
+    return ids;
+}
 
 TEST_F(Emoji, FontReportsColourGlyphs) {
     EXPECT_TRUE(colour_->has_colour_glyph_for(0x2764));
@@ -346,6 +376,178 @@ TEST_F(Emoji, ColourGlyphWithoutOutlinesIsBlank) {
     layout = lay({font.get()}, "\u263A", {}, {.colour_glyphs = false});
     ASSERT_EQ(layout.glyphs.size(), 1u);
     EXPECT_GT(layout.glyphs[0].width, 0u);
+}
+
+TEST_F(Emoji, SelectorsChooseColourOrPlain) {
+    const std::vector<const Font*> plain_first = {plain_.get(), colour_.get()};
+    const std::vector<const Font*> colour_first = {colour_.get(), plain_.get()};
+    // U+2764 is text by default: the plain font, wherever the colour one is.
+    EXPECT_EQ(font_ids(lay(plain_first, "\u2764")), std::vector<FontId>{kPlainId});
+    EXPECT_EQ(font_ids(lay(colour_first, "\u2764")), std::vector<FontId>{kPlainId});
+    // U+FE0F: the colour font; U+FE0E: the plain one.
+    TextLayout layout = lay(plain_first, "\u2764\uFE0F");
+    EXPECT_EQ(font_ids(layout), (std::vector<FontId>{kColourId, kColourId}));
+    EXPECT_EQ(layout.colour_glyphs, 1u);
+    EXPECT_EQ(layout.shaped_glyphs, 1u);  // the selector is consumed
+    EXPECT_EQ(font_ids(lay(colour_first, "\u2764\uFE0E")), std::vector<FontId>{kPlainId});
+    // U+26A1 is an emoji by default; U+FE0E makes it text.
+    EXPECT_EQ(font_ids(lay(plain_first, "\u26A1")), (std::vector<FontId>{kColourId, kColourId}));
+    EXPECT_EQ(font_ids(lay(plain_first, "\u26A1\uFE0E")), std::vector<FontId>{kPlainId});
+    EXPECT_EQ(font_ids(lay(colour_first, "\u26A1\uFE0E")), std::vector<FontId>{kPlainId});
+    // Between words of the colour font a heart of text presentation still goes to the plain one.
+    layout = lay(colour_first, "a\u2764b");
+    EXPECT_EQ(font_ids(layout), (std::vector<FontId>{kColourId, kPlainId, kColourId}));
+    // Without a font with the plain outline, text presentation takes the colour glyph.
+    EXPECT_EQ(lay({colour_.get()}, "\u2764\uFE0E").colour_glyphs, 1u);
+    // And an emoji no font has in colour is the first font's that has it.
+    EXPECT_EQ(font_ids(lay({plain_.get(), emoji_plain_.get()}, "\U0001F600")), std::vector<FontId>{kPlainId});
+}
+
+TEST_F(Emoji, DigitsAfterAnEmojiStayText) {
+    // The emoji font draws '1' in colour (as Noto Color Emoji does); after an emoji, digits of
+    // text presentation go back to the plain font rather than staying in the emoji font.
+    const TextLayout layout = lay({plain_.get(), emoji_.get()}, "\U0001F600 12");
+    ASSERT_EQ(layout.glyphs.size(), 4u);  // two layers of the emoji, two digits (the space is dropped)
+    EXPECT_EQ(font_ids(layout), (std::vector<FontId>{kEmojiId, kEmojiId, kPlainId, kPlainId}));
+    EXPECT_EQ(lay({plain_.get(), emoji_.get()}, "1\uFE0F").colour_glyphs, 1u);
+}
+
+// Every glyph of `layout` is in font `id`, in cluster 0, and they are the layers of one colour glyph.
+void expect_one_colour_glyph(const TextLayout& layout, FontId id) {
+    EXPECT_EQ(layout.shaped_glyphs, 1u);
+    EXPECT_EQ(layout.colour_glyphs, 1u);
+    EXPECT_EQ(layout.colour_layers, 2u);
+    EXPECT_EQ(layout.missing_glyphs, 0u);
+    ASSERT_EQ(layout.glyphs.size(), 2u);
+    for (const GlyphInstance& glyph : layout.glyphs) {
+        EXPECT_EQ(glyph.key.font, id);
+        EXPECT_EQ(glyph.cluster, 0u);
+        EXPECT_EQ(glyph.colour_glyph, layout.glyphs[0].colour_glyph);
+    }
+}
+
+TEST_F(Emoji, SequencesStayInOneFontAndCluster) {
+    const std::vector<const Font*> fonts = {plain_.get(), emoji_.get()};
+    struct Case {
+        const char* name;
+        std::string text;
+    };
+    const Case cases[] = {
+        {"ZWJ family", "\U0001F468\u200D\U0001F469\u200D\U0001F467"},
+        {"skin tone", "\U0001F44D\U0001F3FD"},
+        {"flag", "\U0001F1FA\U0001F1F8"},
+        {"keycap", "1\uFE0F\u20E3"},
+        {"tag sequence", "\U0001F3F4\U000E0067\U000E0062\U000E0065\U000E006E\U000E0067\U000E007F"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        // HarfBuzz forms the font's ligature of the whole sequence.
+        const TextLayout plain = lay({emoji_plain_.get()}, c.text);
+        EXPECT_EQ(plain.shaped_glyphs, 1u);
+        expect_one_colour_glyph(lay(fonts, c.text), kEmojiId);
+        // In a right-to-left paragraph, and with a wrap width narrower than the emoji.
+        const TextLayout rtl = lay(fonts, "\u05D0 " + c.text + " \u05D1");
+        EXPECT_EQ(rtl.colour_glyphs, 1u);
+        const TextLayout narrow = lay(fonts, c.text, {.size = 20.0f}, {.wrap_width = 5.0f, .break_long_words = true});
+        EXPECT_EQ(narrow.lines.size(), 1u);
+        EXPECT_EQ(narrow.colour_glyphs, 1u);
+    }
+    // Two flags in a row are two clusters; a third indicator stands alone.
+    const TextLayout flags = lay(fonts, "\U0001F1FA\U0001F1F8\U0001F1FA\U0001F1F8\U0001F1FA");
+    EXPECT_EQ(flags.colour_glyphs, 2u);
+    EXPECT_EQ(flags.shaped_glyphs, 3u);
+    std::set<uint32_t> clusters;
+    for (const GlyphInstance& glyph : flags.glyphs) clusters.insert(glyph.cluster);
+    EXPECT_EQ(clusters, (std::set<uint32_t>{0, 8, 16}));
+}
+
+TEST_F(Emoji, SequenceFollowsItsFirstCharactersFont) {
+    // U+263A after a joiner continues the sequence: it stays in the emoji font, which lacks it
+    // (HarfBuzz gives .notdef), rather than going to the plain font that has it.
+    const TextLayout layout = lay({plain_.get(), emoji_.get()}, "\U0001F600\u200D\u263A");
+    EXPECT_EQ(layout.missing_glyphs, 1u);
+    for (const GlyphInstance& glyph : layout.glyphs) EXPECT_EQ(glyph.key.font, kEmojiId);
+    // Without the joiner it is a character of its own, text by default: the plain font.
+    const TextLayout apart = lay({plain_.get(), emoji_.get()}, "\U0001F600\u263A");
+    EXPECT_EQ(apart.missing_glyphs, 0u);
+    EXPECT_EQ(apart.glyphs.back().key.font, kPlainId);
+}
+
+TEST_F(Emoji, LongJoinerChainsAreCut) {
+    // A sequence is one HarfBuzz cluster; like marks, past kMaxMarksPerCluster characters it
+    // continues in a new run.
+    constexpr uint32_t kEmojiCount = 1000;
+    std::string text = "\U0001F600";
+    for (uint32_t i = 1; i < kEmojiCount; ++i) text += "\u200D\U0001F600";
+    const TextLayout layout = lay({plain_.get(), emoji_.get()}, text);
+    const uint32_t continuing = 2 * (kEmojiCount - 1);
+    EXPECT_EQ(layout.mark_splits, 1 + (continuing - kMaxMarksPerCluster - 1) / kMaxMarksPerCluster);
+    EXPECT_EQ(layout.colour_glyphs, kEmojiCount);
+    for (const GlyphInstance& glyph : layout.glyphs) EXPECT_EQ(glyph.key.font, kEmojiId);
+}
+
+TEST_F(Emoji, HostileSequencesKeepTheInvariants) {
+    std::mt19937 random(51);
+    const std::vector<const Font*> fonts = {plain_.get(), emoji_.get(), colour_.get()};
+    const std::string pieces[] = {"a",          " ",          "1",          "#",          "\u2764",     "\u26A1",
+                                  "\uFE0F",     "\uFE0E",     "\u200D",     "\u20E3",     "\u05D0",     "\u0301",
+                                  "\U0001F600", "\U0001F44D", "\U0001F3FD", "\U0001F1FA", "\U0001F1F8", "\U0001F3F4",
+                                  "\U000E0067", "\U000E007F", "\U0001F468", "\U0001F469", "\n",         "\xF0\x9F"};
+    for (int round = 0; round < 300; ++round) {
+        std::string text;
+        const auto length = random() % 48;
+        for (uint32_t i = 0; i < length; ++i) text += pieces[random() % std::size(pieces)];
+        LayoutOptions options;
+        options.wrap_width = static_cast<float>(random() % 3) * 30.0f;
+        options.direction = static_cast<Direction>(random() % 3);
+        options.keep_blank_glyphs = random() % 2 == 0;
+        options.colour_glyphs = random() % 4 != 0;
+        options.first_paint_order = 7;
+        const TextLayout layout = lay(fonts, text, {.size = 17.0f}, options);
+        SCOPED_TRACE(text);
+        uint32_t layers = 0;
+        for (size_t g = 0; g < layout.glyphs.size(); ++g) {
+            const GlyphInstance& glyph = layout.glyphs[g];
+            EXPECT_EQ(glyph.paint_order, 7 + g);
+            ASSERT_LT(glyph.line, layout.lines.size());
+            const TextLine& line = layout.lines[glyph.line];
+            EXPECT_GE(g, line.glyph_begin);
+            EXPECT_LT(g, line.glyph_begin + line.glyph_count);
+            EXPECT_LE(glyph.cluster, text.size());
+            if (glyph.paint == kNoPaint) {
+                EXPECT_EQ(glyph.colour_glyph, kNoColourGlyph);
+                continue;
+            }
+            ++layers;
+            EXPECT_TRUE(options.colour_glyphs);
+            const Font* font = glyph.key.font == kEmojiId ? emoji_.get() : colour_.get();
+            ASSERT_LT(glyph.colour_glyph, font->asset().colour_glyphs.size());
+            EXPECT_LT(glyph.paint, font->asset().paints.size());
+        }
+        EXPECT_EQ(layers, layout.colour_layers);
+        EXPECT_LE(layout.colour_glyphs, layout.colour_layers);
+        EXPECT_EQ(layout.next_paint_order, 7 + layout.glyphs.size());
+    }
+}
+
+TEST_F(Emoji, NotoColorEmoji) {
+    Result<FontAsset> asset = bake(kNotoEmojiPath, {0x2764, 0x1F44D, 0x1F3FD, 0x1F1FA, 0x1F1F8});
+    if (!asset) GTEST_SKIP() << "the baker does not read Noto Color Emoji yet: " << asset.error().message;
+    std::unique_ptr<Font> noto = make_font(std::move(asset).value(), kNotoId);
+    ASSERT_NE(noto, nullptr);
+    const std::vector<const Font*> fonts = {plain_.get(), noto.get()};
+    EXPECT_EQ(font_ids(lay(fonts, "\u2764")), std::vector<FontId>{kPlainId});
+    for (const std::string text : {"\u2764\uFE0F", "\U0001F44D\U0001F3FD", "\U0001F1FA\U0001F1F8"}) {
+        const TextLayout layout = lay(fonts, text);
+        EXPECT_EQ(layout.shaped_glyphs, 1u) << text;
+        EXPECT_EQ(layout.colour_glyphs, 1u) << text;
+        EXPECT_GE(layout.glyphs.size(), 1u) << text;
+        for (const GlyphInstance& glyph : layout.glyphs) {
+            EXPECT_EQ(glyph.key.font, kNotoId) << text;
+            EXPECT_EQ(glyph.cluster, 0u) << text;
+            EXPECT_NE(glyph.paint, kNoPaint) << text;
+        }
+    }
 }
 
 }  // namespace

@@ -8,7 +8,12 @@
 //    (Common and Inherited characters take the script of their neighbours) and a font per
 //    character: the first font of the list that has the character's glyph baked; combining marks
 //    stay with their base's font when it has them; a character no font has is shaped with the
-//    first font and comes out as its .notdef (glyph 0), counted in missing_glyphs.
+//    first font and comes out as its .notdef (glyph 0), counted in missing_glyphs. Emoji (Unicode
+//    TR51): a character of Emoji_Presentation, or an emoji with U+FE0F after it, takes the first
+//    font with a colour glyph for it (Font::has_colour_glyph_for), else the rule above; U+FE0E after
+//    an emoji, or an emoji of text presentation by default, the first with a plain one. An emoji
+//    sequence (ZWJ sequences, skin tone modifiers, flags, keycaps, tag sequences) stays whole in the
+//    font chosen for its first character, in one run.
 // 3. Runs of equal level, script and font are shaped with HarfBuzz (kerning, ligatures, marks,
 //    joining, mirroring).
 // 4. With a wrap width, lines break greedily at word boundaries (a subset of UAX #14: after
@@ -45,11 +50,12 @@ inline constexpr double kMaxCoordinate = 1 << 30;
 // shaping buffers stay within a few GiB (docs/limits.md). (FriBidi and HarfBuzz index text with
 // int; this is far below.)
 inline constexpr size_t kMaxTextBytes = size_t{16} << 20;
-// Combining marks (joiners and variation selectors count too) shaped with one base character:
-// past this many a new shaping run starts, and the further marks are drawn after the base rather
-// than attached to it (TextLayout::mark_splits counts the cuts). HarfBuzz reorders a cluster's
-// marks in time quadratic in their number: 'a' and 100,000 marks took 21 s. Real text stacks a
-// handful (Vietnamese, Tibetan, Indic up to about 10); "Zalgo" text dozens.
+// Combining marks (joiners, variation selectors and the characters that continue an emoji sequence
+// count too) shaped with one base character: past this many a new shaping run starts, and the
+// further marks are drawn after the base rather than attached to it (TextLayout::mark_splits counts
+// the cuts). HarfBuzz reorders a cluster's marks in time quadratic in their number: 'a' and 100,000
+// marks took 21 s. Real text stacks a handful (Vietnamese, Tibetan, Indic up to about 10; the
+// longest emoji sequences, families with skin tones, 10); "Zalgo" text dozens.
 inline constexpr uint32_t kMaxMarksPerCluster = 64;
 // Layer instances one layout expands colour glyphs into: past this many, further colour glyphs
 // are drawn as their plain outline (as with LayoutOptions::colour_glyphs off), so that a long text

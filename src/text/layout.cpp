@@ -185,6 +185,10 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     std::span<uint8_t> paragraph_flags(flags.data() + p0, n);
     classify(text, paragraph_flags);
     const uint8_t base_level = resolve_levels(text, o.direction, bidi, std::span(levels.data() + p0, n));
+    // An emoji sequence is one run: its joiners, selectors and tags (BN, NSM) and its flag's second
+    // indicator could otherwise resolve apart from its first character.
+    for (uint32_t i = p0 + 1; i < p1; ++i)
+        if ((flags[i] & kCharEmojiNext) != 0) levels[i] = levels[i - 1];
     // Tabs are shaped as spaces (few fonts map U+0009) after bidi, which treats them as segment
     // separators; their width is set when the line is placed.
     for (size_t i = 0; i < n; ++i)
@@ -196,12 +200,13 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     shaped.clear();
     uint32_t run_begin = p0;
     // Combining marks (and joiners, selectors) attached to one base: HarfBuzz reorders a cluster's
-    // marks in time quadratic in their number, so past kMaxMarksPerCluster a new run starts.
+    // marks in time quadratic in their number, so past kMaxMarksPerCluster a new run starts. What
+    // continues an emoji sequence counts too: HarfBuzz makes the whole sequence one cluster.
     uint32_t attached = (flags[p0] & kCharAttached) != 0 ? 1 : 0;
     for (uint32_t i = p0 + 1; i <= p1; ++i) {
         bool split = false;
         if (i < p1) {
-            attached = (flags[i] & kCharAttached) != 0 ? attached + 1 : 0;
+            attached = (flags[i] & (kCharAttached | kCharEmojiNext)) != 0 ? attached + 1 : 0;
             split = attached > kMaxMarksPerCluster;
         }
         if (i < p1 && !split && levels[i] == levels[i - 1] && scripts[i] == scripts[i - 1] &&
