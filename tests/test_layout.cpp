@@ -2,6 +2,8 @@
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -68,12 +70,7 @@ protected:
 
     static TextLayout lay(std::vector<const Font*> fonts, std::string_view text, const TextStyle& style = {},
                           const LayoutOptions& options = {}) {
-        Result<TextLayout> layout = layout_text(fonts, text, style, options);
-        if (!layout) {
-            ADD_FAILURE() << layout.error().message;
-            return {};
-        }
-        return std::move(layout).value();
+        return test::layout_or_fail(fonts, text, style, options);
     }
     static TextLayout lay(std::string_view text, const TextStyle& style = {}, const LayoutOptions& options = {}) {
         return lay({dejavu_}, text, style, options);

@@ -7,6 +7,7 @@
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
+#include <crisp/layout.hpp>
 #include <crisp/renderer.hpp>
 
 #include <gtest/gtest.h>
@@ -49,6 +50,18 @@ inline std::unique_ptr<Font> bake_test_font(std::string_view text, FontId id = 1
     if (!baked) return nullptr;
     auto font = Font::create(std::move(baked->asset), id);
     return font ? std::make_unique<Font>(std::move(*font)) : nullptr;
+}
+
+// `text` laid out with `fonts`; where that fails, a failure of the test (with the message) and an
+// empty layout.
+inline TextLayout layout_or_fail(const std::vector<const Font*>& fonts, std::string_view text,
+                                 const TextStyle& style = {}, const LayoutOptions& options = {}) {
+    Result<TextLayout> layout = layout_text(fonts, text, style, options);
+    if (!layout) {
+        ADD_FAILURE() << layout.error().message;
+        return {};
+    }
+    return std::move(layout).value();
 }
 
 // A context with the validation layer on whose device was created with what crisp's renderer and

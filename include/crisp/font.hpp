@@ -32,7 +32,8 @@ public:
     // this font carries; the caller chooses it and keeps it unique among the fonts one atlas sees.
     // Errors: ErrorCode::asset_invalid when the asset fails validate_asset() (the message names the
     // fault), when HarfBuzz cannot open the face, or when the face disagrees with the asset's
-    // glyph count or units per em. Safe to use with untrusted assets.
+    // glyph count (its face glyphs, synthetic ones excluded) or units per em. Safe to use with
+    // untrusted assets.
     static Result<Font> create(FontAsset asset, FontId id);
 
     Font(Font&& other) noexcept;
@@ -57,6 +58,9 @@ public:
     bool has_glyph_for(uint32_t codepoint) const;
     // The glyph has_glyph_for() found, or 0 (.notdef) when it returns false.
     uint32_t nominal_glyph(uint32_t codepoint) const;
+    // True when has_glyph_for(codepoint) and the asset has a colour glyph (FontAsset::colour_glyph)
+    // for that nominal glyph: layout draws it in colour. Any value is accepted, as above.
+    bool has_colour_glyph_for(uint32_t codepoint) const;
     // The record of glyph index `glyph`, or nullptr when the index is past the font's glyphs.
     const GlyphRecord* glyph_record(uint32_t glyph) const;
     // True when `glyph` is a glyph of the font that the asset baked and did not fail.

@@ -8,7 +8,12 @@
 //    (Common and Inherited characters take the script of their neighbours) and a font per
 //    character: the first font of the list that has the character's glyph baked; combining marks
 //    stay with their base's font when it has them; a character no font has is shaped with the
-//    first font and comes out as its .notdef (glyph 0), counted in missing_glyphs.
+//    first font and comes out as its .notdef (glyph 0), counted in missing_glyphs. Emoji (Unicode
+//    TR51): a character of Emoji_Presentation, or an emoji with U+FE0F after it, takes the first
+//    font with a colour glyph for it (Font::has_colour_glyph_for), else the rule above; U+FE0E after
+//    an emoji, or an emoji of text presentation by default, the first with a plain one. An emoji
+//    sequence (ZWJ sequences, skin tone modifiers, flags, keycaps, tag sequences) stays whole in the
+//    font chosen for its first character, in one run.
 // 3. Runs of equal level, script and font are shaped with HarfBuzz (kerning, ligatures, marks,
 //    joining, mirroring).
 // 4. With a wrap width, lines break greedily at word boundaries (a subset of UAX #14: after
@@ -18,7 +23,8 @@
 // 5. Each line is reordered into visual order (UAX #9 L1, L2), aligned, and placed on its
 //    baseline; pen positions are fractional pixels unless snapping is asked for.
 // 6. Each glyph's pen position is split into a whole pixel and a subpixel offset quantized to
-//    `subpixel_steps`; its GlyphKey and glyph_rect() give the rect on the target.
+//    `subpixel_steps`; its GlyphKey and glyph_rect() give the rect on the target. A colour glyph
+//    becomes one instance per layer, back to front, all at the glyph's pen.
 #pragma once
 
 #include <crisp/export.hpp>
@@ -44,12 +50,20 @@ inline constexpr double kMaxCoordinate = 1 << 30;
 // shaping buffers stay within a few GiB (docs/limits.md). (FriBidi and HarfBuzz index text with
 // int; this is far below.)
 inline constexpr size_t kMaxTextBytes = size_t{16} << 20;
-// Combining marks (joiners and variation selectors count too) shaped with one base character:
-// past this many a new shaping run starts, and the further marks are drawn after the base rather
-// than attached to it (TextLayout::mark_splits counts the cuts). HarfBuzz reorders a cluster's
-// marks in time quadratic in their number: 'a' and 100,000 marks took 21 s. Real text stacks a
-// handful (Vietnamese, Tibetan, Indic up to about 10); "Zalgo" text dozens.
+// Combining marks (joiners, variation selectors and the characters that continue an emoji sequence
+// count too) shaped with one base character: past this many a new shaping run starts, and the
+// further marks are drawn after the base rather than attached to it (TextLayout::mark_splits counts
+// the cuts). HarfBuzz reorders a cluster's marks in time quadratic in their number: 'a' and 100,000
+// marks took 21 s. Real text stacks a handful (Vietnamese, Tibetan, Indic up to about 10; the
+// longest emoji sequences, families with skin tones, 10); "Zalgo" text dozens.
 inline constexpr uint32_t kMaxMarksPerCluster = 64;
+// Layer instances one layout expands colour glyphs into: past this many, further colour glyphs
+// are drawn as their plain outline (as with LayoutOptions::colour_glyphs off), so that a long text
+// in a font of many-layered glyphs (up to kMaxColourLayers each) stays within memory.
+inline constexpr uint32_t kMaxColourLayerInstances = 1u << 24;
+// GlyphInstance::paint and ::colour_glyph of an instance that is not a colour glyph's layer.
+inline constexpr uint32_t kNoPaint = 0xFFFFFFFF;
+inline constexpr uint32_t kNoColourGlyph = 0xFFFFFFFF;
 
 enum class Align : uint8_t {
     left,
@@ -70,6 +84,8 @@ struct TextStyle {
     float size_y = 0.0f;                        // pixels per em, vertically; 0: same as size
     float color[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // sRGB, straight (not premultiplied) alpha; clamped to [0, 1]
     float depth = 0.0f;                         // copied to every instance, for the compositor
+    // CPAL palette of colour glyphs; past a font's palettes (or in a font without any), palette 0.
+    uint32_t palette = 0;
 };
 
 struct LayoutOptions {
@@ -96,10 +112,10 @@ struct LayoutOptions {
     // BCP 47 language for shaping ("tr", "sr", "ar", ...), or nullptr for the OpenType default
     // language system. Read during the call only.
     const char* language = nullptr;
+    // Colour glyphs (FontAsset::colour_glyphs) become their layers; false draws each as its plain
+    // outline, one instance with kNoPaint. Fonts are chosen the same either way.
+    bool colour_glyphs = true;
 };
-
-inline constexpr uint32_t kNoPaint = 0xFFFFFFFFu;
-inline constexpr uint32_t kNoColourGlyph = 0xFFFFFFFFu;
 
 struct GlyphInstance {
     GlyphKey key;        // font id, glyph index, size (u24.8), subpixel offset (u0.8)
@@ -114,11 +130,12 @@ struct GlyphInstance {
     uint32_t paint_order = 0;  // consecutive from first_paint_order, in logical order
     uint32_t cluster = 0;      // byte offset in the UTF-8 text of the first character it shows
     uint32_t line = 0;         // index into TextLayout::lines
-    // A layer of a colour glyph (asset.hpp, "Colour glyphs"): the paint it is filled with, an index
-    // in its font's FontAsset::paints; kNoPaint: the instance's own colour (monochrome text).
-    uint32_t paint = kNoPaint;
+    // A colour glyph's layer: key.glyph is the layer's outline (a face glyph or a synthetic one) and
+    // the rect is that outline's at the colour glyph's pen. A glyph's layers follow each other, back
+    // to front, in consecutive paint orders, with its cluster, line, depth and colour.
+    uint32_t paint = kNoPaint;               // index in the font's FontAsset::paints; kNoPaint: `color`
     uint32_t colour_glyph = kNoColourGlyph;  // index in FontAsset::colour_glyphs of the glyph it is a layer of
-    uint32_t palette = 0;                    // CPAL palette (TextStyle::palette)
+    uint32_t palette = 0;                    // CPAL palette: TextStyle::palette where the font has it, else 0
 };
 
 struct TextLine {
@@ -147,6 +164,8 @@ struct TextLayout {
     uint32_t blank_glyphs = 0;         // glyphs without an outline (dropped unless keep_blank_glyphs)
     uint32_t out_of_range_glyphs = 0;  // not emitted: pen beyond kMaxCoordinate
     uint32_t mark_splits = 0;          // clusters cut after kMaxMarksPerCluster combining marks
+    uint32_t colour_glyphs = 0;        // shaped glyphs drawn in colour (as layers)
+    uint32_t colour_layers = 0;        // the instances they became
     uint32_t next_paint_order = 0;     // first_paint_order + glyphs.size()
 };
 

@@ -181,6 +181,11 @@ uint32_t Font::nominal_glyph(uint32_t codepoint) const {
     return hb_font_get_nominal_glyph(harfbuzz_font(), codepoint, &glyph) ? glyph : 0;
 }
 
+bool Font::has_colour_glyph_for(uint32_t codepoint) const {
+    hb_codepoint_t glyph = 0;
+    return hb_font_get_nominal_glyph(harfbuzz_font(), codepoint, &glyph) && asset().colour_glyph(glyph) != nullptr;
+}
+
 const GlyphRecord* Font::glyph_record(uint32_t glyph) const {
     const std::vector<GlyphRecord>& glyphs = asset().glyphs;
     return glyph < glyphs.size() ? &glyphs[glyph] : nullptr;

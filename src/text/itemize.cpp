@@ -1,6 +1,8 @@
 // Decoding and itemization for layout: bidi levels (FriBidi), scripts and font fallback.
 #include "text/itemize.hpp"
 
+#include "text/emoji.hpp"
+
 #include <fribidi.h>
 
 #include <algorithm>
@@ -146,12 +148,17 @@ void classify(std::span<const uint32_t> text, std::span<uint8_t> flags) {
         }
         flags[i] = f;
     }
-    // Break opportunities (a subset of UAX #14). Never inside a cluster, never before a space
-    // (spaces hang), after every run of spaces, after a zero width space, after a hyphen between
-    // letters, and around ideographs unless punctuation forbids it.
+    for (size_t i = 0; i < n;) {
+        const size_t end = emoji_sequence_end(text, i);
+        for (size_t k = i + 1; k < end; ++k) flags[k] |= kCharEmojiNext;
+        i = end;
+    }
+    // Break opportunities (a subset of UAX #14). Never inside a cluster or an emoji sequence, never
+    // before a space (spaces hang), after every run of spaces, after a zero width space, after a
+    // hyphen between letters, and around ideographs unless punctuation forbids it.
     for (size_t i = 1; i < n; ++i) {
         const uint32_t prev = text[i - 1], cp = text[i];
-        if ((flags[i] & (kCharAttached | kCharSpace)) != 0) continue;
+        if ((flags[i] & (kCharAttached | kCharEmojiNext | kCharSpace)) != 0) continue;
         bool opportunity = false;
         if ((flags[i - 1] & kCharSpace) != 0 || prev == 0x200B) {
             opportunity = true;
@@ -237,43 +244,56 @@ void choose_fonts(std::span<const Font* const> fonts, std::span<const uint32_t> 
     const auto font_count = static_cast<uint16_t>(fonts.size());
     size_t i = 0;
     while (i < n) {
-        // A cluster for font choice: a base and the marks, joiners and selectors after it.
-        size_t end = i + 1;
-        while (end < n && (flags[end] & kCharAttached) != 0) ++end;
+        // A cluster for font choice: a base and the marks, joiners and selectors after it, or a
+        // whole emoji sequence.
+        size_t sequence_end = i + 1;
+        while (sequence_end < n && (flags[sequence_end] & kCharEmojiNext) != 0) ++sequence_end;
+        size_t end = sequence_end;
+        while (end < n && (flags[end] & (kCharAttached | kCharEmojiNext)) != 0) ++end;
         const uint32_t base = text[i];
+        const Presentation presentation = emoji_presentation(text.subspan(i, sequence_end - i));
         auto covers_cluster = [&](uint16_t f) {
             for (size_t k = i + 1; k < end; ++k)
                 if (!covers_mark(*fonts[f], unicode, base, text[k])) return false;
             return true;
         };
+        // Text presentation wants the base as a plain outline.
+        auto shows_base = [&](uint16_t f, bool plain) {
+            return fonts[f]->has_glyph_for(base) && !(plain && fonts[f]->has_colour_glyph_for(base));
+        };
 
-        // Spaces, digits and punctuation stay in the font of the text around them, so a run is
-        // not cut at every space between two words of a fallback font.
         uint16_t chosen = font_count;
-        if ((flags[i] & kCharCommon) != 0 && i > 0 && fonts[font_of[i - 1]]->has_glyph_for(base) &&
-            covers_cluster(font_of[i - 1])) {
+        if (presentation == Presentation::emoji) {
+            for (uint16_t f = 0; f < font_count && chosen == font_count; ++f)
+                if (fonts[f]->has_colour_glyph_for(base)) chosen = f;
+        }
+        if (chosen == font_count && (flags[i] & kCharCommon) != 0 && i > 0 &&
+            shows_base(font_of[i - 1], presentation == Presentation::text) && covers_cluster(font_of[i - 1])) {
+            // Spaces, digits and punctuation stay in the font of the text around them, so a run is
+            // not cut at every space between two words of a fallback font.
             chosen = font_of[i - 1];
         }
-        if (chosen == font_count) {
-            uint16_t first_with_base = font_count;
+        uint16_t first_with_base = font_count;
+        for (int pass = presentation == Presentation::text ? 0 : 1; pass < 2 && chosen == font_count; ++pass) {
             for (uint16_t f = 0; f < font_count; ++f) {
-                if (!fonts[f]->has_glyph_for(base)) continue;
+                if (!shows_base(f, pass == 0)) continue;
                 if (first_with_base == font_count) first_with_base = f;
                 if (end == i + 1 || covers_cluster(f)) {
                     chosen = f;
                     break;
                 }
             }
-            // No font shows the whole cluster: the base's font; no font has the base: the first,
-            // whose .notdef it becomes.
-            if (chosen == font_count) chosen = first_with_base == font_count ? uint16_t{0} : first_with_base;
         }
+        // No font shows the whole cluster: the base's font; no font has the base: the first,
+        // whose .notdef it becomes.
+        if (chosen == font_count) chosen = first_with_base == font_count ? uint16_t{0} : first_with_base;
         font_of[i] = chosen;
         for (size_t k = i + 1; k < end; ++k) {
-            // A mark the chosen font cannot show comes from the first font that has it (it then
-            // sits in a run of its own, unattached); a mark no font has stays with its base.
+            // An emoji sequence stays whole in its font (HarfBuzz shapes what it can of it). A mark
+            // the chosen font cannot show comes from the first font that has it (it then sits in a
+            // run of its own, unattached); a mark no font has stays with its base.
             uint16_t mark_font = chosen;
-            if (!covers_mark(*fonts[chosen], unicode, base, text[k])) {
+            if (k >= sequence_end && !covers_mark(*fonts[chosen], unicode, base, text[k])) {
                 for (uint16_t f = 0; f < font_count; ++f) {
                     if (fonts[f]->has_glyph_for(text[k])) {
                         mark_font = f;

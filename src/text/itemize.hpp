@@ -25,8 +25,9 @@ enum CharFlags : uint8_t {
     kCharBreakBefore = 1u << 2,   // a line may break before this character
     kCharAttached = 1u << 3,      // a combining mark, joiner or variation selector: part of the previous cluster
     kCharCommon = 1u << 4,        // script Common, Inherited or Unknown: follows its neighbours
-    kCharClusterStart = 1u << 5,  // a shaped cluster starts here
-    kCharUnsafe = 1u << 6,        // HarfBuzz: breaking before this cluster changes the shaping
+    kCharEmojiNext = 1u << 5,     // continues the emoji sequence before it (text/emoji.hpp): same font, run, level
+    kCharClusterStart = 1u << 6,  // a shaped cluster starts here
+    kCharUnsafe = 1u << 7,        // HarfBuzz: breaking before this cluster changes the shaping
 };
 
 // Mandatory breaks (UAX #14 BK, CR, LF, NL): LF, VT, FF, CR, NEL, U+2028, U+2029.
@@ -52,7 +53,9 @@ uint8_t resolve_levels(std::span<const uint32_t> text, Direction direction, Bidi
 // in (the preceding character's; at the start, the first real script after them).
 void resolve_scripts(std::span<const uint32_t> text, std::span<const uint8_t> flags, std::span<hb_script_t> scripts);
 
-// Font (index into `fonts`) of every character of one paragraph; see layout.hpp for the rule.
+// Font (index into `fonts`) of every character of one paragraph; see layout.hpp for the rule. An
+// emoji sequence takes the font chosen for its first character: the first font with a colour glyph
+// for it where it is presented as emoji, the first with a plain one where as text.
 void choose_fonts(std::span<const Font* const> fonts, std::span<const uint32_t> text, std::span<const uint8_t> flags,
                   std::span<uint16_t> font_of);
 

@@ -106,7 +106,19 @@ void reset(TextLayout& out, uint32_t first_paint_order) {
     out.lines.clear();
     out.x = out.y = out.width = out.height = out.line_height = 0.0f;
     out.shaped_glyphs = out.missing_glyphs = out.blank_glyphs = out.out_of_range_glyphs = out.mark_splits = 0;
+    out.colour_glyphs = out.colour_layers = 0;
     out.next_paint_order = first_paint_order;
+}
+
+constexpr GlyphRecord kNoOutline{};
+
+// The layers of face glyph `glyph`'s colour glyph, with its index in `colour_index`; empty where it
+// has none or (only with an inconsistent asset) its layers run past the asset's.
+std::span<const ColourLayer> colour_layers(const FontAsset& asset, uint32_t glyph, uint32_t& colour_index) {
+    const ColourGlyph* colour = asset.colour_glyph(glyph);
+    if (colour == nullptr || uint64_t{colour->first_layer} + colour->layer_count > asset.layers.size()) return {};
+    colour_index = static_cast<uint32_t>(colour - asset.colour_glyphs.data());
+    return std::span(asset.layers).subspan(colour->first_layer, colour->layer_count);
 }
 
 }  // namespace
@@ -173,6 +185,10 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     std::span<uint8_t> paragraph_flags(flags.data() + p0, n);
     classify(text, paragraph_flags);
     const uint8_t base_level = resolve_levels(text, o.direction, bidi, std::span(levels.data() + p0, n));
+    // An emoji sequence is one run: its joiners, selectors and tags (BN, NSM) and its flag's second
+    // indicator could otherwise resolve apart from its first character.
+    for (uint32_t i = p0 + 1; i < p1; ++i)
+        if ((flags[i] & kCharEmojiNext) != 0) levels[i] = levels[i - 1];
     // Tabs are shaped as spaces (few fonts map U+0009) after bidi, which treats them as segment
     // separators; their width is set when the line is placed.
     for (size_t i = 0; i < n; ++i)
@@ -184,12 +200,13 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     shaped.clear();
     uint32_t run_begin = p0;
     // Combining marks (and joiners, selectors) attached to one base: HarfBuzz reorders a cluster's
-    // marks in time quadratic in their number, so past kMaxMarksPerCluster a new run starts.
+    // marks in time quadratic in their number, so past kMaxMarksPerCluster a new run starts. What
+    // continues an emoji sequence counts too: HarfBuzz makes the whole sequence one cluster.
     uint32_t attached = (flags[p0] & kCharAttached) != 0 ? 1 : 0;
     for (uint32_t i = p0 + 1; i <= p1; ++i) {
         bool split = false;
         if (i < p1) {
-            attached = (flags[i] & kCharAttached) != 0 ? attached + 1 : 0;
+            attached = (flags[i] & (kCharAttached | kCharEmojiNext)) != 0 ? attached + 1 : 0;
             split = attached > kMaxMarksPerCluster;
         }
         if (i < p1 && !split && levels[i] == levels[i - 1] && scripts[i] == scripts[i - 1] &&
@@ -237,7 +254,8 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
 }
 
 // The placed glyphs as instances into `out`, line by line: .notdef for glyphs the asset lacks,
-// blank glyphs kept only when asked, pens beyond kMaxCoordinate counted and dropped.
+// colour glyphs as their layers, blank glyphs kept only when asked, pens beyond kMaxCoordinate
+// counted and dropped.
 void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
     const LayoutOptions& o = *options;
     float color[4];
@@ -265,7 +283,16 @@ void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
                 if (!font.is_baked(0)) continue;
             }
             const GlyphRecord& glyph_record = font.glyphs[glyph];
-            if (glyph_record.curve_count == 0) {
+            // A colour glyph is drawn as its layers (blank when none has an outline), unless the
+            // layout's budget of layers is spent: then as its plain outline.
+            uint32_t colour_index = kNoColourGlyph;
+            std::span<const ColourLayer> layers =
+                o.colour_glyphs ? colour_layers(*font.asset, glyph, colour_index) : std::span<const ColourLayer>{};
+            const auto drawn_layers = static_cast<uint32_t>(std::count_if(
+                layers.begin(), layers.end(), [&](const ColourLayer& layer) { return font.is_drawn(layer); }));
+            if (drawn_layers > kMaxColourLayerInstances - out.colour_layers) layers = {};
+            const bool blank = layers.empty() ? glyph_record.curve_count == 0 : drawn_layers == 0;
+            if (blank) {
                 ++out.blank_glyphs;
                 if (!o.keep_blank_glyphs) continue;
             }
@@ -280,22 +307,40 @@ void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
             quantize(pen_x, o.subpixel_steps, whole_x, instance.key.subpixel_x);
             quantize(pen_y, o.subpixel_steps, whole_y, instance.key.subpixel_y);
             instance.key.font = font.id;
-            instance.key.glyph = glyph;
             instance.key.size_x = size_x_fixed;
             instance.key.size_y = size_y_fixed;
-            const GlyphRect rect = glyph_rect(glyph_record, instance.key);
-            instance.x = whole_x + rect.x;
-            instance.y = whole_y + rect.y;
-            instance.width = rect.width;
-            instance.height = rect.height;
             instance.pen_x = static_cast<float>(pen_x);
             instance.pen_y = static_cast<float>(pen_y);
             std::copy(std::begin(color), std::end(color), std::begin(instance.color));
             instance.depth = style.depth;
-            instance.paint_order = o.first_paint_order + static_cast<uint32_t>(out.glyphs.size());
             instance.cluster = offsets[placed_glyph.cluster];
             instance.line = static_cast<uint32_t>(i);
-            out.glyphs.push_back(instance);
+            // The outline `outline` of glyph index `index` at the glyph's pen, next in paint order.
+            auto push = [&](uint32_t index, const GlyphRecord& outline) {
+                instance.key.glyph = index;
+                const GlyphRect rect = glyph_rect(outline, instance.key);
+                instance.x = whole_x + rect.x;
+                instance.y = whole_y + rect.y;
+                instance.width = rect.width;
+                instance.height = rect.height;
+                instance.paint_order = o.first_paint_order + static_cast<uint32_t>(out.glyphs.size());
+                out.glyphs.push_back(instance);
+            };
+            if (blank || layers.empty()) {
+                // A kept blank colour glyph is the base glyph without its outline (0 x 0, as
+                // every kept blank glyph).
+                push(glyph, blank ? kNoOutline : glyph_record);
+                continue;
+            }
+            ++out.colour_glyphs;
+            out.colour_layers += drawn_layers;
+            instance.colour_glyph = colour_index;
+            instance.palette = font.palette;
+            for (const ColourLayer& layer : layers) {
+                if (!font.is_drawn(layer)) continue;
+                instance.paint = layer.paint;
+                push(layer.glyph, font.glyphs[layer.glyph]);
+            }
         }
         record.glyph_count = static_cast<uint32_t>(out.glyphs.size()) - record.glyph_begin;
     }
@@ -314,8 +359,11 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
 
     fonts = font_list;
     font_views.clear();
-    for (const Font* font : fonts)
-        font_views.push_back({font->asset().glyphs.data(), font->asset().glyphs.size(), font->id()});
+    for (const Font* font : fonts) {
+        const FontAsset& asset = font->asset();
+        const uint32_t palette = style.palette < asset.palette_count() ? style.palette : 0;
+        font_views.push_back({asset.glyphs.data(), asset.glyphs.size(), font->id(), &asset, palette});
+    }
     options = &layout_options;
     failed = false;
     mark_splits = 0;

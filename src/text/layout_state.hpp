@@ -61,8 +61,14 @@ struct FontView {
     const GlyphRecord* glyphs = nullptr;
     size_t glyph_count = 0;
     FontId id = 0;
+    const FontAsset* asset = nullptr;
+    uint32_t palette = 0;  // TextStyle::palette, or 0 past the font's palettes
     bool is_baked(uint32_t glyph) const {
         return glyph < glyph_count && (glyphs[glyph].flags & (kGlyphBaked | kGlyphFailed)) == kGlyphBaked;
+    }
+    // A layer draws something: its outline is a glyph of the asset with curves.
+    bool is_drawn(const ColourLayer& layer) const {
+        return layer.glyph < glyph_count && glyphs[layer.glyph].curve_count != 0;
     }
 };
 
