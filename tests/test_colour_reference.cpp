@@ -1,7 +1,9 @@
 // The CPU reference of colour glyphs (support/colour_reference.hpp): each paint against values
-// worked out by hand, the reference image's compositing against what layers must give.
+// worked out by hand, the reference image's compositing against what layers must give, and
+// FreeType's own blending of COLRv0 layers (FT_LOAD_COLOR) as an outside check.
 #include "colour_reference.hpp"
 #include "coverage.hpp"
+#include "freetype_reference.hpp"
 #include "image_io.hpp"
 #include "test_support.hpp"
 
@@ -729,6 +731,155 @@ TEST(ColourReference, ImageLayersNearestAndBoxFiltered) {
     // the coverage is 3e-8 short.)
     expect_colour(pixel(*nearest, 2, -13), weighted(image.texels, {0.375}), "nearest at the outline's edge", 1e-7);
     expect_colour(pixel(*box, 2, -13), weighted(image.texels, {0.375}), "box at the outline's edge", 1e-7);
+}
+
+TEST(ColourReference, FreeTypeColourLayersRefuseWhatTheyCannotDraw) {
+    Result<freetype::Face> colr = freetype::Face::open_file(kColrV0);
+    ASSERT_TRUE(colr.ok()) << colr.error().message;
+    const std::array<uint8_t, 4> text = {0, 0, 0, 255};
+    Result<freetype::ColourBitmap> drawn = freetype::render_colour_layers(*colr, key_at(14, 20, 0, 0), 1, text);
+    ASSERT_TRUE(drawn.ok()) << drawn.error().message;
+    EXPECT_GT(drawn->width, 0u);
+    EXPECT_EQ(drawn->bgra.size(), size_t{drawn->width} * drawn->height * 4);
+    Result<freetype::ColourBitmap> past = freetype::render_colour_layers(*colr, key_at(14, 20, 0, 0), 2, text);
+    ASSERT_FALSE(past.ok());
+    EXPECT_EQ(past.error().code, ErrorCode::invalid_argument);
+    Result<freetype::ColourBitmap> plain = freetype::render_colour_layers(*colr, key_at(1, 20, 0, 0), 0, text);
+    ASSERT_FALSE(plain.ok());  // the square has no layers
+    EXPECT_EQ(plain.error().code, ErrorCode::glyph_failed);
+    EXPECT_FALSE(freetype::render_colour_layers(*colr, key_at(9999, 20, 0, 0), 0, text).ok());
+    // COLRv1 paints FreeType 2.12 does not blend.
+    Result<freetype::Face> v1 = freetype::Face::open_file(test::source_path("tests/fonts/colour/colrv1.ttf"));
+    ASSERT_TRUE(v1.ok()) << v1.error().message;
+    Result<freetype::ColourBitmap> v1_solid = freetype::render_colour_layers(*v1, key_at(15, 20, 0, 0), 0, text);
+    ASSERT_FALSE(v1_solid.ok());
+    EXPECT_EQ(v1_solid.error().code, ErrorCode::glyph_failed);
+    Result<freetype::Face> dejavu = freetype::Face::open_file(test::kDejaVuSans);
+    ASSERT_TRUE(dejavu.ok());
+    Result<freetype::ColourBitmap> no_cpal = freetype::render_colour_layers(*dejavu, key_at(36, 20, 0, 0), 0, text);
+    ASSERT_FALSE(no_cpal.ok());
+    EXPECT_EQ(no_cpal.error().code, ErrorCode::font_unsupported);
+}
+
+// ---- FreeType's own COLRv0 blending (FT_LOAD_COLOR) as an outside check.
+
+struct Difference {
+    double sum = 0.0;
+    double worst = 0.0;
+    uint64_t count = 0;
+    void add(double d) {
+        sum += d;
+        worst = std::max(worst, d);
+        ++count;
+    }
+    double mean() const { return count ? sum / static_cast<double>(count) : 0.0; }
+};
+
+TEST(ColourReference, MatchesFreeTypeColrV0BlendingAwayFromEdges) {
+    const FontAsset asset = colrv0_asset();
+    ASSERT_EQ(asset.colour_glyphs.size(), std::size(kColrV0Glyphs));
+    Result<freetype::Face> opened = freetype::Face::open_file(kColrV0);
+    ASSERT_TRUE(opened.ok()) << opened.error().message;
+    freetype::Face& face = *opened;
+    const SubpixelLayout gray = preset("gray");
+    // Opaque: FreeType gives the text's alpha to the foreground layers alone, crisp to every layer.
+    const std::array<uint8_t, 4> text8 = {0x30, 0x90, 0xE0, 0xFF};
+    const Srgba text = {text8[0] / 255.0, text8[1] / 255.0, text8[2] / 255.0, 1.0};
+
+    std::printf("%-5s %3s %3s %23s %23s %23s %19s\n", "glyph", "px", "pal", "all: mean/max (codes)",
+                "interior: mean/max", "edges: mean/max", "layer edge vs exact");
+    Difference all_cases_interior, all_cases_edges, all_cases_coverage;
+    for (uint32_t index = 0; index < asset.colour_glyphs.size(); ++index) {
+        const ColourGlyph& glyph = asset.colour_glyphs[index];
+        for (const uint32_t pixels : {17u, 48u}) {
+            for (uint32_t palette = 0; palette < 2; ++palette) {
+                // Offsets in 1/64 px, which FreeType's 26.6 pen holds exactly.
+                const GlyphKey key = key_at(glyph.glyph, pixels, 64, 192);
+                Result<freetype::ColourBitmap> theirs = freetype::render_colour_layers(face, key, palette, text8);
+                ASSERT_TRUE(theirs.ok()) << theirs.error().message;
+                Result<colour::ColourImage> ours =
+                    colour::render_colour_reference(asset, index, key, gray, palette, text, {0.0, 0.0, 0.0});
+                ASSERT_TRUE(ours.ok()) << ours.error().message;
+                const GlyphRect& rect = ours->rect;
+                // FreeType blends each layer's own gray rendering: those say where its edges are, and the
+                // exact coverage where ours are.
+                std::vector<std::vector<float>> their_layers;
+                std::vector<ExactCoverage> our_layers;
+                for (uint32_t l = 0; l < glyph.layer_count; ++l) {
+                    GlyphKey layer_key = key;
+                    layer_key.glyph = asset.layers[glyph.first_layer + l].glyph;
+                    Result<freetype::PeerRender> peer =
+                        freetype::render_peer(face, layer_key, rect, freetype::PeerMode::gray, 1);
+                    ASSERT_TRUE(peer.ok()) << peer.error().message;
+                    EXPECT_EQ(peer->lost_coverage, 0.0);
+                    their_layers.push_back(peer->image.values);
+                    our_layers.emplace_back(asset, asset.glyphs[layer_key.glyph]);
+                }
+                // Every pixel FreeType drew lies in our rect.
+                EXPECT_GE(theirs->left, rect.x);
+                EXPECT_GE(-theirs->top, rect.y);
+                EXPECT_LE(theirs->left + static_cast<int64_t>(theirs->width),
+                          rect.x + static_cast<int64_t>(rect.width));
+                EXPECT_LE(-theirs->top + static_cast<int64_t>(theirs->height),
+                          rect.y + static_cast<int64_t>(rect.height));
+
+                Difference everywhere, interior, edges, coverage;
+                for (uint32_t j = 0; j < rect.height; ++j) {
+                    for (uint32_t i = 0; i < rect.width; ++i) {
+                        const int32_t x = rect.x + static_cast<int32_t>(i), y = rect.y + static_cast<int32_t>(j);
+                        // FreeType's premultiplied BGRA, as RGBA codes; 0 outside its bitmap.
+                        double their[4] = {};
+                        const int64_t column = int64_t{x} - theirs->left, row = int64_t{y} + theirs->top;
+                        if (column >= 0 && column < theirs->width && row >= 0 && row < theirs->height) {
+                            const uint8_t* bgra =
+                                &theirs->bgra[(static_cast<size_t>(row) * theirs->width + static_cast<size_t>(column)) *
+                                              4];
+                            their[0] = bgra[2], their[1] = bgra[1], their[2] = bgra[0], their[3] = bgra[3];
+                        }
+                        // Ours over nothing: linear premultiplied light and alpha, to premultiplied sRGB.
+                        const double alpha = ours->alpha_at(i, j, 0);
+                        double our[4] = {0.0, 0.0, 0.0, 255.0 * alpha};
+                        for (uint32_t c = 0; c < 3 && alpha > 0.0; ++c) {
+                            our[c] = 255.0 * alpha * linear_to_srgb(std::min(1.0, ours->at(i, j, c) / alpha));
+                        }
+                        bool edge = false;
+                        for (size_t l = 0; l < our_layers.size(); ++l) {
+                            const double k = pixel_coverage(our_layers[l], key, x, y);
+                            const double v = their_layers[l][(size_t{j} * rect.width + i) * 3];
+                            const bool our_edge = k > 1e-9 && k < 1.0 - 1e-9;
+                            const bool their_edge = v > 0.0 && v < 1.0;
+                            edge = edge || our_edge || their_edge;
+                            if (our_edge || their_edge) coverage.add(255.0 * std::fabs(v - k));
+                        }
+                        if (std::max({their[3], our[3]}) == 0.0) continue;
+                        double worst = 0.0;
+                        for (uint32_t c = 0; c < 4; ++c) worst = std::max(worst, std::fabs(their[c] - our[c]));
+                        everywhere.add(worst);
+                        (edge ? edges : interior).add(worst);
+                        if (!edge) {
+                            EXPECT_LE(worst, 2.0) << "glyph " << glyph.glyph << " at " << pixels << " px, palette "
+                                                  << palette << ", pixel (" << x << ", " << y << ")";
+                        }
+                    }
+                }
+                EXPECT_GT(interior.count, uint64_t{pixels * pixels / 8});
+                const auto cell = [](const Difference& d) {
+                    char line[32];
+                    std::snprintf(line, sizeof line, "%.3f/%.1f (%llu)", d.mean(), d.worst,
+                                  static_cast<unsigned long long>(d.count));
+                    return std::string(line);
+                };
+                std::printf("%-5u %3u %3u %23s %23s %23s %19s\n", glyph.glyph, pixels, palette,
+                            cell(everywhere).c_str(), cell(interior).c_str(), cell(edges).c_str(),
+                            cell(coverage).c_str());
+                all_cases_interior.worst = std::max(all_cases_interior.worst, interior.worst);
+                all_cases_edges.worst = std::max(all_cases_edges.worst, edges.worst);
+                all_cases_coverage.worst = std::max(all_cases_coverage.worst, coverage.worst);
+            }
+        }
+    }
+    std::printf("worst: interior %.1f, edges %.1f codes; a layer's edge coverage %.1f codes off exact\n",
+                all_cases_interior.worst, all_cases_edges.worst, all_cases_coverage.worst);
 }
 
 }  // namespace
