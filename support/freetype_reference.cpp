@@ -5,6 +5,7 @@
 
 #include <ft2build.h>
 #include FT_FREETYPE_H
+#include FT_COLOR_H
 #include FT_LCD_FILTER_H
 #include FT_MULTIPLE_MASTERS_H
 #include FT_OUTLINE_H
@@ -609,6 +610,20 @@ double place_bitmap(const FT_GlyphSlot slot, const GlyphRect& rect, PeerMode mod
     return lost;
 }
 
+// Sizes the face at the key's pixel size and moves the pen by its subpixel offset, as an
+// application placing a glyph at a fractional pen does; FT_Set_Transform(face, nullptr, nullptr)
+// undoes the move.
+Status place_pen(FT_Face face, const GlyphKey& key) {
+    // 26.6 from u24.8 and u0.8, rounded to the nearest 1/64 px.
+    const auto to_26_6 = [](uint32_t fixed) { return static_cast<FT_F26Dot6>((fixed + 2) / 4); };
+    if (const FT_Error error = FT_Set_Char_Size(face, to_26_6(key.size_x), to_26_6(key.size_y), 72, 72); error != 0) {
+        return Error{ErrorCode::glyph_failed, "cannot scale the face: " + freetype_error(error)};
+    }
+    FT_Vector pen{to_26_6(key.subpixel_x), -to_26_6(key.subpixel_y)};  // FreeType's y runs up
+    FT_Set_Transform(face, nullptr, &pen);
+    return {};
+}
+
 }  // namespace
 
 Result<PeerRender> render_peer(Face& face, const GlyphKey& key, const GlyphRect& rect, PeerMode mode,
@@ -622,14 +637,7 @@ Result<PeerRender> render_peer(Face& face, const GlyphKey& key, const GlyphRect&
             return Error{ErrorCode::font_unsupported, "FreeType cannot set the LCD filter: " + freetype_error(error)};
         }
     }
-    // 26.6 from u24.8 and u0.8, rounded to the nearest 1/64 px.
-    const auto to_26_6 = [](uint32_t fixed) { return static_cast<FT_F26Dot6>((fixed + 2) / 4); };
-    if (const FT_Error error = FT_Set_Char_Size(ft_face, to_26_6(key.size_x), to_26_6(key.size_y), 72, 72);
-        error != 0) {
-        return Error{ErrorCode::glyph_failed, "cannot scale the face: " + freetype_error(error)};
-    }
-    FT_Vector pen{to_26_6(key.subpixel_x), -to_26_6(key.subpixel_y)};  // FreeType's y runs up
-    FT_Set_Transform(ft_face, nullptr, &pen);
+    if (Status status = place_pen(ft_face, key); !status) return status.error();
     const FT_Render_Mode render_mode = mode == PeerMode::gray ? FT_RENDER_MODE_NORMAL : FT_RENDER_MODE_LCD;
 
     std::vector<double> seconds;
@@ -653,6 +661,53 @@ Result<PeerRender> render_peer(Face& face, const GlyphKey& key, const GlyphRect&
     peer.image.values.assign(size_t{rect.width} * rect.height * 3, 0.0f);
     peer.lost_coverage = place_bitmap(ft_face->glyph, rect, mode, peer.image);
     return peer;
+}
+
+Result<ColourBitmap> render_colour_layers(Face& face, const GlyphKey& key, uint32_t palette,
+                                          const std::array<uint8_t, 4>& foreground) {
+    if (Status status = check_key(face, key); !status) return status.error();
+    FT_Face ft_face = face_state(face)->face.get();
+    FT_Palette_Data palettes;
+    if (const FT_Error error = FT_Palette_Data_Get(ft_face, &palettes); error != 0 || palettes.num_palettes == 0) {
+        return Error{ErrorCode::font_unsupported, "the face has no CPAL palettes"};
+    }
+    if (palette >= palettes.num_palettes) {
+        return Error{ErrorCode::invalid_argument, "palette " + std::to_string(palette) + " is past the face's " +
+                                                      std::to_string(palettes.num_palettes)};
+    }
+    if (const FT_Error error = FT_Palette_Select(ft_face, static_cast<FT_UShort>(palette), nullptr); error != 0) {
+        return Error{ErrorCode::font_unsupported,
+                     "cannot select palette " + std::to_string(palette) + ": " + freetype_error(error)};
+    }
+    const FT_Color text{foreground[2], foreground[1], foreground[0], foreground[3]};
+    if (const FT_Error error = FT_Palette_Set_Foreground_Color(ft_face, text); error != 0) {
+        return Error{ErrorCode::font_unsupported, "cannot set the foreground colour: " + freetype_error(error)};
+    }
+    if (Status status = place_pen(ft_face, key); !status) return status.error();
+    const FT_Error error = FT_Load_Glyph(ft_face, key.glyph, FT_LOAD_COLOR | FT_LOAD_RENDER | FT_LOAD_NO_HINTING);
+    FT_Set_Transform(ft_face, nullptr, nullptr);
+    if (error != 0) {
+        return Error{ErrorCode::glyph_failed,
+                     "FreeType cannot render glyph " + std::to_string(key.glyph) + ": " + freetype_error(error)};
+    }
+    const FT_GlyphSlot slot = ft_face->glyph;
+    const FT_Bitmap& bitmap = slot->bitmap;
+    if (slot->format != FT_GLYPH_FORMAT_BITMAP || bitmap.pixel_mode != FT_PIXEL_MODE_BGRA) {
+        return Error{ErrorCode::glyph_failed,
+                     "FreeType gave glyph " + std::to_string(key.glyph) + " no BGRA bitmap: it has no COLRv0 layers"};
+    }
+    ColourBitmap out;
+    out.left = slot->bitmap_left;
+    out.top = slot->bitmap_top;
+    out.width = bitmap.width;
+    out.height = bitmap.rows;
+    out.bgra.resize(size_t{bitmap.width} * bitmap.rows * 4);
+    for (uint32_t row = 0; row < bitmap.rows; ++row) {
+        const unsigned char* line = bitmap.buffer + static_cast<ptrdiff_t>(row) * bitmap.pitch;
+        std::copy(line, line + size_t{bitmap.width} * 4,
+                  out.bgra.begin() + static_cast<ptrdiff_t>(row) * bitmap.width * 4);
+    }
+    return out;
 }
 
 Result<CoverageError> compare_coverage(const CoverageImage& a, const CoverageImage& b) {

@@ -26,6 +26,7 @@
 //    (unhinted; gray, or LCD with or without FreeType's default filter), placed on crisp's texel
 //    grid, with its CPU time per glyph.
 // 3. The error between two coverage images on the same grid.
+// 4. FreeType's blending of a COLRv0 glyph's layers (FT_LOAD_COLOR), beside the colour reference.
 //
 // Every function here takes a GlyphRect: the texels the image covers. Pass glyph_rect() of the
 // baked asset's GlyphRecord to compare with crisp's atlas texel for texel; outline_rect() computes
@@ -38,6 +39,7 @@
 #include <crisp/result.hpp>
 #include <crisp/subpixel.hpp>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -144,6 +146,30 @@ struct PeerRender {
 // without LCD filtering.
 Result<PeerRender> render_peer(Face& face, const GlyphKey& key, const GlyphRect& rect, PeerMode mode,
                                uint32_t repetitions = 9);
+
+// FreeType's own blending of a COLRv0 glyph's layers, as an outside check of the colour glyph
+// reference (colour_reference.hpp): one BGRA bitmap, premultiplied, sRGB-encoded.
+struct ColourBitmap {
+    // Column c of the bitmap is pixel left + c right of the pen's whole pixel; row r is pixel
+    // r - top below it (FreeType's bitmap_left and bitmap_top).
+    int32_t left = 0;
+    int32_t top = 0;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<uint8_t> bgra;  // rows top to bottom, width * 4 bytes each: blue, green, red, alpha
+};
+
+// Glyph key.glyph loaded with FT_LOAD_COLOR | FT_LOAD_RENDER | FT_LOAD_NO_HINTING at the key's
+// size and subpixel offset (placed as render_peer places it), with palette `palette` selected
+// (FT_Palette_Select) and `foreground` (sRGB-encoded straight RGBA8: red, green, blue, alpha) as
+// the text colour (FT_Palette_Set_Foreground_Color). FreeType renders each COLRv0 layer's outline
+// gray and blends it src-over into the bitmap in 8-bit premultiplied sRGB-encoded values,
+// truncating each product (FreeType 2.12's tt_face_colr_blend_layer); COLRv1 glyphs it does not
+// blend. Errors: as render_peer; invalid_argument for a palette past the face's (font_unsupported
+// where the face has none); glyph_failed where FreeType gives no BGRA bitmap (a glyph without
+// COLRv0 layers).
+Result<ColourBitmap> render_colour_layers(Face& face, const GlyphKey& key, uint32_t palette,
+                                          const std::array<uint8_t, 4>& foreground);
 
 // The difference between two coverage images on the same grid, over the texels either touches
 // (some channel above 0 in either).

@@ -24,15 +24,7 @@ using freetype::CoverageImage;
 using freetype::Face;
 using freetype::PeerMode;
 using test::kDejaVuSans;
-
-GlyphKey key_at(uint32_t glyph, uint32_t pixels, uint8_t subpixel_x, uint8_t subpixel_y) {
-    GlyphKey key;
-    key.glyph = glyph;
-    key.size_x = key.size_y = pixels * kSizeOne;
-    key.subpixel_x = subpixel_x;
-    key.subpixel_y = subpixel_y;
-    return key;
-}
+using test::key_at;
 
 // crisp's exact area coverage of each channel rectangle of each texel of the rect, on the mapping
 // reference_coverage documents (texel_to_em's, in double).

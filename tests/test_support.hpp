@@ -40,6 +40,16 @@ inline const std::string kInterVariable = source_path("fonts/Inter-roman.var.ttf
 inline const std::string kNotoCjk = "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc";       // CFF collection
 inline const std::string kCantarell = "/usr/share/fonts/opentype/cantarell/Cantarell-Regular.otf";  // CFF, 1000 upem
 
+// The key of `glyph` at `pixels` px per em and a subpixel offset (1/256 px).
+inline GlyphKey key_at(uint32_t glyph, uint32_t pixels, uint8_t subpixel_x, uint8_t subpixel_y) {
+    GlyphKey key;
+    key.glyph = glyph;
+    key.size_x = key.size_y = pixels * kSizeOne;
+    key.subpixel_x = subpixel_x;
+    key.subpixel_y = subpixel_y;
+    return key;
+}
+
 // DejaVu Sans baked with only the glyphs of `text`, as FontId `id`; null when baking fails (the
 // test's own checks then fail).
 inline std::unique_ptr<Font> bake_test_font(std::string_view text, FontId id = 1) {
