@@ -19,3 +19,8 @@ for font in "$fonts"/*-subset.*; do
 done
 "$bake" "$fonts/inter-var-subset.ttf" --var wght=900 -q -o "$assets/inter-var-subset-wght900.crisp"
 "$bake" "$fonts/inter-cff-subset.otf" --split-y-extrema --tolerance 0.01 -q -o "$assets/inter-cff-subset-split.crisp"
+# Colour glyphs (asset version 2's colour sections): crisp's own COLRv0 and COLRv1 test fonts.
+for name in colrv0 colrv1; do
+  cp "tests/fonts/colour/$name.ttf" "$fonts/$name.ttf"
+  "$bake" "$fonts/$name.ttf" -q -o "$assets/$name.crisp"
+done

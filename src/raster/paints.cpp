@@ -45,14 +45,15 @@ PenPlace pen_place(const DrawnGlyph& glyph, const GlyphRecord& record) {
             static_cast<double>(subpixel_to_float(instance.key.subpixel_x));
     pen.y = static_cast<double>(instance.y) - glyph.part_y - rect.y +
             static_cast<double>(subpixel_to_float(instance.key.subpixel_y));
-    pen.sx = size_to_float(instance.key.size_x);
-    pen.sy = size_to_float(instance.key.size_y);
+    pen.sx = static_cast<double>(size_to_float(instance.key.size_x));
+    pen.sy = static_cast<double>(size_to_float(instance.key.size_y));
     return pen;
 }
 
 // to_paint (from em, y up) after the pixels-to-em map X -> ((X - pen.x) / sx, -(Y - pen.y) / sy).
 void pixel_to_paint(const Affine& m, const PenPlace& pen, float out[6]) {
-    const double xx = m.xx, xy = m.xy, yx = m.yx, yy = m.yy, dx = m.dx, dy = m.dy;
+    const auto wide = [](float value) { return static_cast<double>(value); };
+    const double xx = wide(m.xx), xy = wide(m.xy), yx = wide(m.yx), yy = wide(m.yy), dx = wide(m.dx), dy = wide(m.dy);
     const double ax = xx / pen.sx, bx = -xy / pen.sy;
     const double ay = yx / pen.sx, by = -yy / pen.sy;
     out[0] = static_cast<float>(ax);
