@@ -8,14 +8,14 @@ bench=$1 source=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 cd "$source" || exit 1  # the suites' default fonts are relative to the repository root
 . "$(dirname "${BASH_SOURCE[0]}")/cli_common.sh"
-suites=(frames coverage compositing scaling atlas frame-cpu cpu contrast)
+suites=(frames coverage compositing scaling atlas frame-cpu cpu contrast colour)
 
 # ---- --help and usage errors: exit 2, nothing measured.
 expect_exit 0 "--help" -- "$bench" --help
 for suite in "${suites[@]}"; do
   grep -q "^  $suite " "$work/out" || fail "--help does not list the suite $suite"
 done
-for option in --quick --suite --out --canvas --samples --sample-kind --clock-load --modes --variants --steps --pictures; do
+for option in --quick --suite --out --canvas --samples --sample-kind --clock-load --modes --variants --steps --pictures --glyphs; do
   grep -qF -- "$option" "$work/out" || fail "--help does not list $option"
 done
 expect_exit 2 "unknown suite" -- "$bench" --suite nonesuch
@@ -52,7 +52,7 @@ python3 - "$json" <<'EOF' || fail "the JSON is not what the suites write"
 import json, math, sys
 data = json.load(open(sys.argv[1]))
 suites = data["suites"]
-for name in ["frames", "coverage", "compositing", "scaling", "atlas", "frame-cpu", "cpu", "contrast"]:
+for name in ["frames", "coverage", "compositing", "scaling", "atlas", "frame-cpu", "cpu", "contrast", "colour"]:
     assert name in suites, name
 assert data["tool"] == "crisp-bench" and data["quick"] is True and data["command"].startswith("crisp-bench")
 def unit(x):
@@ -88,6 +88,24 @@ for r in rows:
         assert unit(r[k]) and r[k] > 0, r
     assert r["ratio"] > 0 and math.isclose(r["ratio"], r["ink_dark"] / r["ink_light"], rel_tol=1e-9), r
 assert contrast["pictures"] == ["quick-%s-%s.png" % (p, s) for s in ("linear", "default") for p in ("dark", "light")]
+colour = suites["colour"]
+assert colour["count"] == 100 and colour["size"] == 24, colour
+screens = {s["name"]: s for s in colour["screens"]}
+assert list(screens) == ["bitmap", "colrv1", "monochrome"], screens
+assert not screens["colrv1"]["skipped"] and not screens["monochrome"]["skipped"], screens
+for name, s in screens.items():
+    if s["skipped"]:
+        assert name == "bitmap" and "NotoColorEmoji" in s["skipped"], s
+        continue
+    assert s["converged"] and s["shaped_glyphs"] == 100 and s["colour_glyphs"] == (0 if name == "monochrome" else 100), s
+    first, last = s["first"], s["converged_frame"]
+    assert s["layout_ms"] > 0 and first["quads"] > 0 and last["quads"] == first["quads"], s
+    assert first["glyphs_refined"] > 0 and last["glyphs_refined"] == 0, s
+    for f in (first, last):
+        assert f["cpu_ms"] > 0 and f["raster_gpu_ms"] >= 0 and f["composite_gpu_ms"] > 0 and f["bitmap_misses"] == 0, f
+        assert (f["colour_layers"] > 0) == (name != "monochrome"), (name, f)
+    assert (first["bitmap_uploads"] > 0) == (name == "bitmap") and last["bitmap_uploads"] == 0, s
+    assert (first["frame_paints"] > 0) == (name != "monochrome"), s
 EOF
 for picture in quick-{dark,light}-{linear,default}.png; do
   [ "$(head -c 4 "$work/results/$picture" 2>/dev/null | od -An -c | tr -d ' ')" = "211PNG" ] || fail "$picture is not a PNG"

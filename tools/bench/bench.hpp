@@ -85,6 +85,9 @@ struct Options {
     uint32_t cells_gray = 16;
     uint32_t cells_rgb = 64;
 
+    // colour
+    std::optional<uint32_t> glyphs;
+
     // atlas
     std::vector<uint32_t> steps = {256, 64, 16, 8, 4, 2, 1};
     bool steps_given = false;
@@ -105,6 +108,7 @@ inline constexpr SuiteInfo kSuites[] = {
     {"frame-cpu", "CPU time of a frame of UI text (was crisp-bench-frame)", true},
     {"cpu", "layout and atlas CPU time (was crisp-bench-cpu)", false},
     {"contrast", "ink dark on light against light on dark per contrast setting and size; FreeType as a peer", true},
+    {"colour", "colour glyphs (bitmap emoji, COLRv1) beside monochrome text: frame 1, converged, per layer", true},
 };
 
 // Parses argv; prints --help, or exits 2 on a usage error.
@@ -167,5 +171,6 @@ void run_atlas(Session& session);
 void run_frame_cpu(Session& session);
 void run_cpu(Session& session);
 void run_contrast(Session& session);
+void run_colour(Session& session);
 
 }  // namespace crisp::bench

@@ -110,6 +110,7 @@ void run_suite(Session& session, const std::string& name) {
     if (name == "frame-cpu") return run_frame_cpu(session);
     if (name == "cpu") return run_cpu(session);
     if (name == "contrast") return run_contrast(session);
+    if (name == "colour") return run_colour(session);
 }
 
 // The error at each sample count against the GPU ms the frames suite spent reaching that count:

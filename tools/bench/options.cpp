@@ -198,7 +198,7 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
                "(default static,changed,moving)",
                name_list(o.variants));
 
-    cli.section("cpu, contrast:");
+    cli.section("cpu, contrast, colour:");
     cli.text("--dejavu", "PATH", "DejaVu Sans (default fonts/DejaVuSans.ttf)", o.dejavu);
     cli.text("--inter", "PATH", "Inter Regular, first font of the fallback chain (default fonts/Inter-Regular.otf)",
              o.inter);
@@ -211,6 +211,10 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
     cli.section("contrast:");
     cli.text("--pictures", "DIR", "where its pictures go (default: the --out directory)", o.pictures_dir);
     cli.text("--only", "TEXT", "run only the cases whose name contains TEXT", o.only);
+
+    cli.section("colour:");
+    cli.number<uint32_t>("--glyphs", "N", "glyphs on each screen (default 1000; 100 with --quick)", o.glyphs,
+                         {1, 100000});
 }
 
 }  // namespace
