@@ -3,7 +3,8 @@
 # report), renders a paragraph with subpixel anti-aliasing into a PNG on the GPU (lavapipe when
 # there is no GPU), composites it over a photo-like backdrop and a gradient with the tile path,
 # composites a scene of overlapping translucent text with the tiled
-# order-independent transparency and, to compare, unsorted, and prints where the images are.
+# order-independent transparency and, to compare, unsorted, draws a line of colour glyphs (bitmap
+# emoji and COLRv1 gradients), and prints where the images are.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
@@ -18,6 +19,12 @@ build/tools/crisp-bake fonts/Inter-Regular.otf -o "$out/Inter-Regular.crisp"
 echo
 echo "== crisp-bake: a variable face (Inter) at wght=700"
 build/tools/crisp-bake fonts/Inter-roman.var.ttf --var wght=700 -o "$out/Inter-Bold.crisp"
+echo
+echo "== crisp-bake: colour glyphs, a dozen bitmap emoji of Noto Color Emoji (CBDT) and COLRv1 gradients"
+emoji_text="😀👍🏽❤️🇺🇸🎉🚀🌈🍕✨🐱"
+build/tools/crisp-bake /usr/share/fonts/truetype/noto/NotoColorEmoji.ttf --text "$emoji_text" \
+  -o "$out/NotoColorEmoji.crisp"
+build/tools/crisp-bake tests/fonts/colour/colrv1.ttf --codepoints U+E002-E004 -o "$out/colrv1.crisp" -q
 echo
 echo "== crisp-bake --check"
 build/tools/crisp-bake --check "$out/DejaVuSans.crisp"
@@ -48,6 +55,12 @@ cp docs/examples/overlap.json "$out/overlap.json"  # its font path is relative t
 build/tools/crisp-render --scene "$out/overlap.json" --composite tiled -o "$out/overlap-tiled.png"
 build/tools/crisp-render --scene "$out/overlap.json" --composite unsorted -o "$out/overlap-unsorted.png" >/dev/null
 echo
+echo "== crisp-render: colour glyphs after a text font in the fallback chain (emoji presentation picks the"
+echo "   colour font), bitmap emoji and COLRv1 linear, radial and sweep gradients"
+build/tools/crisp-render --font "$out/DejaVuSans.crisp" --font "$out/NotoColorEmoji.crisp" --font "$out/colrv1.crisp" \
+  --text "Colour glyphs: 😀 👍🏽 ❤️ 🇺🇸 and COLRv1 gradients $(printf '\xee\x80\x82 \xee\x80\x83 \xee\x80\x84')
+The baked subset: $emoji_text" --size 24 --origin 12,34 --canvas 720,90 -o "$out/emoji.png"
+echo
 echo "The assets are in $(pwd)/$out:"
 ls -1 "$(pwd)/$out"/*.crisp
 echo "The rendered paragraph (subpixel rgb, and grayscale to compare):"
@@ -59,3 +72,5 @@ echo "$(pwd)/$out/paragraph-gradient-rgb.png"
 echo "The scene, composited in depth order (tiled) and in draw order (unsorted):"
 echo "$(pwd)/$out/overlap-tiled.png"
 echo "$(pwd)/$out/overlap-unsorted.png"
+echo "Colour glyphs (bitmap emoji and COLRv1 gradients):"
+echo "$(pwd)/$out/emoji.png"

@@ -4,6 +4,7 @@
 #include "core/limits.hpp"
 #include "core/json.hpp"
 
+#include <crisp/asset.hpp>
 #include <crisp/renderer.hpp>
 
 #include <cfloat>
@@ -16,8 +17,8 @@ namespace {
 
 using Type = json::Value::Type;
 
-constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "contrast", "runs"};
-constexpr std::string_view kRunMembers[] = {"font", "text", "size", "origin", "color", "depth", "contrast"};
+constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "contrast", "palette", "runs"};
+constexpr std::string_view kRunMembers[] = {"font", "text", "size", "origin", "color", "depth", "contrast", "palette"};
 constexpr std::string_view kContrastMembers[] = {"mode", "gamma", "contrast", "stem_darkening"};
 
 Error fault(const std::string& path, const std::string& what) {
@@ -93,6 +94,16 @@ std::optional<Error> read_color(const json::Value& value, const std::string& pat
         color[i] = static_cast<float>(component.number);
     }
     if (value.array.size() == 3) color[3] = 1.0f;
+    return std::nullopt;
+}
+
+// A CPAL palette index, an integer below kMaxPalettes (a font without that palette draws its 0).
+std::optional<Error> read_palette(const json::Value& value, const std::string& path, uint32_t& palette) {
+    if (value.type != Type::number || !(value.number >= 0.0 && value.number < static_cast<double>(kMaxPalettes)) ||
+        value.number != std::floor(value.number)) {
+        return fault(path, "expected a palette index, an integer from 0 to " + std::to_string(kMaxPalettes - 1));
+    }
+    palette = static_cast<uint32_t>(value.number);
     return std::nullopt;
 }
 
@@ -199,6 +210,11 @@ std::optional<Error> read_run(const json::Value& value, const std::string& path,
         if (auto error = read_contrast(*contrast, path + ".contrast", own)) return error;
         run.contrast = own;
     }
+
+    run.palette = scene.palette;
+    if (const json::Value* palette = value.find("palette")) {
+        if (auto error = read_palette(*palette, path + ".palette", run.palette)) return error;
+    }
     return std::nullopt;
 }
 
@@ -239,6 +255,10 @@ Result<Scene> parse_scene(std::string_view json) {
         TextContrast defaults;
         if (auto error = read_contrast(*contrast, "contrast", defaults)) return *error;
         scene.contrast = defaults;
+    }
+
+    if (const json::Value* palette = root.find("palette")) {
+        if (auto error = read_palette(*palette, "palette", scene.palette)) return *error;
     }
 
     const json::Value* runs = root.find("runs");

@@ -37,6 +37,8 @@ struct SceneRun {
     // How the run's coverage is blended (DrawOptions::contrast): its own "contrast" member over the
     // scene's, field by field; nullopt where neither says, for the drawer's default.
     std::optional<TextContrast> contrast;
+    // CPAL palette of its colour glyphs (TextStyle::palette): its own "palette" or the scene's.
+    uint32_t palette = 0;
     friend bool operator==(const SceneRun&, const SceneRun&) = default;
 };
 
@@ -46,6 +48,7 @@ struct Scene {
     float background[4] = {1.0f, 1.0f, 1.0f, 1.0f};  // sRGB-encoded, straight alpha, each in [0, 1]
     std::string layout = "rgb";                      // a subpixel preset name or a layout file path
     std::optional<TextContrast> contrast;            // the runs' default, as written; valid
+    uint32_t palette = 0;                            // the runs' default palette, below kMaxPalettes
     std::vector<SceneRun> runs;                      // drawn in this (file) order
     friend bool operator==(const Scene&, const Scene&) = default;
 };

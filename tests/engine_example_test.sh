@@ -213,7 +213,8 @@ PY
 
 # ---- The command line.
 "$example" --help >help.txt || fail "--help exited $?"
-for option in --frames --screenshot --validation --drop-every --resize-at --minimize-at --font --report; do
+for option in --frames --screenshot --validation --drop-every --resize-at --minimize-at --font --emoji-font \
+  --report; do
   grep -q -- "$option" help.txt || fail "--help does not mention $option"
 done
 "$example" --frames 2>/dev/null; [ $? -eq 1 ] || fail "--frames without a value: want exit 1"
@@ -221,6 +222,9 @@ done
 "$example" --bogus 2>/dev/null; [ $? -eq 1 ] || fail "an unknown option: want exit 1"
 "$example" --font does-not-exist.ttf --frames 1 2>font.err; code=$?
 [ "$code" -eq 2 ] && grep -q "does-not-exist.ttf" font.err || fail "a missing font: exit $code, $(cat font.err)"
+"$example" --emoji-font no-emoji.ttf --frames 1 2>emoji.err; code=$?
+[ "$code" -eq 2 ] && grep -q -- "--emoji-font no-emoji.ttf" emoji.err ||
+  fail "a missing emoji font: exit $code, $(cat emoji.err)"
 
 # run NAME ARGS...: one validated run at 640x400 writing NAME.png and NAME.json; exit code 0 means
 # the validation layer reported nothing, teardown included.
@@ -244,6 +248,23 @@ run plain_again --frames 40
 cmp -s plain.png plain_again.png || fail "two identical runs gave different screenshots"
 python3 check_screenshot.py plain.png plain.json || fail "plain.png: text missing or misplaced"
 [ "$(field plain presented)" = 40 ] || fail "plain: $(field plain presented) frames presented, want 40"
+# With Noto Color Emoji installed (the default --emoji-font), the title ends in a yellow face: the
+# HUD above its paragraph, white text on a dark panel otherwise, has pixels of its yellow.
+if [ -f /usr/share/fonts/truetype/noto/NotoColorEmoji.ttf ]; then
+  python3 - plain.png plain.json <<'PY' || fail "plain.png: no colour emoji in the HUD's title"
+import json, sys
+from check_screenshot import read_png
+width, height, pixels = read_png(sys.argv[1])
+boxes = {box["name"]: box for box in json.load(open(sys.argv[2]))["text"]}
+hud, paragraph = boxes["hud"], boxes["paragraph"]
+yellow = 0
+for y in range(int(hud["y"]), int(paragraph["y"])):
+    for x in range(int(hud["x"]), int(hud["x"] + hud["width"])):
+        r, g, b = pixels[(y * width + x) * 3:(y * width + x) * 3 + 3]
+        yellow += r > 200 and g > 150 and b < 100
+assert yellow > 40, f"{yellow} yellow pixels in the title"
+PY
+fi
 
 # ---- Dropped frames, resizes and a minimized window: the run with drops must end on the image of
 # the run without them. Frames count presented frames, so both animate the same 60 frames; every

@@ -6,6 +6,8 @@ set -uo pipefail
 render=$1 bake=$2 source=$3 work=$4
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
 . "$(dirname "${BASH_SOURCE[0]}")/cli_common.sh"
+# The Python checks import read_png from beside this script.
+export PYTHONPATH="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)${PYTHONPATH:+:$PYTHONPATH}"
 
 "$bake" "$source/fonts/DejaVuSans.ttf" --text "Hi" -o "$work/dejavu.crisp" -q || { echo "crisp-bake failed" >&2; exit 1; }
 font=$work/dejavu.crisp
@@ -82,7 +84,7 @@ expect_exit 2 "--layers" -- "$render" "${base[@]}" --layers 2 -o x.png
 expect_exit 2 "--composite layered" -- "$render" "${base[@]}" --composite layered -o x.png
 # --scene gives the text, fonts, canvas, colours and layout: none of those options may come with it.
 for option in "--font $font" "--text Hi" "--size 20" "--origin 0,20" "--canvas 48,32" "--color 0,0,0" \
-              "--background 1,1,1" "--layout gray"; do
+              "--background 1,1,1" "--palette 1" "--layout gray"; do
   # shellcheck disable=SC2086
   expect_exit 2 "--scene with $option" -- "$render" --scene "$work/any.json" $option -o x.png
   expect_stderr "${option%% *}" "--scene with $option"
@@ -330,41 +332,9 @@ for mode in wboit exact; do
   cmp -s "$work/scene-$mode.png" "$work/scene-$mode-compute.png" || fail "--path compute changes the $mode image"
 done
 python3 - "$work" <<'PY' || fail "the composite modes' outputs are wrong"
-import json, struct, sys, zlib
+import json, sys
+from read_png import read_png
 work = sys.argv[1]
-
-def read_png(path):  # 8-bit RGB or RGBA, non-interlaced, as libpng writes them
-    data = open(path, "rb").read()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n", path + " is not a PNG"
-    pos, idat = 8, b""
-    while pos < len(data):
-        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + length]
-        pos += 12 + length
-        if kind == b"IHDR":
-            width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
-            assert depth == 8 and colour in (2, 6) and interlace == 0, (path, depth, colour, interlace)
-        elif kind == b"IDAT":
-            idat += body
-    channels = 3 if colour == 2 else 4
-    raw, stride = zlib.decompress(idat), width * channels
-    rows, previous = [], bytearray(stride)
-    for y in range(height):
-        kind, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for x in range(stride):
-            a = line[x - channels] if x >= channels else 0
-            b = previous[x]
-            c = previous[x - channels] if x >= channels else 0
-            if kind == 1: line[x] = (line[x] + a) & 255
-            elif kind == 2: line[x] = (line[x] + b) & 255
-            elif kind == 3: line[x] = (line[x] + (a + b) // 2) & 255
-            elif kind == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        rows.append(line)
-        previous = line
-    return width, height, channels, b"".join(rows)
 
 images = {}
 for mode in ("tiled", "draw", "unsorted", "wboit", "exact"):
@@ -440,6 +410,77 @@ expect_exit 0 "exact past 64 fragments a pixel" -- "$render" --scene "$work/pile
 expect_stderr "dropped" "exact past 64 fragments a pixel"
 python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['composite']; assert c['exact_dropped'] > 0, c" \
   "$work/out" || fail "the exact mode's dropped fragments are not reported"
+
+# ---- Colour glyphs: COLRv1 layers drawn by default and counted in the report; --no-colour draws the
+# plain outlines; --palette and a scene's "palette" choose the CPAL palette.
+"$bake" "$source/tests/fonts/colour/colrv1.ttf" --codepoints U+E000-E004 -o "$work/colrv1.crisp" -q ||
+  fail "crisp-bake colrv1.ttf failed"
+colr=(--font "$work/colrv1.crisp" --text "$(printf '\xee\x80\x80\xee\x80\x82\xee\x80\x83\xee\x80\x84')" --size 24
+  --origin 2,24 --canvas 104,32 --samples 16)
+expect_exit 2 "--palette 256" -- "$render" "${colr[@]}" --palette 256 -o x.png
+expect_stderr "--palette" "--palette 256"
+expect_exit 0 "colour glyphs" -- "$render" "${colr[@]}" -o "$work/colr.png"
+expect_stdout_line() {  # expect_stdout_line TEXT DESCRIPTION: the last command's stdout holds TEXT
+  grep -qF -- "$1" "$work/out" || fail "$2: stdout lacks '$1': $(head -c 600 "$work/out")"
+}
+expect_stdout_line "colour   4 glyphs as 5 layers (5 drawn, 3 paints), 0 bitmap uploads, 0 missed" "colour glyphs"
+for variant in "--no-colour" "--palette 1"; do
+  # shellcheck disable=SC2086
+  expect_exit 0 "colour glyphs $variant" -- "$render" "${colr[@]}" $variant -o "$work/colr${variant// /}.png" --json
+  cp "$work/out" "$work/colr${variant// /}.json"
+done
+scene_run colr-scene.json "{\"text\": \"$(printf '\xee\x80\x80')\", \"size\": 24, \"origin\": [2, 24], \"palette\": 1}"
+sed -i "s|dejavu.crisp|colrv1.crisp|" "$work/colr-scene.json"
+expect_exit 0 "a scene run's palette" -- "$render" --scene "$work/colr-scene.json" --samples 16 -o "$work/colr-scene.png"
+expect_exit 0 "--palette 1 on one glyph" -- "$render" "${colr[@]/$(printf '\xee\x80\x80\xee\x80\x82\xee\x80\x83\xee\x80\x84')/$(printf '\xee\x80\x80')}" \
+  --canvas 48,32 --palette 1 -o "$work/colr-palette1.png"
+scene_run colr-bad-palette.json '{"text": "Hi", "size": 20, "origin": [4, 24], "palette": 256}'
+expect_exit 7 "a scene run's palette 256" -- "$render" --scene "$work/colr-bad-palette.json" -o x.png
+expect_stderr "runs[0].palette" "a scene run's palette 256"
+python3 - "$work" <<'PY' || fail "colour glyphs are not drawn or counted as they should be"
+import json, sys
+work = sys.argv[1]
+plain = json.load(open(work + "/colr--no-colour.json"))["colour"]
+assert plain == {"enabled": False, "glyphs": 0, "layers": 0, "drawn_layers": 0, "paints": 0,
+                 "bitmap_uploads": 0, "bitmap_misses": 0}, plain
+other = json.load(open(work + "/colr--palette1.json"))
+assert other["colour"]["glyphs"] == 4 and other["colour"]["drawn_layers"] == 5, other["colour"]
+assert other["glyphs"]["drawn"] == 5, other["glyphs"]
+read = lambda name: open("%s/%s.png" % (work, name), "rb").read()
+assert read("colr") != read("colr--no-colour"), "--no-colour draws the same image"
+assert read("colr") != read("colr--palette1"), "palette 1 draws the same image as palette 0"
+assert read("colr-scene") == read("colr-palette1"), "a scene run's palette 1 is not --palette 1"
+PY
+
+# Bitmap emoji (Noto Color Emoji, CBDT) after a text font in the fallback chain: the emoji take the
+# colour font, each image uploaded once.
+noto=/usr/share/fonts/truetype/noto/NotoColorEmoji.ttf
+if [ -f "$noto" ]; then
+  "$bake" "$noto" --text "😀👍🏽" -o "$work/noto.crisp" -q || fail "crisp-bake of a Noto Color Emoji subset failed"
+  emoji=(--font "$font" --font "$work/noto.crisp" --text "Hi 😀👍🏽" --size 24 --origin 2,26 --canvas 96,32
+    --samples 16)
+  expect_exit 0 "bitmap emoji" -- "$render" "${emoji[@]}" -o "$work/emoji.png" --json
+  cp "$work/out" "$work/emoji.json"
+  expect_exit 0 "bitmap emoji --no-colour" -- "$render" "${emoji[@]}" --no-colour -o "$work/emoji-plain.png"
+  expect_exit 0 "bitmap emoji, the report" -- "$render" "${emoji[@]}" -o "$work/emoji.png"
+  expect_stdout_line "colour   2 glyphs as 2 layers (2 drawn" "bitmap emoji"
+  expect_stdout_line "2 bitmap uploads, 0 missed" "bitmap emoji"
+  python3 - "$work" <<'PY' || fail "bitmap emoji are not drawn or counted as they should be"
+import json, sys
+from read_png import read_png
+work = sys.argv[1]
+c = json.load(open(work + "/emoji.json"))["colour"]
+assert c["glyphs"] == 2 and c["layers"] == 2 and c["drawn_layers"] == 2, c
+assert c["bitmap_uploads"] == 2 and c["bitmap_misses"] == 0, c
+_, _, channels, colour = read_png(work + "/emoji.png")
+plain = read_png(work + "/emoji-plain.png")[3]
+assert colour != plain, "--no-colour draws the same image"
+# The emoji's yellow face: a pixel far from grey, which black text on white never makes.
+saturated = lambda px: max(px) - min(px) > 96
+pixels = [colour[i:i + 3] for i in range(0, len(colour), channels)]
+assert sum(1 for px in pixels if saturated(px)) > 50, "no colourful pixels: the emoji are not drawn in colour"
+PY
+fi
 
 # With the validation layer (when installed), a clean run stays clean.
 if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.json' 2>/dev/null)" ]; then

@@ -76,7 +76,20 @@ TEST(Scene, DefaultsFillWhatIsLeftOut) {
     EXPECT_EQ(run.color[2], 0.0f);
     EXPECT_EQ(run.color[3], 1.0f);
     EXPECT_EQ(run.depth, 0.5f);
+    EXPECT_EQ(run.palette, 0u);
     EXPECT_EQ(parse_scene(R"({"fonts": ["a"], "canvas": [8, 8], "runs": []})")->runs.size(), 0u);
+}
+
+TEST(Scene, RunsTakeTheScenePaletteUnlessTheyGiveTheirOwn) {
+    auto scene = parse_scene(R"({"fonts": ["a"], "canvas": [8, 8], "palette": 2, "runs": [
+        {"text": "a", "size": 9, "origin": [0, 0]}, {"text": "b", "size": 9, "origin": [0, 0], "palette": 255},
+        {"text": "c", "size": 9, "origin": [0, 0], "palette": 0}]})");
+    ASSERT_TRUE(scene) << scene.error().message;
+    EXPECT_EQ(scene->palette, 2u);
+    ASSERT_EQ(scene->runs.size(), 3u);
+    EXPECT_EQ(scene->runs[0].palette, 2u);
+    EXPECT_EQ(scene->runs[1].palette, 255u);
+    EXPECT_EQ(scene->runs[2].palette, 0u);
 }
 
 TEST(Scene, MemberOrderDoesNotMatter) {
@@ -101,7 +114,7 @@ TEST(Scene, BadScenesNameTheirFault) {
         {R"({"fonts": ["a"], "fonts": ["b"], "canvas": [1, 1], "runs": []})", "scene: line 1"},  // duplicate
         {"[]", "scene: expected an object, got an array"},
         {R"({"fonts": ["a"], "canvas": [8, 8], "runs": [], "colour": 1})",
-         "scene: unknown member \"colour\" (known: fonts, canvas, background, layout, contrast, runs)"},
+         "scene: unknown member \"colour\" (known: fonts, canvas, background, layout, contrast, palette, runs)"},
         // fonts
         {R"({"canvas": [8, 8], "runs": []})", "scene: the \"fonts\" member is missing"},
         {R"({"fonts": "a.crisp", "canvas": [8, 8], "runs": []})", "scene: fonts: expected a non-empty array"},
@@ -142,7 +155,8 @@ TEST(Scene, BadScenesNameTheirFault) {
         {with_run("5"), "scene: runs[0]: expected an object, got a number"},
         {with_run(
              R"({"text": "a", "size": 9, "origin": [0, 0]}, {"text": "a", "size": 9, "origin": [0, 0], "colour": [0, 0, 0]})"),
-         "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth, contrast)"},
+         "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth, contrast, "
+         "palette)"},
         // runs[].font
         {with_run(R"({"font": -1, "text": "a", "size": 9, "origin": [0, 0]})"),
          "scene: runs[0].font: expected an index into fonts (an integer from 0)"},
@@ -181,6 +195,14 @@ TEST(Scene, BadScenesNameTheirFault) {
          "scene: runs[0].depth: expected a number from 0 (nearest) to 1 (farthest)"},
         {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "depth": -0.1})"), "scene: runs[0].depth: expected"},
         {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "depth": "near"})"), "scene: runs[0].depth: expected"},
+        // palette, at the top level and in runs
+        {R"({"fonts": ["a"], "canvas": [8, 8], "palette": 256, "runs": []})",
+         "scene: palette: expected a palette index, an integer from 0 to 255"},
+        {R"({"fonts": ["a"], "canvas": [8, 8], "palette": "1", "runs": []})", "scene: palette: expected a palette"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "palette": 1.5})"),
+         "scene: runs[0].palette: expected a palette index"},
+        {with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "palette": -1})"),
+         "scene: runs[0].palette: expected a palette index"},
         // contrast, at the top level and in runs: the member's path and the value
         {R"({"fonts": ["a"], "canvas": [8, 8], "contrast": "linear", "runs": []})",
          "scene: contrast: expected an object, got a string"},

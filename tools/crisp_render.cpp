@@ -95,6 +95,8 @@ struct Arguments {
     uint32_t samples = kDefaultSamples;
     std::optional<std::array<float, 4>> color;
     std::optional<std::array<float, 4>> background;
+    std::optional<uint32_t> palette;  // TextStyle::palette of the command line's text
+    bool no_colour = false;           // LayoutOptions::colour_glyphs off: colour glyphs as plain outlines
     std::string scene;
     crisp::CompositeMode composite = crisp::CompositeMode::tiled;
     std::string backdrop = "flat";
@@ -240,6 +242,14 @@ void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
                "background, the same way (default 1,1,1,1); with alpha below 1 the PNG\n"
                "has an alpha channel",
                store(args.background, color("--background")));
+    cli.number<uint32_t>("--palette", "N",
+                         "CPAL palette of colour glyphs, 0..255 (default 0); a font with fewer\n"
+                         "palettes draws its palette 0",
+                         args.palette, {0, crisp::kMaxPalettes - 1});
+    cli.flag("--no-colour",
+             "draw colour glyphs (COLR layers, bitmap emoji) as their plain outline in\n"
+             "the text colour, as fonts without colour tables are drawn",
+             args.no_colour);
     cli.choice<CompositeMode>("--composite", "MODE",
                               "how the glyphs are blended over what is behind them: tiled (screen\n"
                               "tiles in workgroup memory, exact front to back; the default), draw\n"
@@ -279,8 +289,8 @@ void check_text_source(const crisp::cli::CommandLine& cli, const Arguments& args
     if (!args.scene.empty()) {
         // The scene says all of these; a second source would leave one of them ignored.
         std::string given;
-        for (const char* name :
-             {"--font", "--text", "--size", "--origin", "--canvas", "--color", "--background", "--layout"}) {
+        for (const char* name : {"--font", "--text", "--size", "--origin", "--canvas", "--color", "--background",
+                                 "--palette", "--layout"}) {
             if (cli.given(name)) given += std::string(given.empty() ? "" : ", ") + name;
         }
         if (!given.empty()) {
@@ -412,6 +422,7 @@ struct Job {
     std::vector<Draw> draws;
     size_t laid_out = 0;  // instances the text layouts produced, culled ones included
     uint32_t missing = 0, blank = 0, out_of_range = 0;
+    uint32_t colour_glyphs = 0, colour_layers = 0;  // TextLayout's, culled ones included
 };
 
 struct CompositeReport {
@@ -433,6 +444,8 @@ struct RenderReport {
     crisp::RendererStats last_frame;
     uint64_t total_samples = 0;
     uint64_t total_curve_tests = 0;
+    uint64_t total_bitmap_uploads = 0;  // bitmap glyph images uploaded, all frames together
+    uint32_t max_bitmap_misses = 0;     // image layers drawn without their image, in the worst frame
     crisp::AtlasStats atlas;
     uint32_t atlas_side = 0;
     std::vector<crisp::DrawnGlyph> drawn;  // the last frame's, in paint order
@@ -697,6 +710,8 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
             report.frame_ms.push_back(milliseconds_since(frame_start));
             report.total_samples += renderer.stats().samples;
             report.total_curve_tests += renderer.stats().curve_tests;
+            report.total_bitmap_uploads += renderer.stats().bitmap_uploads;
+            report.max_bitmap_misses = std::max(report.max_bitmap_misses, renderer.stats().bitmap_misses);
         });
     if (!frames) {
         std::fprintf(stderr, "crisp-render: frame %llu: %s\n",
@@ -854,6 +869,15 @@ void write_glyphs_and_timings(crisp::JsonWriter& json, const Summary& s) {
         .field("blank", job.blank)
         .field("out_of_range", job.out_of_range)
         .end_object();
+    json.key("colour").begin_object();
+    json.field("enabled", !s.args->no_colour)
+        .field("glyphs", job.colour_glyphs)
+        .field("layers", job.colour_layers)
+        .field("drawn_layers", last.colour_layers)
+        .field("paints", last.frame_paints)
+        .field("bitmap_uploads", r.total_bitmap_uploads)
+        .field("bitmap_misses", r.max_bitmap_misses)
+        .end_object();
     json.field("total_samples", r.total_samples).field("total_curve_tests", r.total_curve_tests);
     json.key("composite");
     write_composite(json, *s.args, r.composite);
@@ -983,6 +1007,11 @@ void print_human(const Summary& s) {
                 crisp::cli::printable(job.subpixel_layout.name).c_str(), args.samples);
     std::printf("  glyphs   %u drawn, %zu laid out (%u outside the canvas), %u missing, %u failed\n",
                 r.last_frame.drawn_glyphs, job.laid_out, s.culled_glyphs, job.missing, r.last_frame.failed_glyphs);
+    if (job.colour_glyphs > 0 || r.max_bitmap_misses > 0) {
+        std::printf("  colour   %u glyphs as %u layers (%u drawn, %u paints), %llu bitmap uploads, %u missed\n",
+                    job.colour_glyphs, job.colour_layers, r.last_frame.colour_layers, r.last_frame.frame_paints,
+                    static_cast<unsigned long long>(r.total_bitmap_uploads), r.max_bitmap_misses);
+    }
     std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)\n", static_cast<unsigned long long>(r.frames),
                 frame_total, r.frames ? frame_total / static_cast<double>(r.frames) : 0.0);
     std::printf("  blend    %s\n", human_composite(args, r.composite).c_str());
@@ -1009,6 +1038,7 @@ crisp::Scene scene_from_arguments(const Arguments& args) {
     run.origin_x = (*args.origin)[0];
     run.origin_y = (*args.origin)[1];
     if (args.color) std::copy(args.color->begin(), args.color->end(), run.color);
+    scene.palette = run.palette = args.palette.value_or(0);
     scene.runs.push_back(std::move(run));
     return scene;
 }
@@ -1030,7 +1060,9 @@ void lay_out(const Arguments& args, Job& job) {
         style.size = run.size;
         std::copy(std::begin(run.color), std::end(run.color), style.color);  // sRGB: the layouter linearizes it
         style.depth = run.depth;
+        style.palette = run.palette;
         crisp::LayoutOptions options;
+        options.colour_glyphs = !args.no_colour;
         options.origin_x = run.origin_x;
         options.origin_y = run.origin_y;
         options.first_paint_order = paint_order;
@@ -1052,6 +1084,8 @@ void lay_out(const Arguments& args, Job& job) {
         job.missing += text.missing_glyphs;
         job.blank += text.blank_glyphs;
         job.out_of_range += text.out_of_range_glyphs;
+        job.colour_glyphs += text.colour_glyphs;
+        job.colour_layers += text.colour_layers;
         if (job.draws.empty() || job.draws.back().contrast != run.contrast) {
             job.draws.push_back({job.glyphs.size(), 0, run.contrast});
         }

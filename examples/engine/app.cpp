@@ -23,13 +23,13 @@ bool operator==(VkExtent2D a, VkExtent2D b) {
 
 App::App(Device& device) : device_(device) {}
 
-crisp::Result<std::unique_ptr<App>> App::create(Device& device, crisp::Font font) {
+crisp::Result<std::unique_ptr<App>> App::create(Device& device, std::vector<crisp::Font> fonts) {
     std::unique_ptr<App> app(new App(device));
     app->depth_format_ = choose_depth_format(device.physical_device());
     crisp::Result<Scene> scene = Scene::create(device, app->depth_format_);
     if (!scene) return scene.error();
     app->scene_.emplace(std::move(*scene));
-    crisp::Result<std::unique_ptr<TextOverlay>> text = TextOverlay::create(device, std::move(font));
+    crisp::Result<std::unique_ptr<TextOverlay>> text = TextOverlay::create(device, std::move(fonts));
     if (!text) return text.error();
     app->text_ = std::move(*text);
     if (crisp::Status s = app->create_frame_slots(); !s) return s.error();

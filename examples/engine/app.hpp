@@ -36,7 +36,7 @@ struct RunReport {
 
 class App {
 public:
-    static crisp::Result<std::unique_ptr<App>> create(Device& device, crisp::Font font);
+    static crisp::Result<std::unique_ptr<App>> create(Device& device, std::vector<crisp::Font> fonts);
     App(const App&) = delete;
     App& operator=(const App&) = delete;
     // Waits for the GPU, then destroys crisp's objects and the engine's (the device outlives them).

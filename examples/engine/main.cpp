@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,30 +20,46 @@ namespace {
 using namespace engine;
 
 // crisp bakes the font's outlines at start-up (an engine would ship a .crisp asset made offline by
-// crisp-bake and load it with crisp::load_asset_file): printable ASCII and the few other
-// characters the example shows.
-std::optional<crisp::Font> load_font(const std::string& path) {
+// crisp-bake and load it with crisp::load_asset_file): only the characters the example shows.
+std::optional<crisp::Font> load_font(const char* option, const std::string& path, std::vector<uint32_t> codepoints,
+                                     crisp::FontId id) {
     crisp::BakeOptions options;
     options.all_glyphs = false;
-    for (uint32_t c = 0x20; c < 0x7F; ++c) options.codepoints.push_back(c);
-    options.codepoints.push_back(0x00D7);  // multiplication sign
+    options.codepoints = std::move(codepoints);
     options.allow_failed = true;
     crisp::Result<crisp::BakeResult> baked = crisp::bake_font_file(path, options);
     if (!baked) {
-        std::fprintf(stderr, "crisp-engine-example: --font %s: %s\n", path.c_str(), baked.error().message.c_str());
+        std::fprintf(stderr, "crisp-engine-example: %s %s: %s\n", option, path.c_str(), baked.error().message.c_str());
         return std::nullopt;
     }
-    crisp::Result<crisp::Font> font = crisp::Font::create(std::move(baked->asset), 1);
+    crisp::Result<crisp::Font> font = crisp::Font::create(std::move(baked->asset), id);
     if (!font) {
-        std::fprintf(stderr, "crisp-engine-example: --font %s: %s\n", path.c_str(), font.error().message.c_str());
+        std::fprintf(stderr, "crisp-engine-example: %s %s: %s\n", option, path.c_str(), font.error().message.c_str());
         return std::nullopt;
     }
     return std::move(*font);
 }
 
+// The text font (printable ASCII and the multiplication sign), then the emoji font where there is
+// one: the layouts' fallback chain, in which emoji presentation picks the colour font.
+std::optional<std::vector<crisp::Font>> load_fonts(const Options& options) {
+    std::vector<uint32_t> text;
+    for (uint32_t c = 0x20; c < 0x7F; ++c) text.push_back(c);
+    text.push_back(0x00D7);  // multiplication sign
+    std::optional<crisp::Font> font = load_font("--font", options.font, std::move(text), 1);
+    if (!font) return std::nullopt;
+    std::vector<crisp::Font> fonts;
+    fonts.push_back(std::move(*font));
+    if (!options.emoji_font_given && !std::filesystem::exists(options.emoji_font)) return fonts;
+    std::optional<crisp::Font> emoji = load_font("--emoji-font", options.emoji_font, {kHudEmoji}, 2);
+    if (!emoji) return std::nullopt;
+    fonts.push_back(std::move(*emoji));
+    return fonts;
+}
+
 // The window's life. Every Vulkan object is gone when it returns, so that the validation layer's
 // count includes the teardown.
-int run(const Options& options, crisp::Font font, std::atomic<uint32_t>& messages, RunReport& report) {
+int run(const Options& options, std::vector<crisp::Font> fonts, std::atomic<uint32_t>& messages, RunReport& report) {
     DeviceOptions device_options;
     device_options.width = options.width;
     device_options.height = options.height;
@@ -53,7 +70,7 @@ int run(const Options& options, crisp::Font font, std::atomic<uint32_t>& message
         std::fprintf(stderr, "crisp-engine-example: %s\n", device.error().message.c_str());
         return kExitVulkan;
     }
-    crisp::Result<std::unique_ptr<App>> app = App::create(**device, std::move(font));
+    crisp::Result<std::unique_ptr<App>> app = App::create(**device, std::move(fonts));
     if (!app) {
         std::fprintf(stderr, "crisp-engine-example: %s\n", app.error().message.c_str());
         return kExitVulkan;
@@ -102,11 +119,11 @@ int main(int argc, char** argv) {
         std::fputs(usage().c_str(), stdout);
         return kExitOk;
     }
-    std::optional<crisp::Font> font = load_font(options.font);
-    if (!font) return kExitFont;
+    std::optional<std::vector<crisp::Font>> fonts = load_fonts(options);
+    if (!fonts) return kExitFont;
     std::atomic<uint32_t> messages{0};
     RunReport report;
-    const int code = run(options, std::move(*font), messages, report);
+    const int code = run(options, std::move(*fonts), messages, report);
     if (code != kExitOk) return code;
     if (const int written = write_outputs(options, report, messages.load()); written != kExitOk) return written;
     if (messages.load() > 0) {

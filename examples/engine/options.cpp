@@ -62,6 +62,14 @@ const std::vector<OptionSpec>& option_table() {
          [](Options& o, std::string_view v) { return !(o.report = v).empty(); }},
         {"--font", "PATH", "the font for all text (TrueType/OpenType; default: crisp's DejaVu Sans)",
          [](Options& o, std::string_view v) { return !(o.font = v).empty(); }},
+        {"--emoji-font", "PATH",
+         "a colour font (COLR or bitmap emoji) for the emoji in the HUD's title (default: Noto Color Emoji, "
+         "/usr/share/fonts/truetype/noto/NotoColorEmoji.ttf, where that file exists; without it the title has no "
+         "emoji)",
+         [](Options& o, std::string_view v) {
+             o.emoji_font_given = true;
+             return !(o.emoji_font = v).empty();
+         }},
         {"--validation", nullptr,
          "VK_LAYER_KHRONOS_validation with synchronization validation; any warning or error it reports makes the "
          "exit code 4",
@@ -110,6 +118,7 @@ std::string usage() {
 ParseResult parse_options(int argc, const char* const* argv, const std::string& default_font) {
     ParseResult result;
     result.options.font = default_font;
+    result.options.emoji_font = kDefaultEmojiFont;
     for (int i = 1; i < argc; ++i) {
         const std::string_view arg = argv[i];
         const OptionSpec* spec = nullptr;

@@ -34,12 +34,17 @@ struct Options {
     std::string screenshot;  // PNG of the last presented frame
     std::string report;      // JSON: what happened, and where text was drawn
     std::string font;
+    std::string emoji_font;         // a colour font for the HUD's emoji
+    bool emoji_font_given = false;  // --emoji-font: a font that cannot be loaded is an error
     bool validation = false;
     uint32_t drop_every = 0;  // every Nth frame is recorded, then abandoned
     std::vector<ResizeAt> resizes;
     std::vector<MinimizeAt> minimizes;
     bool help = false;
 };
+
+// The emoji font unless --emoji-font is given: Debian's fonts-noto-color-emoji, used where installed.
+inline constexpr const char* kDefaultEmojiFont = "/usr/share/fonts/truetype/noto/NotoColorEmoji.ttf";
 
 // The parsed command line, or a message for a person (the caller prints it and exits kExitUsage).
 // `default_font` is used unless --font is given.

@@ -69,10 +69,12 @@ crisp::LayoutOptions at(float x, float y, uint32_t first_paint_order, float wrap
 
 }  // namespace
 
-TextOverlay::TextOverlay(crisp::Font font) : font_(std::move(font)) {}
+TextOverlay::TextOverlay(std::vector<crisp::Font> fonts) : fonts_(std::move(fonts)) {
+    for (const crisp::Font& font : fonts_) font_chain_.push_back(&font);
+}
 
-crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& device, crisp::Font font) {
-    std::unique_ptr<TextOverlay> self(new TextOverlay(std::move(font)));
+crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& device, std::vector<crisp::Font> fonts) {
+    std::unique_ptr<TextOverlay> self(new TextOverlay(std::move(fonts)));
     crisp::RendererCreateInfo renderer_info;
     renderer_info.instance = device.instance();
     renderer_info.get_instance_proc_addr = vkGetInstanceProcAddr;  // volk's: crisp calls what the engine calls
@@ -86,7 +88,9 @@ crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& de
     crisp::Result<crisp::Renderer> renderer = crisp::Renderer::create(renderer_info);
     if (!renderer) return renderer.error();
     self->renderer_.emplace(std::move(*renderer));
-    if (crisp::Status s = self->renderer_->add_font(self->font_); !s) return s.error();
+    for (const crisp::Font& font : self->fonts_) {
+        if (crisp::Status s = self->renderer_->add_font(font); !s) return s.error();
+    }
 
     crisp::CompositorCreateInfo compositor_info;
     compositor_info.instance = device.instance();
@@ -107,25 +111,26 @@ crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& de
 
 crisp::Status TextOverlay::lay_out(std::string_view text, const crisp::TextStyle& text_style,
                                    const crisp::LayoutOptions& options, crisp::TextLayout& out) {
-    const crisp::Font* fonts[] = {&font_};
-    return layouter_.layout(fonts, text, text_style, options, out);
+    return layouter_.layout(font_chain_, text, text_style, options, out);
 }
 
 // The HUD's text that never changes is laid out where it is drawn; the rows and labels, which
 // move, at the origin: draw options place them each frame.
 crisp::Status TextOverlay::lay_out_static() {
     const float x = kHudX + kPadding, wrap = kHudWidth - 2.0f * kPadding;
-    const float ascender = font_.ascender();
+    const float ascender = fonts_.front().ascender();
     float y = kHudY + kPadding;
-    crisp::Status s =
-        lay_out("crisp in a small engine", style(kTitleSize, kWhite), at(x, y + ascender * kTitleSize, 0), title_);
+    // With an emoji font, the title ends in a colour glyph: its layers are drawn like any glyph.
+    const std::string title =
+        fonts_.size() > 1 ? "crisp in a small engine \xF0\x9F\x98\x80" : "crisp in a small engine";
+    crisp::Status s = lay_out(title, style(kTitleSize, kWhite), at(x, y + ascender * kTitleSize, 0), title_);
     y = title_.y + title_.height + 4.0f;
     if (s)
         s = lay_out(kParagraph, style(kBodySize, kBodyColor),
                     at(x, y + ascender * kBodySize, title_.next_paint_order, wrap), paragraph_);
     y = paragraph_.y + paragraph_.height + 6.0f;
     counter_y_ = y + ascender * kCounterSize;
-    y += 2.0f * font_.line_height() * kCounterSize + 6.0f;  // the counter's two lines
+    y += 2.0f * fonts_.front().line_height() * kCounterSize + 6.0f;  // the counter's two lines
     list_box_ = {x, std::round(y), wrap, kVisibleRows * kRowHeight, kListPanel};
     list_clip_ = {{static_cast<int32_t>(list_box_.x), static_cast<int32_t>(list_box_.y)},
                   {static_cast<uint32_t>(list_box_.width), static_cast<uint32_t>(list_box_.height)}};
@@ -192,7 +197,7 @@ void TextOverlay::draw_list(uint64_t frame) {
     const double cycle_frames = static_cast<double>(rows_.size()) * static_cast<double>(kRowHeight) / speed;
     const auto scroll = static_cast<float>(std::fmod(static_cast<double>(frame), cycle_frames) * speed);
     const float cycle = static_cast<float>(rows_.size()) * kRowHeight;
-    const float baseline = 3.0f + font_.ascender() * kRowSize;
+    const float baseline = 3.0f + fonts_.front().ascender() * kRowSize;
     for (size_t i = 0; i < rows_.size(); ++i) {
         const float unwrapped = static_cast<float>(i) * kRowHeight - scroll;
         float top = unwrapped - std::floor(unwrapped / cycle) * cycle;

@@ -1,4 +1,4 @@
-// Everything the example does with crisp: one font, one Renderer (the glyph atlas and its
+// Everything the example does with crisp: a font (and an emoji font after it), one Renderer (the glyph atlas and its
 // rasterizer) and one Compositor (the tile path), the HUD and the world-space labels. This is the
 // part of the example an engine programmer copies; docs/integration.md walks through it.
 //
@@ -29,6 +29,9 @@
 
 namespace engine {
 
+// The emoji at the end of the HUD's title when there is an emoji font (U+1F600 grinning face).
+inline constexpr uint32_t kHudEmoji = 0x1F600;
+
 // Where a piece of text was drawn this frame, in window pixels (for --report and its test).
 struct TextBox {
     std::string name;  // "hud", "paragraph", "counter", "list", "label:Cube", ...
@@ -46,9 +49,10 @@ struct OverlayFrame {
 class TextOverlay {
 public:
     // Creates the renderer and compositor on `device` (whose feature chain crisp checks) and lays
-    // out the text that never changes. Errors: crisp's, when the device lacks what it needs or the
+    // out the text that never changes. `fonts`: the text font, then optionally a colour font whose
+    // kHudEmoji ends the HUD's title. Errors: crisp's, when the device lacks what it needs or the
     // compositor cannot store to the scene target's format.
-    static crisp::Result<std::unique_ptr<TextOverlay>> create(const Device& device, crisp::Font font);
+    static crisp::Result<std::unique_ptr<TextOverlay>> create(const Device& device, std::vector<crisp::Font> fonts);
     TextOverlay(const TextOverlay&) = delete;
     TextOverlay& operator=(const TextOverlay&) = delete;
 
@@ -72,7 +76,7 @@ public:
     const OverlayFrame& frame() const { return frame_; }
 
 private:
-    explicit TextOverlay(crisp::Font font);
+    explicit TextOverlay(std::vector<crisp::Font> fonts);
     crisp::Status lay_out_static();
     crisp::Status lay_out(std::string_view text, const crisp::TextStyle& style, const crisp::LayoutOptions& options,
                           crisp::TextLayout& out);
@@ -81,7 +85,10 @@ private:
     void draw_labels(VkExtent2D extent, const SceneState& scene);
     TextBox box_of(const char* name, const crisp::TextLayout& layout, float dx, float dy) const;
 
-    crisp::Font font_;  // declared before the renderer, which keeps a pointer to it
+    // The text font first, the fallback chain of every layout; declared before the renderer, which
+    // keeps pointers to them (the vector is never resized).
+    std::vector<crisp::Font> fonts_;
+    std::vector<const crisp::Font*> font_chain_;
     std::optional<crisp::Renderer> renderer_;
     std::optional<crisp::Compositor> compositor_;
     crisp::Layouter layouter_;
