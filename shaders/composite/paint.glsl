@@ -89,12 +89,14 @@ vec4 paint_fill(uint paint, vec4 colour, ivec2 pixel) {
     const QuadPaint p = paints[paint];
     const vec2 corner = vec2(pixel);
     const vec3 centre = vec3(corner + 0.5, 1.0);
-    const vec2 at = vec2(dot(p.to_paint_x.xyz, centre), dot(p.to_paint_y.xyz, centre));
+    vec2 at = vec2(dot(p.to_paint_x.xyz, centre), dot(p.to_paint_y.xyz, centre));
     vec4 premultiplied;  // linear
     if (p.kind == kPaintSolid) {
         premultiplied = vec4(colour.rgb * colour.a, colour.a);
     } else if (p.kind == kPaintImage) {
-        if (any(lessThan(at, vec2(0.0))) || any(greaterThan(at, vec2(1.0)))) return vec4(0.0);
+        // The layer's outline is the image's rectangle, so a pixel its edge crosses reads the image's
+        // edge, not the outside (a pixel centre can lie just past the edge), as the CPU reference does.
+        at = clamp(at, vec2(0.0), vec2(1.0));
         // The level whose texels are a pixel apart: the mapping's larger scale in layer texels.
         const vec2 side = vec2(textureSize(paint_images, 0).xy) * vec2(p.image_u, p.image_v);
         const float scale = max(length(p.to_paint_x.xy * side.x), length(p.to_paint_y.xy * side.y));
