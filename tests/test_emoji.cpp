@@ -34,6 +34,7 @@ constexpr FontId kColourId = 22;
 constexpr FontId kEmojiId = 23;
 constexpr FontId kNotoId = 24;
 constexpr FontId kEmojiPlainId = 25;
+constexpr FontId kColrId = 26;
 
 size_t sequence_length(std::string_view utf8) {
     return emoji_sequence_end(decode_utf8(utf8), 0);
@@ -527,6 +528,52 @@ TEST_F(Emoji, HostileSequencesKeepTheInvariants) {
         EXPECT_EQ(layers, layout.colour_layers);
         EXPECT_LE(layout.colour_glyphs, layout.colour_layers);
         EXPECT_EQ(layout.next_paint_order, 7 + layout.glyphs.size());
+    }
+}
+
+TEST_F(Emoji, ColrTestFonts) {
+    // The emoji of the COLR test fonts (tests/fonts/colour/README.md), baked from their COLR tables,
+    // behind DejaVu Sans: presentation picks the font, sequences become its ligatures.
+    for (const char* file : {"colrv0.ttf", "colrv1.ttf"}) {
+        SCOPED_TRACE(file);
+        Result<FontAsset> asset = bake(test::source_path(std::string("tests/fonts/colour/") + file), {});
+        ASSERT_TRUE(asset) << asset.error().message;
+        std::unique_ptr<Font> colr = make_font(std::move(asset).value(), kColrId);
+        ASSERT_NE(colr, nullptr);
+        const std::vector<const Font*> fonts = {plain_.get(), colr.get()};
+        EXPECT_EQ(font_ids(lay(fonts, "\u2764")), std::vector<FontId>{kPlainId});
+        EXPECT_EQ(lay(fonts, "\u2764").colour_glyphs, 0u);
+        struct Case {
+            const char* name;
+            std::string text;
+        };
+        const Case cases[] = {
+            {"heart with VS16", "\u2764\uFE0F"},
+            {"smile", "\U0001F600"},
+            {"skin tone", "\U0001F44D\U0001F3FD"},
+            {"flag", "\U0001F1FA\U0001F1F8"},
+            {"ZWJ sequence", "\u2764\uFE0F\u200D\U0001F600"},
+            {"ZWJ sequence without VS16", "\u2764\u200D\U0001F600"},  // an emoji though U+2764 is text
+        };
+        for (const Case& c : cases) {
+            SCOPED_TRACE(c.name);
+            const TextLayout layout = lay(fonts, c.text);
+            EXPECT_EQ(layout.shaped_glyphs, 1u);
+            EXPECT_EQ(layout.colour_glyphs, 1u);
+            EXPECT_EQ(layout.missing_glyphs, 0u);
+            ASSERT_FALSE(layout.glyphs.empty());
+            for (const GlyphInstance& glyph : layout.glyphs) {
+                EXPECT_EQ(glyph.key.font, kColrId);
+                EXPECT_EQ(glyph.cluster, 0u);
+                EXPECT_NE(glyph.paint, kNoPaint);
+                EXPECT_EQ(glyph.colour_glyph, layout.glyphs[0].colour_glyph);
+            }
+        }
+        // Text after the emoji goes back to DejaVu Sans.
+        const TextLayout mixed = lay(fonts, "\U0001F600a1");
+        ASSERT_GE(mixed.glyphs.size(), 3u);
+        EXPECT_EQ(mixed.glyphs[mixed.glyphs.size() - 2].key.font, kPlainId);
+        EXPECT_EQ(mixed.glyphs.back().key.font, kPlainId);
     }
 }
 
