@@ -50,19 +50,20 @@ size_t DescriptorWrites::write(uint32_t binding, [[maybe_unused]] VkDescriptorTy
     return index;
 }
 
-DescriptorWrites& DescriptorWrites::storage_image(uint32_t binding, VkImageView view, VkImageLayout layout) {
-    const size_t i = write(binding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1);
-    images_[i] = {VK_NULL_HANDLE, view, layout};
+DescriptorWrites& DescriptorWrites::image(uint32_t binding, VkDescriptorType type, const VkDescriptorImageInfo& info) {
+    const size_t i = write(binding, type, 1);
+    images_[i] = info;
     writes_[i].pImageInfo = &images_[i];
     return *this;
 }
 
+DescriptorWrites& DescriptorWrites::storage_image(uint32_t binding, VkImageView view, VkImageLayout layout) {
+    return image(binding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, {VK_NULL_HANDLE, view, layout});
+}
+
 DescriptorWrites& DescriptorWrites::sampled_image(uint32_t binding, VkImageView view, VkSampler sampler,
                                                   VkImageLayout layout) {
-    const size_t i = write(binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1);
-    images_[i] = {sampler, view, layout};
-    writes_[i].pImageInfo = &images_[i];
-    return *this;
+    return image(binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, {sampler, view, layout});
 }
 
 DescriptorWrites& DescriptorWrites::storage_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset,

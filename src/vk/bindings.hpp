@@ -72,6 +72,8 @@ private:
     // Marks the write of `binding` written and returns its index, asserting that the binding is
     // declared with `type` and `count` and was not written before.
     size_t write(uint32_t binding, VkDescriptorType type, uint32_t count);
+    // The one image descriptor of `binding`, of `type`.
+    DescriptorWrites& image(uint32_t binding, VkDescriptorType type, const VkDescriptorImageInfo& info);
 
     const BindingTable& table_;
     std::array<VkWriteDescriptorSet, kMaxBindings> writes_{};  // at their bindings' places in the table
