@@ -75,6 +75,9 @@ CRISP_CONSTANT(uint, kRasterBindItems, 1u);           // RasterItem[]
 CRISP_CONSTANT(uint, kRasterBindPoints, 2u);          // kRasterFontPages buffers of curve points
 CRISP_CONSTANT(uint, kRasterBindBands, 3u);           // kRasterFontPages buffers of band words
 CRISP_CONSTANT(uint, kRasterBindWorkgroupItems, 4u);  // uint[]: the item of each workgroup
+CRISP_CONSTANT(uint, kRasterBindTransforms, 5u);      // RasterTransform[]: transformed glyphs' maps
+// RasterItem::transform of a glyph that is not transformed (texel_to_em's offset and scale serve it).
+CRISP_CONSTANT(uint, kRasterNoTransform, 0xFFFFFFFFu);
 
 // One glyph's work this frame, in a std430 storage buffer.
 struct RasterItem {
@@ -100,6 +103,15 @@ struct RasterItem {
     uint first_texel;  // the work's texels, row-major over width x height
     uint texel_count;
     uint first_workgroup;  // this item's first workgroup; the items' ranges tile the dispatch, in order
+    uint transform;        // index into RasterTransform[], or kRasterNoTransform
+};
+
+// A transformed glyph's maps (include/crisp/glyph.hpp, em_to_texel): rows of 3x3 projective
+// matrices, em (y up) to the rect's texels and back. W is 1 without perspective. to_texel[0].w is
+// the map's orientation, +1 or -1 (the sign of its determinant); the other w are unused.
+struct RasterTransform {
+    vec4 to_texel[3];
+    vec4 to_em[3];
 };
 
 struct RasterPushConstants {
@@ -335,7 +347,8 @@ struct TilePushConstants {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RasterItem) == 88);
+static_assert(sizeof(RasterItem) == 92);
+static_assert(sizeof(RasterTransform) == 96);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
 static_assert(sizeof(TileBinEntry) == 32);
 static_assert(offsetof(TileHeader, layered_dispatch_x) == kTileLayeredDispatchOffset);

@@ -7,6 +7,7 @@
 #include <crisp/asset.hpp>
 #include <crisp/renderer.hpp>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <optional>
@@ -18,7 +19,8 @@ namespace {
 using Type = json::Value::Type;
 
 constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "contrast", "palette", "runs"};
-constexpr std::string_view kRunMembers[] = {"font", "text", "size", "origin", "color", "depth", "contrast", "palette"};
+constexpr std::string_view kRunMembers[] = {"font",  "text",     "size",    "origin",   "color",
+                                            "depth", "contrast", "palette", "transform"};
 constexpr std::string_view kContrastMembers[] = {"mode", "gamma", "contrast", "stem_darkening"};
 
 Error fault(const std::string& path, const std::string& what) {
@@ -214,6 +216,23 @@ std::optional<Error> read_run(const json::Value& value, const std::string& path,
     run.palette = scene.palette;
     if (const json::Value* palette = value.find("palette")) {
         if (auto error = read_palette(*palette, path + ".palette", run.palette)) return error;
+    }
+
+    if (const json::Value* transform = value.find("transform")) {
+        const auto entry = [](const json::Value& number) {
+            return number.type == Type::number && std::fabs(number.number) <= 65536.0;
+        };
+        if (transform->type != Type::array || transform->array.size() != 4 ||
+            !std::all_of(transform->array.begin(), transform->array.end(), entry)) {
+            return fault(path + ".transform", "expected [a, b, c, d], numbers in [-65536, 65536]");
+        }
+        std::array<float, 4> m{};
+        for (size_t i = 0; i < 4; ++i) m[i] = static_cast<float>(transform->array[i].number);
+        TextTransform t{m[0], m[1], m[2], m[3], 0.0f, 0.0f};
+        if (!valid_transform(t)) {
+            return fault(path + ".transform", "is singular: |a d - b c| must be at least 2^-16");
+        }
+        run.transform = m;
     }
     return std::nullopt;
 }

@@ -11,6 +11,7 @@
 #include <crisp/contrast.hpp>
 #include <crisp/result.hpp>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -39,6 +40,9 @@ struct SceneRun {
     std::optional<TextContrast> contrast;
     // CPAL palette of its colour glyphs (TextStyle::palette): its own "palette" or the scene's.
     uint32_t palette = 0;
+    // The 2x2 linear part of a transform applied about the run's origin (y down: x' = a x + b y,
+    // y' = c x + d y; DrawOptions::transform): "transform": [a, b, c, d]. nullopt: none.
+    std::optional<std::array<float, 4>> transform;
     friend bool operator==(const SceneRun&, const SceneRun&) = default;
 };
 

@@ -380,7 +380,9 @@ TEST(RasterWorkItems, ItemsAddressTheirFontsRangesAndTileTheWorkgroups) {
 
     std::vector<gpu::RasterItem> items = {gpu::RasterItem{}};  // stale: replaced
     std::vector<uint32_t> table = {9};
-    EXPECT_EQ(raster::build_work_items(work, fonts, items, table), 4u);
+    std::vector<gpu::RasterTransform> transforms = {gpu::RasterTransform{}};  // stale: replaced
+    EXPECT_EQ(raster::build_work_items(work, fonts, items, transforms, table), 4u);
+    EXPECT_TRUE(transforms.empty());
     ASSERT_EQ(items.size(), 2u);
     EXPECT_EQ(table, (std::vector<uint32_t>{0, 0, 0, 1}));
     const GlyphRecord& record = record_of(h);
@@ -409,9 +411,10 @@ TEST(RasterWorkItems, ItemsAddressTheirFontsRangesAndTileTheWorkgroups) {
     EXPECT_EQ(item.texel_count, 130u);
     EXPECT_EQ(item.first_workgroup, 0u);
     EXPECT_EQ(items[1].first_workgroup, 3u);
+    EXPECT_EQ(item.transform, gpu::kRasterNoTransform);
     EXPECT_EQ(items[1].point_offset, 1000 + record_of(g).point_offset);
     EXPECT_NE(items[1].point_offset, item.point_offset);
-    EXPECT_EQ(raster::build_work_items({}, fonts, items, table), 0u);
+    EXPECT_EQ(raster::build_work_items({}, fonts, items, transforms, table), 0u);
     EXPECT_TRUE(items.empty());
     EXPECT_TRUE(table.empty());
 }

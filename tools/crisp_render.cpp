@@ -95,8 +95,9 @@ struct Arguments {
     uint32_t samples = kDefaultSamples;
     std::optional<std::array<float, 4>> color;
     std::optional<std::array<float, 4>> background;
-    std::optional<uint32_t> palette;  // TextStyle::palette of the command line's text
-    bool no_colour = false;           // LayoutOptions::colour_glyphs off: colour glyphs as plain outlines
+    std::optional<uint32_t> palette;                // TextStyle::palette of the command line's text
+    std::optional<std::array<float, 4>> transform;  // the 2x2 of DrawOptions::transform, about the origin
+    bool no_colour = false;                         // LayoutOptions::colour_glyphs off: colour glyphs as plain outlines
     std::string scene;
     crisp::CompositeMode composite = crisp::CompositeMode::tiled;
     std::string backdrop = "flat";
@@ -137,6 +138,20 @@ crisp::Result<std::array<float, 4>> parse_color(std::string_view option, std::st
         color[i] = (*values)[i];
     }
     return color;
+}
+
+// "A,B,C,D": a 2x2 linear part that valid_transform() accepts.
+crisp::Result<std::array<float, 4>> parse_transform(std::string_view text) {
+    const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>("--transform", text);
+    if (!values) return values.error();
+    auto refuse = [&](const std::string& why) { return crisp::Error{crisp::ErrorCode::invalid_argument, why}; };
+    if (values->size() != 4) return refuse("--transform takes A,B,C,D, not '" + std::string(text) + "'");
+    const std::array<float, 4> m = {(*values)[0], (*values)[1], (*values)[2], (*values)[3]};
+    if (!crisp::valid_transform({m[0], m[1], m[2], m[3], 0.0f, 0.0f})) {
+        return refuse("--transform '" + std::string(text) +
+                      "': entries must be finite and at most 65536, and |A D - B C| at least 2^-16");
+    }
+    return m;
 }
 
 // An option whose value `parse` turns into `target` (an optional), or refuses.
@@ -246,6 +261,12 @@ void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
                          "CPAL palette of colour glyphs, 0..255 (default 0); a font with fewer\n"
                          "palettes draws its palette 0",
                          args.palette, {0, crisp::kMaxPalettes - 1});
+    cli.option("--transform", "A,B,C,D",
+               "draw the text transformed about --origin by the 2x2 matrix (y down):\n"
+               "x' = A x + B y, y' = C x + D y; e.g. 0.8,-0.6,0.6,0.8 rotates it 36.87\n"
+               "degrees clockwise, -1,0,0,1 mirrors it; |A D - B C| at least 2^-16\n"
+               "(docs/transforms.md)",
+               store(args.transform, [](std::string_view text) { return parse_transform(text); }));
     cli.flag("--no-colour",
              "draw colour glyphs (COLR layers, bitmap emoji) as their plain outline in\n"
              "the text colour, as fonts without colour tables are drawn",
@@ -290,7 +311,7 @@ void check_text_source(const crisp::cli::CommandLine& cli, const Arguments& args
         // The scene says all of these; a second source would leave one of them ignored.
         std::string given;
         for (const char* name : {"--font", "--text", "--size", "--origin", "--canvas", "--color", "--background",
-                                 "--palette", "--layout"}) {
+                                 "--palette", "--layout", "--transform"}) {
             if (cli.given(name)) given += std::string(given.empty() ? "" : ", ") + name;
         }
         if (!given.empty()) {
@@ -418,6 +439,7 @@ struct Job {
     struct Draw {
         size_t first = 0, count = 0;  // in glyphs
         std::optional<crisp::TextContrast> contrast;
+        std::optional<crisp::TextTransform> transform;  // a run's, about its origin
     };
     std::vector<Draw> draws;
     size_t laid_out = 0;  // instances the text layouts produced, culled ones included
@@ -696,13 +718,14 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
             const VkRect2D canvas{{0, 0}, {job.scene.width, job.scene.height}};
             for (const Job::Draw& draw : job.draws) {
                 const std::span<const crisp::GlyphInstance> glyphs(job.glyphs.data() + draw.first, draw.count);
-                if (!draw.contrast) {
+                if (!draw.contrast && !draw.transform) {
                     renderer.draw(glyphs, canvas);
                     continue;
                 }
                 crisp::DrawOptions options;
                 options.visible = canvas;
                 options.contrast = draw.contrast;
+                options.transform = draw.transform;
                 renderer.draw(glyphs, options);
             }
         },
@@ -1039,6 +1062,7 @@ crisp::Scene scene_from_arguments(const Arguments& args) {
     run.origin_y = (*args.origin)[1];
     if (args.color) std::copy(args.color->begin(), args.color->end(), run.color);
     scene.palette = run.palette = args.palette.value_or(0);
+    run.transform = args.transform;
     scene.runs.push_back(std::move(run));
     return scene;
 }
@@ -1086,12 +1110,20 @@ void lay_out(const Arguments& args, Job& job) {
         job.out_of_range += text.out_of_range_glyphs;
         job.colour_glyphs += text.colour_glyphs;
         job.colour_layers += text.colour_layers;
-        if (job.draws.empty() || job.draws.back().contrast != run.contrast) {
-            job.draws.push_back({job.glyphs.size(), 0, run.contrast});
+        // A transformed run is a draw of its own, about its origin; the renderer culls its glyphs
+        // where they land.
+        std::optional<crisp::TextTransform> transform;
+        if (run.transform) {
+            const auto& m = *run.transform;
+            transform = crisp::TextTransform{m[0], m[1], m[2], m[3], run.origin_x, run.origin_y};
+        }
+        if (job.draws.empty() || job.draws.back().contrast != run.contrast || transform || job.draws.back().transform) {
+            job.draws.push_back({job.glyphs.size(), 0, run.contrast, transform});
         }
         const size_t before = job.glyphs.size();
         for (const crisp::GlyphInstance& glyph : text.glyphs) {
-            if (touches_canvas(glyph, job.scene.width, job.scene.height)) job.glyphs.push_back(glyph);
+            if (transform ? glyph.width > 0 : touches_canvas(glyph, job.scene.width, job.scene.height))
+                job.glyphs.push_back(glyph);
         }
         job.draws.back().count += job.glyphs.size() - before;
     }

@@ -31,6 +31,7 @@
 #include <crisp/layout.hpp>
 #include <crisp/result.hpp>
 #include <crisp/subpixel.hpp>
+#include <crisp/transform.hpp>
 
 #include <vulkan/vulkan.h>
 
@@ -141,8 +142,9 @@ struct DrawOptions {
     // moved within the last kMotionSettleFrames frames is moving text, and its glyphs take
     // quarter-pixel subpixel steps (kMovingSubpixelSteps), so that a label gliding a fraction of a
     // pixel a frame reuses at most 4 x 4 atlas entries per glyph and keeps gathering samples
-    // instead of starting over in a new entry every frame. Once it rests, it returns to the fine
-    // steps. Counted in RendererStats::moving_glyphs.
+    // instead of starting over in a new entry every frame. A draw whose transform or plane changed
+    // lately is moving too, and its keys take kMovingTransformSteps. Once it rests, it returns to
+    // the fine steps. Counted in RendererStats::moving_glyphs.
     uint64_t id = 0;
     // Contrast settings for these glyphs instead of the renderer's (set_contrast()). A setting
     // validate_text_contrast() refuses draws nothing (skipped_glyphs).
@@ -150,6 +152,21 @@ struct DrawOptions {
     // The CPAL palette of colour glyphs instead of their layout's (TextStyle::palette). A palette
     // past a font's palettes draws with its palette 0.
     std::optional<uint32_t> palette;
+    // Rotated, scaled, sheared or mirrored text (transform.hpp, docs/transforms.md): every glyph's
+    // pen and outline mapped about the pivot, then moved by the offset. Each glyph stays an
+    // axis-aligned rect of the target whose texels hold the coverage of its transformed outline,
+    // keyed by the transform's linear part quantized to 1/256 px per em (1/4 px per em while a named
+    // draw's transform changes: see `id`). A transform valid_transform() refuses (not finite, a
+    // determinant below 2^-16) draws nothing (skipped_glyphs).
+    std::optional<TextTransform> transform;
+    // Text on a plane in world space seen through a view-projection (transform.hpp): each glyph at
+    // the local affine map of the projection at its centre, or exactly projective where that
+    // would be more than kMaxLocalAffineError px off, at its centre's depth (unless `depth` is
+    // given). The offset moves the text within the plane, in layout pixels. Glyphs with a bbox
+    // corner behind the eye or outside the depth range are culled (culled_glyphs). A plane
+    // valid_plane() refuses, or a plane together with a transform, draws nothing (skipped_glyphs).
+    // Glyphs already transformed (a key with a linear part) are not transformed again: skipped.
+    std::optional<TextPlane> plane;
 };
 
 // Subpixel steps per pixel of moving text (DrawOptions::id).

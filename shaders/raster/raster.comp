@@ -15,6 +15,11 @@
 //
 // Point samples: one point per channel inside its rectangle (the R2 sequence), a ray towards +x,
 // and the nonzero winding number; a covered sample adds kRasterCoverageOne.
+//
+// A transformed glyph (an item with a RasterTransform; docs/transforms.md) is sampled in its
+// rect's texels, where rows stay horizontal: each curve of the bands its row segment crosses in em
+// is mapped to texels in homogeneous coordinates (X, Y, W), a rational quadratic whose crossings
+// with the row are the roots of Y - y W, classified as above, at x = X / W.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -35,6 +40,10 @@ layout(std430, set = 0, binding = kRasterBindItems) readonly buffer Items {
 // The index into `items` of each workgroup of the dispatch.
 layout(std430, set = 0, binding = kRasterBindWorkgroupItems) readonly buffer WorkgroupItems {
     uint workgroup_items[];
+};
+
+layout(std430, set = 0, binding = kRasterBindTransforms) readonly buffer Transforms {
+    RasterTransform transforms[];
 };
 
 layout(std430, set = 0, binding = kRasterBindPoints) readonly buffer Points {
@@ -230,36 +239,55 @@ void row_sort(inout RowList r) {
     }
 }
 
-// The crossings of one curve with the row at height y (absolute em): Lengyel's roots as in
-// winding(), as absolute x's, added to the list.
-void row_curve(inout RowList r, vec2 p0, vec2 p1, vec2 p2, float y) {
-    p0.y -= y;
-    p1.y -= y;
-    p2.y -= y;
-    uint shift = (floatBitsToUint(p0.y) >> 31) | ((floatBitsToUint(p1.y) >> 30) & 2u) |
-                 ((floatBitsToUint(p2.y) >> 29) & 4u);
+// The roots of a quadratic whose Bernstein coefficients are y0, y1, y2 (a curve's y relative to
+// the row): Lengyel's classification of their signs, which roots count (code: bit 0 the first,
+// bit 8 the second; 0 none), and the roots as in winding().
+uint row_roots(float y0, float y1, float y2, out float t1, out float t2) {
+    uint shift = (floatBitsToUint(y0) >> 31) | ((floatBitsToUint(y1) >> 30) & 2u) | ((floatBitsToUint(y2) >> 29) & 4u);
     uint code = (0x2E74u >> shift) & 0x0101u;
-    if (code == 0u) return;
-    float ay = p0.y - 2.0 * p1.y + p2.y;
-    float by = p0.y - p1.y;
-    float d = sqrt(max(by * by - ay * p0.y, 0.0));
-    float t1, t2;
+    float ay = y0 - 2.0 * y1 + y2;
+    float by = y0 - y1;
+    float d = sqrt(max(by * by - ay * y0, 0.0));
     if (abs(ay) < kLinearEpsilon) {
-        t1 = t2 = p0.y / (2.0 * by);
+        t1 = t2 = y0 / (2.0 * by);
     } else {
         t1 = (by - d) / ay;
         t2 = (by + d) / ay;
     }
-    float ax = p0.x - 2.0 * p1.x + p2.x;
-    float bx = p0.x - p1.x;
-    float x1 = (ax * t1 - 2.0 * bx) * t1 + p0.x;
-    float x2 = (ax * t2 - 2.0 * bx) * t2 + p0.x;
-    // Two roots that meet (a tangent, or a curve that misses the row) cancel exactly: skipping them
-    // keeps the walk the same whichever band range the curves come from (the CPU reference reads
-    // only the sample's band).
+    return code;
+}
+
+// The quadratic of Bernstein coefficients x0, x1, x2 at t.
+float bernstein(float x0, float x1, float x2, float t) {
+    return ((x0 - 2.0 * x1 + x2) * t - 2.0 * (x0 - x1)) * t + x0;
+}
+
+// Adds the crossings x1 and x2 that `code` counts. Two roots that meet (a tangent, or a curve
+// that misses the row) cancel exactly: skipping them keeps the walk the same whichever band range
+// the curves come from (the CPU reference reads only the sample's band).
+void row_add_roots(inout RowList r, uint code, float x1, float x2) {
     if (code == 0x0101u && x1 == x2) return;
     if ((code & 1u) != 0u) row_crossing(r, x1, 1);
     if (code > 1u) row_crossing(r, x2, -1);
+}
+
+// The crossings of one curve with the row at height y (absolute em): Lengyel's roots as in
+// winding(), as absolute x's, added to the list.
+void row_curve(inout RowList r, vec2 p0, vec2 p1, vec2 p2, float y) {
+    float t1, t2;
+    uint code = row_roots(p0.y - y, p1.y - y, p2.y - y, t1, t2);
+    if (code == 0u) return;
+    row_add_roots(r, code, bernstein(p0.x, p1.x, p2.x, t1), bernstein(p0.x, p1.x, p2.x, t2));
+}
+
+// The same for a curve in homogeneous texels (X, Y, W), W > 0: the roots of Y - y W, at X / W.
+void row_curve_projective(inout RowList r, vec3 h0, vec3 h1, vec3 h2, float y) {
+    float t1, t2;
+    uint code = row_roots(h0.y - y * h0.z, h1.y - y * h1.z, h2.y - y * h2.z, t1, t2);
+    if (code == 0u) return;
+    float x1 = bernstein(h0.x, h1.x, h2.x, t1) / bernstein(h0.z, h1.z, h2.z, t1);
+    float x2 = bernstein(h0.x, h1.x, h2.x, t2) / bernstein(h0.z, h1.z, h2.z, t2);
+    row_add_roots(r, code, x1, x2);
 }
 
 // Adds the covered stretch [from, to] of the row, clipped to each channel's segment [lo, hi].
@@ -297,6 +325,7 @@ vec3 row_walk(inout RowList r, vec3 lo, vec3 hi) {
     row_walk_step(r, 7u, lo, hi, w, at, covered);
     if (r.more) {
         r.start = at;
+        r.winding = w;  // just right of the new start: what a transformed row carries to its next pass
     } else if (w != 0) {
         row_cover(covered, at, r.end, lo, hi);
     }
@@ -319,6 +348,19 @@ float row_height(uint n) {
     return fract(float(bitfieldReverse(n)) * (1.0 / 4294967296.0) + kRasterRowOffset);
 }
 
+// Texel point (x, y) of a transformed glyph's rect in em.
+vec2 texel_em(RasterTransform m, float x, float y) {
+    vec3 h = vec3(dot(m.to_em[0].xyz, vec3(x, y, 1.0)), dot(m.to_em[1].xyz, vec3(x, y, 1.0)),
+                  dot(m.to_em[2].xyz, vec3(x, y, 1.0)));
+    return h.xy / h.z;
+}
+
+// Curve point p (em) of a transformed glyph in homogeneous texels.
+vec3 em_texel(RasterTransform m, vec2 p) {
+    vec3 q = vec3(p, 1.0);
+    return vec3(dot(m.to_texel[0].xyz, q), dot(m.to_texel[1].xyz, q), dot(m.to_texel[2].xyz, q));
+}
+
 uint band_of(RasterItem item, float y) {
     float height = (item.bbox_max_y - item.bbox_min_y) / float(item.band_count);
     if (!(height > 0.0)) return 0u;
@@ -331,6 +373,9 @@ uint band_of(RasterItem item, float y) {
 // sample and channel.
 uvec3 point_samples(RasterItem item, uint tx, uint ty) {
     uint font = item.font;
+    bool transformed = item.transform != kRasterNoTransform;
+    RasterTransform m;
+    if (transformed) m = transforms[item.transform];
     uvec3 sums = uvec3(0u);
     for (uint k = 0u; k < item.sample_count; ++k) {
         // R2: frac(0.5 + n * (1/g, 1/g^2)), g the plastic number. n stays far below 2^24.
@@ -341,7 +386,8 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
         for (int c = 0; c < 3; ++c) {
             vec4 rect = pc.channel_rects[c];
             vec2 p = vec2(float(tx), float(ty)) + mix(rect.xy, rect.zw, r2);
-            em[c] = vec2(item.offset_x + item.scale_x * p.x, item.offset_y + item.scale_y * p.y);
+            em[c] = transformed ? texel_em(m, p.x, p.y)
+                                : vec2(item.offset_x + item.scale_x * p.x, item.offset_y + item.scale_y * p.y);
             uint band = band_of(item, em[c].y);
             lo_band = min(lo_band, band);
             hi_band = max(hi_band, band);
@@ -362,7 +408,7 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
                 vec2 p0 = fonts_points[font].points[first];
                 vec2 p1 = fonts_points[font].points[first + 1u];
                 vec2 p2 = fonts_points[font].points[first + 2u];
-                if (pc.shared_rows != 0u) {
+                if (pc.shared_rows != 0u && !transformed) {
                     w += winding_row(p0, p1, p2, em[0].y, vec3(em[0].x, em[1].x, em[2].x));
                 } else {
                     w.r += winding(p0 - em[0], p1 - em[0], p2 - em[0]);
@@ -380,12 +426,16 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
 // fraction of the channel's segment in kRasterCoverageOne units.
 uvec3 row_samples(RasterItem item, uint tx, uint ty) {
     uint font = item.font;
-    // Each channel's segment in x (em), the same for every sample.
+    // A transformed glyph walks its rows in texels, others in em.
+    bool transformed = item.transform != kRasterNoTransform;
+    RasterTransform m;
+    if (transformed) m = transforms[item.transform];
+    // Each channel's segment in x, the same for every sample.
     vec3 lo, hi;
     for (int c = 0; c < 3; ++c) {
         vec4 rect = pc.channel_rects[c];
-        lo[c] = item.offset_x + item.scale_x * (float(tx) + rect.x);
-        hi[c] = item.offset_x + item.scale_x * (float(tx) + rect.z);
+        lo[c] = transformed ? float(tx) + rect.x : item.offset_x + item.scale_x * (float(tx) + rect.x);
+        hi[c] = transformed ? float(tx) + rect.z : item.offset_x + item.scale_x * (float(tx) + rect.z);
     }
     // Channels that share their rows (stripes, gray) walk one list over the union of their
     // segments; otherwise each channel is a row of its own, walked in turn.
@@ -399,7 +449,8 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
         vec3 covered = vec3(0.0);
         for (uint row = 0u; row < rows; ++row) {
             vec4 rect = pc.channel_rects[row];
-            float y = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
+            float y = float(ty) + (rect.y + (rect.w - rect.y) * v);
+            if (!transformed) y = item.offset_y + item.scale_y * y;
             // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
             vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
             RowList r;
@@ -409,13 +460,34 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             // as its fullest band has curves, where a band range shared by the subgroup took the
             // curves of all its rows' bands (the loads differ between invocations on different
             // rows, a few addresses a step).
-            uint words = item.band_offset + band_of(item, y) * item.band_words;
+            // A transformed glyph's row segment is oblique in em: it walks the bands it crosses. Its
+            // crossings past the segment's end lie in other bands, so the winding at its start is
+            // not theirs to count: it is the start's own, from a ray along em x in the start's band
+            // (winding()), negated where the map to texels reverses orientation, and carried from
+            // pass to pass.
+            uint lo_band = band_of(item, y), hi_band = lo_band, start_band = lo_band;
+            vec2 start_em = vec2(0.0);
+            int start_winding = 0;
+            if (transformed) {
+                start_em = texel_em(m, r.start, y);
+                float yb = texel_em(m, r.end, y).y;
+                start_band = band_of(item, start_em.y);
+                lo_band = band_of(item, min(start_em.y, yb));
+                hi_band = band_of(item, max(start_em.y, yb));
+            }
             // A pass per kRasterRowCrossings crossings.
             bool pending = true;
+            bool first_pass = true;
             while (pending) {
                 row_begin_pass(r);
                 for (uint word = 0u; word < item.band_words; ++word) {
-                    uint bits = fonts_bands[font].words[words + word];
+                    uint bits = 0u;
+                    for (uint band = lo_band; band <= hi_band; ++band) {
+                        bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
+                    }
+                    uint start_bits = transformed && first_pass
+                                          ? fonts_bands[font].words[item.band_offset + start_band * item.band_words + word]
+                                          : 0u;
                     while (bits != 0u) {
                         uint bit = findLSB(bits);
                         bits &= bits - 1u;
@@ -423,11 +495,20 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                         vec2 p0 = fonts_points[font].points[first];
                         vec2 p1 = fonts_points[font].points[first + 1u];
                         vec2 p2 = fonts_points[font].points[first + 2u];
-                        row_curve(r, p0, p1, p2, y);
+                        if (transformed) {
+                            row_curve_projective(r, em_texel(m, p0), em_texel(m, p1), em_texel(m, p2), y);
+                            if (((start_bits >> bit) & 1u) != 0u)
+                                start_winding += winding(p0 - start_em, p1 - start_em, p2 - start_em);
+                        } else {
+                            row_curve(r, p0, p1, p2, y);
+                        }
                     }
                 }
+                if (transformed) r.winding = first_pass ? start_winding * int(m.to_texel[0].w) : start_winding;
                 covered += row_walk(r, lo, hi) * mine;
                 pending = r.more;
+                start_winding = r.winding;
+                first_pass = false;
             }
         }
         sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),

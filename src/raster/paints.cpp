@@ -3,6 +3,7 @@
 
 #include <crisp/glyph.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace crisp::raster {
@@ -30,32 +31,55 @@ std::array<float, 4> stop_colour(const FontAsset& asset, uint32_t palette, const
     return c;
 }
 
-// Where a layer's em space lands in the target's pixels: its pen (the whole pixel plus the key's
-// subpixel offset) and its pixels per em.
+// Where a layer's em space lands in the target's pixels: pixel = (x, y) + A e, e in em (y up),
+// pixels y down. A transformed glyph's map is its key's linear part (with perspective, its local
+// affine map at the bbox centre: paints are affine).
 struct PenPlace {
-    double x = 0.0, y = 0.0;    // pixels, y down
-    double sx = 1.0, sy = 1.0;  // pixels per em
+    double x = 0.0, y = 0.0;              // pixels, y down
+    double a[4] = {1.0, 0.0, 0.0, -1.0};  // pixels per em
+    double px(double ex, double ey) const { return x + a[0] * ex + a[1] * ey; }
+    double py(double ex, double ey) const { return y + a[2] * ex + a[3] * ey; }
 };
 
 PenPlace pen_place(const DrawnGlyph& glyph, const GlyphRecord& record) {
     const GlyphInstance& instance = glyph.instance;
-    const GlyphRect rect = glyph_rect(record, instance.key);
+    const GlyphKey& key = instance.key;
+    const GlyphRect rect = glyph_rect(record, key);
     PenPlace pen;
     pen.x = static_cast<double>(instance.x) - glyph.part_x - rect.x +
-            static_cast<double>(subpixel_to_float(instance.key.subpixel_x));
+            static_cast<double>(subpixel_to_float(key.subpixel_x));
     pen.y = static_cast<double>(instance.y) - glyph.part_y - rect.y +
-            static_cast<double>(subpixel_to_float(instance.key.subpixel_y));
-    pen.sx = static_cast<double>(size_to_float(instance.key.size_x));
-    pen.sy = static_cast<double>(size_to_float(instance.key.size_y));
+            static_cast<double>(subpixel_to_float(key.subpixel_y));
+    if (!is_transformed(key)) {
+        pen.a[0] = static_cast<double>(size_to_float(key.size_x));
+        pen.a[3] = -static_cast<double>(size_to_float(key.size_y));
+        return pen;
+    }
+    double l[4], p[2];
+    for (int i = 0; i < 4; ++i) l[i] = static_cast<double>(key.linear[i]) / kLinearOne;
+    for (int i = 0; i < 2; ++i) p[i] = static_cast<double>(key.perspective[i]) / kPerspectiveOne;
+    // q(e) = L e / w(e), w = 1 + p . e; at the centre c: J = (L - q(c) p^T) / w(c).
+    const double cx = 0.5 * static_cast<double>(record.bbox_min_x + record.bbox_max_x);
+    const double cy = 0.5 * static_cast<double>(record.bbox_min_y + record.bbox_max_y);
+    const double w = 1.0 + p[0] * cx + p[1] * cy;
+    const double qx = (l[0] * cx + l[1] * cy) / w, qy = (l[2] * cx + l[3] * cy) / w;
+    pen.a[0] = (l[0] - qx * p[0]) / w;
+    pen.a[1] = (l[1] - qx * p[1]) / w;
+    pen.a[2] = (l[2] - qy * p[0]) / w;
+    pen.a[3] = (l[3] - qy * p[1]) / w;
+    pen.x += qx - pen.a[0] * cx - pen.a[1] * cy;
+    pen.y += qy - pen.a[2] * cx - pen.a[3] * cy;
     return pen;
 }
 
-// to_paint (from em, y up) after the pixels-to-em map X -> ((X - pen.x) / sx, -(Y - pen.y) / sy).
+// to_paint (from em, y up) after the pixels-to-em map, the inverse of the pen's.
 void pixel_to_paint(const Affine& m, const PenPlace& pen, float out[6]) {
     const auto wide = [](float value) { return static_cast<double>(value); };
     const double xx = wide(m.xx), xy = wide(m.xy), yx = wide(m.yx), yy = wide(m.yy), dx = wide(m.dx), dy = wide(m.dy);
-    const double ax = xx / pen.sx, bx = -xy / pen.sy;
-    const double ay = yx / pen.sx, by = -yy / pen.sy;
+    const double det = pen.a[0] * pen.a[3] - pen.a[1] * pen.a[2];
+    const double i00 = pen.a[3] / det, i01 = -pen.a[1] / det, i10 = -pen.a[2] / det, i11 = pen.a[0] / det;
+    const double ax = xx * i00 + xy * i10, bx = xx * i01 + xy * i11;
+    const double ay = yx * i00 + yy * i10, by = yx * i01 + yy * i11;
     out[0] = static_cast<float>(ax);
     out[1] = static_cast<float>(bx);
     out[2] = static_cast<float>(dx - ax * pen.x - bx * pen.y);
@@ -91,10 +115,22 @@ void FramePaints::resolve(std::span<DrawnGlyph> drawn, const HeldFonts& fonts, I
                                         : nullptr;
         const bool clipped = colour && (colour->flags & kColourClipped) != 0;
         if (clipped) {
-            fill.clip[0] = static_cast<float>(pen.x + static_cast<double>(colour->clip_min_x) * pen.sx);
-            fill.clip[1] = static_cast<float>(pen.y - static_cast<double>(colour->clip_max_y) * pen.sy);
-            fill.clip[2] = static_cast<float>(pen.x + static_cast<double>(colour->clip_max_x) * pen.sx);
-            fill.clip[3] = static_cast<float>(pen.y - static_cast<double>(colour->clip_min_y) * pen.sy);
+            // The clip box's pixel bounds (a transformed glyph's box is not axis-aligned: its bounds).
+            const double ex[2] = {static_cast<double>(colour->clip_min_x), static_cast<double>(colour->clip_max_x)};
+            const double ey[2] = {static_cast<double>(colour->clip_min_y), static_cast<double>(colour->clip_max_y)};
+            double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
+            for (double u : ex) {
+                for (double v : ey) {
+                    x0 = std::min(x0, pen.px(u, v));
+                    x1 = std::max(x1, pen.px(u, v));
+                    y0 = std::min(y0, pen.py(u, v));
+                    y1 = std::max(y1, pen.py(u, v));
+                }
+            }
+            fill.clip[0] = static_cast<float>(x0);
+            fill.clip[1] = static_cast<float>(y0);
+            fill.clip[2] = static_cast<float>(x1);
+            fill.clip[3] = static_cast<float>(y1);
         }
         if (paint.kind == PaintKind::solid) {
             // One colour: the instance's, linear and straight, with the text's alpha.

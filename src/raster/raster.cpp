@@ -21,6 +21,7 @@ constexpr vk::Binding kBindings[] = {
     {gpu::kRasterBindPoints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages},
     {gpu::kRasterBindBands, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kRendererFontPages},
     {gpu::kRasterBindWorkgroupItems, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kRasterBindTransforms, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
 };
 constexpr vk::BindingTable kTable{kBindings, VK_SHADER_STAGE_COMPUTE_BIT};
 
@@ -31,9 +32,28 @@ static_assert(static_cast<uint32_t>(SampleKind::rows) == gpu::kRasterSampleRows)
 static_assert(static_cast<uint32_t>(SampleKind::points) == gpu::kRasterSamplePoints);
 static_assert(kRendererFontPages == gpu::kRasterFontPages);
 
+namespace {
+
+gpu::vec4 row_of(const Projective& map, int row) {
+    const double* m = map.m + 3 * row;
+    return {static_cast<float>(m[0]), static_cast<float>(m[1]), static_cast<float>(m[2]), 0.0f};
+}
+
+// +1 where the map keeps the orientation of em (y up) in texels (y down), -1 where it reverses it
+// (every unmirrored glyph: y flips): the sign of its determinant, W being positive.
+float orientation(const Projective& map) {
+    const double* m = map.m;
+    const double det =
+        m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) + m[2] * (m[3] * m[7] - m[4] * m[6]);
+    return det > 0.0 ? 1.0f : -1.0f;
+}
+
+}  // namespace
+
 uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fonts, std::vector<gpu::RasterItem>& items,
-                          std::vector<uint32_t>& workgroup_items) {
+                          std::vector<gpu::RasterTransform>& transforms, std::vector<uint32_t>& workgroup_items) {
     items.clear();
+    transforms.clear();
     workgroup_items.clear();
     uint32_t workgroups = 0;
     for (const RasterWork& w : work) {
@@ -41,8 +61,18 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
         if (!font || w.sample_count == 0) continue;
         const GlyphRecord& glyph = font->asset->glyphs[w.key.glyph];
         const GlyphRect rect = glyph_rect(glyph, w.key);
-        const TexelToEm map = texel_to_em(rect, w.key);
         gpu::RasterItem item{};
+        item.transform = gpu::kRasterNoTransform;
+        if (is_transformed(w.key)) {
+            const Projective to_texel = em_to_texel(rect, w.key);
+            const Projective to_em = inverse(to_texel);
+            item.transform = static_cast<uint32_t>(transforms.size());
+            gpu::RasterTransform t{{row_of(to_texel, 0), row_of(to_texel, 1), row_of(to_texel, 2)},
+                                   {row_of(to_em, 0), row_of(to_em, 1), row_of(to_em, 2)}};
+            t.to_texel[0].w = orientation(to_texel);
+            transforms.push_back(t);
+        }
+        const TexelToEm map = is_transformed(w.key) ? TexelToEm{} : texel_to_em(rect, w.key);
         item.atlas_x = w.x;
         item.atlas_y = w.y;
         item.width = w.width;
@@ -81,8 +111,11 @@ Status RasterPass::make_item_buffers(uint32_t capacity, uint64_t atlas_texels, u
     // texels plus one partial workgroup per item.
     const uint64_t workgroups = atlas_texels / gpu::kRasterWorkgroupSize + capacity;
     if (workgroups > UINT32_MAX) return Error{ErrorCode::invalid_argument, "renderer: the atlas is too large"};
-    // The table starts at an offset every device accepts for a storage buffer (at most 256).
-    const VkDeviceSize offset = (VkDeviceSize{capacity} * sizeof(gpu::RasterItem) + 255) / 256 * 256;
+    // The transforms and the table start at offsets every device accepts for a storage buffer (at
+    // most 256).
+    const auto aligned = [](VkDeviceSize bytes) { return (bytes + 255) / 256 * 256; };
+    const VkDeviceSize transform_offset = aligned(VkDeviceSize{capacity} * sizeof(gpu::RasterItem));
+    const VkDeviceSize offset = transform_offset + aligned(VkDeviceSize{capacity} * sizeof(gpu::RasterTransform));
     const VkDeviceSize bytes = offset + workgroups * sizeof(uint32_t);
     vk::DeviceBuffer device_items;
     if (Status s = vk::create_buffer(ref_, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -104,6 +137,7 @@ Status RasterPass::make_item_buffers(uint32_t capacity, uint64_t atlas_texels, u
     item_staging_ = std::move(staging);
     item_capacity_ = capacity;
     workgroup_capacity_ = static_cast<uint32_t>(workgroups);
+    transform_offset_ = transform_offset;
     table_offset_ = offset;
     return {};
 }
@@ -142,7 +176,8 @@ void RasterPass::write_descriptors(VkDescriptorSet set, VkImageView atlas, std::
     }
     vk::DescriptorWrites(kTable, set)
         .storage_image(gpu::kRasterBindAtlas, atlas)
-        .storage_buffer(gpu::kRasterBindItems, items_.buffer, 0, table_offset_)
+        .storage_buffer(gpu::kRasterBindItems, items_.buffer, 0, transform_offset_)
+        .storage_buffer(gpu::kRasterBindTransforms, items_.buffer, transform_offset_, table_offset_ - transform_offset_)
         .storage_buffers(gpu::kRasterBindPoints, point_infos)
         .storage_buffers(gpu::kRasterBindBands, band_infos)
         .storage_buffer(gpu::kRasterBindWorkgroupItems, items_.buffer, table_offset_)
@@ -158,7 +193,7 @@ Status RasterPass::fit(uint32_t cells, uint64_t atlas_texels, uint64_t this_fram
 
 uint32_t RasterPass::build(std::span<const RasterWork> work, const HeldFonts& fonts, const GlyphAtlas& atlas,
                            RendererStats& stats) {
-    const uint32_t workgroups = build_work_items(work, fonts, item_data_, workgroup_items_);
+    const uint32_t workgroups = build_work_items(work, fonts, item_data_, transform_data_, workgroup_items_);
     stats.work_items = static_cast<uint32_t>(item_data_.size());
     stats.workgroups = workgroups;
     stats.samples = atlas.stats().frame.samples;
@@ -183,13 +218,17 @@ void RasterPass::record_upload(VkCommandBuffer command_buffer, uint64_t this_fra
         assert(item_data_.size() <= item_capacity_ && workgroup_items_.size() <= workgroup_capacity_);
         const vk::DeviceBuffer& staging = item_staging_[this_frame % options_.frames_in_flight];
         const VkDeviceSize item_bytes = item_data_.size() * sizeof(gpu::RasterItem);
+        const VkDeviceSize transform_bytes = transform_data_.size() * sizeof(gpu::RasterTransform);
         const VkDeviceSize table_bytes = workgroup_items_.size() * sizeof(uint32_t);
         auto* bytes = static_cast<std::byte*>(staging.mapped);
         std::memcpy(bytes, item_data_.data(), item_bytes);
+        if (transform_bytes != 0) std::memcpy(bytes + transform_offset_, transform_data_.data(), transform_bytes);
         std::memcpy(bytes + table_offset_, workgroup_items_.data(), table_bytes);
-        const VkBufferCopy copies[2] = {{0, 0, item_bytes}, {table_offset_, table_offset_, table_bytes}};
-        fn.vkCmdCopyBuffer(command_buffer, staging.buffer, items_.buffer, 2, copies);
-        stats.upload_bytes += item_bytes + table_bytes;
+        const VkBufferCopy copies[3] = {{0, 0, item_bytes},
+                                        {table_offset_, table_offset_, table_bytes},
+                                        {transform_offset_, transform_offset_, transform_bytes}};
+        fn.vkCmdCopyBuffer(command_buffer, staging.buffer, items_.buffer, transform_bytes != 0 ? 3 : 2, copies);
+        stats.upload_bytes += item_bytes + transform_bytes + table_bytes;
     }
     if (fonts_uploaded || !item_data_.empty()) {
         vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,

@@ -25,8 +25,9 @@ namespace crisp::raster {
 // The rasterizer's work items for `work` into `items`, and into `workgroup_items` the item of
 // each workgroup; returns the workgroups they take. Work of a font not held, or without samples,
 // makes none.
+// Transformed glyphs' items point into `transforms`, one per such item.
 uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fonts, std::vector<gpu::RasterItem>& items,
-                          std::vector<uint32_t>& workgroup_items);
+                          std::vector<gpu::RasterTransform>& transforms, std::vector<uint32_t>& workgroup_items);
 
 // What the rasterizer samples (RendererCreateInfo), fixed at create().
 struct RasterOptions {
@@ -63,17 +64,19 @@ private:
 
     const vk::DeviceRef& ref_;
     RasterOptions options_;
-    // Device-local: RasterItem[item_capacity], then at table_offset the item of each workgroup,
-    // uint[workgroup_capacity].
+    // Device-local: RasterItem[item_capacity], at transform_offset RasterTransform[item_capacity],
+    // then at table_offset the item of each workgroup, uint[workgroup_capacity].
     vk::DeviceBuffer items_;
     // Host-visible and mapped, one per frame in flight, laid out as `items`: a frame's items and
     // table are written here and copied into `items` by its command buffer.
     std::vector<vk::DeviceBuffer> item_staging_;
     uint32_t item_capacity_ = 0;
     uint32_t workgroup_capacity_ = 0;
+    VkDeviceSize transform_offset_ = 0;
     VkDeviceSize table_offset_ = 0;
     vk::DeviceBuffer dummy_;  // bound to the font slots no font uses
     std::vector<gpu::RasterItem> item_data_;
+    std::vector<gpu::RasterTransform> transform_data_;
     std::vector<uint32_t> workgroup_items_;  // this frame's table
 
     vk::DeviceObjects objects_;  // the shader module and the pipeline

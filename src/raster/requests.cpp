@@ -1,6 +1,7 @@
 #include "raster/requests.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <iterator>
 
@@ -47,18 +48,19 @@ void MotionTracker::begin_frame() {
     undo_.clear();
 }
 
-bool MotionTracker::moving(uint64_t id, double x, double y) {
-    auto [it, added] = motions_.try_emplace(id, Motion{x, y, 0, frames_begun_});
+bool MotionTracker::moving(uint64_t id, double x, double y, uint64_t shape) {
+    auto [it, added] = motions_.try_emplace(id, Motion{x, y, shape, 0, frames_begun_});
     Motion& m = it->second;
     if (added) {
         undo_.emplace_back(id, std::nullopt);
     } else if (m.seen != frames_begun_) {  // its first draw this frame
         undo_.emplace_back(id, m);
     }
-    if (!added && (m.pen_x != x || m.pen_y != y)) {
+    if (!added && (m.pen_x != x || m.pen_y != y || m.shape != shape)) {
         m.moved = frames_begun_;
         m.pen_x = x;
         m.pen_y = y;
+        m.shape = shape;
     }
     m.seen = frames_begun_;
     return m.moved != 0 && frames_begun_ - m.moved < kMotionSettleFrames;
@@ -75,6 +77,33 @@ void MotionTracker::abandon_frame() {
     undo_.clear();
     --frames_begun_;
 }
+
+namespace {
+
+// A fingerprint of a draw's transform or plane: any change of a value changes it (0: none).
+uint64_t shape_of(const DrawOptions& options) {
+    uint64_t h = 0;
+    const auto add = [&](float v) {
+        uint32_t bits = 0;
+        std::memcpy(&bits, &v, sizeof bits);
+        h = (h ^ bits) * 0x100000001B3ull + 0x9E3779B97F4A7C15ull;
+    };
+    if (options.transform) {
+        for (float v : {options.transform->a, options.transform->b, options.transform->c, options.transform->d,
+                        options.transform->pivot_x, options.transform->pivot_y})
+            add(v);
+    }
+    if (options.plane) {
+        for (const auto* v : {&options.plane->origin, &options.plane->axis_x, &options.plane->axis_y}) {
+            for (float f : *v) add(f);
+        }
+        for (float f : options.plane->view_projection) add(f);
+        for (float f : options.plane->viewport) add(f);
+    }
+    return h;
+}
+
+}  // namespace
 
 FrameRequests::FrameRequests(GlyphAtlas& atlas, const HeldFonts& fonts, Coarsening& coarsening, RendererStats& stats)
     : atlas_(atlas), fonts_(fonts), coarsening_(coarsening), stats_(stats) {}
@@ -103,7 +132,10 @@ void FrameRequests::add(const GlyphInstance& glyph, const VkRect2D* visible, uin
 void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions& options, MotionTracker& motion) {
     if (glyphs.empty()) return;
     const double dx = static_cast<double>(options.offset_x), dy = static_cast<double>(options.offset_y);
-    if (!std::isfinite(dx) || !std::isfinite(dy) || (options.contrast && !validate_text_contrast(*options.contrast))) {
+    const bool bad_transform = (options.transform && !valid_transform(*options.transform)) ||
+                               (options.plane && !valid_plane(*options.plane)) || (options.transform && options.plane);
+    if (!std::isfinite(dx) || !std::isfinite(dy) || bad_transform ||
+        (options.contrast && !validate_text_contrast(*options.contrast))) {
         const auto count = static_cast<uint32_t>(std::min<size_t>(glyphs.size(), UINT32_MAX));
         stats_.skipped_glyphs += count;
         unplaceable_ += count;
@@ -118,26 +150,66 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
         }
     }
     uint32_t steps = kSubpixelSteps;
+    TransformSteps transform_steps = kStillTransformSteps;
     if (options.id != 0) {
         const GlyphInstance& first = glyphs.front();
-        if (motion.moving(options.id, static_cast<double>(first.pen_x) + dx, static_cast<double>(first.pen_y) + dy)) {
+        if (motion.moving(options.id, static_cast<double>(first.pen_x) + dx, static_cast<double>(first.pen_y) + dy,
+                          shape_of(options))) {
             steps = kMovingSubpixelSteps;
+            transform_steps = kMovingTransformSteps;
             stats_.moving_glyphs += static_cast<uint32_t>(std::min<size_t>(glyphs.size(), UINT32_MAX));
         }
     }
     const VkRect2D* visible = options.visible ? &*options.visible : nullptr;
     for (const GlyphInstance& asked : glyphs) {
         GlyphInstance glyph = asked;
-        if (!moved(fonts_.asset(glyph.key.font), glyph, dx, dy)) {
+        float depth = glyph.depth;
+        const Placed placed = place(glyph, options, transform_steps, dx, dy, depth);
+        if (placed == Placed::culled) {
+            ++stats_.culled_glyphs;
+            continue;
+        }
+        if (placed == Placed::refused) {
             ++stats_.skipped_glyphs;
             ++unplaceable_;
             continue;
         }
+        glyph.depth = depth;
         if (options.color) std::copy(std::begin(color), std::end(color), std::begin(glyph.color));
         if (options.depth) glyph.depth = *options.depth;
         if (options.palette) glyph.palette = *options.palette;
         add(glyph, visible, steps, options.contrast ? *options.contrast : contrast_);
     }
+}
+
+// `glyph` moved by (dx, dy), or placed at the draw's transform or on its plane (depth: the glyph's
+// on the plane).
+FrameRequests::Placed FrameRequests::place(GlyphInstance& glyph, const DrawOptions& options,
+                                           const TransformSteps& steps, double dx, double dy, float& depth) const {
+    const FontAsset* asset = fonts_.asset(glyph.key.font);
+    if (!options.transform && !options.plane) return moved(asset, glyph, dx, dy) ? Placed::placed : Placed::refused;
+    if (!asset || glyph.key.glyph >= asset->glyphs.size()) return Placed::placed;  // admit() counts it
+    // Transforms apply to glyphs as laid out: one already transformed is refused.
+    if (is_transformed(glyph.key)) return Placed::refused;
+    const GlyphRecord& record = asset->glyphs[glyph.key.glyph];
+    const double sx = static_cast<double>(glyph.key.size_x) / kSizeOne,
+                 sy = static_cast<double>(glyph.key.size_y) / kSizeOne;
+    const double pen_x = static_cast<double>(glyph.pen_x), pen_y = static_cast<double>(glyph.pen_y);
+    GlyphPlacement placement;
+    if (options.transform) {
+        placement = place_transformed(*options.transform, pen_x, pen_y, sx, sy, dx, dy);
+    } else {
+        const PlanePlacement on_plane = place_on_plane(*options.plane, record, pen_x + dx, pen_y + dy, sx, sy);
+        if (!on_plane.visible) return Placed::culled;
+        placement = on_plane.place;
+        depth = on_plane.depth;
+    }
+    GlyphInstance out = glyph;
+    out.key.subpixel_x = out.key.subpixel_y = 0;
+    if (!place_glyph(record, placement, {steps.linear, steps.perspective, steps.subpixel}, out)) return Placed::refused;
+    if (record.curve_count != 0 && (out.width == 0 || out.height == 0)) return Placed::culled;
+    glyph = out;
+    return Placed::placed;
 }
 
 // One draw()n instance: at the frame's subpixel steps, then culled, admitted whole, or kept

@@ -9,6 +9,7 @@
 
 #include <crisp/atlas.hpp>
 #include <crisp/renderer.hpp>
+#include <crisp/transform.hpp>
 
 #include <cstdint>
 #include <optional>
@@ -31,14 +32,16 @@ public:
     static constexpr uint64_t kForgetMotionFrames = 256;
 
     void begin_frame();
-    // Whether the named draw whose first glyph's pen is (x, y) this frame moved lately.
-    bool moving(uint64_t id, double x, double y);
+    // Whether the named draw whose first glyph's pen is (x, y) this frame, drawn at a transform
+    // whose fingerprint is `shape` (0: none), moved or changed its transform lately.
+    bool moving(uint64_t id, double x, double y, uint64_t shape = 0);
     // The named draws as they were before this frame's begin_frame(), as if it never began.
     void abandon_frame();
 
 private:
     struct Motion {
         double pen_x = 0.0, pen_y = 0.0;  // a named draw's first glyph's pen, offset included
+        uint64_t shape = 0;               // its transform's fingerprint
         uint64_t moved = 0;               // the frame its pen last changed (0: never seen move)
         uint64_t seen = 0;                // the frame it was last drawn
     };
@@ -98,6 +101,9 @@ private:
         GlyphContrast contrast;
     };
 
+    enum class Placed { placed, refused, culled };
+    Placed place(GlyphInstance& glyph, const DrawOptions& options, const TransformSteps& steps, double dx, double dy,
+                 float& depth) const;
     void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps, const GlyphContrast& contrast);
     void admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
                const TexelRect* shown = nullptr);

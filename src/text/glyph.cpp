@@ -1,5 +1,6 @@
 #include <crisp/glyph.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -22,11 +23,60 @@ size_t GlyphKeyHash::operator()(const GlyphKey& key) const {
     const uint64_t a = (uint64_t{key.font} << 32) | key.glyph;
     const uint64_t b =
         (uint64_t{key.size_x} << 40) ^ (uint64_t{key.size_y} << 16) ^ (uint64_t{key.subpixel_x} << 8) ^ key.subpixel_y;
-    return static_cast<size_t>(mix(a ^ mix(b)));
+    uint64_t h = mix(a ^ mix(b));
+    if (is_transformed(key) || key.perspective[0] != 0 || key.perspective[1] != 0) {
+        const auto word = [](int32_t v) { return static_cast<uint64_t>(static_cast<uint32_t>(v)); };
+        h = mix(h ^ ((word(key.linear[0]) << 32) | word(key.linear[1])));
+        h = mix(h ^ ((word(key.linear[2]) << 32) | word(key.linear[3])));
+        h = mix(h ^ ((word(key.perspective[0]) << 32) | word(key.perspective[1])));
+    }
+    return static_cast<size_t>(h);
 }
+
+namespace {
+
+// A transformed key's em-to-pixel map relative to the pen's whole pixel: q = sub + (L e) / w,
+// w = 1 + p . e.
+struct KeyMap {
+    double l[4] = {};
+    double p[2] = {};
+    double sub_x = 0.0, sub_y = 0.0;
+
+    explicit KeyMap(const GlyphKey& key) {
+        for (int i = 0; i < 4; ++i) l[i] = static_cast<double>(key.linear[i]) / kLinearOne;
+        for (int i = 0; i < 2; ++i) p[i] = static_cast<double>(key.perspective[i]) / kPerspectiveOne;
+        sub_x = static_cast<double>(key.subpixel_x) / kSubpixelSteps;
+        sub_y = static_cast<double>(key.subpixel_y) / kSubpixelSteps;
+    }
+};
+
+GlyphRect transformed_rect(const GlyphRecord& glyph, const GlyphKey& key) {
+    const KeyMap map(key);
+    double lo_x = HUGE_VAL, lo_y = HUGE_VAL, hi_x = -HUGE_VAL, hi_y = -HUGE_VAL;
+    for (int corner = 0; corner < 4; ++corner) {
+        const double ex = static_cast<double>((corner & 1) != 0 ? glyph.bbox_max_x : glyph.bbox_min_x);
+        const double ey = static_cast<double>((corner & 2) != 0 ? glyph.bbox_max_y : glyph.bbox_min_y);
+        const double w = 1.0 + map.p[0] * ex + map.p[1] * ey;
+        if (!(w >= kMinPerspectiveW)) return {};
+        const double qx = map.sub_x + (map.l[0] * ex + map.l[1] * ey) / w;
+        const double qy = map.sub_y + (map.l[2] * ex + map.l[3] * ey) / w;
+        if (!(std::abs(qx) <= kMaxTransformedExtent && std::abs(qy) <= kMaxTransformedExtent)) return {};
+        lo_x = std::min(lo_x, qx);
+        hi_x = std::max(hi_x, qx);
+        lo_y = std::min(lo_y, qy);
+        hi_y = std::max(hi_y, qy);
+    }
+    const double left = std::floor(lo_x) - kGlyphPadding, right = std::ceil(hi_x) + kGlyphPadding;
+    const double top = std::floor(lo_y) - kGlyphPadding, bottom = std::ceil(hi_y) + kGlyphPadding;
+    return {static_cast<int32_t>(left), static_cast<int32_t>(top), static_cast<uint32_t>(right - left),
+            static_cast<uint32_t>(bottom - top)};
+}
+
+}  // namespace
 
 GlyphRect glyph_rect(const GlyphRecord& glyph, const GlyphKey& key) {
     if (glyph.curve_count == 0) return {};
+    if (is_transformed(key)) return transformed_rect(glyph, key);
     const double size_x = static_cast<double>(key.size_x) / kSizeOne;
     const double size_y = static_cast<double>(key.size_y) / kSizeOne;
     const double sub_x = static_cast<double>(key.subpixel_x) / kSubpixelSteps;
@@ -52,8 +102,71 @@ TexelToEm texel_to_em(const GlyphRect& rect, const GlyphKey& key) {
     return mapping;
 }
 
+Projective em_to_texel(const GlyphRect& rect, const GlyphKey& key) {
+    const KeyMap map(key);
+    double l[4] = {static_cast<double>(key.size_x) / kSizeOne, 0.0, 0.0, -static_cast<double>(key.size_y) / kSizeOne};
+    if (is_transformed(key)) std::copy(std::begin(map.l), std::end(map.l), std::begin(l));
+    const double p[2] = {is_transformed(key) ? map.p[0] : 0.0, is_transformed(key) ? map.p[1] : 0.0};
+    const double ox = map.sub_x - rect.x, oy = map.sub_y - rect.y;
+    return {{l[0] + ox * p[0], l[1] + ox * p[1], ox, l[2] + oy * p[0], l[3] + oy * p[1], oy, p[0], p[1], 1.0}};
+}
+
+Projective inverse(const Projective& map) {
+    const double* m = map.m;
+    const double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8], c02 = m[3] * m[7] - m[4] * m[6];
+    const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+    if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return {};
+    const double r = 1.0 / det;
+    return {{c00 * r, (m[2] * m[7] - m[1] * m[8]) * r, (m[1] * m[5] - m[2] * m[4]) * r, c01 * r,
+             (m[0] * m[8] - m[2] * m[6]) * r, (m[2] * m[3] - m[0] * m[5]) * r, c02 * r, (m[1] * m[6] - m[0] * m[7]) * r,
+             (m[0] * m[4] - m[1] * m[3]) * r}};
+}
+
+namespace {
+
+// The curves a band range lists together (each counted once).
+uint64_t curves_in_bands(const FontAsset& asset, const GlyphRecord& glyph, uint32_t lo, uint32_t hi) {
+    uint64_t count = 0;
+    for (size_t w = 0; w < glyph.band_words; ++w) {
+        uint32_t bits = 0;
+        for (uint32_t band = lo; band <= hi; ++band)
+            bits |= asset.band_words[size_t{glyph.band_offset} + size_t{band} * glyph.band_words + w];
+        count += static_cast<uint64_t>(std::popcount(bits));
+    }
+    return count;
+}
+
+// A transformed glyph's cost: each texel's row walks the bands its em segment crosses (the
+// rasterizer's rule), estimated on a grid of at most 64 x 64 texels scaled to the rect.
+uint64_t transformed_curve_tests(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key) {
+    const GlyphRect rect = glyph_rect(glyph, key);
+    if (rect.width == 0 || rect.height == 0) return 0;
+    const Projective to_em = inverse(em_to_texel(rect, key));
+    const auto em_y = [&](double x, double y) {
+        const double* m = to_em.m;
+        return (m[3] * x + m[4] * y + m[5]) / (m[6] * x + m[7] * y + m[8]);
+    };
+    const uint32_t step_x = std::max(1u, rect.width / 64), step_y = std::max(1u, rect.height / 64);
+    uint64_t tests = 0;
+    for (uint32_t ty = 0; ty < rect.height; ty += step_y) {
+        const uint32_t rows = std::min(step_y, rect.height - ty);
+        for (uint32_t tx = 0; tx < rect.width; tx += step_x) {
+            const uint32_t columns = std::min(step_x, rect.width - tx);
+            const double y = ty + 0.5;
+            const auto a = static_cast<float>(em_y(tx, y)), b = static_cast<float>(em_y(tx + 1.0, y));
+            const uint32_t lo = FontAsset::band_of(glyph, std::min(a, b)),
+                           hi = FontAsset::band_of(glyph, std::max(a, b));
+            tests += curves_in_bands(asset, glyph, lo, hi) * rows * columns;
+        }
+    }
+    return tests;
+}
+
+}  // namespace
+
 uint64_t curve_tests_per_sample(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key) {
     if (glyph.curve_count == 0 || glyph.band_count == 0) return 0;
+    if (is_transformed(key)) return transformed_curve_tests(asset, glyph, key);
     const GlyphRect rect = glyph_rect(glyph, key);
     const TexelToEm map = texel_to_em(rect, key);
     uint64_t tests = 0;
