@@ -104,6 +104,7 @@ struct RasterItem {
     uint texel_count;
     uint first_workgroup;  // this item's first workgroup; the items' ranges tile the dispatch, in order
     uint transform;        // index into RasterTransform[], or kRasterNoTransform
+    uint flat_row;         // transformed: first word of its flat curves' row in the band buffer, or kRasterNoTransform
 };
 
 // A transformed glyph's maps (include/crisp/glyph.hpp, em_to_texel): rows of 3x3 projective
@@ -347,7 +348,7 @@ struct TilePushConstants {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RasterItem) == 92);
+static_assert(sizeof(RasterItem) == 96);
 static_assert(sizeof(RasterTransform) == 96);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
 static_assert(sizeof(TileBinEntry) == 32);

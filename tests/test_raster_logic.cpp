@@ -76,7 +76,7 @@ GlyphAtlas make_atlas(uint32_t side) {
 // A renderer's CPU parts over one atlas and the test font.
 struct Frame {
     explicit Frame(uint32_t atlas_side) : atlas(make_atlas(atlas_side)), requests(atlas, fonts, coarsening, stats) {
-        fonts.fonts[kFontId] = {&test_font().asset(), 0, 0, 0};
+        fonts.fonts[kFontId] = {&test_font().asset(), 0, 0, 0, {}};
     }
     void begin() {
         atlas.begin_frame();
@@ -356,7 +356,7 @@ TEST(RasterWorkItems, ItemsAddressTheirFontsRangesAndTileTheWorkgroups) {
     const GlyphInstance g = glyph_at(24.0f, 0.5f, 30.0f, "g");
     TestFonts fonts;
     const uint64_t points_at = 1000 * sizeof(Point), bands_at = 64 * sizeof(uint32_t);
-    fonts.fonts[kFontId] = {&test_font().asset(), 5, points_at, bands_at};
+    fonts.fonts[kFontId] = {&test_font().asset(), 5, points_at, bands_at, {}};
     RasterWork first{};
     first.key = h.key;
     first.x = 32;
@@ -440,7 +440,7 @@ FontAsset painted_asset() {
 TEST(FramePaints, SolidFillsBecomeColoursAndGradientsMapPixelsToTheirSpace) {
     const FontAsset asset = painted_asset();
     TestFonts fonts;
-    fonts.fonts[kFontId] = {&asset, 0, 0, 0};
+    fonts.fonts[kFontId] = {&asset, 0, 0, 0, {}};
     const GlyphInstance base = glyph_at(32.0f, 10.3f, 40.6f);
     auto layer = [&](uint32_t paint, uint32_t palette, uint32_t colour_glyph) {
         DrawnGlyph drawn;

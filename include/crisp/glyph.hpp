@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 namespace crisp {
 
@@ -107,6 +108,13 @@ struct Projective {
 CRISP_API Projective em_to_texel(const GlyphRect& rect, const GlyphKey& key);
 // The inverse of a projective map; the identity for a singular one.
 CRISP_API Projective inverse(const Projective& map);
+
+// The glyph's curves that are flat in y (horizontal lines in em), as bits over its curve slots
+// (glyph.band_words words; empty when it has none). No band lists them, since a horizontal ray
+// never crosses one, but the oblique rows of a transformed glyph do. A slot counts when its three
+// points share y and its control point is not its start (a pad slot between contours repeats its
+// start; a line's control point is its midpoint). `asset` must be valid (load_asset()).
+CRISP_API std::vector<uint32_t> flat_curve_words(const FontAsset& asset, const GlyphRecord& glyph);
 
 // What one sample of every texel of the glyph's rect costs the rasterizer, in curve tests: the
 // sum over the rect's rows of its width times the curves listed in the band of the row's centre.

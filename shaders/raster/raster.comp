@@ -348,6 +348,10 @@ float row_height(uint n) {
     return fract(float(bitfieldReverse(n)) * (1.0 / 4294967296.0) + kRasterRowOffset);
 }
 
+// How far left of its segment a transformed row starts (texels): an odd fraction, unlike curve
+// positions on a fixed-point grid.
+const float kTransformedStartBack = 0.000707107;
+
 // Texel point (x, y) of a transformed glyph's rect in em.
 vec2 texel_em(RasterTransform m, float x, float y) {
     vec3 h = vec3(dot(m.to_em[0].xyz, vec3(x, y, 1.0)), dot(m.to_em[1].xyz, vec3(x, y, 1.0)),
@@ -469,6 +473,10 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             vec2 start_em = vec2(0.0);
             int start_winding = 0;
             if (transformed) {
+                // The start a hair left of the segment, so that it is not on a curve where the
+                // segment begins at one (a stem on the texel's edge): the walk clips to the
+                // channels' segments, so the stretch before them adds nothing.
+                r.start -= kTransformedStartBack;
                 start_em = texel_em(m, r.start, y);
                 float yb = texel_em(m, r.end, y).y;
                 start_band = band_of(item, start_em.y);
@@ -485,6 +493,9 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                     for (uint band = lo_band; band <= hi_band; ++band) {
                         bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
                     }
+                    // Curves flat in em, which no band lists, cross oblique rows.
+                    if (transformed && item.flat_row != kRasterNoTransform)
+                        bits |= fonts_bands[font].words[item.flat_row + word];
                     uint start_bits = transformed && first_pass
                                           ? fonts_bands[font].words[item.band_offset + start_band * item.band_words + word]
                                           : 0u;

@@ -71,7 +71,15 @@ Status FontStore::add(const Font& font) {
     GpuFont gpu;
     gpu.asset = &asset;
     gpu.points_bytes = asset.points.size() * sizeof(Point);
-    gpu.bands_bytes = asset.band_words.size() * sizeof(uint32_t);
+    gpu.flat_row_of.assign(asset.glyphs.size(), kNoFlatRow);
+    for (size_t g = 0; g < asset.glyphs.size(); ++g) {
+        const std::vector<uint32_t> row = flat_curve_words(asset, asset.glyphs[g]);
+        if (row.empty()) continue;
+        gpu.flat_row_of[g] = static_cast<uint32_t>(asset.band_words.size() + gpu.flat_words.size());
+        gpu.flat_words.insert(gpu.flat_words.end(), row.begin(), row.end());
+    }
+    gpu.flat_rows = gpu.flat_row_of;  // moving the vector keeps its storage
+    gpu.bands_bytes = (asset.band_words.size() + gpu.flat_words.size()) * sizeof(uint32_t);
     if (std::max(gpu.points_bytes, gpu.bands_bytes) > max_range_) {
         return Error{ErrorCode::vulkan,
                      "renderer: the font's " +
@@ -89,7 +97,12 @@ Status FontStore::add(const Font& font) {
     }
     auto* bytes = static_cast<std::byte*>(gpu.staging.mapped);
     if (gpu.points_bytes) std::memcpy(bytes, asset.points.data(), gpu.points_bytes);
-    if (gpu.bands_bytes) std::memcpy(bytes + gpu.points_bytes, asset.band_words.data(), gpu.bands_bytes);
+    const size_t asset_band_bytes = asset.band_words.size() * sizeof(uint32_t);
+    if (asset_band_bytes) std::memcpy(bytes + gpu.points_bytes, asset.band_words.data(), asset_band_bytes);
+    if (!gpu.flat_words.empty()) {
+        std::memcpy(bytes + gpu.points_bytes + asset_band_bytes, gpu.flat_words.data(),
+                    gpu.flat_words.size() * sizeof(uint32_t));
+    }
     // A removed font's place is taken again before the list grows.
     const auto free_place = std::find_if(fonts_.begin(), fonts_.end(), [](const GpuFont& f) { return !f.asset; });
     const auto index = static_cast<uint32_t>(free_place - fonts_.begin());

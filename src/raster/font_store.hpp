@@ -33,6 +33,8 @@ struct FontPage {
 };
 
 struct GpuFont : HeldFont {
+    std::vector<uint32_t> flat_row_of;  // HeldFont::flat_rows
+    std::vector<uint32_t> flat_words;   // the rows, uploaded after the asset's band words
     VkDeviceSize points_bytes = 0;
     VkDeviceSize bands_bytes = 0;
     vk::DeviceBuffer staging;  // host-visible, points then bands; freed once copied and done

@@ -6,6 +6,7 @@
 #include <crisp/glyph.hpp>
 
 #include <cstdint>
+#include <span>
 
 namespace crisp::raster {
 
@@ -14,7 +15,12 @@ struct HeldFont {
     uint32_t page = 0;                 // the font page that holds its ranges
     uint64_t points_at = 0;            // byte offsets of its ranges in the page's buffers
     uint64_t bands_at = 0;
+    // Per glyph, where its flat curves' row (flat_curve_words()) starts, in words from bands_at
+    // (after the asset's band words), or kNoFlatRow: what a transformed glyph's rows add.
+    std::span<const uint32_t> flat_rows;
 };
+
+inline constexpr uint32_t kNoFlatRow = 0xFFFFFFFFu;
 
 class HeldFonts {
 public:

@@ -63,7 +63,10 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
         const GlyphRect rect = glyph_rect(glyph, w.key);
         gpu::RasterItem item{};
         item.transform = gpu::kRasterNoTransform;
+        item.flat_row = gpu::kRasterNoTransform;
         if (is_transformed(w.key)) {
+            const uint32_t row = w.key.glyph < font->flat_rows.size() ? font->flat_rows[w.key.glyph] : kNoFlatRow;
+            if (row != kNoFlatRow) item.flat_row = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + row;
             const Projective to_texel = em_to_texel(rect, w.key);
             const Projective to_em = inverse(to_texel);
             item.transform = static_cast<uint32_t>(transforms.size());

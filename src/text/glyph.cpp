@@ -164,6 +164,17 @@ uint64_t transformed_curve_tests(const FontAsset& asset, const GlyphRecord& glyp
 
 }  // namespace
 
+std::vector<uint32_t> flat_curve_words(const FontAsset& asset, const GlyphRecord& glyph) {
+    std::vector<uint32_t> words;
+    for (uint32_t slot = 0; slot < glyph.curve_count; ++slot) {
+        const Point* p = &asset.points[size_t{glyph.point_offset} + 2 * size_t{slot}];
+        if (p[0].y != p[1].y || p[1].y != p[2].y || (p[1].x == p[0].x && p[1].y == p[0].y)) continue;
+        if (words.empty()) words.assign(glyph.band_words, 0u);
+        words[slot / 32] |= 1u << (slot % 32);
+    }
+    return words;
+}
+
 uint64_t curve_tests_per_sample(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key) {
     if (glyph.curve_count == 0 || glyph.band_count == 0) return 0;
     if (is_transformed(key)) return transformed_curve_tests(asset, glyph, key);
