@@ -84,10 +84,6 @@ Error render_and_measure(const Font& font, std::span<const GlyphInstance> glyphs
                     const double got = static_cast<double>(sums[c]) / (kCoverageOne * std::max<uint32_t>(t.count, 1));
                     if (truth[c] == 0.0 && got == 0.0) continue;
                     const double e = std::fabs(got - truth[c]);
-                        std::printf("glyph %u texel %u,%u c %zu got %.3f truth %.3f key %d %d %d %d sub %u %u\n",
-                                    d.instance.key.glyph, tx, ty, c, got, truth[c], d.instance.key.linear[0],
-                                    d.instance.key.linear[1], d.instance.key.linear[2], d.instance.key.linear[3],
-                                    d.instance.key.subpixel_x, d.instance.key.subpixel_y);
                     sum += e;
                     result.max = std::max(result.max, e);
                     ++result.channels;

@@ -136,30 +136,31 @@ uint64_t curves_in_bands(const FontAsset& asset, const GlyphRecord& glyph, uint3
     return count;
 }
 
-// A transformed glyph's cost: each texel's row walks the bands its em segment crosses (the
-// rasterizer's rule), estimated on a grid of at most 64 x 64 texels scaled to the rect.
+// A transformed glyph's cost, estimated in O(bands): each texel's row walks the bands its em
+// segment crosses (about 1 + the segment's height in em over a band's, a segment being up to
+// kSegment texels long) and the start's band once more for its winding, plus the curves flat in em.
 uint64_t transformed_curve_tests(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key) {
     const GlyphRect rect = glyph_rect(glyph, key);
     if (rect.width == 0 || rect.height == 0) return 0;
     const Projective to_em = inverse(em_to_texel(rect, key));
-    const auto em_y = [&](double x, double y) {
-        const double* m = to_em.m;
-        return (m[3] * x + m[4] * y + m[5]) / (m[6] * x + m[7] * y + m[8]);
-    };
-    const uint32_t step_x = std::max(1u, rect.width / 64), step_y = std::max(1u, rect.height / 64);
-    uint64_t tests = 0;
-    for (uint32_t ty = 0; ty < rect.height; ty += step_y) {
-        const uint32_t rows = std::min(step_y, rect.height - ty);
-        for (uint32_t tx = 0; tx < rect.width; tx += step_x) {
-            const uint32_t columns = std::min(step_x, rect.width - tx);
-            const double y = ty + 0.5;
-            const auto a = static_cast<float>(em_y(tx, y)), b = static_cast<float>(em_y(tx + 1.0, y));
-            const uint32_t lo = FontAsset::band_of(glyph, std::min(a, b)),
-                           hi = FontAsset::band_of(glyph, std::max(a, b));
-            tests += curves_in_bands(asset, glyph, lo, hi) * rows * columns;
-        }
-    }
-    return tests;
+    const double* m = to_em.m;
+    // d(em y)/d(texel x) at the rect's centre.
+    const double cx = 0.5 * rect.width, cy = 0.5 * rect.height;
+    const double w = m[6] * cx + m[7] * cy + m[8];
+    const double ey = (m[3] * cx + m[4] * cy + m[5]) / w;
+    const double slope = std::abs((m[3] - ey * m[6]) / w);
+    constexpr double kSegment = 5.0 / 3.0;  // the widest channel union of the presets, texels
+    const double band_height = static_cast<double>(glyph.bbox_max_y - glyph.bbox_min_y) / glyph.band_count;
+    const double bands =
+        1.0 +
+        (band_height > 0.0 ? std::min(slope * kSegment / band_height, static_cast<double>(glyph.band_count)) : 0.0);
+    uint64_t entries = 0;
+    for (uint32_t band = 0; band < glyph.band_count; ++band) entries += curves_in_bands(asset, glyph, band, band);
+    const double per_band = static_cast<double>(entries) / glyph.band_count;
+    uint64_t flat = 0;
+    for (uint32_t word : flat_curve_words(asset, glyph)) flat += static_cast<uint64_t>(std::popcount(word));
+    const double per_texel = per_band * (bands + 1.0) + static_cast<double>(flat);
+    return static_cast<uint64_t>(std::ceil(per_texel * rect.width * rect.height));
 }
 
 }  // namespace
