@@ -109,7 +109,8 @@ struct RasterItem {
 
 // A transformed glyph's maps (include/crisp/glyph.hpp, em_to_texel): rows of 3x3 projective
 // matrices, em (y up) to the rect's texels and back. W is 1 without perspective. to_texel[0].w is
-// the map's orientation, +1 or -1 (the sign of its determinant); the other w are unused.
+// the map's orientation, +1 or -1 (the sign of its determinant); to_texel[1].w and [2].w the
+// glyph's em bbox in x; the other w are unused.
 struct RasterTransform {
     vec4 to_texel[3];
     vec4 to_em[3];

@@ -156,7 +156,7 @@ TEST(Scene, BadScenesNameTheirFault) {
         {with_run(
              R"({"text": "a", "size": 9, "origin": [0, 0]}, {"text": "a", "size": 9, "origin": [0, 0], "colour": [0, 0, 0]})"),
          "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth, contrast, "
-         "palette)"},
+         "palette, transform)"},
         // runs[].font
         {with_run(R"({"font": -1, "text": "a", "size": 9, "origin": [0, 0]})"),
          "scene: runs[0].font: expected an index into fonts (an integer from 0)"},

@@ -472,6 +472,7 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             uint lo_band = band_of(item, y), hi_band = lo_band, start_band = lo_band;
             vec2 start_em = vec2(0.0);
             int start_winding = 0;
+            bool start_inside = false;
             if (transformed) {
                 // The start a hair left of the segment, so that it is not on a curve where the
                 // segment begins at one (a stem on the texel's edge): the walk clips to the
@@ -480,6 +481,9 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                 start_em = texel_em(m, r.start, y);
                 float yb = texel_em(m, r.end, y).y;
                 start_band = band_of(item, start_em.y);
+                // Outside the glyph's bbox the start's winding is 0: no ray to cast.
+                start_inside = start_em.x >= m.to_texel[1].w && start_em.x <= m.to_texel[2].w &&
+                               start_em.y >= item.bbox_min_y && start_em.y <= item.bbox_max_y;
                 lo_band = band_of(item, min(start_em.y, yb));
                 hi_band = band_of(item, max(start_em.y, yb));
             }
@@ -496,7 +500,7 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                     // Curves flat in em, which no band lists, cross oblique rows.
                     if (transformed && item.flat_row != kRasterNoTransform)
                         bits |= fonts_bands[font].words[item.flat_row + word];
-                    uint start_bits = transformed && first_pass
+                    uint start_bits = transformed && first_pass && start_inside
                                           ? fonts_bands[font].words[item.band_offset + start_band * item.band_words + word]
                                           : 0u;
                     while (bits != 0u) {

@@ -73,6 +73,8 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
             gpu::RasterTransform t{{row_of(to_texel, 0), row_of(to_texel, 1), row_of(to_texel, 2)},
                                    {row_of(to_em, 0), row_of(to_em, 1), row_of(to_em, 2)}};
             t.to_texel[0].w = orientation(to_texel);
+            t.to_texel[1].w = glyph.bbox_min_x;
+            t.to_texel[2].w = glyph.bbox_max_x;
             transforms.push_back(t);
         }
         const TexelToEm map = is_transformed(w.key) ? TexelToEm{} : texel_to_em(rect, w.key);
