@@ -280,14 +280,23 @@ void row_curve(inout RowList r, vec2 p0, vec2 p1, vec2 p2, float y) {
     row_add_roots(r, code, bernstein(p0.x, p1.x, p2.x, t1), bernstein(p0.x, p1.x, p2.x, t2));
 }
 
-// The same for a curve in homogeneous texels (X, Y, W), W > 0: the roots of Y - y W, at X / W.
-void row_curve_projective(inout RowList r, vec3 h0, vec3 h1, vec3 h2, float y) {
+// The same for a curve of a transformed glyph (em), for the row whose Y - y W is dot(row, (p, 1))
+// (to_texel's second row less y times its third): its roots classified from those three values,
+// and only a curve that crosses is mapped on, to X / W (W is 1 without perspective).
+void row_curve_transformed(inout RowList r, RasterTransform m, vec3 row, bool perspective, vec2 p0, vec2 p1, vec2 p2) {
     float t1, t2;
-    uint code = row_roots(h0.y - y * h0.z, h1.y - y * h1.z, h2.y - y * h2.z, t1, t2);
+    uint code = row_roots(dot(row, vec3(p0, 1.0)), dot(row, vec3(p1, 1.0)), dot(row, vec3(p2, 1.0)), t1, t2);
     if (code == 0u) return;
-    float x1 = bernstein(h0.x, h1.x, h2.x, t1) / bernstein(h0.z, h1.z, h2.z, t1);
-    float x2 = bernstein(h0.x, h1.x, h2.x, t2) / bernstein(h0.z, h1.z, h2.z, t2);
-    row_add_roots(r, code, x1, x2);
+    vec3 to_x = m.to_texel[0].xyz;
+    float x0 = dot(to_x, vec3(p0, 1.0)), x1 = dot(to_x, vec3(p1, 1.0)), x2 = dot(to_x, vec3(p2, 1.0));
+    float a = bernstein(x0, x1, x2, t1), b = bernstein(x0, x1, x2, t2);
+    if (perspective) {
+        vec3 to_w = m.to_texel[2].xyz;
+        float w0 = dot(to_w, vec3(p0, 1.0)), w1 = dot(to_w, vec3(p1, 1.0)), w2 = dot(to_w, vec3(p2, 1.0));
+        a /= bernstein(w0, w1, w2, t1);
+        b /= bernstein(w0, w1, w2, t2);
+    }
+    row_add_roots(r, code, a, b);
 }
 
 // Adds the covered stretch [from, to] of the row, clipped to each channel's segment [lo, hi].
@@ -359,12 +368,6 @@ vec2 texel_em(RasterTransform m, float x, float y) {
     return h.xy / h.z;
 }
 
-// Curve point p (em) of a transformed glyph in homogeneous texels.
-vec3 em_texel(RasterTransform m, vec2 p) {
-    vec3 q = vec3(p, 1.0);
-    return vec3(dot(m.to_texel[0].xyz, q), dot(m.to_texel[1].xyz, q), dot(m.to_texel[2].xyz, q));
-}
-
 uint band_of(RasterItem item, float y) {
     float height = (item.bbox_max_y - item.bbox_min_y) / float(item.band_count);
     if (!(height > 0.0)) return 0u;
@@ -434,6 +437,7 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
     bool transformed = item.transform != kRasterNoTransform;
     RasterTransform m;
     if (transformed) m = transforms[item.transform];
+    bool perspective = transformed && (m.to_texel[2].x != 0.0 || m.to_texel[2].y != 0.0);
     // Each channel's segment in x, the same for every sample.
     vec3 lo, hi;
     for (int c = 0; c < 3; ++c) {
@@ -473,7 +477,9 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             vec2 start_em = vec2(0.0);
             int start_winding = 0;
             bool start_inside = false;
+            vec3 y_row = vec3(0.0);
             if (transformed) {
+                y_row = m.to_texel[1].xyz - y * m.to_texel[2].xyz;
                 // The start a hair left of the segment, so that it is not on a curve where the
                 // segment begins at one (a stem on the texel's edge): the walk clips to the
                 // channels' segments, so the stretch before them adds nothing.
@@ -511,7 +517,7 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                         vec2 p1 = fonts_points[font].points[first + 1u];
                         vec2 p2 = fonts_points[font].points[first + 2u];
                         if (transformed) {
-                            row_curve_projective(r, em_texel(m, p0), em_texel(m, p1), em_texel(m, p2), y);
+                            row_curve_transformed(r, m, y_row, perspective, p0, p1, p2);
                             if (((start_bits >> bit) & 1u) != 0u)
                                 start_winding += winding(p0 - start_em, p1 - start_em, p2 - start_em);
                         } else {
