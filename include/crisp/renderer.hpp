@@ -268,7 +268,13 @@ struct RendererStats {
     uint32_t atlas_width = 0;
     uint32_t atlas_height = 0;
     uint32_t atlas_grown = 0;
-    uint32_t moving_glyphs = 0;   // instances of moving named draws (DrawOptions::id), at kMovingSubpixelSteps
+    uint32_t moving_glyphs = 0;  // instances of moving named draws (DrawOptions::id), at kMovingSubpixelSteps
+    // Instances draw() placed at a transform or on a plane (DrawOptions::transform, ::plane), those of
+    // a plane whose key kept its perspective (their local affine map was more than
+    // kMaxLocalAffineError off), and the largest local-affine error (px) among the others.
+    uint32_t transformed_glyphs = 0;
+    uint32_t projective_glyphs = 0;
+    float max_affine_error = 0.0f;
     uint32_t unknown_fonts = 0;   // instances whose FontId was never added
     uint32_t culled_glyphs = 0;   // instances wholly outside draw()'s visible rect
     uint32_t clipped_glyphs = 0;  // instances partly outside it: only their visible part is rasterized

@@ -185,7 +185,7 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
 // `glyph` moved by (dx, dy), or placed at the draw's transform or on its plane (depth: the glyph's
 // on the plane).
 FrameRequests::Placed FrameRequests::place(GlyphInstance& glyph, const DrawOptions& options,
-                                           const TransformSteps& steps, double dx, double dy, float& depth) const {
+                                           const TransformSteps& steps, double dx, double dy, float& depth) {
     const FontAsset* asset = fonts_.asset(glyph.key.font);
     if (!options.transform && !options.plane) return moved(asset, glyph, dx, dy) ? Placed::placed : Placed::refused;
     if (!asset || glyph.key.glyph >= asset->glyphs.size()) return Placed::placed;  // admit() counts it
@@ -203,7 +203,13 @@ FrameRequests::Placed FrameRequests::place(GlyphInstance& glyph, const DrawOptio
         if (!on_plane.visible) return Placed::culled;
         placement = on_plane.place;
         depth = on_plane.depth;
+        if (on_plane.projective) {
+            ++stats_.projective_glyphs;
+        } else {
+            stats_.max_affine_error = std::max(stats_.max_affine_error, static_cast<float>(on_plane.affine_error));
+        }
     }
+    ++stats_.transformed_glyphs;
     GlyphInstance out = glyph;
     out.key.subpixel_x = out.key.subpixel_y = 0;
     if (!place_glyph(record, placement, {steps.linear, steps.perspective, steps.subpixel}, out)) return Placed::refused;
@@ -328,10 +334,13 @@ void FrameRequests::settle(const AtlasLimits& limits) {
         pending_.clear();
         clipped_.clear();
         // The requests count again; what draw() counted before them stays.
-        const uint32_t moving = stats_.moving_glyphs, grown = stats_.atlas_grown;
+        const RendererStats asked = stats_;
         stats_ = {};
-        stats_.moving_glyphs = moving;
-        stats_.atlas_grown = grown;
+        stats_.moving_glyphs = asked.moving_glyphs;
+        stats_.transformed_glyphs = asked.transformed_glyphs;
+        stats_.projective_glyphs = asked.projective_glyphs;
+        stats_.max_affine_error = asked.max_affine_error;
+        stats_.atlas_grown = asked.atlas_grown;
         stats_.skipped_glyphs = unplaceable_;
         atlas_full_ = 0;
         for (const Request& r : requests_) request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps, r.contrast);

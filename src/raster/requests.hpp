@@ -103,7 +103,7 @@ private:
 
     enum class Placed { placed, refused, culled };
     Placed place(GlyphInstance& glyph, const DrawOptions& options, const TransformSteps& steps, double dx, double dy,
-                 float& depth) const;
+                 float& depth);
     void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps, const GlyphContrast& contrast);
     void admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
                const TexelRect* shown = nullptr);
