@@ -6,7 +6,9 @@
 #     validation layer and synchronization validation on: the command line (help, bad arguments,
 #     a missing font, no display); two identical runs give the same screenshot, bit for bit; the
 #     screenshot shows text where the report says it was drawn (HUD paragraph, counter, list rows
-#     clipped to their box, one hovered label, each label above the shape it names); a run that
+#     clipped to their box, one hovered label, each label above the shape it names, the spinner
+#     below the HUD turned to the angle the report gives, the sign in its colour on the cube's face
+#     where the report projects it, and only their glyphs transformed); a run that
 #     drops every 7th frame (recorded, then abandoned), is resized twice and minimized once ends
 #     on the very image of the run that only resized: Renderer::abandon_frame() and
 #     Compositor::abandon_frame() leave no trace, and minimizing draws nothing.
@@ -60,11 +62,14 @@ cat >check_screenshot.py <<'PY'
 
 check_screenshot.py SHOT.png REPORT.json: text is where the report says it was drawn (enough ink
 in the HUD's paragraph, counter and list, and in every label), the list's rows are clipped to the
-list box, exactly one label wears the hover colour, and each label stands above the shape it names
-(pixels of that shape's colour just below its anchor). Exit status 0 when all hold; each failure
-is printed. Pure Python (zlib), so it needs nothing beyond Debian's python3.
+list box, exactly one label wears the hover colour, each label stands above the shape it names
+(pixels of that shape's colour just below its anchor), the spinner's ink is centred on its pivot
+and lies along the angle the report gives (the principal axis of its pixels), and the sign's ink
+lies on the cube's face as the report projects it. Exit status 0 when all hold; each failure is
+printed. Pure Python (zlib), so it needs nothing beyond Debian's python3.
 """
 import json
+import math
 import struct
 import sys
 import zlib
@@ -141,6 +146,10 @@ def hover_ink(p):  # the hover colour, sRGB (1.0, 0.78, 0.22), where coverage is
     return p[0] >= 200 and 150 <= p[1] <= 230 and p[2] <= 110
 
 
+def sign_ink(p):  # the sign's colour, sRGB (0.55, 0.93, 1.0), over the cube's red (the octahedron is darker)
+    return p[1] >= 170 and p[2] >= 170 and p[2] >= p[0] + 20
+
+
 SHAPE_COLOURS = {  # what the lit shapes look like: the dominant channel
     "Cube": lambda p: p[0] > p[1] + 40 and p[0] > p[2] + 40,
     "Octahedron": lambda p: p[2] > p[0] + 40 and p[2] > p[1] + 10,
@@ -202,9 +211,81 @@ def main():
         shape_pixels = sum(1 for p in image.region(ax - 30, ay + 4, ax + 30, ay + 70) if SHAPE_COLOURS[shape](p))
         if shape_pixels < 300:
             failures.append(f"{box['name']}: only {shape_pixels} {shape}-coloured pixels below its anchor")
+    spinner = boxes.get("spinner")
+    if spinner is None:
+        failures.append("no spinner in the report")
+    else:
+        failures += check_spinner(image, spinner)
+    sign = boxes.get("sign")
+    if sign is None:
+        failures.append("no sign in the report (the cube's face is turned to the camera in these frames)")
+    else:
+        failures += check_sign(image, sign)
     for failure in failures:
         print(f"check_screenshot {sys.argv[1]}: {failure}")
     return 1 if failures else 0
+
+
+def check_spinner(image, box):
+    """The spinner's light pixels, inside the circle it turns in: centred on the box's centre, and
+    their principal axis (of the second moments, y down) at the report's angle, modulo 180."""
+    cx, cy = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    radius = math.hypot(box["width"], box["height"]) / 2 + 1
+    points = []
+    for y in range(int(cy - radius), int(cy + radius) + 1):
+        for x in range(int(cx - radius), int(cx + radius) + 1):
+            if math.hypot(x + 0.5 - cx, y + 0.5 - cy) <= radius and 0 <= x < image.width and 0 <= y < image.height:
+                i = (y * image.width + x) * 3
+                if light(image.pixels[i:i + 3]):
+                    points.append((x + 0.5, y + 0.5))
+    if len(points) < 60:
+        return [f"spinner: {len(points)} light pixels"]
+    mx = sum(p[0] for p in points) / len(points)
+    my = sum(p[1] for p in points) / len(points)
+    xx = sum((p[0] - mx) ** 2 for p in points) / len(points)
+    yy = sum((p[1] - my) ** 2 for p in points) / len(points)
+    xy = sum((p[0] - mx) * (p[1] - my) for p in points) / len(points)
+    failures = []
+    if math.hypot(mx - cx, my - cy) > 3:
+        failures.append(f"spinner: its ink is centred at ({mx:.1f}, {my:.1f}), its pivot at ({cx:.1f}, {cy:.1f})")
+    axis = math.degrees(0.5 * math.atan2(2 * xy, xx - yy))
+    off = (axis - box["angle"] + 90) % 180 - 90
+    spread = math.sqrt(((xx - yy) / 2) ** 2 + xy ** 2)
+    elongation = ((xx + yy) / 2 + spread) / max((xx + yy) / 2 - spread, 1e-6)
+    if abs(off) > 4 or elongation < 6:
+        failures.append(f"spinner: its ink lies at {axis:.1f} degrees (elongation {elongation:.1f}), "
+                        f"the report says {box['angle']}")
+    return failures
+
+
+def check_sign(image, box):
+    """The sign's colour on the cube's face: inside the face's projected quad, which is mostly the
+    cube's red, and hardly anywhere around it."""
+    quad = box["quad"]
+
+    def inside(x, y):
+        sides = [(quad[(i + 1) % 4][0] - quad[i][0]) * (y - quad[i][1]) -
+                 (quad[(i + 1) % 4][1] - quad[i][1]) * (x - quad[i][0]) for i in range(4)]
+        return all(s > 0 for s in sides) or all(s < 0 for s in sides)
+
+    ink_in = ink_out = red = area = 0
+    margin = 16
+    for y in range(max(int(box["y"]) - margin, 0), min(int(box["y"] + box["height"]) + margin, image.height)):
+        for x in range(max(int(box["x"]) - margin, 0), min(int(box["x"] + box["width"]) + margin, image.width)):
+            i = (y * image.width + x) * 3
+            p = image.pixels[i:i + 3]
+            if inside(x + 0.5, y + 0.5):
+                area += 1
+                ink_in += sign_ink(p)
+                red += SHAPE_COLOURS["Cube"](p)
+            else:
+                ink_out += sign_ink(p)
+    failures = []
+    if red < 0.3 * area:
+        failures.append(f"sign: only {red} of the {area} pixels of its face are the cube's colour")
+    if ink_in < 60 or ink_out > 0.05 * ink_in:
+        failures.append(f"sign: {ink_in} pixels of its colour on its face, {ink_out} around it")
+    return failures
 
 
 if __name__ == "__main__":
@@ -248,6 +329,13 @@ run plain_again --frames 40
 cmp -s plain.png plain_again.png || fail "two identical runs gave different screenshots"
 python3 check_screenshot.py plain.png plain.json || fail "plain.png: text missing or misplaced"
 [ "$(field plain presented)" = 40 ] || fail "plain: $(field plain presented) frames presented, want 40"
+# Only the spinner's 8 glyphs ("rotating") and the sign's 5 are drawn at a
+# transform; both turn every frame, so they are drawn as moving.
+python3 - plain.json <<'PY' || fail "plain: the transformed glyphs are not the spinner's and the sign's"
+import json, sys
+glyphs = json.load(open(sys.argv[1]))["glyphs"]
+assert glyphs["transformed"] == 13 and glyphs["moving"] >= 13 and glyphs["projective"] <= 13, glyphs
+PY
 # With Noto Color Emoji installed (the default --emoji-font), the title ends in a yellow face: the
 # HUD above its paragraph, white text on a dark panel otherwise, has pixels of its yellow.
 if [ -f /usr/share/fonts/truetype/noto/NotoColorEmoji.ttf ]; then
@@ -284,6 +372,18 @@ for name in dropped resized; do
   python3 check_screenshot.py $name.png $name.json || fail "$name.png: text missing or misplaced"
 done
 cmp -s dropped.png resized.png || fail "the run that dropped frames ended on another image than the one that did not"
+# The spinner turns: 20 frames after plain's last frame its square holds other pixels (30 degrees
+# further on; check_screenshot.py found each at its own angle).
+python3 - plain.png resized.png resized.json <<'PY' || fail "the spinner did not turn between frames 39 and 59"
+import json, sys
+from check_screenshot import Image
+box = {b["name"]: b for b in json.load(open(sys.argv[3]))["text"]}["spinner"]
+square = (box["x"], box["y"] + box["height"] / 2 - box["width"] / 2,
+          box["x"] + box["width"], box["y"] + box["height"] / 2 + box["width"] / 2)
+a, b = (list(Image(path).region(*square)) for path in sys.argv[1:3])
+changed = sum(1 for p, q in zip(a, b) if max(abs(x - y) for x, y in zip(p, q)) > 60)
+assert changed > 100, f"{changed} pixels changed"
+PY
 
 if [ "$failures" -ne 0 ]; then
   echo "engine_example_test: $failures failure(s); files in $work" >&2

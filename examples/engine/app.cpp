@@ -314,6 +314,7 @@ crisp::Status App::submit_and_present(FrameSlot& slot, uint32_t image_index, boo
     // Submitted: crisp's frame counts, and so does the frame for the animation.
     text_->frame_submitted();
     report_.boxes = text_->frame().boxes;
+    report_.glyphs = text_->submitted_glyphs();
     report_.extent = swapchain_->extent();
     ++report_.presented;
     ++frame_;

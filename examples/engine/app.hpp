@@ -31,6 +31,7 @@ struct RunReport {
     VkExtent2D extent{};           // of the last presented frame
     VkFormat swapchain_format = VK_FORMAT_UNDEFINED;
     std::vector<TextBox> boxes;       // text of the last presented frame
+    GlyphCounts glyphs;               // of the last presented frame
     std::vector<uint8_t> screenshot;  // RGB8 of the last presented frame, when asked for
 };
 

@@ -62,6 +62,13 @@ inline std::array<float, 4> transform_point(const Mat4& matrix, Vec3 p) {
     return out;
 }
 
+// The direction `v` under `matrix` (w = 0: no translation).
+inline Vec3 transform_direction(const Mat4& matrix, Vec3 v) {
+    return {matrix.at(0, 0) * v.x + matrix.at(1, 0) * v.y + matrix.at(2, 0) * v.z,
+            matrix.at(0, 1) * v.x + matrix.at(1, 1) * v.y + matrix.at(2, 1) * v.z,
+            matrix.at(0, 2) * v.x + matrix.at(1, 2) * v.y + matrix.at(2, 2) * v.z};
+}
+
 inline Mat4 translation(Vec3 t) {
     Mat4 out = Mat4::identity();
     out.at(3, 0) = t.x;

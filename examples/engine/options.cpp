@@ -58,7 +58,8 @@ const std::vector<OptionSpec>& option_table() {
          }},
         {"--screenshot", "PATH.png", "write the last presented frame as a PNG (needs --frames)",
          [](Options& o, std::string_view v) { return !(o.screenshot = v).empty(); }},
-        {"--report", "PATH.json", "write what happened (frames, drops, resizes) and where text was drawn",
+        {"--report", "PATH.json",
+         "write what happened (frames, drops, resizes), where text was drawn and the last frame's glyphs",
          [](Options& o, std::string_view v) { return !(o.report = v).empty(); }},
         {"--font", "PATH", "the font for all text (TrueType/OpenType; default: crisp's DejaVu Sans)",
          [](Options& o, std::string_view v) { return !(o.font = v).empty(); }},
@@ -101,7 +102,8 @@ std::string usage() {
     std::string text =
         "Usage: crisp-engine-example [options]\n\n"
         "A small engine that draws a lit 3D scene with its own Vulkan device and puts crisp's text in it:\n"
-        "labels that follow the shapes, and a HUD with a paragraph, a frame counter and a scrolling list.\n\n"
+        "labels that follow the shapes, a HUD with a paragraph, a frame counter and a scrolling list, a\n"
+        "label below the HUD that turns every frame, and a sign in perspective on a face of the cube.\n\n"
         "Options:\n";
     for (const OptionSpec& option : option_table()) {
         std::string left = std::string("  ") + option.name + (option.value ? std::string(" ") + option.value : "");

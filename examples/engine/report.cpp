@@ -29,6 +29,13 @@ void write_box(std::ostream& out, const TextBox& box) {
         out << ", \"hovered\": " << (box.hovered ? "true" : "false") << ", \"anchor\": [" << box.anchor_x << ", "
             << box.anchor_y << "]";
     }
+    if (box.name == "spinner") out << ", \"angle\": " << box.angle;
+    if (box.name == "sign") {
+        out << ", \"quad\": [";
+        for (size_t i = 0; i < box.quad.size(); ++i)
+            out << (i ? ", [" : "[") << box.quad[i][0] << ", " << box.quad[i][1] << "]";
+        out << "]";
+    }
     out << "}";
 }
 
@@ -41,7 +48,10 @@ crisp::Status write_report(const std::string& path, const RunReport& report, uin
         << ",\n  \"minimized_polls\": " << report.minimized_polls << ",\n  \"resizes\": " << report.resizes
         << ",\n  \"width\": " << report.extent.width << ",\n  \"height\": " << report.extent.height
         << ",\n  \"swapchain_format\": \"" << format_name(report.swapchain_format)
-        << "\",\n  \"validation_messages\": " << validation_messages << ",\n  \"text\": [\n";
+        << "\",\n  \"validation_messages\": " << validation_messages
+        << ",\n  \"glyphs\": {\"drawn\": " << report.glyphs.drawn << ", \"moving\": " << report.glyphs.moving
+        << ", \"transformed\": " << report.glyphs.transformed << ", \"projective\": " << report.glyphs.projective
+        << "},\n  \"text\": [\n";
     for (size_t i = 0; i < report.boxes.size(); ++i) {
         write_box(out, report.boxes[i]);
         out << (i + 1 < report.boxes.size() ? ",\n" : "\n");

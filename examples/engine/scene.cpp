@@ -62,8 +62,10 @@ void build_ground(MeshBuilder& mesh) {
     }
 }
 
+constexpr float kCubeHalfSide = 0.6f;
+
 void build_cube(MeshBuilder& mesh) {
-    constexpr float h = 0.6f;
+    constexpr float h = kCubeHalfSide;
     const Vec3 color{0.80f, 0.22f, 0.10f};
     for (int axis = 0; axis < 3; ++axis) {
         for (float sign : {-1.0f, 1.0f}) {
@@ -142,6 +144,14 @@ SceneState Scene::animate(uint64_t frame, VkExtent2D extent, float scene_left) {
         state.shapes[i] = translation(position) * rotation_y(t * m.spin);
         state.label_anchors[i] = position + Vec3{0.0f, m.label_height, 0.0f};
     }
+    const Mat4& cube = state.shapes[0];
+    const std::array<float, 4> centre = transform_point(cube, {0.0f, 0.0f, kCubeHalfSide});
+    SignFace& sign = state.sign;
+    sign.centre = {centre[0], centre[1], centre[2]};
+    sign.right = transform_direction(cube, {1.0f, 0.0f, 0.0f});
+    sign.down = transform_direction(cube, {0.0f, -1.0f, 0.0f});
+    sign.half_side = kCubeHalfSide;
+    sign.facing = dot(transform_direction(cube, {0.0f, 0.0f, 1.0f}), eye - sign.centre) > 0.0f;
     return state;
 }
 

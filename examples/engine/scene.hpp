@@ -21,12 +21,24 @@ inline constexpr size_t kShapeCount = 3;
 // The shapes' names, which their labels show.
 inline constexpr std::array<const char*, kShapeCount> kShapeNames = {"Cube", "Octahedron", "Pyramid"};
 
+// The cube's face that carries a sign (its +z face, turning with the cube), in world space.
+struct SignFace {
+    Vec3 centre;
+    Vec3 right;  // unit vectors along the face: as the sign's text reads, and down its lines
+    Vec3 down;
+    float half_side = 0.0f;  // world units from the centre to each edge
+    // The eye sees the face's front. The tile path draws text over the scene, so a face turned
+    // away gets no sign (the cube is convex: a face the eye sees is never behind the cube itself).
+    bool facing = false;
+};
+
 // Where everything is in one frame.
 struct SceneState {
     Mat4 view_projection;
     Mat4 ground;
     std::array<Mat4, kShapeCount> shapes;
     std::array<Vec3, kShapeCount> label_anchors;  // world position just above each shape
+    SignFace sign;
 };
 
 // A filled rectangle in window pixels, linear colour with straight alpha.

@@ -1,5 +1,7 @@
 #include "text_overlay.hpp"
 
+#include <crisp/transform.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,20 +13,31 @@ namespace {
 // The HUD: a panel at the top left of the window, in pixels.
 constexpr float kHudX = 12.0f, kHudY = 12.0f, kHudWidth = 262.0f, kPadding = 12.0f;
 constexpr float kTitleSize = 17.0f, kBodySize = 13.0f, kCounterSize = 12.0f, kRowSize = 12.0f, kLabelSize = 15.0f;
+constexpr float kSpinnerSize = 14.0f, kSignSize = 24.0f;
 constexpr float kRowHeight = 17.0f;
 constexpr uint32_t kVisibleRows = 5;
 // Rows glide up by a fraction of a pixel per frame: they never sit on whole pixels for long.
 constexpr float kScrollPerFrame = 0.37f;
 // Labels: the gap between a label's background and the point it marks, and the background's margin.
 constexpr float kStem = 10.0f, kLabelMargin = 4.0f;
+// The spinner turns this many degrees clockwise a frame (a turn in 240 frames), below the HUD.
+constexpr double kSpinPerFrame = 1.5;
+constexpr float kSpinnerGap = 10.0f;
+// The sign's text spans this part of the cube face's width.
+constexpr float kSignFill = 0.8f;
+constexpr double kPi = 3.14159265358979323846;
 
 // DrawOptions::id: each label and each row keeps its name from frame to frame.
 constexpr uint64_t kLabelId = 1;
 constexpr uint64_t kRowId = 100;
+constexpr uint64_t kSpinnerId = 200;
+constexpr uint64_t kSignId = 300;
 // Paint orders: each text its own range (the HUD's texts do not overlap, so any order would do).
 constexpr uint32_t kCounterPaintOrder = 10000;
 constexpr uint32_t kRowPaintOrder = 20000, kRowPaintOrders = 256;  // per row
+constexpr uint32_t kSpinnerPaintOrder = 30000;
 constexpr uint32_t kLabelPaintOrder = 40000;
+constexpr uint32_t kSignPaintOrder = 50000;
 
 // Text colours are sRGB (as crisp takes them); panel colours are linear (the scene target's).
 constexpr std::array<float, 4> kWhite = {1.0f, 1.0f, 1.0f, 1.0f};
@@ -33,6 +46,8 @@ constexpr std::array<float, 4> kCounterColor = {0.55f, 0.90f, 0.62f, 1.0f};
 constexpr std::array<float, 4> kRowColor = {0.88f, 0.86f, 0.78f, 1.0f};
 constexpr std::array<float, 4> kLabelColor = {0.94f, 0.95f, 0.97f, 1.0f};
 constexpr std::array<float, 4> kHoverColor = {1.0f, 0.78f, 0.22f, 1.0f};
+constexpr std::array<float, 4> kSpinnerColor = {0.98f, 0.72f, 0.86f, 1.0f};
+constexpr std::array<float, 4> kSignColor = {0.55f, 0.93f, 1.0f, 1.0f};
 constexpr std::array<float, 4> kHudPanel = {0.004f, 0.005f, 0.009f, 0.80f};
 constexpr std::array<float, 4> kListPanel = {0.0f, 0.0f, 0.0f, 0.45f};
 constexpr std::array<float, 4> kLabelPanel = {0.003f, 0.004f, 0.007f, 0.72f};
@@ -65,6 +80,17 @@ crisp::LayoutOptions at(float x, float y, uint32_t first_paint_order, float wrap
     out.wrap_width = wrap_width;
     out.first_paint_order = first_paint_order;
     return out;
+}
+
+// Window pixels of a point through the view-projection; nullopt behind the eye.
+std::optional<std::array<float, 2>> to_window(const Mat4& view_projection, Vec3 point, float width, float height) {
+    const std::array<float, 4> clip = transform_point(view_projection, point);
+    if (!(clip[3] > 0.0f)) return std::nullopt;
+    return std::array<float, 2>{(clip[0] / clip[3] + 1.0f) * 0.5f * width, (clip[1] / clip[3] + 1.0f) * 0.5f * height};
+}
+
+std::array<float, 3> to_array(Vec3 v) {
+    return {v.x, v.y, v.z};
 }
 
 }  // namespace
@@ -142,17 +168,24 @@ crisp::Status TextOverlay::lay_out_static() {
     for (uint32_t i = 0; s && i < kShapeCount; ++i) {
         s = lay_out(kShapeNames[i], style(kLabelSize, kLabelColor), at(0, 0, kLabelPaintOrder + i * 64), labels_[i]);
     }
+    if (s) s = lay_out("rotating", style(kSpinnerSize, kSpinnerColor), at(0, 0, kSpinnerPaintOrder), spinner_);
+    const float side = std::ceil(std::hypot(spinner_.width, spinner_.height)) + 2.0f * kLabelMargin;
+    spinner_panel_ = {std::round(kHudX + (kHudWidth - side) / 2.0f), hud_.y + hud_.height + kSpinnerGap, side, side,
+                      kLabelPanel};
+    if (s) s = lay_out("CRISP", style(kSignSize, kSignColor), at(0, 0, kSignPaintOrder), sign_);
     return s;
 }
 
 const OverlayFrame& TextOverlay::draw(uint64_t frame, VkExtent2D extent, const SceneState& scene) {
     renderer_->begin_frame();
     composited_ = false;
-    frame_.panels.assign({hud_, list_box_});
+    frame_.panels.assign({hud_, list_box_, spinner_panel_});
     frame_.boxes.clear();
     draw_hud(frame, extent);
     draw_list(frame);
+    draw_spinner(frame);
     draw_labels(extent, scene);
+    draw_sign(extent, scene);
     return frame_;
 }
 
@@ -212,6 +245,27 @@ void TextOverlay::draw_list(uint64_t frame) {
     frame_.boxes.push_back({"list", list_box_.x, list_box_.y, list_box_.width, list_box_.height, false, 0.0f, 0.0f});
 }
 
+// The spinner turns about its centre, which stays at the middle of its panel: the transform's pivot
+// is the centre as laid out (at the origin) and the offset takes it to the panel's. A named draw
+// whose transform changes is moving: its keys take the coarse linear steps (kMovingTransformSteps),
+// so a turning label does not fill the atlas with an entry per angle.
+void TextOverlay::draw_spinner(uint64_t frame) {
+    // In doubles, and wrapped once per turn, so that the angle stays exact however long the program runs.
+    const double degrees = std::fmod(static_cast<double>(frame) * kSpinPerFrame, 360.0);
+    const auto radians = static_cast<float>(degrees * kPi / 180.0);
+    const float cos_t = std::cos(radians), sin_t = std::sin(radians);
+    const float pivot_x = spinner_.x + spinner_.width / 2.0f, pivot_y = spinner_.y + spinner_.height / 2.0f;
+    crisp::DrawOptions options;
+    options.transform = crisp::TextTransform{cos_t, -sin_t, sin_t, cos_t, pivot_x, pivot_y};  // clockwise, y down
+    options.offset_x = spinner_panel_.x + spinner_panel_.width / 2.0f - pivot_x;
+    options.offset_y = spinner_panel_.y + spinner_panel_.height / 2.0f - pivot_y;
+    options.id = kSpinnerId;
+    renderer_->draw(spinner_.glyphs, options);
+    TextBox box = box_of("spinner", spinner_, options.offset_x, options.offset_y);
+    box.angle = static_cast<float>(degrees);
+    frame_.boxes.push_back(box);
+}
+
 void TextOverlay::draw_labels(VkExtent2D extent, const SceneState& scene) {
     struct Placed {
         size_t shape = 0;
@@ -226,9 +280,9 @@ void TextOverlay::draw_labels(VkExtent2D extent, const SceneState& scene) {
         // nullopt behind the eye or past the far plane: no label.
         const std::optional<float> depth = crisp::depth_from_view_projection(scene.view_projection.m.data(), position);
         if (!depth) continue;
-        const std::array<float, 4> clip = transform_point(scene.view_projection, anchor);
-        placed.push_back(
-            {i, (clip[0] / clip[3] + 1.0f) * 0.5f * width, (clip[1] / clip[3] + 1.0f) * 0.5f * height, *depth});
+        const std::optional<std::array<float, 2>> at_window = to_window(scene.view_projection, anchor, width, height);
+        if (!at_window) continue;
+        placed.push_back({i, (*at_window)[0], (*at_window)[1], *depth});
     }
     // Hover: the label nearest the centre of the scene's part of the window.
     const float centre_x = (hud_right() + width) / 2.0f, centre_y = height / 2.0f;
@@ -266,6 +320,45 @@ void TextOverlay::draw_labels(VkExtent2D extent, const SceneState& scene) {
     }
 }
 
+// The sign lies on the cube's face: a plane through the face whose axes are world units per layout
+// pixel, seen through the view-projection and the viewport the scene is drawn with. crisp places
+// each glyph at the projection's local affine map at its centre (projective where that would be
+// more than kMaxLocalAffineError px off), at its centre's depth. The face turns with the cube, so
+// the draw is named and moving, as the spinner.
+void TextOverlay::draw_sign(VkExtent2D extent, const SceneState& scene) {
+    const SignFace& face = scene.sign;
+    if (!face.facing) return;
+    const float width = static_cast<float>(extent.width), height = static_cast<float>(extent.height);
+    const float scale = kSignFill * 2.0f * face.half_side / sign_.width;  // world units per layout pixel
+    const float centre_x = sign_.x + sign_.width / 2.0f, centre_y = sign_.y + sign_.height / 2.0f;
+    crisp::TextPlane plane;
+    plane.origin = to_array(face.centre - face.right * (centre_x * scale) - face.down * (centre_y * scale));
+    plane.axis_x = to_array(face.right * scale);
+    plane.axis_y = to_array(face.down * scale);
+    plane.view_projection = scene.view_projection.m;
+    plane.viewport = {0.0f, 0.0f, width, height};
+    crisp::DrawOptions options;
+    options.plane = plane;
+    options.id = kSignId;
+    renderer_->draw(sign_.glyphs, options);
+
+    TextBox box;
+    box.name = "sign";
+    float x0 = width, y0 = height, x1 = 0.0f, y1 = 0.0f;
+    const float corners[4][2] = {{-1.0f, -1.0f}, {1.0f, -1.0f}, {1.0f, 1.0f}, {-1.0f, 1.0f}};
+    for (size_t i = 0; i < 4; ++i) {
+        const Vec3 corner =
+            face.centre + face.right * (corners[i][0] * face.half_side) + face.down * (corners[i][1] * face.half_side);
+        const std::optional<std::array<float, 2>> at_window = to_window(scene.view_projection, corner, width, height);
+        if (!at_window) return;  // crisp culls what is behind the eye; the report gets no box
+        box.quad[i] = *at_window;
+        x0 = std::min(x0, box.quad[i][0]), y0 = std::min(y0, box.quad[i][1]);
+        x1 = std::max(x1, box.quad[i][0]), y1 = std::max(y1, box.quad[i][1]);
+    }
+    box.x = x0, box.y = y0, box.width = x1 - x0, box.height = y1 - y0;
+    frame_.boxes.push_back(box);
+}
+
 crisp::Status TextOverlay::record_rasterization(VkCommandBuffer command_buffer) {
     return renderer_->record(command_buffer);
 }
@@ -293,6 +386,12 @@ void TextOverlay::abandon_frame() {
 void TextOverlay::frame_submitted() {
     last_submitted_ = renderer_->stats();
     have_stats_ = true;
+    submitted_glyphs_ = {last_submitted_.drawn_glyphs, last_submitted_.moving_glyphs, 0, 0};
+    for (const crisp::DrawnGlyph& glyph : renderer_->drawn_frame().glyphs) {
+        const crisp::GlyphKey& key = glyph.instance.key;
+        submitted_glyphs_.transformed += crisp::is_transformed(key) ? 1u : 0u;
+        submitted_glyphs_.projective += key.perspective[0] != 0 || key.perspective[1] != 0 ? 1u : 0u;
+    }
 }
 
 }  // namespace engine

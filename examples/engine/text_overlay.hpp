@@ -34,10 +34,22 @@ inline constexpr uint32_t kHudEmoji = 0x1F600;
 
 // Where a piece of text was drawn this frame, in window pixels (for --report and its test).
 struct TextBox {
-    std::string name;  // "hud", "paragraph", "counter", "list", "label:Cube", ...
+    std::string name;  // "hud", "paragraph", "counter", "list", "label:Cube", "spinner", "sign"
+    // The spinner: its layout box before the turn, centred on the point it turns about; the sign:
+    // the bounds of `quad`.
     float x = 0.0f, y = 0.0f, width = 0.0f, height = 0.0f;
-    bool hovered = false;                    // labels: drawn in the hover colour
-    float anchor_x = 0.0f, anchor_y = 0.0f;  // labels: the projected point they point at
+    bool hovered = false;                        // labels: drawn in the hover colour
+    float anchor_x = 0.0f, anchor_y = 0.0f;      // labels: the projected point they point at
+    float angle = 0.0f;                          // the spinner: degrees clockwise on screen, 0 to 360
+    std::array<std::array<float, 2>, 4> quad{};  // the sign: its face's corners on screen
+};
+
+// Glyphs of the last submitted frame (Renderer::stats() and the keys of Renderer::drawn_frame()).
+struct GlyphCounts {
+    uint32_t drawn = 0;
+    uint32_t moving = 0;
+    uint32_t transformed = 0;  // keys with a linear part: the spinner's and the sign's glyphs
+    uint32_t projective = 0;   // of those, keys that kept their perspective (one affine map was not enough)
 };
 
 // What one frame of text needs from the scene pass (panels under the text), and where it went.
@@ -60,8 +72,10 @@ public:
     float hud_right() const { return hud_.x + hud_.width; }
 
     // Starts crisp's frame and issues this frame's draws: the HUD's static text, its counter (laid
-    // out again every frame), the list rows (moved and clipped to the list box), and one label
-    // per shape (moved to its projected anchor, at its depth, hover colour as a draw option).
+    // out again every frame), the list rows (moved and clipped to the list box), the spinner below
+    // the HUD (turned about its centre by a transform), one label per shape (moved to its
+    // projected anchor, at its depth, hover colour as a draw option) and the sign on the cube's
+    // face (on a plane seen through the camera).
     const OverlayFrame& draw(uint64_t frame, VkExtent2D extent, const SceneState& scene);
     // renderer.record(): outside any render pass, before anything reads the atlas.
     crisp::Status record_rasterization(VkCommandBuffer command_buffer);
@@ -74,6 +88,7 @@ public:
     void frame_submitted();
     // What the last draw() drew.
     const OverlayFrame& frame() const { return frame_; }
+    const GlyphCounts& submitted_glyphs() const { return submitted_glyphs_; }
 
 private:
     explicit TextOverlay(std::vector<crisp::Font> fonts);
@@ -82,7 +97,9 @@ private:
                           crisp::TextLayout& out);
     void draw_hud(uint64_t frame, VkExtent2D extent);
     void draw_list(uint64_t frame);
+    void draw_spinner(uint64_t frame);
     void draw_labels(VkExtent2D extent, const SceneState& scene);
+    void draw_sign(VkExtent2D extent, const SceneState& scene);
     TextBox box_of(const char* name, const crisp::TextLayout& layout, float dx, float dy) const;
 
     // The text font first, the fallback chain of every layout; declared before the renderer, which
@@ -101,7 +118,11 @@ private:
     float counter_y_ = 0.0f;
     std::vector<crisp::TextLayout> rows_;
     std::array<crisp::TextLayout, kShapeCount> labels_;
+    crisp::TextLayout spinner_;
+    Panel spinner_panel_;  // a square the spinner turns in, whatever its angle
+    crisp::TextLayout sign_;
     crisp::RendererStats last_submitted_{};
+    GlyphCounts submitted_glyphs_;
     bool have_stats_ = false;
     OverlayFrame frame_;
     bool composited_ = false;  // the compositor recorded this frame
