@@ -249,6 +249,47 @@ TEST(Transform, TinyAndLargeScales) {
     EXPECT_GT(big.channels, 3000u);
 }
 
+TEST(Transform, ALargeRotatedGlyphSeenInPartIsExactThere) {
+    REQUIRE_GPU();
+    auto font = test::bake_test_font("a");
+    ASSERT_TRUE(font);
+    // 12 px x 40: a 480 px glyph, rotated; only a 40 x 40 window of the target can be seen, so
+    // the atlas holds that part with its margin, at texel offsets part_x, part_y of the rect.
+    const std::vector<GlyphInstance> glyphs = lay_out(*font, "a", 12.0f, 100.0f, 300.0f);
+    DrawOptions options = transformed(rotation(30.0, 40.0, 100.0f, 300.0f));
+    options.visible = VkRect2D{{270, 220}, {40, 40}};  // about the glyph's centre
+    const Error e = render_and_measure(*font, glyphs, options, 64);
+    expect_within_bounds("a 12 px x 40 rgb, 30 degrees, a 40 x 40 part", 64, e);
+    EXPECT_EQ(e.drawn, 1u);
+    EXPECT_GT(e.channels, 1000u);
+    EXPECT_LT(e.channels, 3u * 40 * 40 + 1);  // only the visible texels are reported
+}
+
+TEST(Transform, TransformsAtTheirLimitsAreRefusedOrDrawnNeverACrash) {
+    REQUIRE_GPU();
+    auto font = test::bake_test_font("Ag");
+    ASSERT_TRUE(font);
+    const std::vector<GlyphInstance> glyphs = lay_out(*font, "Ag", 14.0f, 20.0f, 30.0f);
+    std::unique_ptr<Renderer> renderer = make_renderer(*font, 8, *subpixel_preset("rgb"));
+    ASSERT_TRUE(renderer);
+    // 65536 x 14 px: glyphs about a million pixels wide, larger than any atlas.
+    for (const TextTransform& t : {rotation(33.0, 65536.0, 20.0f, 30.0f), TextTransform{65536.0f, 0.0f, 0.0f,
+                                                                                         65536.0f, 0.0f, 0.0f}}) {
+        ASSERT_TRUE(valid_transform(t));
+        ASSERT_TRUE(test::render_until_converged(*context(), *renderer, 1,
+                                                 [&] { renderer->draw(glyphs, transformed(t)); }));
+        const RendererStats& stats = renderer->stats();
+        EXPECT_TRUE(renderer->drawn().empty());
+        EXPECT_EQ(stats.failed_glyphs + stats.culled_glyphs, 2u);
+    }
+    // The smallest determinant valid_transform() takes: glyphs smaller than a texel, drawn.
+    ASSERT_TRUE(test::render_until_converged(*context(), *renderer, 1, [&] {
+        renderer->draw(glyphs, transformed({1.0f / 256, 0.0f, 0.0f, 1.0f / 256, 20.0f, 30.0f}));
+    }));
+    EXPECT_EQ(renderer->stats().drawn_glyphs, 2u);
+    expect_no_validation_messages();
+}
+
 TEST(Transform, GrayRgbAndVerticalLayouts) {
     REQUIRE_GPU();
     auto font = test::bake_test_font("g");
