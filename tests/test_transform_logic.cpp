@@ -21,7 +21,7 @@ constexpr float kSize = 14.0f;
 
 // DejaVu Sans with the glyphs the tests use, made once.
 const Font& font() {
-    static const std::unique_ptr<Font> made = test::bake_test_font("AEo");
+    static const std::unique_ptr<Font> made = test::bake_test_font("AEoB");
     EXPECT_TRUE(made);
     return *made;
 }
@@ -439,6 +439,23 @@ TEST(TransformKeys, FlatCurveWordsListTheFlatLinesOfEAndNotThePads) {
     }
     // E's outline: 12 corners, 6 horizontal edges.
     EXPECT_EQ(flagged, 6u);
+    // B's three contours are joined by pad slots (their start repeated), which have three points
+    // of one y too: none is listed, each of its flat lines is.
+    const GlyphRecord& b = record_of(laid_out('B', kSize, 0.0f, 0.0f));
+    const std::vector<uint32_t> b_flat = flat_curve_words(asset, b);
+    ASSERT_EQ(b_flat.size(), b.band_words);
+    uint32_t b_pads = 0, b_lines = 0;
+    for (uint32_t slot = 0; slot < b.curve_count; ++slot) {
+        const Point* p = &asset.points[size_t{b.point_offset} + 2 * size_t{slot}];
+        const bool is_flat = ((b_flat[slot / 32] >> (slot % 32)) & 1u) != 0;
+        const bool pad = p[1].x == p[0].x && p[1].y == p[0].y;
+        const bool line = !pad && p[0].y == p[1].y && p[1].y == p[2].y;
+        b_pads += pad ? 1u : 0u;
+        b_lines += line ? 1u : 0u;
+        EXPECT_EQ(is_flat, line) << "B slot " << slot;
+    }
+    EXPECT_GT(b_pads, 0u);
+    EXPECT_GE(b_lines, 4u);
     // 'o' has none: its curves only touch horizontal at their ends.
     EXPECT_TRUE(flat_curve_words(asset, record_of(laid_out('o', kSize, 0.0f, 0.0f))).empty());
     std::printf("[ transform ] E: %u flat lines, %u pad slots of %u\n", flagged, pads, g.curve_count);
