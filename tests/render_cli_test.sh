@@ -482,6 +482,53 @@ assert sum(1 for px in pixels if saturated(px)) > 50, "no colourful pixels: the 
 PY
 fi
 
+# ---- --transform A,B,C,D (docs/transforms.md): a 2x2 about --origin, y down. Bad values are usage
+# errors naming the option; a good one turns the ink.
+for value in 1,0,0 1,0,0,1,0 a,b,c,d 1,0,0,x "" 1,,0,1 nan,0,0,1 1,inf,0,1 70000,0,0,1 0,0,0,0 1,2,2,4 1e-3,0,0,1e-3; do
+  expect_exit 2 "--transform '$value'" -- "$render" "${base[@]}" --transform "$value" -o x.png
+  expect_stderr "--transform" "--transform '$value'"
+done
+expect_exit 2 "--transform 1,0,0" -- "$render" "${base[@]}" --transform 1,0,0 -o x.png
+expect_stderr "--transform takes A,B,C,D" "--transform 1,0,0"
+expect_exit 2 "--transform 1,2,2,4" -- "$render" "${base[@]}" --transform 1,2,2,4 -o x.png
+expect_stderr "|A D - B C| at least 2^-16" "--transform 1,2,2,4"
+printf '{"fonts": ["dejavu.crisp"], "canvas": [8, 8], "runs": []}' > "$work/transform-any.json"
+expect_exit 2 "--scene with --transform" -- "$render" --scene "$work/transform-any.json" --transform 0,-1,1,0 -o x.png
+expect_stderr "--transform must not be given with it" "--scene with --transform"
+# "Hi" upright is wider than tall; turned 90 degrees clockwise (y down) about its origin, taller than
+# wide and right of the origin; mirrored in x, left of it. A scene run's "transform" is the same draw.
+turn=(--font "$font" --text "Hi" --size 16 --origin 32,20 --canvas 64,64 --samples 16 --layout gray)
+expect_exit 0 "render upright" -- "$render" "${turn[@]}" -o "$work/upright.png"
+expect_exit 0 "render --transform 0,-1,1,0" -- "$render" "${turn[@]}" --transform 0,-1,1,0 -o "$work/turned.png"
+expect_exit 0 "render --transform -1,0,0,1" -- "$render" "${turn[@]}" --transform -1,0,0,1 -o "$work/mirrored.png"
+printf '{"fonts": ["dejavu.crisp"], "canvas": [64, 64], "layout": "gray", "runs": [
+  {"text": "Hi", "size": 16, "origin": [32, 20], "transform": [0, -1, 1, 0]}]}' > "$work/turned.json"
+expect_exit 0 "render a scene run's transform" -- "$render" --scene "$work/turned.json" --samples 16 \
+  -o "$work/turned-scene.png"
+python3 - "$work" <<'PY' || fail "--transform does not turn the ink as it should"
+import sys
+from read_png import read_png
+def ink(name):
+    width, height, channels, data = read_png(sys.argv[1] + "/" + name)
+    xs, ys = [], []
+    for y in range(height):
+        for x in range(width):
+            if min(data[(y * width + x) * channels:(y * width + x) * channels + 3]) < 128:
+                xs.append(x)
+                ys.append(y)
+    assert xs, name + " has no ink"
+    return min(xs), min(ys), max(xs) + 1, max(ys) + 1
+x0, y0, x1, y1 = ink("upright.png")
+assert x1 - x0 > y1 - y0 and x0 >= 32 and y1 <= 21, ("upright", x0, y0, x1, y1)
+for name in ("turned.png", "turned-scene.png"):
+    t0, u0, t1, u1 = ink(name)
+    assert u1 - u0 > t1 - t0, (name, "not taller than wide", t0, u0, t1, u1)
+    assert t0 >= 31 and u0 >= 19 and abs((u1 - u0) - (x1 - x0)) <= 2, (name, t0, u0, t1, u1, x0, x1)
+m0, n0, m1, n1 = ink("mirrored.png")
+assert m1 <= 33 and abs((m1 - m0) - (x1 - x0)) <= 2 and (n0, n1) == (y0, y1), ("mirrored", m0, n0, m1, n1)
+PY
+cmp -s "$work/turned.png" "$work/turned-scene.png" || fail "a scene run's transform differs from --transform"
+
 # With the validation layer (when installed), a clean run stays clean.
 if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.json' 2>/dev/null)" ]; then
   expect_exit 0 "render --validate" -- "$render" "${base[@]}" --layout gray --background 1,1,1,0.5 \

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -90,6 +91,50 @@ TEST(Scene, RunsTakeTheScenePaletteUnlessTheyGiveTheirOwn) {
     EXPECT_EQ(scene->runs[0].palette, 2u);
     EXPECT_EQ(scene->runs[1].palette, 255u);
     EXPECT_EQ(scene->runs[2].palette, 0u);
+}
+
+TEST(Scene, ARunsTransformIsItsTwoByTwo) {
+    auto scene = parse_scene(R"({"fonts": ["a"], "canvas": [8, 8], "runs": [
+        {"text": "a", "size": 9, "origin": [0, 0], "transform": [0, -1, 1, 0]},
+        {"text": "b", "size": 9, "origin": [0, 0], "transform": [-1, 0.5, -0.25, 65536]},
+        {"text": "c", "size": 9, "origin": [0, 0]}]})");
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_EQ(scene->runs.size(), 3u);
+    EXPECT_EQ(scene->runs[0].transform, (std::array<float, 4>{0.0f, -1.0f, 1.0f, 0.0f}));
+    EXPECT_EQ(scene->runs[1].transform, (std::array<float, 4>{-1.0f, 0.5f, -0.25f, 65536.0f}));
+    EXPECT_FALSE(scene->runs[2].transform);
+}
+
+TEST(Scene, BadTransformsNameTheRunAndTheLimit) {
+    const struct {
+        const char* transform;
+        const char* fragment;
+    } cases[] = {
+        {"[1, 0, 0]", "scene: runs[0].transform: expected [a, b, c, d], numbers in [-65536, 65536]"},
+        {"[1, 0, 0, 1, 0]", "scene: runs[0].transform: expected [a, b, c, d]"},
+        {"[]", "scene: runs[0].transform: expected [a, b, c, d]"},
+        {"\"0,1,-1,0\"", "scene: runs[0].transform: expected [a, b, c, d]"},
+        {"{\"a\": 1}", "scene: runs[0].transform: expected [a, b, c, d]"},
+        {"[1, \"0\", 0, 1]", "scene: runs[0].transform: expected [a, b, c, d]"},
+        {"[1, null, 0, 1]", "scene: runs[0].transform: expected [a, b, c, d]"},
+        {"[1, 0, 0, 65537]", "scene: runs[0].transform: expected [a, b, c, d], numbers in [-65536, 65536]"},
+        {"[-1e300, 0, 0, 1]", "scene: runs[0].transform: expected [a, b, c, d]"},
+        {"[0, 0, 0, 0]", "scene: runs[0].transform: is singular: |a d - b c| must be at least 2^-16"},
+        {"[1, 2, 2, 4]", "scene: runs[0].transform: is singular"},
+        {"[0.001, 0, 0, 0.001]", "scene: runs[0].transform: is singular"},
+    };
+    for (const auto& c : cases) {
+        auto scene = parse_scene(with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "transform": )" +
+                                          std::string(c.transform) + "}"));
+        ASSERT_FALSE(scene) << c.transform;
+        EXPECT_EQ(scene.error().code, ErrorCode::invalid_argument);
+        EXPECT_NE(scene.error().message.find(c.fragment), std::string::npos)
+            << "message: " << scene.error().message << "\nexpected: " << c.fragment;
+    }
+    // A run's unknown member lists transform among the known ones.
+    auto scene = parse_scene(with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "transfrom": [1, 0, 0, 1]})"));
+    ASSERT_FALSE(scene);
+    EXPECT_NE(scene.error().message.find("palette, transform)"), std::string::npos) << scene.error().message;
 }
 
 TEST(Scene, MemberOrderDoesNotMatter) {
