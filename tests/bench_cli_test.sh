@@ -136,6 +136,8 @@ for c in transform["grid"]:
 assert [t["tilt_degrees"] for t in transform["perspective"]] == [45, 80], transform["perspective"]
 for t in transform["perspective"]:
     assert t["glyphs"] > 0 and 0 <= t["projective"] <= t["glyphs"] - t["culled"], t
+    # The suite's own place_on_plane() count is the renderer's (RendererStats::projective_glyphs).
+    assert t["renderer_projective_glyphs"] == t["projective"], t
     assert len(t["affine_error"]) == t["glyphs"] - t["culled"] and t["affine_error_max"] >= t["affine_error_median"] >= 0
     assert [p["samples"] for p in t["points"]] == [8, 16] and len(t["projective_points"]) == 2, t
     for p in t["points"]:

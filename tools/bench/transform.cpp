@@ -470,6 +470,7 @@ struct TiltRun {
     std::vector<Checkpoint> points;
     std::vector<TexelError> projective_points;  // the projective keys of each checkpoint's subset
     uint32_t drawn = 0;
+    RendererStats stats;  // the last frame's: its own count of projective glyphs and largest affine error
 };
 
 // The camera at the origin looking down +z (x right, y down, as Vulkan's NDC), the text block's
@@ -539,6 +540,7 @@ std::vector<TiltRun> perspective(TransformSuite& suite, const Font& font) {
             run.projective_points.push_back(e.projective);
         }
         run.drawn = renderer.stats().drawn_glyphs;
+        run.stats = renderer.stats();
         progress(kSuite, "perspective: " + std::to_string(static_cast<int>(degrees)) + " degrees, " +
                              std::to_string(run.projective) + " of " + std::to_string(run.glyphs) + " projective");
         runs.push_back(std::move(run));
@@ -712,6 +714,7 @@ void write_json(JsonWriter& json, const Args& args, size_t laid_out, const std::
                 .field("glyphs_refined", f.stats.work_items)
                 .field("culled", f.stats.culled_glyphs)
                 .field("moving", f.stats.moving_glyphs)
+                .field("transformed", f.stats.transformed_glyphs)
                 .field("coarsened", f.stats.coarsened_glyphs)
                 .field("failed", f.stats.failed_glyphs)
                 .field("atlas_allocations", f.allocations)
@@ -754,6 +757,8 @@ void write_json(JsonWriter& json, const Args& args, size_t laid_out, const std::
             .field("culled", r.culled)
             .field("projective", r.projective)
             .field("glyphs_drawn", r.drawn)
+            .field("renderer_projective_glyphs", r.stats.projective_glyphs)
+            .field("renderer_max_affine_error", r.stats.max_affine_error)
             .field("affine_error_median", percentile(r.affine_error, 0.5))
             .field("affine_error_p90", percentile(r.affine_error, 0.9))
             .field("affine_error_max", percentile(r.affine_error, 1.0))
