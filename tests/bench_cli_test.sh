@@ -8,7 +8,7 @@ bench=$1 source=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 cd "$source" || exit 1  # the suites' default fonts are relative to the repository root
 . "$(dirname "${BASH_SOURCE[0]}")/cli_common.sh"
-suites=(frames coverage compositing scaling atlas frame-cpu cpu contrast colour)
+suites=(frames coverage compositing scaling atlas frame-cpu cpu contrast colour transform)
 
 # ---- --help and usage errors: exit 2, nothing measured.
 expect_exit 0 "--help" -- "$bench" --help
@@ -52,7 +52,7 @@ python3 - "$json" <<'EOF' || fail "the JSON is not what the suites write"
 import json, math, sys
 data = json.load(open(sys.argv[1]))
 suites = data["suites"]
-for name in ["frames", "coverage", "compositing", "scaling", "atlas", "frame-cpu", "cpu", "contrast", "colour"]:
+for name in ["frames", "coverage", "compositing", "scaling", "atlas", "frame-cpu", "cpu", "contrast", "colour", "transform"]:
     assert name in suites, name
 assert data["tool"] == "crisp-bench" and data["quick"] is True and data["command"].startswith("crisp-bench")
 def unit(x):
@@ -106,6 +106,42 @@ for name, s in screens.items():
         assert (f["colour_layers"] > 0) == (name != "monochrome"), (name, f)
     assert (first["bitmap_uploads"] > 0) == (name == "bitmap") and last["bitmap_uploads"] == 0, s
     assert (first["frame_paints"] > 0) == (name != "monochrome"), s
+transform = suites["transform"]
+assert transform["canvas"] == [256, 128] and transform["samples"] == 16 and transform["laid_out_glyphs"] > 0, transform
+def measured(e, glyphs=1):
+    assert unit(e["mean"]) and unit(e["worst"]) and e["mean"] <= e["worst"], e
+    assert e["glyphs"] >= glyphs and (e["channels"] > 0) == (e["glyphs"] > 0), e
+assert [r["variant"] for r in transform["animated"]] == ["plain", "named"], transform["animated"]
+for r in transform["animated"]:
+    assert len(r["frames"]) == 3, r
+    for f in r["frames"]:
+        assert f["gpu_ms"] >= 0 and f["cpu_ms"] > 0 and f["samples"] > 0 and f["curve_tests"] > 0, f
+        assert f["glyphs_drawn"] > 0 and f["culled"] > 0 and f["atlas_allocations"] > 0, f
+        assert (f["moving"] > 0) == (r["variant"] == "named"), f
+        measured(f)
+        assert unit(f["still_key_mean"]) and unit(f["still_key_worst"]), f
+        # An unnamed draw's keys are the still keys: the same texels against the same areas.
+        assert r["variant"] == "named" or math.isclose(f["still_key_mean"], f["mean"], rel_tol=1e-9), f
+still = transform["still"]
+assert still["converged"] and still["frames"] > 1 and still["total_gpu_ms"] >= still["first_gpu_ms"] >= 0, still
+assert [p["samples"] for p in still["points"]] == [8, 16], still
+for p in still["points"]:
+    measured(p)
+assert [(c["degrees"], c["scale"], c["shear"]) for c in transform["grid"]] == [
+    (a, s, h) for a in (37, 211) for s in (0.25, 8) for h in (0, 0.5)], transform["grid"]
+for c in transform["grid"]:
+    assert [p["samples"] for p in c["points"]] == [8, 16] and c["glyphs_drawn"] == 2, c
+    for p in c["points"]:
+        measured(p, 2)
+assert [t["tilt_degrees"] for t in transform["perspective"]] == [45, 80], transform["perspective"]
+for t in transform["perspective"]:
+    assert t["glyphs"] > 0 and 0 <= t["projective"] <= t["glyphs"] - t["culled"], t
+    # The suite's own place_on_plane() count is the renderer's (RendererStats::projective_glyphs).
+    assert t["renderer_projective_glyphs"] == t["projective"], t
+    assert len(t["affine_error"]) == t["glyphs"] - t["culled"] and t["affine_error_max"] >= t["affine_error_median"] >= 0
+    assert [p["samples"] for p in t["points"]] == [8, 16] and len(t["projective_points"]) == 2, t
+    for p in t["points"]:
+        measured(p)
 EOF
 for picture in quick-{dark,light}-{linear,default}.png; do
   [ "$(head -c 4 "$work/results/$picture" 2>/dev/null | od -An -c | tr -d ' ')" = "211PNG" ] || fail "$picture is not a PNG"

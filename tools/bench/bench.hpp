@@ -109,6 +109,7 @@ inline constexpr SuiteInfo kSuites[] = {
     {"cpu", "layout and atlas CPU time (was crisp-bench-cpu)", false},
     {"contrast", "ink dark on light against light on dark per contrast setting and size; FreeType as a peer", true},
     {"colour", "colour glyphs (bitmap emoji, COLRv1) beside monochrome text: frame 1, converged, per layer", true},
+    {"transform", "rotated, scaled, sheared and perspective text: GPU ms per frame with its error", true},
 };
 
 // Parses argv; prints --help, or exits 2 on a usage error.
@@ -172,5 +173,6 @@ void run_frame_cpu(Session& session);
 void run_cpu(Session& session);
 void run_contrast(Session& session);
 void run_colour(Session& session);
+void run_transform(Session& session);
 
 }  // namespace crisp::bench

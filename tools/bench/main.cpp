@@ -111,6 +111,7 @@ void run_suite(Session& session, const std::string& name) {
     if (name == "cpu") return run_cpu(session);
     if (name == "contrast") return run_contrast(session);
     if (name == "colour") return run_colour(session);
+    if (name == "transform") return run_transform(session);
 }
 
 // The error at each sample count against the GPU ms the frames suite spent reaching that count:
