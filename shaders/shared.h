@@ -118,10 +118,10 @@ struct RasterTransform {
 
 struct RasterPushConstants {
     vec4 channel_rects[3];  // subpixel layout: x0, y0, x1, y1 of red, green, blue, pixel units, y down
-    uint item_count;
-    uint workgroup_count;  // workgroups that have work (the dispatch may round up)
-    uint shared_rows;      // 1: the three rects share their rows: one set of roots, one row list, serves all
-    uint sample_kind;      // kRasterSampleRows or kRasterSamplePoints
+    uint workgroup_base;    // the dispatch's first workgroup in the table (transformed items follow the others)
+    uint workgroup_count;   // workgroups that have work (the dispatch may round up)
+    uint shared_rows;       // 1: the three rects share their rows: one set of roots, one row list, serves all
+    uint sample_kind;       // kRasterSampleRows or kRasterSamplePoints
 };
 
 // ---- The compositor (quad_pipeline.vert and the *.frag / *_resolve.comp of each mode).
@@ -369,7 +369,7 @@ static_assert(sizeof(CompositePushConstants) == 64);
 static_assert(offsetof(CompositePushConstants, width) == 16);
 static_assert(offsetof(RasterItem, first_workgroup) == 84);
 static_assert(sizeof(RasterPushConstants) == 64);
-static_assert(offsetof(RasterPushConstants, item_count) == 48);
+static_assert(offsetof(RasterPushConstants, workgroup_base) == 48);
 static_assert(sizeof(SelftestPushConstants) == 8);
 static_assert(offsetof(SelftestPushConstants, seed) == 4);
 static_assert(sizeof(SelftestResult) == 24);  // std430 array stride: 6 uints, 4-byte aligned

@@ -19,8 +19,12 @@ inline std::array<double, 4> bbox_of(const GlyphRecord& g) {
             static_cast<double>(g.bbox_max_y)};
 }
 
-inline Vec3 sub3(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-inline double dot3(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline Vec3 sub3(const Vec3& a, const Vec3& b) {
+    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+inline double dot3(const Vec3& a, const Vec3& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 inline Vec3 cross3(const Vec3& a, const Vec3& b) {
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
@@ -43,9 +47,9 @@ inline std::array<float, 16> view_projection(const Vec3& eye, const Vec3& centre
                                {0.0, 0.0, 0.0, 1.0}};
     const double t = 1.0 / std::tan(fov_y / 2.0);
     const double projection[4][4] = {{t / aspect, 0.0, 0.0, 0.0},
-                                      {0.0, -t, 0.0, 0.0},
-                                      {0.0, 0.0, far / (near - far), near * far / (near - far)},
-                                      {0.0, 0.0, -1.0, 0.0}};
+                                     {0.0, -t, 0.0, 0.0},
+                                     {0.0, 0.0, far / (near - far), near * far / (near - far)},
+                                     {0.0, 0.0, -1.0, 0.0}};
     std::array<float, 16> out{};
     for (int r = 0; r < 4; ++r) {
         for (int c = 0; c < 4; ++c) {

@@ -124,8 +124,8 @@ TEST(Scene, BadTransformsNameTheRunAndTheLimit) {
         {"[0.001, 0, 0, 0.001]", "scene: runs[0].transform: is singular"},
     };
     for (const auto& c : cases) {
-        auto scene = parse_scene(with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "transform": )" +
-                                          std::string(c.transform) + "}"));
+        auto scene = parse_scene(
+            with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "transform": )" + std::string(c.transform) + "}"));
         ASSERT_FALSE(scene) << c.transform;
         EXPECT_EQ(scene.error().code, ErrorCode::invalid_argument);
         EXPECT_NE(scene.error().message.find(c.fragment), std::string::npos)

@@ -47,7 +47,7 @@ struct Error {
     double max = 0.0;
     uint64_t channels = 0;
     uint32_t drawn = 0;
-    bool in_range = true;  // every coverage within [0, 1]
+    bool in_range = true;      // every coverage within [0, 1]
     uint32_t transformed = 0;  // drawn glyphs whose key carries a linear part
     uint32_t projective = 0;   // and a perspective
 };
@@ -149,8 +149,8 @@ constexpr double kMean64 = 0.002;
 constexpr double kMax64 = 0.02;
 
 void report(const std::string& what, uint32_t samples, const Error& e) {
-    std::printf("[ transform ] %s, %u samples: mean %.5f, max %.5f over %llu channels\n", what.c_str(), samples,
-                e.mean, e.max, static_cast<unsigned long long>(e.channels));
+    std::printf("[ transform ] %s, %u samples: mean %.5f, max %.5f over %llu channels\n", what.c_str(), samples, e.mean,
+                e.max, static_cast<unsigned long long>(e.channels));
 }
 
 // Reports `e` and holds it to the bounds of its sample count: the targets at 512 samples, the
@@ -273,11 +273,11 @@ TEST(Transform, TransformsAtTheirLimitsAreRefusedOrDrawnNeverACrash) {
     std::unique_ptr<Renderer> renderer = make_renderer(*font, 8, *subpixel_preset("rgb"));
     ASSERT_TRUE(renderer);
     // 65536 x 14 px: glyphs about a million pixels wide, larger than any atlas.
-    for (const TextTransform& t : {rotation(33.0, 65536.0, 20.0f, 30.0f), TextTransform{65536.0f, 0.0f, 0.0f,
-                                                                                         65536.0f, 0.0f, 0.0f}}) {
+    for (const TextTransform& t :
+         {rotation(33.0, 65536.0, 20.0f, 30.0f), TextTransform{65536.0f, 0.0f, 0.0f, 65536.0f, 0.0f, 0.0f}}) {
         ASSERT_TRUE(valid_transform(t));
-        ASSERT_TRUE(test::render_until_converged(*context(), *renderer, 1,
-                                                 [&] { renderer->draw(glyphs, transformed(t)); }));
+        ASSERT_TRUE(
+            test::render_until_converged(*context(), *renderer, 1, [&] { renderer->draw(glyphs, transformed(t)); }));
         const RendererStats& stats = renderer->stats();
         EXPECT_TRUE(renderer->drawn().empty());
         EXPECT_EQ(stats.failed_glyphs + stats.culled_glyphs, 2u);
@@ -313,8 +313,9 @@ void expect_rotated_shape_accurate(const char* what, const std::vector<Contour>&
     ASSERT_TRUE(font) << what;
     const GlyphInstance instance = test::place(*font, glyph, 20.0f, 20.25f, 30.0f);
     for (const char* layout : {"gray", "vrgb"}) {
-        const Error e = render_and_measure(*font, std::span(&instance, 1),
-                                           transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64, *subpixel_preset(layout));
+        const Error e =
+            render_and_measure(*font, std::span(&instance, 1), transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64,
+                               *subpixel_preset(layout));
         expect_within_bounds(std::string(what) + ", 20 px " + layout + ", 37 degrees", 64, e);
         EXPECT_EQ(e.drawn, 1u) << what;  // overlapping contours never above 1
     }
@@ -324,9 +325,8 @@ TEST(TransformHardCase, OverlappingHolesSelfIntersectingAndHairlinesRotated) {
     REQUIRE_GPU();
     using test::circle;
     using test::polygon;
-    expect_rotated_shape_accurate(
-        "overlapping squares",
-        {polygon({{0, 0}, {0.6, 0}, {0.6, 0.6}, {0, 0.6}}), polygon({{0.3, 0.3}, {0.9, 0.3}, {0.9, 0.9}, {0.3, 0.9}})});
+    expect_rotated_shape_accurate("overlapping squares", {polygon({{0, 0}, {0.6, 0}, {0.6, 0.6}, {0, 0.6}}),
+                                                          polygon({{0.3, 0.3}, {0.9, 0.3}, {0.9, 0.9}, {0.3, 0.9}})});
     expect_rotated_shape_accurate("ring", {circle(0.5, 0.5, 0.45, false), circle(0.5, 0.5, 0.25, true)});
     expect_rotated_shape_accurate("pentagram",
                                   {polygon({{0.5, 0.95}, {0.79, 0.05}, {0.02, 0.61}, {0.98, 0.61}, {0.21, 0.05}})});
@@ -351,8 +351,8 @@ TEST(TransformHardCase, RowsWithMoreCrossingsThanTheRegistersHoldRotated) {
     const std::vector<GlyphInstance> glyphs = lay_out(*font, "H", 24.0f, 20.0f, 30.0f);
     ASSERT_EQ(glyphs.size(), 1u);
     EXPECT_GE(font->asset().glyphs[glyphs[0].key.glyph].curve_count, 4000u);
-    const Error e = render_and_measure(*font, glyphs, transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64,
-                                       *subpixel_preset("gray"));
+    const Error e =
+        render_and_measure(*font, glyphs, transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64, *subpixel_preset("gray"));
     expect_within_bounds("many-curves.ttf H (4,000 curves) 24 px gray, 37 degrees", 64, e);
     EXPECT_EQ(e.drawn, 1u);
 }
@@ -371,8 +371,8 @@ TEST(TransformHardCase, CjkGlyphAndFourPixelsRotated) {
     const std::vector<GlyphInstance> glyphs = lay_out(*cjk, "龘", 16.0f, 20.0f, 30.0f);
     ASSERT_EQ(glyphs.size(), 1u);
     EXPECT_GT(cjk->asset().glyphs[glyphs[0].key.glyph].curve_count, 200u);
-    const Error a = render_and_measure(*cjk, glyphs, transformed(rotation(-21.0, 1.0, 20.0f, 30.0f)), 64,
-                                       *subpixel_preset("gray"));
+    const Error a =
+        render_and_measure(*cjk, glyphs, transformed(rotation(-21.0, 1.0, 20.0f, 30.0f)), 64, *subpixel_preset("gray"));
     expect_within_bounds("Noto Sans CJK 龘 16 px gray, -21 degrees", 64, a);
     EXPECT_EQ(a.drawn, 1u);
 }
@@ -410,9 +410,13 @@ void expect_depths_of_centres(const Font& font, std::span<const GlyphInstance> g
 
 // A plane a little tilted, seen from 6 world units: each glyph's local affine is within
 // kMaxLocalAffineError of the projection.
-TextPlane tilted_plane() { return test::plane_seen_from({0.42, 0.1, 6.0}, {0.36, 0.15, 0.0}, 0.04f, 200.0f, 150.0f); }
+TextPlane tilted_plane() {
+    return test::plane_seen_from({0.42, 0.1, 6.0}, {0.36, 0.15, 0.0}, 0.04f, 200.0f, 150.0f);
+}
 // The same plane seen at a grazing angle from nearby: no glyph's local affine is close enough.
-TextPlane grazing_plane() { return test::plane_seen_from({0.36, -1.5, 0.6}, {0.36, 0.15, 0.0}, 0.04f, 200.0f, 150.0f); }
+TextPlane grazing_plane() {
+    return test::plane_seen_from({0.36, -1.5, 0.6}, {0.36, 0.15, 0.0}, 0.04f, 200.0f, 150.0f);
+}
 
 TEST(TransformPlane, LocalAffineGlyphsAgainstTheirKeyAndTheExactProjection) {
     REQUIRE_GPU();
@@ -424,7 +428,8 @@ TEST(TransformPlane, LocalAffineGlyphsAgainstTheirKeyAndTheExactProjection) {
     std::unique_ptr<Renderer> renderer = make_renderer(font, 64, layout);
     ASSERT_TRUE(renderer);
     const DrawOptions options = on_plane(plane);
-    ASSERT_TRUE(test::render_until_converged(*context(), *renderer, 2000, [&] { renderer->draw(scene.glyphs, options); }));
+    ASSERT_TRUE(
+        test::render_until_converged(*context(), *renderer, 2000, [&] { renderer->draw(scene.glyphs, options); }));
     Result<std::vector<test::Texel>> texels = test::read_atlas(*context(), *renderer);
     ASSERT_TRUE(texels);
     const Error own = measure(font, *renderer, *texels, 64, layout);
@@ -476,10 +481,11 @@ TEST(TransformPlane, LocalAffineGlyphsAgainstTheirKeyAndTheExactProjection) {
             }
         }
     }
-    std::printf("[ transform ] local affine against the exact projection: references differ by at most %.5f "
-                "(allowed %.5f); GPU mean %.5f, max %.5f over %llu channels\n",
-                worst_reference, allowed, sum_gpu / static_cast<double>(std::max<uint64_t>(channels, 1)), worst_gpu,
-                static_cast<unsigned long long>(channels));
+    std::printf(
+        "[ transform ] local affine against the exact projection: references differ by at most %.5f "
+        "(allowed %.5f); GPU mean %.5f, max %.5f over %llu channels\n",
+        worst_reference, allowed, sum_gpu / static_cast<double>(std::max<uint64_t>(channels, 1)), worst_gpu,
+        static_cast<unsigned long long>(channels));
     EXPECT_GT(channels, 100u);
     EXPECT_LE(worst_reference, allowed);
     EXPECT_LE(worst_gpu, own.max + allowed);
@@ -495,7 +501,8 @@ TEST(TransformPlane, GrazingGlyphsAreProjectiveAndMatchTheExactProjection) {
     std::unique_ptr<Renderer> renderer = make_renderer(*scene.font, 64, *subpixel_preset("rgb"));
     ASSERT_TRUE(renderer);
     const DrawOptions options = on_plane(plane);
-    ASSERT_TRUE(test::render_until_converged(*context(), *renderer, 2000, [&] { renderer->draw(scene.glyphs, options); }));
+    ASSERT_TRUE(
+        test::render_until_converged(*context(), *renderer, 2000, [&] { renderer->draw(scene.glyphs, options); }));
     Result<std::vector<test::Texel>> texels = test::read_atlas(*context(), *renderer);
     ASSERT_TRUE(texels);
     const Error e = measure(*scene.font, *renderer, *texels, 64, *subpixel_preset("rgb"));

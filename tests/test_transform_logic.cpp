@@ -38,7 +38,9 @@ GlyphInstance laid_out(char32_t c, float size, float x, float y) {
     return layout.glyphs.empty() ? GlyphInstance{} : layout.glyphs[0];
 }
 
-const GlyphRecord& record_of(const GlyphInstance& g) { return font().asset().glyphs[g.key.glyph]; }
+const GlyphRecord& record_of(const GlyphInstance& g) {
+    return font().asset().glyphs[g.key.glyph];
+}
 
 TextTransform rotation(double degrees, double scale = 1.0) {
     const double t = degrees * std::numbers::pi / 180.0;
@@ -116,10 +118,10 @@ TEST(TransformPlacement, MirroredAndRotatedKeysCarryTheirSigns) {
     const GlyphInstance laid = laid_out('A', kSize, 20.0f, 30.0f);
     const int32_t one = static_cast<int32_t>(static_cast<double>(kSize) * kLinearOne);
     GlyphInstance mirrored_x, mirrored_y, turned;
-    ASSERT_TRUE(place(laid, transformed(laid, {-1.0f, 0.0f, 0.0f, 1.0f, 20.0f, 30.0f}), kStillTransformSteps,
-                      mirrored_x));
-    ASSERT_TRUE(place(laid, transformed(laid, {1.0f, 0.0f, 0.0f, -1.0f, 20.0f, 30.0f}), kStillTransformSteps,
-                      mirrored_y));
+    ASSERT_TRUE(
+        place(laid, transformed(laid, {-1.0f, 0.0f, 0.0f, 1.0f, 20.0f, 30.0f}), kStillTransformSteps, mirrored_x));
+    ASSERT_TRUE(
+        place(laid, transformed(laid, {1.0f, 0.0f, 0.0f, -1.0f, 20.0f, 30.0f}), kStillTransformSteps, mirrored_y));
     ASSERT_TRUE(place(laid, transformed(laid, rotation(180.0)), kStillTransformSteps, turned));
     // em y up to pixels y down: the untransformed L is diag(size, -size).
     EXPECT_TRUE(is_transformed(mirrored_x.key));
@@ -148,11 +150,11 @@ TEST(TransformPlacement, RefusesWhatCannotBeDrawnAndLeavesTheGlyphAlone) {
     bad[1].pen_x = inf;
     bad[2].perspective[0] = nan;
     bad[3].linear[0] = bad[3].linear[1] = bad[3].linear[2] = bad[3].linear[3] = 0.0;  // singular
-    bad[4].linear[0] = 2.0;  // rank 1, exactly in key units
+    bad[4].linear[0] = 2.0;                                                           // rank 1, exactly in key units
     bad[4].linear[1] = 4.0;
     bad[4].linear[2] = 1.0;
     bad[4].linear[3] = 2.0;
-    bad[5].linear[0] = 8388608.0;                                                     // 2^23 px per em
+    bad[5].linear[0] = 8388608.0;  // 2^23 px per em
     bad[6].perspective[1] = 2048.0;
     bad[7].pen_y = 3.0e7;
     for (size_t i = 0; i < bad.size(); ++i) {
@@ -217,10 +219,9 @@ TEST(TransformPlacement, RectHoldsTheMappedBboxCornersWithPadding) {
     GlyphPlacement projective = transformed(laid, rotation(20.0));
     projective.perspective[0] = 0.2;
     projective.perspective[1] = -0.1;
-    for (const GlyphPlacement& p :
-         {transformed(laid, rotation(37.0)), transformed(laid, rotation(271.3, 8.0)),
-          transformed(laid, {1.0f, 0.5f, -0.5f, 1.0f, 0.0f, 0.0f}), transformed(laid, rotation(90.0, 0.25)),
-          projective}) {
+    for (const GlyphPlacement& p : {transformed(laid, rotation(37.0)), transformed(laid, rotation(271.3, 8.0)),
+                                    transformed(laid, {1.0f, 0.5f, -0.5f, 1.0f, 0.0f, 0.0f}),
+                                    transformed(laid, rotation(90.0, 0.25)), projective}) {
         GlyphInstance placed;
         ASSERT_TRUE(place(laid, p, kStillTransformSteps, placed));
         ASSERT_TRUE(is_transformed(placed.key));
@@ -228,7 +229,8 @@ TEST(TransformPlacement, RectHoldsTheMappedBboxCornersWithPadding) {
         ASSERT_GT(rect.width, 0u);
         double lo_x = HUGE_VAL, hi_x = -HUGE_VAL, lo_y = HUGE_VAL, hi_y = -HUGE_VAL;
         for (int corner = 0; corner < 4; ++corner) {
-            const double ex = (corner & 1) ? g.bbox_max_x : g.bbox_min_x, ey = (corner & 2) ? g.bbox_max_y : g.bbox_min_y;
+            const double ex = (corner & 1) ? g.bbox_max_x : g.bbox_min_x,
+                         ey = (corner & 2) ? g.bbox_max_y : g.bbox_min_y;
             const std::array<double, 2> q = test::placed_point(p, ex, ey);
             // Relative to the rect of the placed instance on the target.
             lo_x = std::min(lo_x, q[0] - placed.x);
@@ -287,8 +289,9 @@ TEST(TransformPlacement, EmToTexelAndItsInverseRoundTrip) {
     // Axis-aligned keys: em_to_texel() is texel_to_em()'s inverse.
     const GlyphRect rect = glyph_rect(g, laid.key);
     const TexelToEm map = texel_to_em(rect, laid.key);
-    const std::array<double, 2> t = apply(em_to_texel(rect, laid.key), static_cast<double>(map.offset_x + 3.0f * map.scale_x),
-                                          static_cast<double>(map.offset_y + 5.0f * map.scale_y));
+    const std::array<double, 2> t =
+        apply(em_to_texel(rect, laid.key), static_cast<double>(map.offset_x + 3.0f * map.scale_x),
+              static_cast<double>(map.offset_y + 5.0f * map.scale_y));
     EXPECT_NEAR(t[0], 3.0, 1e-5);
     EXPECT_NEAR(t[1], 5.0, 1e-5);
     // A singular map inverts to the identity.
@@ -302,8 +305,8 @@ TEST(TransformPlacement, EmToTexelAndItsInverseRoundTrip) {
 
 // The largest distance between `place` and the plane's exact projection over the glyph's bbox
 // (its corners and edge midpoints).
-double distance_from_projection(const TextPlane& plane, const GlyphRecord& g, const GlyphPlacement& place,
-                                double pen_x, double pen_y, double size) {
+double distance_from_projection(const TextPlane& plane, const GlyphRecord& g, const GlyphPlacement& place, double pen_x,
+                                double pen_y, double size) {
     double worst = 0.0;
     for (const double fx : {0.0, 0.5, 1.0}) {
         for (const double fy : {0.0, 0.5, 1.0}) {
@@ -472,8 +475,8 @@ TEST(TransformKeys, ARotatedGlyphsCurveTestsArePositiveAndNearTheAxisAlignedOnes
         ASSERT_TRUE(place(laid, transformed(laid, rotation(degrees)), kStillTransformSteps, placed));
         ASSERT_TRUE(is_transformed(placed.key));
         const uint64_t turned = curve_tests_per_sample(asset, g, placed.key);
-        std::printf("[ transform ] curve tests per sample of A at 20 px, %.1f degrees: %llu (upright %llu)\n",
-                    degrees, static_cast<unsigned long long>(turned), static_cast<unsigned long long>(upright));
+        std::printf("[ transform ] curve tests per sample of A at 20 px, %.1f degrees: %llu (upright %llu)\n", degrees,
+                    static_cast<unsigned long long>(turned), static_cast<unsigned long long>(upright));
         EXPECT_GT(turned, upright / 2) << degrees;
         EXPECT_LT(turned, upright * 8) << degrees;
     }

@@ -56,54 +56,58 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
     transforms.clear();
     workgroup_items.clear();
     uint32_t workgroups = 0;
-    for (const RasterWork& w : work) {
-        const HeldFont* font = fonts.find(w.key.font);
-        if (!font || w.sample_count == 0) continue;
-        const GlyphRecord& glyph = font->asset->glyphs[w.key.glyph];
-        const GlyphRect rect = glyph_rect(glyph, w.key);
-        gpu::RasterItem item{};
-        item.transform = gpu::kRasterNoTransform;
-        item.flat_row = gpu::kRasterNoTransform;
-        if (is_transformed(w.key)) {
-            const uint32_t row = w.key.glyph < font->flat_rows.size() ? font->flat_rows[w.key.glyph] : kNoFlatRow;
-            if (row != kNoFlatRow) item.flat_row = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + row;
-            const Projective to_texel = em_to_texel(rect, w.key);
-            const Projective to_em = inverse(to_texel);
-            item.transform = static_cast<uint32_t>(transforms.size());
-            gpu::RasterTransform t{{row_of(to_texel, 0), row_of(to_texel, 1), row_of(to_texel, 2)},
-                                   {row_of(to_em, 0), row_of(to_em, 1), row_of(to_em, 2)}};
-            t.to_texel[0].w = orientation(to_texel);
-            t.to_texel[1].w = glyph.bbox_min_x;
-            t.to_texel[2].w = glyph.bbox_max_x;
-            transforms.push_back(t);
+    // The axis-aligned items first, then the transformed ones: each set is one dispatch of its own
+    // pipeline (RasterPass::record_dispatch).
+    for (const bool transformed_pass : {false, true}) {
+        for (const RasterWork& w : work) {
+            const HeldFont* font = fonts.find(w.key.font);
+            if (!font || w.sample_count == 0 || is_transformed(w.key) != transformed_pass) continue;
+            const GlyphRecord& glyph = font->asset->glyphs[w.key.glyph];
+            const GlyphRect rect = glyph_rect(glyph, w.key);
+            gpu::RasterItem item{};
+            item.transform = gpu::kRasterNoTransform;
+            item.flat_row = gpu::kRasterNoTransform;
+            if (is_transformed(w.key)) {
+                const uint32_t row = w.key.glyph < font->flat_rows.size() ? font->flat_rows[w.key.glyph] : kNoFlatRow;
+                if (row != kNoFlatRow) item.flat_row = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + row;
+                const Projective to_texel = em_to_texel(rect, w.key);
+                const Projective to_em = inverse(to_texel);
+                item.transform = static_cast<uint32_t>(transforms.size());
+                gpu::RasterTransform t{{row_of(to_texel, 0), row_of(to_texel, 1), row_of(to_texel, 2)},
+                                       {row_of(to_em, 0), row_of(to_em, 1), row_of(to_em, 2)}};
+                t.to_texel[0].w = orientation(to_texel);
+                t.to_texel[1].w = glyph.bbox_min_x;
+                t.to_texel[2].w = glyph.bbox_max_x;
+                transforms.push_back(t);
+            }
+            const TexelToEm map = is_transformed(w.key) ? TexelToEm{} : texel_to_em(rect, w.key);
+            item.atlas_x = w.x;
+            item.atlas_y = w.y;
+            item.width = w.width;
+            item.height = w.height;
+            item.offset_x = map.offset_x;
+            item.offset_y = map.offset_y;
+            item.scale_x = map.scale_x;
+            item.scale_y = map.scale_y;
+            item.bbox_min_y = glyph.bbox_min_y;
+            item.bbox_max_y = glyph.bbox_max_y;
+            item.point_offset = static_cast<uint32_t>(font->points_at / sizeof(Point)) + glyph.point_offset;
+            item.band_offset = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + glyph.band_offset;
+            item.band_count = glyph.band_count;
+            item.band_words = glyph.band_words;
+            item.font = font->page;
+            item.first_sample = w.first_sample;
+            item.sample_count = w.sample_count;
+            item.part_x = w.part_x;
+            item.part_y = w.part_y;
+            item.first_texel = w.first_texel;
+            item.texel_count = w.texel_count;
+            item.first_workgroup = workgroups;
+            const uint32_t own = (w.texel_count + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
+            workgroups += own;
+            workgroup_items.insert(workgroup_items.end(), own, static_cast<uint32_t>(items.size()));
+            items.push_back(item);
         }
-        const TexelToEm map = is_transformed(w.key) ? TexelToEm{} : texel_to_em(rect, w.key);
-        item.atlas_x = w.x;
-        item.atlas_y = w.y;
-        item.width = w.width;
-        item.height = w.height;
-        item.offset_x = map.offset_x;
-        item.offset_y = map.offset_y;
-        item.scale_x = map.scale_x;
-        item.scale_y = map.scale_y;
-        item.bbox_min_y = glyph.bbox_min_y;
-        item.bbox_max_y = glyph.bbox_max_y;
-        item.point_offset = static_cast<uint32_t>(font->points_at / sizeof(Point)) + glyph.point_offset;
-        item.band_offset = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + glyph.band_offset;
-        item.band_count = glyph.band_count;
-        item.band_words = glyph.band_words;
-        item.font = font->page;
-        item.first_sample = w.first_sample;
-        item.sample_count = w.sample_count;
-        item.part_x = w.part_x;
-        item.part_y = w.part_y;
-        item.first_texel = w.first_texel;
-        item.texel_count = w.texel_count;
-        item.first_workgroup = workgroups;
-        const uint32_t own = (w.texel_count + gpu::kRasterWorkgroupSize - 1) / gpu::kRasterWorkgroupSize;
-        workgroups += own;
-        workgroup_items.insert(workgroup_items.end(), own, static_cast<uint32_t>(items.size()));
-        items.push_back(item);
     }
     return workgroups;
 }
@@ -165,10 +169,16 @@ Status RasterPass::create(uint32_t cells, uint64_t atlas_texels, RetireLists& re
         !s) {
         return s;
     }
-    Result<VkPipeline> made =
-        vk::create_compute_pipeline(ref_, shader_, descriptors_.pipeline_layout, nullptr, "raster.comp");
-    if (!made) return made.error();
-    pipeline_ = objects_.keep(ref_, *made);
+    // Two pipelines of one shader (kTransformedItems): axis-aligned items, and transformed ones.
+    for (const uint32_t transformed : {0u, 1u}) {
+        const VkSpecializationMapEntry entry{0, 0, sizeof transformed};
+        const VkSpecializationInfo specialization{1, &entry, sizeof transformed, &transformed};
+        Result<VkPipeline> made =
+            vk::create_compute_pipeline(ref_, shader_, descriptors_.pipeline_layout, &specialization,
+                                        transformed ? "raster.comp (transformed)" : "raster.comp");
+        if (!made) return made.error();
+        (transformed ? transformed_pipeline_ : pipeline_) = objects_.keep(ref_, *made);
+    }
     return {};
 }
 
@@ -252,7 +262,6 @@ void RasterPass::record_dispatch(VkCommandBuffer command_buffer, uint64_t this_f
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, vk::kShaderAccess);
     const VkDescriptorSet set = descriptors_.sets[this_frame % options_.frames_in_flight];
     write_descriptors(set, atlas, pages);
-    fn.vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
     fn.vkCmdBindDescriptorSets(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &set,
                                0, nullptr);
     gpu::RasterPushConstants push{};
@@ -260,15 +269,28 @@ void RasterPass::record_dispatch(VkCommandBuffer command_buffer, uint64_t this_f
         const SampleRect& r = subpixel.channels[c];
         push.channel_rects[c] = {r.x0, r.y0, r.x1, r.y1};
     }
-    push.item_count = static_cast<uint32_t>(item_data_.size());
-    push.workgroup_count = workgroups;
     push.shared_rows = options_.shared_row_roots && shares_sample_rows(subpixel) ? 1u : 0u;
     push.sample_kind = options_.sample_kind == SampleKind::points ? gpu::kRasterSamplePoints : gpu::kRasterSampleRows;
-    fn.vkCmdPushConstants(command_buffer, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
-                          &push);
-    const uint32_t width = std::min(workgroups, gpu::kRasterDispatchWidth);
-    const uint32_t height = (workgroups + gpu::kRasterDispatchWidth - 1) / gpu::kRasterDispatchWidth;
-    fn.vkCmdDispatch(command_buffer, width, height, 1);
+    // The transformed items follow the others (build_work_items): a dispatch each, no barrier
+    // between (their atlas texels are disjoint).
+    const auto first = std::find_if(item_data_.begin(), item_data_.end(), [](const gpu::RasterItem& item) {
+        return item.transform != gpu::kRasterNoTransform;
+    });
+    const uint32_t split = first == item_data_.end() ? workgroups : first->first_workgroup;
+    const uint32_t ranges[2][2] = {{0, split}, {split, workgroups - split}};
+    for (int pass = 0; pass < 2; ++pass) {
+        const uint32_t count = ranges[pass][1];
+        if (count == 0) continue;
+        fn.vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE,
+                             pass == 0 ? pipeline_ : transformed_pipeline_);
+        push.workgroup_base = ranges[pass][0];
+        push.workgroup_count = count;
+        fn.vkCmdPushConstants(command_buffer, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
+                              &push);
+        const uint32_t width = std::min(count, gpu::kRasterDispatchWidth);
+        const uint32_t height = (count + gpu::kRasterDispatchWidth - 1) / gpu::kRasterDispatchWidth;
+        fn.vkCmdDispatch(command_buffer, width, height, 1);
+    }
     vk::memory_barrier(fn, command_buffer, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, kReaders,
                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
 }

@@ -81,8 +81,9 @@ private:
 
     vk::DeviceObjects objects_;  // the shader module and the pipeline
     VkShaderModule shader_ = VK_NULL_HANDLE;
-    vk::DescriptorSets descriptors_;  // one set per frame in flight
-    VkPipeline pipeline_ = VK_NULL_HANDLE;
+    vk::DescriptorSets descriptors_;                    // one set per frame in flight
+    VkPipeline pipeline_ = VK_NULL_HANDLE;              // axis-aligned items
+    VkPipeline transformed_pipeline_ = VK_NULL_HANDLE;  // items with a RasterTransform
 };
 
 }  // namespace crisp::raster

@@ -37,6 +37,7 @@ constexpr std::string_view kSuite = "transform";
 constexpr double kDegreesPerFrame = 7.3;
 constexpr double kStillDegrees = 37.0;
 constexpr uint32_t kMaxStillFrames = 4000;
+constexpr uint32_t kMaxStillCanvas[2] = {1280, 720};
 // The perspective camera's vertical field of view.
 constexpr double kFieldOfViewDegrees = 60.0;
 
@@ -96,8 +97,12 @@ double radians(double degrees) {
 TextTransform linear_transform(double degrees, double scale, double shear, float pivot_x, float pivot_y) {
     const double c = std::cos(radians(degrees)), s = std::sin(radians(degrees));
     // {c, -s; s, c} {scale, scale shear; 0, scale}
-    return {static_cast<float>(c * scale), static_cast<float>((c * shear - s) * scale), static_cast<float>(s * scale),
-            static_cast<float>((s * shear + c) * scale), pivot_x, pivot_y};
+    return {static_cast<float>(c * scale),
+            static_cast<float>((c * shear - s) * scale),
+            static_cast<float>(s * scale),
+            static_cast<float>((s * shear + c) * scale),
+            pivot_x,
+            pivot_y};
 }
 
 Renderer make_transform_renderer(const HeadlessContext& context, const Args& args, uint32_t atlas_side,
@@ -277,9 +282,9 @@ private:
     // as laid out (found by its paint order) as the renderer places a transformed draw's glyphs.
     std::optional<GlyphInstance> still_instance(const DrawnGlyph& d, const Intended& intended) const {
         if (!intended.options || !intended.options->transform) return std::nullopt;
-        const auto found = std::find_if(intended.laid_out.begin(), intended.laid_out.end(), [&](const GlyphInstance& g) {
-            return g.paint_order == d.instance.paint_order;
-        });
+        const auto found =
+            std::find_if(intended.laid_out.begin(), intended.laid_out.end(),
+                         [&](const GlyphInstance& g) { return g.paint_order == d.instance.paint_order; });
         if (found == intended.laid_out.end()) return std::nullopt;
         const GlyphRecord& record = font_.asset().glyphs[found->key.glyph];
         const GlyphPlacement placement = place_transformed(
@@ -399,8 +404,8 @@ StillRun hold_still(TransformSuite& suite, const RotatingScreen& screen, Rendere
         run.total_gpu_ms += timed.gpu_ms;
         if (renderer.stats().work_items > 0) run.frames = frame;
         const uint32_t held = TransformSuite::frame_samples(renderer);
-        const bool measured = std::any_of(run.points.begin(), run.points.end(),
-                                          [&](const Checkpoint& p) { return p.samples == held; });
+        const bool measured =
+            std::any_of(run.points.begin(), run.points.end(), [&](const Checkpoint& p) { return p.samples == held; });
         if (!measured && std::find(wanted.begin(), wanted.end(), held) != wanted.end()) {
             progress(kSuite, "still: " + std::to_string(held) + " samples at frame " + std::to_string(frame));
             run.points.push_back({held, frame, run.total_gpu_ms, suite.subset_error(renderer, args.subset).all});
@@ -434,16 +439,18 @@ std::vector<GridCell> accuracy_grid(TransformSuite& suite, const Font& font) {
     layout_options.origin_y = 300.6f;
     auto laid = layout_text(fonts, args.quick ? "Ag" : "Ag&@e", style, layout_options);
     if (!laid) fail(kSuite, laid.error().message);
-    const std::vector<double> angles = args.quick ? std::vector<double>{37.0, 211.0} : std::vector<double>{0, 37, 90, 211};
-    const std::vector<double> scales = args.quick ? std::vector<double>{0.25, 8.0} : std::vector<double>{0.25, 1.0, 8.0};
+    const std::vector<double> angles =
+        args.quick ? std::vector<double>{37.0, 211.0} : std::vector<double>{0, 37, 90, 211};
+    const std::vector<double> scales =
+        args.quick ? std::vector<double>{0.25, 8.0} : std::vector<double>{0.25, 1.0, 8.0};
     std::vector<GridCell> cells;
     for (const double degrees : angles) {
         for (const double scale : scales) {
             for (const double shear : {0.0, 0.5}) {
                 GridCell cell{degrees, scale, shear, 0, {}};
                 DrawOptions options;
-                options.transform = linear_transform(degrees, scale, shear, layout_options.origin_x,
-                                                     layout_options.origin_y);
+                options.transform =
+                    linear_transform(degrees, scale, shear, layout_options.origin_x, layout_options.origin_y);
                 double ms = 0.0;
                 for (size_t k = 0; k < points.size(); ++k) {
                     ms += suite.frame(renderer, laid->glyphs, options).gpu_ms;
@@ -515,16 +522,16 @@ std::vector<TiltRun> perspective(TransformSuite& suite, const Font& font) {
         TiltRun run;
         run.degrees = degrees;
         DrawOptions options;
-        options.plane = tilted_plane(args, degrees, static_cast<float>(block_args.width),
-                                     static_cast<float>(block_args.height));
+        options.plane =
+            tilted_plane(args, degrees, static_cast<float>(block_args.width), static_cast<float>(block_args.height));
         options.visible = VkRect2D{{0, 0}, {args.width, args.height}};
         for (const GlyphInstance& g : block) {
             const GlyphRecord& record = font.asset().glyphs[g.key.glyph];
             if (record.curve_count == 0) continue;
             ++run.glyphs;
-            const PlanePlacement p = place_on_plane(*options.plane, record, static_cast<double>(g.pen_x),
-                                                    static_cast<double>(g.pen_y), static_cast<double>(g.key.size_x) / kSizeOne,
-                                                    static_cast<double>(g.key.size_y) / kSizeOne);
+            const PlanePlacement p = place_on_plane(
+                *options.plane, record, static_cast<double>(g.pen_x), static_cast<double>(g.pen_y),
+                static_cast<double>(g.key.size_x) / kSizeOne, static_cast<double>(g.key.size_y) / kSizeOne);
             if (!p.visible) {
                 ++run.culled;
                 continue;
@@ -558,21 +565,21 @@ std::vector<double> column(const AnimatedRun& run, Get&& get) {
 }
 
 void print_animated(std::FILE* md, const Args& args, size_t laid_out, const std::vector<AnimatedRun>& runs) {
-    std::fprintf(md,
-                 "A %ux%u canvas of %s at %.4g px (a square of prose with the canvas's diagonal as its side, "
-                 "%zu glyphs, turned about its centre and clipped to the canvas), layout %s, at a new rotation every "
-                 "frame: %.1f degrees times the frame, so every frame is a first frame (ramp 8 samples, %s frame "
-                 "budget). plain: an unnamed draw (still keys, 1/256 px per em); named: a named draw, moving from "
-                 "its second frame (coarse keys, kMovingTransformSteps). One untimed frame first. GPU ms: timestamps "
-                 "around Renderer::record; CPU ms: begin_frame, draw and record. Error: each frame's atlas against "
-                 "the exact area of its keys' transformed outlines (support/transform_reference.hpp) on %u whole "
-                 "glyphs picked evenly (all their texels): the frame's mean per channel and its worst channel; "
-                 "median, p90 and max over the %u frames.\n\n",
-                 args.width, args.height, args.font.c_str(), double{args.size}, laid_out, args.layout_name.c_str(),
-                 kDegreesPerFrame,
-                 args.frame_budget >= (uint64_t{1} << 50) ? "an unbounded"
-                                                           : ("a " + std::to_string(args.frame_budget)).c_str(),
-                 args.subset, args.frames);
+    std::fprintf(
+        md,
+        "A %ux%u canvas of %s at %.4g px (a square of prose with the canvas's diagonal as its side, "
+        "%zu glyphs, turned about its centre and clipped to the canvas), layout %s, at a new rotation every "
+        "frame: %.1f degrees times the frame, so every frame is a first frame (ramp 8 samples, %s frame "
+        "budget). plain: an unnamed draw (still keys, 1/256 px per em); named: a named draw, moving from "
+        "its second frame (coarse keys, kMovingTransformSteps). One untimed frame first. GPU ms: timestamps "
+        "around Renderer::record; CPU ms: begin_frame, draw and record. Error: each frame's atlas against "
+        "the exact area of its keys' transformed outlines (support/transform_reference.hpp) on %u whole "
+        "glyphs picked evenly (all their texels): the frame's mean per channel and its worst channel; "
+        "median, p90 and max over the %u frames.\n\n",
+        args.width, args.height, args.font.c_str(), double{args.size}, laid_out, args.layout_name.c_str(),
+        kDegreesPerFrame,
+        args.frame_budget >= (uint64_t{1} << 50) ? "an unbounded" : ("a " + std::to_string(args.frame_budget)).c_str(),
+        args.subset, args.frames);
     std::fprintf(md,
                  "| draw | glyphs drawn | GPU ms median | p90 | CPU ms median | p90 | mean error median | p90 | max | "
                  "worst texel median | max | still keys: mean median | max | worst texel max | samples | curve tests | "
@@ -615,13 +622,15 @@ void print_checkpoints(std::FILE* md, const std::vector<Checkpoint>& points) {
 
 void print_still(std::FILE* md, const Args& args, const StillRun& still, const std::vector<GridCell>& grid) {
     std::fprintf(md,
-                 "\nStill: the same screen held at %.0f degrees, the default ramp (8, 4, 2, then 1 sample a frame), "
+                 "\nStill: a %ux%u screen (the canvas, at most 1280x720) held at %.0f degrees, the default ramp (8, 4, "
+                 "2, then 1 sample a frame), "
                  "until every glyph holds %u samples: %u frames (%s), %.3f GPU ms in frame 1 and %.1f ms in all, "
                  "%u glyphs drawn. The error on %u whole glyphs when they hold N samples, with the GPU ms "
                  "summed to that frame:\n\n| samples | frame | mean | worst texel | cumulative GPU ms |\n"
                  "|---:|---:|---:|---:|---:|\n",
-                 kStillDegrees, args.samples, still.frames, still.converged ? "converged" : "NOT converged",
-                 still.first_gpu_ms, still.total_gpu_ms, still.drawn, args.subset);
+                 args.width, args.height, kStillDegrees, args.samples, still.frames,
+                 still.converged ? "converged" : "NOT converged", still.first_gpu_ms, still.total_gpu_ms, still.drawn,
+                 args.subset);
     for (const Checkpoint& p : still.points) {
         std::fprintf(md, "| %u | %u | %.5f | %.5f | %.1f |\n", p.samples, p.frame, p.error.mean(), p.error.worst,
                      p.cumulative_gpu_ms);
@@ -643,8 +652,8 @@ void print_still(std::FILE* md, const Args& args, const StillRun& still, const s
         std::fprintf(md, "\n");
         last.add(cell.points.back().error);
     }
-    std::fprintf(md, "\nOver the grid at %u samples: mean %.5f, worst texel %.5f.\n", grid.front().points.back().samples,
-                 last.mean(), last.worst);
+    std::fprintf(md, "\nOver the grid at %u samples: mean %.5f, worst texel %.5f.\n",
+                 grid.front().points.back().samples, last.mean(), last.worst);
 }
 
 void print_perspective(std::FILE* md, const Args& args, const std::vector<TiltRun>& runs) {
@@ -679,8 +688,10 @@ void write_error(JsonWriter& json, const TexelError& e) {
 void write_checkpoints(JsonWriter& json, const std::vector<Checkpoint>& points) {
     json.key("points").begin_array();
     for (const Checkpoint& p : points) {
-        json.begin_object().field("samples", p.samples).field("frame", p.frame).field("cumulative_gpu_ms",
-                                                                                      p.cumulative_gpu_ms);
+        json.begin_object()
+            .field("samples", p.samples)
+            .field("frame", p.frame)
+            .field("cumulative_gpu_ms", p.cumulative_gpu_ms);
         write_error(json, p.error);
         json.end_object();
     }
@@ -816,12 +827,20 @@ void run_transform(Session& session) {
     }
     print_animated(session.md, args, screen.glyphs.size(), animated);
 
-    progress(kSuite, "still: " + std::to_string(static_cast<int>(kStillDegrees)) + " degrees until converged");
-    Renderer still_renderer = make_transform_renderer(*session.context, args, 2048, {}, atlas_budget);
+    // Convergence is per glyph, not per screen: the still screen is at most kMaxStillCanvas, so that a
+    // 4K run's hundreds of frames to 512 samples (each read back at its checkpoints) stay minutes.
+    Args still_args = args;
+    still_args.width = std::min(args.width, kMaxStillCanvas[0]);
+    still_args.height = std::min(args.height, kMaxStillCanvas[1]);
+    TransformSuite still_suite(session, still_args, *font);
+    const RotatingScreen still_screen = rotating_screen(still_args, *font);
+    progress(kSuite, "still: " + std::to_string(static_cast<int>(kStillDegrees)) + " degrees until converged, " +
+                         std::to_string(still_args.width) + "x" + std::to_string(still_args.height));
+    Renderer still_renderer = make_transform_renderer(*session.context, still_args, 2048, {}, atlas_budget);
     if (Status s = still_renderer.add_font(*font); !s) fail(kSuite, s.error().message);
-    const StillRun still = hold_still(suite, screen, still_renderer);
+    const StillRun still = hold_still(still_suite, still_screen, still_renderer);
     const std::vector<GridCell> grid = accuracy_grid(suite, *font);
-    print_still(session.md, args, still, grid);
+    print_still(session.md, still_args, still, grid);
 
     const std::vector<TiltRun> tilts = perspective(suite, *font);
     print_perspective(session.md, args, tilts);
