@@ -504,13 +504,14 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             while (pending) {
                 row_begin_pass(r);
                 for (uint word = 0u; word < item.band_words; ++word) {
-                    uint bits = 0u;
-                    for (uint band = lo_band; band <= hi_band; ++band) {
-                        bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
+                    uint bits = fonts_bands[font].words[item.band_offset + lo_band * item.band_words + word];
+                    if (transformed) {
+                        for (uint band = lo_band + 1u; band <= hi_band; ++band) {
+                            bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
+                        }
+                        // Curves flat in em, which no band lists, cross oblique rows.
+                        if (item.flat_row != kRasterNoTransform) bits |= fonts_bands[font].words[item.flat_row + word];
                     }
-                    // Curves flat in em, which no band lists, cross oblique rows.
-                    if (transformed && item.flat_row != kRasterNoTransform)
-                        bits |= fonts_bands[font].words[item.flat_row + word];
                     uint start_bits = transformed && first_pass && start_inside
                                           ? fonts_bands[font].words[item.band_offset + start_band * item.band_words + word]
                                           : 0u;
