@@ -88,8 +88,9 @@ bool place_glyph(const GlyphRecord& record, const GlyphPlacement& place, const T
 }
 
 bool valid_transform(const TextTransform& t) {
-    const double a = t.a, b = t.b, c = t.c, d = t.d;
-    if (!finite({a, b, c, d, t.pivot_x, t.pivot_y})) return false;
+    const double a = static_cast<double>(t.a), b = static_cast<double>(t.b), c = static_cast<double>(t.c),
+                 d = static_cast<double>(t.d);
+    if (!finite({a, b, c, d, static_cast<double>(t.pivot_x), static_cast<double>(t.pivot_y)})) return false;
     constexpr double kMaxEntry = 65536.0;
     if (std::max({std::abs(a), std::abs(b), std::abs(c), std::abs(d)}) > kMaxEntry) return false;
     return std::abs(a * d - b * c) >= 1.0 / 65536.0;
@@ -119,7 +120,8 @@ bool valid_plane(const TextPlane& plane) {
 
 GlyphPlacement place_transformed(const TextTransform& t, double pen_x, double pen_y, double size_x, double size_y,
                                  double dx, double dy) {
-    const double a = t.a, b = t.b, c = t.c, d = t.d;
+    const double a = static_cast<double>(t.a), b = static_cast<double>(t.b), c = static_cast<double>(t.c),
+                 d = static_cast<double>(t.d);
     const double px = pen_x - static_cast<double>(t.pivot_x), py = pen_y - static_cast<double>(t.pivot_y);
     GlyphPlacement place;
     place.pen_x = static_cast<double>(t.pivot_x) + a * px + b * py + dx;
@@ -153,7 +155,7 @@ struct PlaneMap {
         clip(plane.axis_x, 0.0, c[0]);
         clip(plane.axis_y, 0.0, c[1]);
         clip(plane.origin, 1.0, c[2]);
-        const double vx = plane.viewport[0], vy = plane.viewport[1];
+        const double vx = static_cast<double>(plane.viewport[0]), vy = static_cast<double>(plane.viewport[1]);
         const double hw = 0.5 * static_cast<double>(plane.viewport[2]),
                      hh = 0.5 * static_cast<double>(plane.viewport[3]);
         for (int k = 0; k < 3; ++k) {
