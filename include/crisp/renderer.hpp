@@ -156,8 +156,11 @@ struct DrawOptions {
     // pen and outline mapped about the pivot, then moved by the offset. Each glyph stays an
     // axis-aligned rect of the target whose texels hold the coverage of its transformed outline,
     // keyed by the transform's linear part quantized to 1/256 px per em (1/4 px per em while a named
-    // draw's transform changes: see `id`). A transform valid_transform() refuses (not finite, a
-    // determinant below 2^-16) draws nothing (skipped_glyphs).
+    // draw's transform changes: see `id`). Animate with an id: a transform that changes every
+    // frame without one makes every glyph a new atlas entry every frame (docs/transforms.md: a 4K
+    // screen of text, 27 ms of GPU time a frame unnamed, 0.54 ms named, on an H200). A transform
+    // valid_transform() refuses (not finite, a determinant below 2^-16) draws nothing
+    // (skipped_glyphs).
     std::optional<TextTransform> transform;
     // Text on a plane in world space seen through a view-projection (transform.hpp): each glyph at
     // the local affine map of the projection at its centre, or exactly projective where that
