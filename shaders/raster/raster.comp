@@ -362,6 +362,10 @@ float row_height(uint n) {
     return fract(float(bitfieldReverse(n)) * (1.0 / 4294967296.0) + kRasterRowOffset);
 }
 
+// A sample's two lines of a glyph whose stems run along the rows sit this far either side of its
+// height: 1/32, so that eight samples' lines are the centres of sixteen strata.
+const float kRasterHalfRowShift = 1.0 / 32.0;
+
 // How far left of its segment a transformed row starts (texels): an odd fraction, unlike curve
 // positions on a fixed-point grid.
 const float kTransformedStartBack = 0.000707107;
@@ -453,6 +457,10 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
     // Channels that share their rows (stripes, gray) walk one list over the union of their
     // segments; otherwise each channel is a row of its own, walked in turn.
     uint rows = pc.shared_rows != 0u ? 1u : 3u;
+    // A transformed glyph whose em y axis lies nearer the rows than across them (text within 45
+    // degrees of vertical: its stems run along the rows, which sample them as they sample
+    // horizontal edges) walks two lines a sample (to_em[0].w).
+    uint lines = transformed && m.to_em[0].w != 0.0 ? 2u : 1u;
     uvec3 sums = uvec3(0u);
     for (uint k = 0u; k < item.sample_count; ++k) {
         uint n = item.first_sample + k;
@@ -460,9 +468,12 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
         // The R2 x offset of n, free now that rows need no x: the dither of the quantization.
         float dither = fract(0.5 + float(n) * kRasterR2StepX);
         vec3 covered = vec3(0.0);
-        for (uint row = 0u; row < rows; ++row) {
+        for (uint line = 0u; line < rows * lines; ++line) {
+            uint row = line % rows;
             vec4 rect = pc.channel_rects[row];
-            float y = float(ty) + (rect.y + (rect.w - rect.y) * v);
+            // Two lines a sample: v -+ 1/32, the centres of sixteen strata where v is of eight.
+            float h = lines == 1u ? v : fract(v + (line < rows ? -kRasterHalfRowShift : kRasterHalfRowShift));
+            float y = float(ty) + (rect.y + (rect.w - rect.y) * h);
             if (!transformed) y = item.offset_y + item.scale_y * y;
             // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
             vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
@@ -538,6 +549,7 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                 first_pass = false;
             }
         }
+        if (lines == 2u) covered *= 0.5;
         sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),
                       row_units(covered.z, hi.z - lo.z, dither));
     }

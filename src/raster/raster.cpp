@@ -76,6 +76,8 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
                 gpu::RasterTransform t{{row_of(to_texel, 0), row_of(to_texel, 1), row_of(to_texel, 2)},
                                        {row_of(to_em, 0), row_of(to_em, 1), row_of(to_em, 2)}};
                 t.to_texel[0].w = orientation(to_texel);
+                // Stems along the rows: the em y axis's image nearer horizontal than vertical.
+                t.to_em[0].w = std::abs(w.key.linear[1]) > std::abs(w.key.linear[3]) ? 1.0f : 0.0f;
                 t.to_texel[1].w = glyph.bbox_min_x;
                 t.to_texel[2].w = glyph.bbox_max_x;
                 transforms.push_back(t);
