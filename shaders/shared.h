@@ -110,7 +110,7 @@ struct RasterItem {
 // A transformed glyph's maps (include/crisp/glyph.hpp, em_to_texel): rows of 3x3 projective
 // matrices, em (y up) to the rect's texels and back. W is 1 without perspective. to_texel[0].w is
 // the map's orientation, +1 or -1 (the sign of its determinant); to_texel[1].w and [2].w the
-// glyph's em bbox in x; to_em[0].w is 1 where the em y axis maps nearer the rows than across them
+// glyph's em bbox in x; to_em[0].w is 1 where the em y axis maps within 15 degrees of the rows
 // (two lines a row sample), else 0; the other w are unused.
 struct RasterTransform {
     vec4 to_texel[3];

@@ -457,9 +457,9 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
     // Channels that share their rows (stripes, gray) walk one list over the union of their
     // segments; otherwise each channel is a row of its own, walked in turn.
     uint rows = pc.shared_rows != 0u ? 1u : 3u;
-    // A transformed glyph whose em y axis lies nearer the rows than across them (text within 45
-    // degrees of vertical: its stems run along the rows, which sample them as they sample
-    // horizontal edges) walks two lines a sample (to_em[0].w).
+    // A transformed glyph whose em y axis lies along the rows (text within 15 degrees of vertical:
+    // its stems run along the rows, which sample them as they sample horizontal edges) walks two
+    // lines a sample (to_em[0].w).
     uint lines = transformed && m.to_em[0].w != 0.0 ? 2u : 1u;
     uvec3 sums = uvec3(0u);
     for (uint k = 0u; k < item.sample_count; ++k) {
