@@ -163,6 +163,16 @@ void expect_within_bounds(const std::string& what, uint32_t samples, const Error
     EXPECT_LE(e.max, converged ? kConvergedMax : kMax64) << what;
 }
 
+// render_and_measure(), then expect_within_bounds() at its sample count, with every glyph drawn.
+Error measure_within_bounds(const std::string& what, const Font& font, std::span<const GlyphInstance> glyphs,
+                            const DrawOptions& options, uint32_t samples,
+                            const SubpixelLayout& layout = *subpixel_preset("rgb")) {
+    const Error e = render_and_measure(font, glyphs, options, samples, layout);
+    expect_within_bounds(what, samples, e);
+    EXPECT_EQ(e.drawn, glyphs.size()) << what;
+    return e;
+}
+
 TextTransform rotation(double degrees, double scale, float pivot_x, float pivot_y) {
     const double t = degrees * std::numbers::pi / 180.0;
     const auto c = static_cast<float>(std::cos(t) * scale), s = static_cast<float>(std::sin(t) * scale);
@@ -198,9 +208,8 @@ TEST(Transform, ConvergedRotationsMeetTheTargets) {
     ASSERT_TRUE(font);
     const std::vector<GlyphInstance> glyphs = lay_out(*font, "g", 14.0f, 20.3f, 30.6f);
     for (double degrees : {37.0, 271.3}) {
-        const Error e = render_and_measure(*font, glyphs, transformed(rotation(degrees, 1.0, 20.0f, 30.0f)), 512);
-        expect_within_bounds("g 14 px rgb, " + std::to_string(degrees) + " degrees", 512, e);
-        EXPECT_EQ(e.drawn, 1u);
+        measure_within_bounds("g 14 px rgb, " + std::to_string(degrees) + " degrees", *font, glyphs,
+                              transformed(rotation(degrees, 1.0, 20.0f, 30.0f)), 512);
     }
 }
 
@@ -222,14 +231,12 @@ TEST(Transform, MirroredAndShearedText) {
     };
     for (const auto& c : cases) {
         ASSERT_TRUE(valid_transform(c.t)) << c.what;
-        const Error e = render_and_measure(*font, glyphs, transformed(c.t), 64);
-        expect_within_bounds(std::string("Rg 14 px rgb, ") + c.what, 64, e);
-        EXPECT_EQ(e.drawn, glyphs.size()) << c.what;
+        measure_within_bounds(std::string("Rg 14 px rgb, ") + c.what, *font, glyphs, transformed(c.t), 64);
     }
     // Converged: the shear at its limit.
     const std::vector<GlyphInstance> one = lay_out(*font, "R", 14.0f, 20.0f, 30.0f);
-    const Error e = render_and_measure(*font, one, transformed({1.0f, 0.5f, 0.0f, 1.0f, 20.0f, 30.0f}), 512);
-    expect_within_bounds("R 14 px rgb, shear x 0.5", 512, e);
+    measure_within_bounds("R 14 px rgb, shear x 0.5", *font, one, transformed({1.0f, 0.5f, 0.0f, 1.0f, 20.0f, 30.0f}),
+                          512);
 }
 
 TEST(Transform, TinyAndLargeScales) {
@@ -238,14 +245,12 @@ TEST(Transform, TinyAndLargeScales) {
     ASSERT_TRUE(font);
     // 0.25x of 16 px: 4 px glyphs, converged.
     const std::vector<GlyphInstance> small = lay_out(*font, "ag", 16.0f, 20.0f, 30.0f);
-    const Error tiny = render_and_measure(*font, small, transformed(rotation(23.0, 0.25, 20.0f, 30.0f)), 512);
-    expect_within_bounds("ag 16 px x 0.25 rgb, 23 degrees", 512, tiny);
-    EXPECT_EQ(tiny.drawn, 2u);
+    measure_within_bounds("ag 16 px x 0.25 rgb, 23 degrees", *font, small,
+                          transformed(rotation(23.0, 0.25, 20.0f, 30.0f)), 512);
     // 8x of 12 px: a 96 px glyph, about 100 x 100 texels.
     const std::vector<GlyphInstance> large = lay_out(*font, "a", 12.0f, 20.0f, 30.0f);
-    const Error big = render_and_measure(*font, large, transformed(rotation(-31.0, 8.0, 20.0f, 30.0f)), 64);
-    expect_within_bounds("a 12 px x 8 rgb, -31 degrees", 64, big);
-    EXPECT_EQ(big.drawn, 1u);
+    const Error big = measure_within_bounds("a 12 px x 8 rgb, -31 degrees", *font, large,
+                                            transformed(rotation(-31.0, 8.0, 20.0f, 30.0f)), 64);
     EXPECT_GT(big.channels, 3000u);
 }
 
@@ -258,9 +263,7 @@ TEST(Transform, ALargeRotatedGlyphSeenInPartIsExactThere) {
     const std::vector<GlyphInstance> glyphs = lay_out(*font, "a", 12.0f, 100.0f, 300.0f);
     DrawOptions options = transformed(rotation(30.0, 40.0, 100.0f, 300.0f));
     options.visible = VkRect2D{{270, 220}, {40, 40}};  // about the glyph's centre
-    const Error e = render_and_measure(*font, glyphs, options, 64);
-    expect_within_bounds("a 12 px x 40 rgb, 30 degrees, a 40 x 40 part", 64, e);
-    EXPECT_EQ(e.drawn, 1u);
+    const Error e = measure_within_bounds("a 12 px x 40 rgb, 30 degrees, a 40 x 40 part", *font, glyphs, options, 64);
     EXPECT_GT(e.channels, 1000u);
     EXPECT_LT(e.channels, 3u * 40 * 40 + 1);  // only the visible texels are reported
 }
@@ -297,13 +300,11 @@ TEST(Transform, GrayRgbAndVerticalLayouts) {
     const std::vector<GlyphInstance> glyphs = lay_out(*font, "g", 14.0f, 20.0f, 30.0f);
     for (const char* name : {"gray", "rgb", "vrgb"}) {
         const SubpixelLayout& layout = *subpixel_preset(name);
-        const Error e = render_and_measure(*font, glyphs, transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64, layout);
-        expect_within_bounds(std::string("g 14 px ") + name + ", 37 degrees", 64, e);
-        EXPECT_EQ(e.drawn, 1u) << name;
+        measure_within_bounds(std::string("g 14 px ") + name + ", 37 degrees", *font, glyphs,
+                              transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64, layout);
     }
-    const Error e = render_and_measure(*font, glyphs, transformed(rotation(123.0, 1.0, 20.0f, 30.0f)), 512,
-                                       *subpixel_preset("vrgb"));
-    expect_within_bounds("g 14 px vrgb, 123 degrees", 512, e);
+    measure_within_bounds("g 14 px vrgb, 123 degrees", *font, glyphs, transformed(rotation(123.0, 1.0, 20.0f, 30.0f)),
+                          512, *subpixel_preset("vrgb"));
 }
 
 // A hand-made shape at 20 px, rotated by 37 degrees about its pen, on gray and vrgb, at 64 samples.
@@ -313,10 +314,9 @@ void expect_rotated_shape_accurate(const char* what, const std::vector<Contour>&
     ASSERT_TRUE(font) << what;
     const GlyphInstance instance = test::place(*font, glyph, 20.0f, 20.25f, 30.0f);
     for (const char* layout : {"gray", "vrgb"}) {
-        const Error e =
-            render_and_measure(*font, std::span(&instance, 1), transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64,
-                               *subpixel_preset(layout));
-        expect_within_bounds(std::string(what) + ", 20 px " + layout + ", 37 degrees", 64, e);
+        const Error e = measure_within_bounds(std::string(what) + ", 20 px " + layout + ", 37 degrees", *font,
+                                              std::span(&instance, 1), transformed(rotation(37.0, 1.0, 20.0f, 30.0f)),
+                                              64, *subpixel_preset(layout));
         EXPECT_EQ(e.drawn, 1u) << what;  // overlapping contours never above 1
     }
 }
@@ -351,10 +351,8 @@ TEST(TransformHardCase, RowsWithMoreCrossingsThanTheRegistersHoldRotated) {
     const std::vector<GlyphInstance> glyphs = lay_out(*font, "H", 24.0f, 20.0f, 30.0f);
     ASSERT_EQ(glyphs.size(), 1u);
     EXPECT_GE(font->asset().glyphs[glyphs[0].key.glyph].curve_count, 4000u);
-    const Error e =
-        render_and_measure(*font, glyphs, transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64, *subpixel_preset("gray"));
-    expect_within_bounds("many-curves.ttf H (4,000 curves) 24 px gray, 37 degrees", 64, e);
-    EXPECT_EQ(e.drawn, 1u);
+    measure_within_bounds("many-curves.ttf H (4,000 curves) 24 px gray, 37 degrees", *font, glyphs,
+                          transformed(rotation(37.0, 1.0, 20.0f, 30.0f)), 64, *subpixel_preset("gray"));
 }
 
 TEST(TransformHardCase, CjkGlyphAndFourPixelsRotated) {
@@ -362,19 +360,15 @@ TEST(TransformHardCase, CjkGlyphAndFourPixelsRotated) {
     auto e = test::bake_test_font("e");
     ASSERT_TRUE(e);
     const std::vector<GlyphInstance> tiny = lay_out(*e, "e", 4.0f, 20.6f, 30.3f);
-    const Error four = render_and_measure(*e, tiny, transformed(rotation(57.0, 1.0, 20.0f, 30.0f)), 512);
-    expect_within_bounds("e 4 px rgb, 57 degrees", 512, four);
-    EXPECT_EQ(four.drawn, 1u);
+    measure_within_bounds("e 4 px rgb, 57 degrees", *e, tiny, transformed(rotation(57.0, 1.0, 20.0f, 30.0f)), 512);
     if (!std::filesystem::exists(test::kNotoCjk)) GTEST_SKIP() << test::kNotoCjk << " is missing";
     auto cjk = test::bake_subset(test::kNotoCjk, "龘");
     ASSERT_TRUE(cjk);
     const std::vector<GlyphInstance> glyphs = lay_out(*cjk, "龘", 16.0f, 20.0f, 30.0f);
     ASSERT_EQ(glyphs.size(), 1u);
     EXPECT_GT(cjk->asset().glyphs[glyphs[0].key.glyph].curve_count, 200u);
-    const Error a =
-        render_and_measure(*cjk, glyphs, transformed(rotation(-21.0, 1.0, 20.0f, 30.0f)), 64, *subpixel_preset("gray"));
-    expect_within_bounds("Noto Sans CJK 龘 16 px gray, -21 degrees", 64, a);
-    EXPECT_EQ(a.drawn, 1u);
+    measure_within_bounds("Noto Sans CJK 龘 16 px gray, -21 degrees", *cjk, glyphs,
+                          transformed(rotation(-21.0, 1.0, 20.0f, 30.0f)), 64, *subpixel_preset("gray"));
 }
 
 // Text "Ag" at 14 px laid out at layout pixels (0, 0) on a plane seen through a camera.
@@ -512,8 +506,8 @@ TEST(TransformPlane, GrazingGlyphsAreProjectiveAndMatchTheExactProjection) {
     expect_depths_of_centres(*scene.font, scene.glyphs, *renderer, plane);
     expect_no_validation_messages();
     // Converged, under perspective: the targets of still text.
-    const Error converged = render_and_measure(*scene.font, scene.glyphs, options, 512);
-    expect_within_bounds("Ag 14 px rgb on a plane at a grazing angle, projective", 512, converged);
+    const Error converged = measure_within_bounds("Ag 14 px rgb on a plane at a grazing angle, projective", *scene.font,
+                                                  scene.glyphs, options, 512);
     EXPECT_EQ(converged.projective, 2u);
 }
 
@@ -685,8 +679,8 @@ TEST(Transform, ColourGlyphsDrawRotated) {
     const std::vector<GlyphInstance> glyphs = lay_out(*font, "\xee\x80\x80\xee\x80\x81", 16.0f, 20.0f, 30.0f);
     ASSERT_GT(glyphs.size(), 2u);  // each colour glyph is two or more layers
     for (const GlyphInstance& g : glyphs) EXPECT_NE(g.colour_glyph, kNoColourGlyph);
-    const Error e = render_and_measure(*font, glyphs, transformed(rotation(30.0, 1.0, 20.0f, 30.0f)), 64);
-    expect_within_bounds("colrv0.ttf U+E000 U+E001 16 px rgb, layers, 30 degrees", 64, e);
+    const Error e = measure_within_bounds("colrv0.ttf U+E000 U+E001 16 px rgb, layers, 30 degrees", *font, glyphs,
+                                          transformed(rotation(30.0, 1.0, 20.0f, 30.0f)), 64);
     EXPECT_EQ(e.drawn, glyphs.size());
     EXPECT_EQ(e.transformed, glyphs.size());
 }
