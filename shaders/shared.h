@@ -78,6 +78,9 @@ CRISP_CONSTANT(uint, kRasterBindWorkgroupItems, 4u);  // uint[]: the item of eac
 CRISP_CONSTANT(uint, kRasterBindTransforms, 5u);      // RasterTransform[]: transformed glyphs' maps
 // RasterItem::transform of a glyph that is not transformed (texel_to_em's offset and scale serve it).
 CRISP_CONSTANT(uint, kRasterNoTransform, 0xFFFFFFFFu);
+// raster.comp's kTransformedItems of the pipeline for transformed items that walk two lines a row
+// sample (0 serves axis-aligned items, 1 the other transformed ones).
+CRISP_CONSTANT(uint, kRasterTwoLineItems, 2u);
 
 // One glyph's work this frame, in a std430 storage buffer.
 struct RasterItem {
@@ -110,8 +113,7 @@ struct RasterItem {
 // A transformed glyph's maps (include/crisp/glyph.hpp, em_to_texel): rows of 3x3 projective
 // matrices, em (y up) to the rect's texels and back. W is 1 without perspective. to_texel[0].w is
 // the map's orientation, +1 or -1 (the sign of its determinant); to_texel[1].w and [2].w the
-// glyph's em bbox in x; to_em[0].w is 1 where the em y axis maps within 15 degrees of the rows
-// (two lines a row sample), else 0; the other w are unused.
+// glyph's em bbox in x; the other w are unused.
 struct RasterTransform {
     vec4 to_texel[3];
     vec4 to_em[3];

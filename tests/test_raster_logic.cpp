@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -381,7 +382,9 @@ TEST(RasterWorkItems, ItemsAddressTheirFontsRangesAndTileTheWorkgroups) {
     std::vector<gpu::RasterItem> items = {gpu::RasterItem{}};  // stale: replaced
     std::vector<uint32_t> table = {9};
     std::vector<gpu::RasterTransform> transforms = {gpu::RasterTransform{}};  // stale: replaced
-    EXPECT_EQ(raster::build_work_items(work, fonts, items, transforms, table), 4u);
+    std::array<uint32_t, raster::kRasterItemKinds> kinds{};
+    EXPECT_EQ(raster::build_work_items(work, fonts, items, transforms, table, kinds), 4u);
+    EXPECT_EQ(kinds, (std::array<uint32_t, raster::kRasterItemKinds>{4, 0, 0}));
     EXPECT_TRUE(transforms.empty());
     ASSERT_EQ(items.size(), 2u);
     EXPECT_EQ(table, (std::vector<uint32_t>{0, 0, 0, 1}));
@@ -414,9 +417,62 @@ TEST(RasterWorkItems, ItemsAddressTheirFontsRangesAndTileTheWorkgroups) {
     EXPECT_EQ(item.transform, gpu::kRasterNoTransform);
     EXPECT_EQ(items[1].point_offset, 1000 + record_of(g).point_offset);
     EXPECT_NE(items[1].point_offset, item.point_offset);
-    EXPECT_EQ(raster::build_work_items({}, fonts, items, transforms, table), 0u);
+    EXPECT_EQ(raster::build_work_items({}, fonts, items, transforms, table, kinds), 0u);
+    EXPECT_EQ(kinds, (std::array<uint32_t, raster::kRasterItemKinds>{0, 0, 0}));
     EXPECT_TRUE(items.empty());
     EXPECT_TRUE(table.empty());
+}
+
+// A key's linear part at `degrees` of rotation, 24 px per em (y down: em y runs up the screen).
+GlyphKey rotated_key(GlyphKey key, double degrees) {
+    const double a = degrees * 3.14159265358979323846 / 180.0, s = 24.0 * 256.0;
+    key.linear[0] = static_cast<int32_t>(std::lround(s * std::cos(a)));
+    key.linear[1] = static_cast<int32_t>(std::lround(s * std::sin(a)));
+    key.linear[2] = static_cast<int32_t>(std::lround(s * std::sin(a)));
+    key.linear[3] = static_cast<int32_t>(std::lround(-s * std::cos(a)));
+    return key;
+}
+
+TEST(RasterWorkItems, TransformedItemsFollowByKindAndNearVerticalOnesWalkTwoLines) {
+    const GlyphInstance h = glyph_at(24.0f, 0.25f, 30.0f);
+    EXPECT_EQ(raster::item_kind(h.key), 0u);
+    // Within 15 degrees of vertical (either way, mirrored too) the stems run along the rows.
+    for (const double degrees : {90.0, 76.0, -80.0, 270.0, 104.0}) {
+        EXPECT_EQ(raster::item_kind(rotated_key(h.key, degrees)), gpu::kRasterTwoLineItems) << degrees;
+    }
+    for (const double degrees : {0.0, 37.0, 74.0, 180.0, 106.0, -45.0}) {
+        EXPECT_EQ(raster::item_kind(rotated_key(h.key, degrees)), 1u) << degrees;
+    }
+
+    TestFonts fonts;
+    fonts.fonts[kFontId] = {&test_font().asset(), 0, 0, 0, {}};
+    RasterWork plain{};
+    plain.key = h.key;
+    plain.width = h.width;
+    plain.height = h.height;
+    plain.texel_count = 2 * gpu::kRasterWorkgroupSize;
+    plain.sample_count = 1;
+    RasterWork vertical = plain, oblique = plain;
+    vertical.key = rotated_key(h.key, 88.0);
+    vertical.texel_count = 1;
+    oblique.key = rotated_key(h.key, 37.0);
+    oblique.texel_count = 3 * gpu::kRasterWorkgroupSize + 1;
+    const RasterWork work[] = {vertical, plain, oblique, plain};
+    std::vector<gpu::RasterItem> items;
+    std::vector<gpu::RasterTransform> transforms;
+    std::vector<uint32_t> table;
+    std::array<uint32_t, raster::kRasterItemKinds> kinds{};
+    EXPECT_EQ(raster::build_work_items(work, fonts, items, transforms, table, kinds), 2u + 2u + 4u + 1u);
+    EXPECT_EQ(kinds, (std::array<uint32_t, raster::kRasterItemKinds>{4, 4, 1}));
+    ASSERT_EQ(items.size(), 4u);
+    ASSERT_EQ(transforms.size(), 2u);
+    EXPECT_EQ(items[0].transform, gpu::kRasterNoTransform);
+    EXPECT_EQ(items[1].transform, gpu::kRasterNoTransform);
+    EXPECT_EQ(items[2].transform, 0u);  // the oblique glyph, then the vertical one
+    EXPECT_EQ(items[3].transform, 1u);
+    EXPECT_EQ(items[2].first_workgroup, 4u);
+    EXPECT_EQ(items[3].first_workgroup, 8u);
+    EXPECT_EQ(table, (std::vector<uint32_t>{0, 0, 1, 1, 2, 2, 2, 2, 3}));
 }
 
 // ---- Colour layers' fills (raster/paints)

@@ -27,9 +27,11 @@
 
 layout(local_size_x = kRasterWorkgroupSize) in;
 
-// 1: this pipeline rasterizes transformed items (those with a RasterTransform), 0: the others. Two
+// The items this pipeline rasterizes: 0 axis-aligned ones, 1 transformed ones (those with a
+// RasterTransform), kRasterTwoLineItems transformed ones that walk two lines a row sample. Three
 // pipelines, so that the axis-aligned one carries none of the transformed path's registers (it
-// cost axis-aligned text 46 % of its speed on an H200 in one kernel).
+// cost axis-aligned text 46 % of its speed on an H200 in one kernel) and the one-line one none of
+// the second line's.
 layout(constant_id = 0) const uint kTransformedItems = 0u;
 
 layout(push_constant) uniform PushConstants {
@@ -457,10 +459,9 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
     // Channels that share their rows (stripes, gray) walk one list over the union of their
     // segments; otherwise each channel is a row of its own, walked in turn.
     uint rows = pc.shared_rows != 0u ? 1u : 3u;
-    // A transformed glyph whose em y axis lies along the rows (text within 15 degrees of vertical:
-    // its stems run along the rows, which sample them as they sample horizontal edges) walks two
-    // lines a sample (to_em[0].w).
-    uint lines = transformed && m.to_em[0].w != 0.0 ? 2u : 1u;
+    // Lines a sample: two for the transformed glyphs whose stems run along the rows (kTwoLines),
+    // walked together: one pass over the curves of both lines' bands serves both lists.
+    const uint lines = kTransformedItems == kRasterTwoLineItems ? 2u : 1u;
     uvec3 sums = uvec3(0u);
     for (uint k = 0u; k < item.sample_count; ++k) {
         uint n = item.first_sample + k;
@@ -468,18 +469,10 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
         // The R2 x offset of n, free now that rows need no x: the dither of the quantization.
         float dither = fract(0.5 + float(n) * kRasterR2StepX);
         vec3 covered = vec3(0.0);
-        for (uint line = 0u; line < rows * lines; ++line) {
-            uint row = line % rows;
+        for (uint row = 0u; row < rows; ++row) {
             vec4 rect = pc.channel_rects[row];
-            // Two lines a sample: v -+ 1/32, the centres of sixteen strata where v is of eight.
-            float h = lines == 1u ? v : fract(v + (line < rows ? -kRasterHalfRowShift : kRasterHalfRowShift));
-            float y = float(ty) + (rect.y + (rect.w - rect.y) * h);
-            if (!transformed) y = item.offset_y + item.scale_y * y;
             // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
             vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
-            RowList r;
-            r.start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
-            r.end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
             // Each invocation walks the curves of its own band: a subgroup then takes as many steps
             // as its fullest band has curves, where a band range shared by the subgroup took the
             // curves of all its rows' bands (the loads differ between invocations on different
@@ -488,34 +481,58 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             // crossings past the segment's end lie in other bands, so the winding at its start is
             // not theirs to count: it is the start's own, from a ray along em x in the start's band
             // (winding()), negated where the map to texels reverses orientation, and carried from
-            // pass to pass.
-            uint lo_band = band_of(item, y), hi_band = lo_band, start_band = lo_band;
-            vec2 start_em = vec2(0.0);
-            int start_winding = 0;
-            bool start_inside = false;
-            vec3 y_row = vec3(0.0);
-            if (transformed) {
-                y_row = m.to_texel[1].xyz - y * m.to_texel[2].xyz;
-                // The start a hair left of the segment, so that it is not on a curve where the
-                // segment begins at one (a stem on the texel's edge): the walk clips to the
-                // channels' segments, so the stretch before them adds nothing.
-                r.start -= kTransformedStartBack;
-                start_em = texel_em(m, r.start, y);
-                float yb = texel_em(m, r.end, y).y;
-                start_band = band_of(item, start_em.y);
-                // Outside the glyph's bbox the start's winding is 0: no ray to cast.
-                start_inside = start_em.x >= m.to_texel[1].w && start_em.x <= m.to_texel[2].w &&
-                               start_em.y >= item.bbox_min_y && start_em.y <= item.bbox_max_y;
-                lo_band = band_of(item, min(start_em.y, yb));
-                hi_band = band_of(item, max(start_em.y, yb));
+            // pass to pass. Two lines walk the union of their bands: a curve of the other line's
+            // bands crosses this line's segment nowhere (it would be listed in the band it crosses
+            // in), and crossings right of the segment add nothing.
+            RowList r[lines];
+            float y[lines];
+            vec3 y_row[lines];
+            vec2 start_em[lines];
+            uint start_band[lines];
+            bool start_inside[lines];
+            int start_winding[lines];
+            bool pending[lines];
+            uint lo_band = 0xFFFFFFFFu, hi_band = 0u;
+            for (uint l = 0u; l < lines; ++l) {
+                // Two lines a sample: v -+ 1/32, the centres of sixteen strata where v is of eight.
+                float h = lines == 1u ? v : fract(v + (l == 0u ? -kRasterHalfRowShift : kRasterHalfRowShift));
+                y[l] = float(ty) + (rect.y + (rect.w - rect.y) * h);
+                if (!transformed) y[l] = item.offset_y + item.scale_y * y[l];
+                r[l].start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
+                r[l].end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
+                start_em[l] = vec2(0.0);
+                start_band[l] = 0u;
+                start_inside[l] = false;
+                start_winding[l] = 0;
+                pending[l] = true;
+                y_row[l] = vec3(0.0);
+                if (transformed) {
+                    y_row[l] = m.to_texel[1].xyz - y[l] * m.to_texel[2].xyz;
+                    // The start a hair left of the segment, so that it is not on a curve where the
+                    // segment begins at one (a stem on the texel's edge): the walk clips to the
+                    // channels' segments, so the stretch before them adds nothing.
+                    r[l].start -= kTransformedStartBack;
+                    start_em[l] = texel_em(m, r[l].start, y[l]);
+                    float yb = texel_em(m, r[l].end, y[l]).y;
+                    start_band[l] = band_of(item, start_em[l].y);
+                    // Outside the glyph's bbox the start's winding is 0: no ray to cast.
+                    start_inside[l] = start_em[l].x >= m.to_texel[1].w && start_em[l].x <= m.to_texel[2].w &&
+                                      start_em[l].y >= item.bbox_min_y && start_em[l].y <= item.bbox_max_y;
+                    lo_band = min(lo_band, band_of(item, min(start_em[l].y, yb)));
+                    hi_band = max(hi_band, band_of(item, max(start_em[l].y, yb)));
+                } else {
+                    lo_band = hi_band = band_of(item, y[l]);
+                }
             }
             // A pass per kRasterRowCrossings crossings.
-            bool pending = true;
             bool first_pass = true;
-            while (pending) {
-                row_begin_pass(r);
+            while (pending[0] || (lines == 2u && pending[lines - 1u])) {
+                for (uint l = 0u; l < lines; ++l) {
+                    if (pending[l]) row_begin_pass(r[l]);
+                }
                 for (uint word = 0u; word < item.band_words; ++word) {
                     uint bits = fonts_bands[font].words[item.band_offset + lo_band * item.band_words + word];
+                    uint start_bits[lines];
                     if (transformed) {
                         for (uint band = lo_band + 1u; band <= hi_band; ++band) {
                             bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
@@ -523,9 +540,12 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                         // Curves flat in em, which no band lists, cross oblique rows.
                         if (item.flat_row != kRasterNoTransform) bits |= fonts_bands[font].words[item.flat_row + word];
                     }
-                    uint start_bits = transformed && first_pass && start_inside
-                                          ? fonts_bands[font].words[item.band_offset + start_band * item.band_words + word]
-                                          : 0u;
+                    for (uint l = 0u; l < lines; ++l) {
+                        start_bits[l] =
+                            transformed && first_pass && start_inside[l]
+                                ? fonts_bands[font].words[item.band_offset + start_band[l] * item.band_words + word]
+                                : 0u;
+                    }
                     while (bits != 0u) {
                         uint bit = findLSB(bits);
                         bits &= bits - 1u;
@@ -533,19 +553,25 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                         vec2 p0 = fonts_points[font].points[first];
                         vec2 p1 = fonts_points[font].points[first + 1u];
                         vec2 p2 = fonts_points[font].points[first + 2u];
-                        if (transformed) {
-                            row_curve_transformed(r, m, y_row, perspective, p0, p1, p2);
-                            if (((start_bits >> bit) & 1u) != 0u)
-                                start_winding += winding(p0 - start_em, p1 - start_em, p2 - start_em);
-                        } else {
-                            row_curve(r, p0, p1, p2, y);
+                        for (uint l = 0u; l < lines; ++l) {
+                            if (!pending[l]) continue;
+                            if (transformed) {
+                                row_curve_transformed(r[l], m, y_row[l], perspective, p0, p1, p2);
+                                if (((start_bits[l] >> bit) & 1u) != 0u)
+                                    start_winding[l] += winding(p0 - start_em[l], p1 - start_em[l], p2 - start_em[l]);
+                            } else {
+                                row_curve(r[l], p0, p1, p2, y[l]);
+                            }
                         }
                     }
                 }
-                if (transformed) r.winding = first_pass ? start_winding * int(m.to_texel[0].w) : start_winding;
-                covered += row_walk(r, lo, hi) * mine;
-                pending = r.more;
-                start_winding = r.winding;
+                for (uint l = 0u; l < lines; ++l) {
+                    if (!pending[l]) continue;
+                    if (transformed) r[l].winding = first_pass ? start_winding[l] * int(m.to_texel[0].w) : start_winding[l];
+                    covered += row_walk(r[l], lo, hi) * mine;
+                    pending[l] = r[l].more;
+                    start_winding[l] = r[l].winding;
+                }
                 first_pass = false;
             }
         }

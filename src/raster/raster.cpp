@@ -56,18 +56,28 @@ float orientation(const Projective& map) {
 
 }  // namespace
 
+uint32_t item_kind(const GlyphKey& key) {
+    if (!is_transformed(key)) return 0;
+    // Stems along the rows: the em y axis's image within 15 degrees of horizontal.
+    return std::abs(static_cast<double>(key.linear[1])) > kTwoLineSlope * std::abs(static_cast<double>(key.linear[3]))
+               ? gpu::kRasterTwoLineItems
+               : 1;
+}
+
 uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fonts, std::vector<gpu::RasterItem>& items,
-                          std::vector<gpu::RasterTransform>& transforms, std::vector<uint32_t>& workgroup_items) {
+                          std::vector<gpu::RasterTransform>& transforms, std::vector<uint32_t>& workgroup_items,
+                          std::array<uint32_t, kRasterItemKinds>& kind_workgroups) {
     items.clear();
     transforms.clear();
     workgroup_items.clear();
     uint32_t workgroups = 0;
-    // The axis-aligned items first, then the transformed ones: each set is one dispatch of its own
-    // pipeline (RasterPass::record_dispatch).
-    for (const bool transformed_pass : {false, true}) {
+    // The axis-aligned items first, then the transformed ones of one line a sample, then those of
+    // two: each set is one dispatch of its own pipeline (RasterPass::record_dispatch).
+    for (uint32_t kind = 0; kind < kRasterItemKinds; ++kind) {
+        const uint32_t first_workgroup = workgroups;
         for (const RasterWork& w : work) {
             const HeldFont* font = fonts.find(w.key.font);
-            if (!font || w.sample_count == 0 || is_transformed(w.key) != transformed_pass) continue;
+            if (!font || w.sample_count == 0 || item_kind(w.key) != kind) continue;
             const GlyphRecord& glyph = font->asset->glyphs[w.key.glyph];
             const GlyphRect rect = glyph_rect(glyph, w.key);
             gpu::RasterItem item{};
@@ -82,11 +92,6 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
                 gpu::RasterTransform t{{row_of(to_texel, 0), row_of(to_texel, 1), row_of(to_texel, 2)},
                                        {row_of(to_em, 0), row_of(to_em, 1), row_of(to_em, 2)}};
                 t.to_texel[0].w = orientation(to_texel);
-                // Stems along the rows: the em y axis's image within 15 degrees of horizontal.
-                t.to_em[0].w = std::abs(static_cast<double>(w.key.linear[1])) >
-                                       kTwoLineSlope * std::abs(static_cast<double>(w.key.linear[3]))
-                                   ? 1.0f
-                                   : 0.0f;
                 t.to_texel[1].w = glyph.bbox_min_x;
                 t.to_texel[2].w = glyph.bbox_max_x;
                 transforms.push_back(t);
@@ -119,6 +124,7 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
             workgroup_items.insert(workgroup_items.end(), own, static_cast<uint32_t>(items.size()));
             items.push_back(item);
         }
+        kind_workgroups[kind] = workgroups - first_workgroup;
     }
     return workgroups;
 }
@@ -180,15 +186,17 @@ Status RasterPass::create(uint32_t cells, uint64_t atlas_texels, RetireLists& re
         !s) {
         return s;
     }
-    // Two pipelines of one shader (kTransformedItems): axis-aligned items, and transformed ones.
-    for (const uint32_t transformed : {0u, 1u}) {
-        const VkSpecializationMapEntry entry{0, 0, sizeof transformed};
-        const VkSpecializationInfo specialization{1, &entry, sizeof transformed, &transformed};
+    // Three pipelines of one shader (kTransformedItems, item_kind()): axis-aligned items,
+    // transformed ones, and transformed ones that walk two lines a sample.
+    static constexpr const char* kNames[kRasterItemKinds] = {"raster.comp", "raster.comp (transformed)",
+                                                             "raster.comp (transformed, two lines)"};
+    for (uint32_t kind = 0; kind < kRasterItemKinds; ++kind) {
+        const VkSpecializationMapEntry entry{0, 0, sizeof kind};
+        const VkSpecializationInfo specialization{1, &entry, sizeof kind, &kind};
         Result<VkPipeline> made =
-            vk::create_compute_pipeline(ref_, shader_, descriptors_.pipeline_layout, &specialization,
-                                        transformed ? "raster.comp (transformed)" : "raster.comp");
+            vk::create_compute_pipeline(ref_, shader_, descriptors_.pipeline_layout, &specialization, kNames[kind]);
         if (!made) return made.error();
-        (transformed ? transformed_pipeline_ : pipeline_) = objects_.keep(ref_, *made);
+        pipelines_[kind] = objects_.keep(ref_, *made);
     }
     return {};
 }
@@ -219,7 +227,8 @@ Status RasterPass::fit(uint32_t cells, uint64_t atlas_texels, uint64_t this_fram
 
 uint32_t RasterPass::build(std::span<const RasterWork> work, const HeldFonts& fonts, const GlyphAtlas& atlas,
                            RendererStats& stats) {
-    const uint32_t workgroups = build_work_items(work, fonts, item_data_, transform_data_, workgroup_items_);
+    const uint32_t workgroups =
+        build_work_items(work, fonts, item_data_, transform_data_, workgroup_items_, kind_workgroups_);
     stats.work_items = static_cast<uint32_t>(item_data_.size());
     stats.workgroups = workgroups;
     stats.samples = atlas.stats().frame.samples;
@@ -262,10 +271,10 @@ void RasterPass::record_upload(VkCommandBuffer command_buffer, uint64_t this_fra
     }
 }
 
-// The rasterizer's dispatch over `workgroups`, between barriers against last frame's readers of
+// The rasterizer's dispatches over this frame's workgroups, between barriers against last frame's readers of
 // the atlas (composite shaders, copies) and for this frame's.
-void RasterPass::record_dispatch(VkCommandBuffer command_buffer, uint64_t this_frame, uint32_t workgroups,
-                                 VkImageView atlas, std::span<const FontPage> pages, const SubpixelLayout& subpixel) {
+void RasterPass::record_dispatch(VkCommandBuffer command_buffer, uint64_t this_frame, VkImageView atlas,
+                                 std::span<const FontPage> pages, const SubpixelLayout& subpixel) {
     const vk::Functions& fn = *ref_.fn;
     constexpr VkPipelineStageFlags kReaders =
         VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
@@ -282,19 +291,15 @@ void RasterPass::record_dispatch(VkCommandBuffer command_buffer, uint64_t this_f
     }
     push.shared_rows = options_.shared_row_roots && shares_sample_rows(subpixel) ? 1u : 0u;
     push.sample_kind = options_.sample_kind == SampleKind::points ? gpu::kRasterSamplePoints : gpu::kRasterSampleRows;
-    // The transformed items follow the others (build_work_items): a dispatch each, no barrier
-    // between (their atlas texels are disjoint).
-    const auto first = std::find_if(item_data_.begin(), item_data_.end(), [](const gpu::RasterItem& item) {
-        return item.transform != gpu::kRasterNoTransform;
-    });
-    const uint32_t split = first == item_data_.end() ? workgroups : first->first_workgroup;
-    const uint32_t ranges[2][2] = {{0, split}, {split, workgroups - split}};
-    for (int pass = 0; pass < 2; ++pass) {
-        const uint32_t count = ranges[pass][1];
+    // The items come kind after kind (build_work_items): a dispatch each, no barrier between
+    // (their atlas texels are disjoint).
+    uint32_t base = 0;
+    for (uint32_t kind = 0; kind < kRasterItemKinds; ++kind) {
+        const uint32_t count = kind_workgroups_[kind];
+        push.workgroup_base = base;
+        base += count;
         if (count == 0) continue;
-        fn.vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE,
-                             pass == 0 ? pipeline_ : transformed_pipeline_);
-        push.workgroup_base = ranges[pass][0];
+        fn.vkCmdBindPipeline(command_buffer, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_[kind]);
         push.workgroup_count = count;
         fn.vkCmdPushConstants(command_buffer, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
                               &push);

@@ -16,18 +16,29 @@
 
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 namespace crisp::raster {
 
+// The kinds of work item, each rasterized by its own pipeline (raster.comp's kTransformedItems).
+inline constexpr uint32_t kRasterItemKinds = 3;
+
+// The kind of a glyph's items: 0 for an axis-aligned key, gpu::kRasterTwoLineItems for a
+// transformed one whose em y axis lies within 15 degrees of the rows (its stems run along them,
+// and it walks two lines a row sample), 1 for other transformed keys.
+uint32_t item_kind(const GlyphKey& key);
+
 // The rasterizer's work items for `work` into `items`, and into `workgroup_items` the item of
 // each workgroup; returns the workgroups they take. Work of a font not held, or without samples,
-// makes none.
+// makes none. Items come kind after kind (item_kind()), and `kind_workgroups` gets the workgroups
+// of each kind.
 // Transformed glyphs' items point into `transforms`, one per such item.
 uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fonts, std::vector<gpu::RasterItem>& items,
-                          std::vector<gpu::RasterTransform>& transforms, std::vector<uint32_t>& workgroup_items);
+                          std::vector<gpu::RasterTransform>& transforms, std::vector<uint32_t>& workgroup_items,
+                          std::array<uint32_t, kRasterItemKinds>& kind_workgroups);
 
 // What the rasterizer samples (RendererCreateInfo), fixed at create().
 struct RasterOptions {
@@ -47,12 +58,12 @@ public:
     // `atlas_texels`; the ones they replace are retired at `this_frame`. On failure nothing changes.
     Status fit(uint32_t cells, uint64_t atlas_texels, uint64_t this_frame, RetireLists& retired);
 
-    // This frame's work items (build_work_items) and their stats.
+    // This frame's work items (build_work_items) and their stats; returns their workgroups.
     uint32_t build(std::span<const RasterWork> work, const HeldFonts& fonts, const GlyphAtlas& atlas,
                    RendererStats& stats);
     bool has_items() const { return !item_data_.empty(); }
     void record_upload(VkCommandBuffer command_buffer, uint64_t this_frame, bool fonts_uploaded, RendererStats& stats);
-    void record_dispatch(VkCommandBuffer command_buffer, uint64_t this_frame, uint32_t workgroups, VkImageView atlas,
+    void record_dispatch(VkCommandBuffer command_buffer, uint64_t this_frame, VkImageView atlas,
                          std::span<const FontPage> pages, const SubpixelLayout& subpixel);
 
 private:
@@ -81,9 +92,10 @@ private:
 
     vk::DeviceObjects objects_;  // the shader module and the pipeline
     VkShaderModule shader_ = VK_NULL_HANDLE;
-    vk::DescriptorSets descriptors_;                    // one set per frame in flight
-    VkPipeline pipeline_ = VK_NULL_HANDLE;              // axis-aligned items
-    VkPipeline transformed_pipeline_ = VK_NULL_HANDLE;  // items with a RasterTransform
+    vk::DescriptorSets descriptors_;  // one set per frame in flight
+    // By item_kind(): axis-aligned items, transformed ones, transformed ones of two lines a sample.
+    std::array<VkPipeline, kRasterItemKinds> pipelines_{};
+    std::array<uint32_t, kRasterItemKinds> kind_workgroups_{};  // this frame's workgroups of each kind
 };
 
 }  // namespace crisp::raster

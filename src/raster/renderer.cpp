@@ -242,10 +242,10 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     const bool fonts_uploaded = s.fonts.record_uploads(command_buffer, frame, s.retired, s.stats);
     if (Status prepared = s.prepare_atlas_image(command_buffer, frame); !prepared) return prepared;
     if (Status images = s.bitmaps.record(command_buffer, frame, s.retired, s.stats); !images) return images;
-    const uint32_t workgroups = s.raster.build(work, s.fonts, s.atlas, s.stats);
+    s.raster.build(work, s.fonts, s.atlas, s.stats);
     s.raster.record_upload(command_buffer, frame, fonts_uploaded, s.stats);
     if (s.raster.has_items()) {
-        s.raster.record_dispatch(command_buffer, frame, workgroups, s.image.image().view, s.fonts.pages(), s.subpixel);
+        s.raster.record_dispatch(command_buffer, frame, s.image.image().view, s.fonts.pages(), s.subpixel);
     }
     return {};
 }
