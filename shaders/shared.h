@@ -78,6 +78,14 @@ CRISP_CONSTANT(uint, kRasterBindWorkgroupItems, 4u);  // uint[]: the item of eac
 CRISP_CONSTANT(uint, kRasterBindTransforms, 5u);      // RasterTransform[]: transformed glyphs' maps
 // RasterItem::transform of a glyph that is not transformed (texel_to_em's offset and scale serve it).
 CRISP_CONSTANT(uint, kRasterNoTransform, 0xFFFFFFFFu);
+// RasterItem::cover_rule of the effect layers (docs/effects.md): with A the first set of curves
+// and B the second (the glyph's own), bit (a + 2 b) says whether a point inside A (a) and B (b)
+// is covered. A plain glyph is kRasterCoverA over one set.
+CRISP_CONSTANT(uint, kRasterCoverA, 0xAu);          // A
+CRISP_CONSTANT(uint, kRasterCoverAOutsideB, 0x2u);  // A and not B
+CRISP_CONSTANT(uint, kRasterCoverAInsideB, 0x8u);   // A and B
+CRISP_CONSTANT(uint, kRasterCoverAOrB, 0xEu);       // A or B
+CRISP_CONSTANT(uint, kRasterCoverBOutsideA, 0x4u);  // B and not A
 // raster.comp's kTransformedItems of the pipeline for transformed items that walk two lines a row
 // sample (0 serves axis-aligned items, 1 the other transformed ones).
 CRISP_CONSTANT(uint, kRasterTwoLineItems, 2u);
@@ -108,6 +116,8 @@ struct RasterItem {
     uint first_workgroup;  // this item's first workgroup; the items' ranges tile the dispatch, in order
     uint transform;        // index into RasterTransform[], or kRasterNoTransform
     uint flat_row;         // transformed: first word of its flat curves' row in the band buffer, or kRasterNoTransform
+    uint set_b_first;      // two-set items (effect layers): the first curve slot of the second set
+    uint cover_rule;       // two-set items: covered where bit (wa != 0) + 2 (wb != 0) is set (kRasterCover*)
 };
 
 // A transformed glyph's maps (include/crisp/glyph.hpp, em_to_texel): rows of 3x3 projective
@@ -352,7 +362,7 @@ struct TilePushConstants {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RasterItem) == 96);
+static_assert(sizeof(RasterItem) == 104);
 static_assert(sizeof(RasterTransform) == 96);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
 static_assert(sizeof(TileBinEntry) == 32);

@@ -33,6 +33,10 @@ layout(local_size_x = kRasterWorkgroupSize) in;
 // cost axis-aligned text 46 % of its speed on an H200 in one kernel) and the one-line one none of
 // the second line's.
 layout(constant_id = 0) const uint kTransformedItems = 0u;
+// 1: this pipeline's items are two sets of curves (an effect layer: docs/effects.md), the slots
+// from RasterItem::set_b_first on the second, covered where the item's cover_rule holds for the
+// two sets' windings; 0: one set, covered where its winding is nonzero.
+layout(constant_id = 1) const uint kTwoSetItems = 0u;
 
 layout(push_constant) uniform PushConstants {
     RasterPushConstants pc;
@@ -135,11 +139,20 @@ struct RowList {
     float start;
     float end;
     int winding;
+    int winding_b;  // the same for the second set of a two-set item
     uint count;
     bool more;
     uint up;
+    uint in_b;  // per entry, set: a crossing of the second set
     float x[kRasterRowCrossings];
 };
+
+// Whether a point of windings wa (the first set) and wb (the second) is covered: nonzero wa, or
+// for a two-set item the item's cover_rule, a truth table indexed by (wa != 0) + 2 (wb != 0).
+bool row_covers(uint rule, int wa, int wb) {
+    if (kTwoSetItems == 0u) return wa != 0;
+    return ((rule >> (uint(wa != 0) | (uint(wb != 0) << 1u))) & 1u) != 0u;
+}
 
 // row_crossing(), row_sort() and row_walk() write out their steps for 8 entries: a shader of this
 // size fails to compile if kRasterRowCrossings changes without them.
@@ -147,9 +160,11 @@ const uint kRowStepsWritten[kRasterRowCrossings == 8u ? 1 : 0] = uint[1](8u);
 
 void row_begin_pass(inout RowList r) {
     r.winding = 0;
+    r.winding_b = 0;
     r.count = 0u;
     r.more = false;
     r.up = 0u;
+    r.in_b = 0u;
     const float inf = uintBitsToFloat(0x7F800000u);
     r.x[0] = inf;
     r.x[1] = inf;
@@ -166,9 +181,13 @@ void row_begin_pass(inout RowList r) {
 // crossings land in some lane's segment. Written out, not a loop: lavapipe ends every loop of an
 // invocation once their iterations together reach 65535, and this runs per crossing (see "Loops"
 // in docs/rasterizer.md).
-void row_crossing(inout RowList r, float x, int direction) {
+void row_crossing(inout RowList r, float x, int direction, bool in_b) {
     if (!(x > r.start)) return;
-    r.winding += direction;
+    if (kTwoSetItems != 0u && in_b) {
+        r.winding_b += direction;
+    } else {
+        r.winding += direction;
+    }
     if (!(x < r.end)) return;
     uint at = r.count;
     if (at == kRasterRowCrossings) {
@@ -197,6 +216,7 @@ void row_crossing(inout RowList r, float x, int direction) {
     r.x[6] = at == 6u ? x : r.x[6];
     r.x[7] = at == 7u ? x : r.x[7];
     r.up = (r.up & ~(1u << at)) | (direction < 0 ? 1u << at : 0u);
+    if (kTwoSetItems != 0u) r.in_b = (r.in_b & ~(1u << at)) | (in_b ? 1u << at : 0u);
 }
 
 // Entries i < j in order, with their direction bits.
@@ -208,6 +228,10 @@ void row_order(inout RowList r, uint i, uint j) {
         r.x[j] = a;
         uint differ = ((r.up >> i) ^ (r.up >> j)) & 1u;
         r.up ^= differ * ((1u << i) | (1u << j));
+        if (kTwoSetItems != 0u) {
+            uint differ_b = ((r.in_b >> i) ^ (r.in_b >> j)) & 1u;
+            r.in_b ^= differ_b * ((1u << i) | (1u << j));
+        }
     }
 }
 
@@ -272,25 +296,26 @@ float bernstein(float x0, float x1, float x2, float t) {
 // Adds the crossings x1 and x2 that `code` counts. Two roots that meet (a tangent, or a curve
 // that misses the row) cancel exactly: skipping them keeps the walk the same whichever band range
 // the curves come from (the CPU reference reads only the sample's band).
-void row_add_roots(inout RowList r, uint code, float x1, float x2) {
+void row_add_roots(inout RowList r, uint code, float x1, float x2, bool in_b) {
     if (code == 0x0101u && x1 == x2) return;
-    if ((code & 1u) != 0u) row_crossing(r, x1, 1);
-    if (code > 1u) row_crossing(r, x2, -1);
+    if ((code & 1u) != 0u) row_crossing(r, x1, 1, in_b);
+    if (code > 1u) row_crossing(r, x2, -1, in_b);
 }
 
 // The crossings of one curve with the row at height y (absolute em): Lengyel's roots as in
 // winding(), as absolute x's, added to the list.
-void row_curve(inout RowList r, vec2 p0, vec2 p1, vec2 p2, float y) {
+void row_curve(inout RowList r, vec2 p0, vec2 p1, vec2 p2, float y, bool in_b) {
     float t1, t2;
     uint code = row_roots(p0.y - y, p1.y - y, p2.y - y, t1, t2);
     if (code == 0u) return;
-    row_add_roots(r, code, bernstein(p0.x, p1.x, p2.x, t1), bernstein(p0.x, p1.x, p2.x, t2));
+    row_add_roots(r, code, bernstein(p0.x, p1.x, p2.x, t1), bernstein(p0.x, p1.x, p2.x, t2), in_b);
 }
 
 // The same for a curve of a transformed glyph (em), for the row whose Y - y W is dot(row, (p, 1))
 // (to_texel's second row less y times its third): its roots classified from those three values,
 // and only a curve that crosses is mapped on, to X / W (W is 1 without perspective).
-void row_curve_transformed(inout RowList r, RasterTransform m, vec3 row, bool perspective, vec2 p0, vec2 p1, vec2 p2) {
+void row_curve_transformed(inout RowList r, RasterTransform m, vec3 row, bool perspective, vec2 p0, vec2 p1, vec2 p2,
+                           bool in_b) {
     float t1, t2;
     uint code = row_roots(dot(row, vec3(p0, 1.0)), dot(row, vec3(p1, 1.0)), dot(row, vec3(p2, 1.0)), t1, t2);
     if (code == 0u) return;
@@ -303,7 +328,7 @@ void row_curve_transformed(inout RowList r, RasterTransform m, vec3 row, bool pe
         a /= bernstein(w0, w1, w2, t1);
         b /= bernstein(w0, w1, w2, t2);
     }
-    row_add_roots(r, code, a, b);
+    row_add_roots(r, code, a, b, in_b);
 }
 
 // Adds the covered stretch [from, to] of the row, clipped to each channel's segment [lo, hi].
@@ -314,11 +339,17 @@ void row_cover(inout vec3 covered, float from, float to, vec3 lo, vec3 hi) {
 }
 
 // Step i of the walk.
-void row_walk_step(RowList r, uint i, vec3 lo, vec3 hi, inout int w, inout float at, inout vec3 covered) {
+void row_walk_step(RowList r, uint rule, uint i, vec3 lo, vec3 hi, inout ivec2 w, inout float at,
+                   inout vec3 covered) {
     if (i >= r.count) return;
     float x = r.x[i];
-    if (w != 0) row_cover(covered, at, x, lo, hi);
-    w -= (r.up & (1u << i)) != 0u ? -1 : 1;
+    if (row_covers(rule, w.x, w.y)) row_cover(covered, at, x, lo, hi);
+    int step = (r.up & (1u << i)) != 0u ? -1 : 1;
+    if (kTwoSetItems != 0u && (r.in_b & (1u << i)) != 0u) {
+        w.y -= step;
+    } else {
+        w.x -= step;
+    }
     at = x;
 }
 
@@ -326,23 +357,24 @@ void row_walk_step(RowList r, uint i, vec3 lo, vec3 hi, inout int w, inout float
 // up to its end, or up to its last crossing kept when more follow (start then moves there for the
 // next pass). Sorts the list first. Written out, as the crossings, so that the list's indices are
 // constants.
-vec3 row_walk(inout RowList r, vec3 lo, vec3 hi) {
+vec3 row_walk(inout RowList r, uint rule, vec3 lo, vec3 hi) {
     row_sort(r);
-    int w = r.winding;
+    ivec2 w = ivec2(r.winding, r.winding_b);
     float at = r.start;
     vec3 covered = vec3(0.0);
-    row_walk_step(r, 0u, lo, hi, w, at, covered);
-    row_walk_step(r, 1u, lo, hi, w, at, covered);
-    row_walk_step(r, 2u, lo, hi, w, at, covered);
-    row_walk_step(r, 3u, lo, hi, w, at, covered);
-    row_walk_step(r, 4u, lo, hi, w, at, covered);
-    row_walk_step(r, 5u, lo, hi, w, at, covered);
-    row_walk_step(r, 6u, lo, hi, w, at, covered);
-    row_walk_step(r, 7u, lo, hi, w, at, covered);
+    row_walk_step(r, rule, 0u, lo, hi, w, at, covered);
+    row_walk_step(r, rule, 1u, lo, hi, w, at, covered);
+    row_walk_step(r, rule, 2u, lo, hi, w, at, covered);
+    row_walk_step(r, rule, 3u, lo, hi, w, at, covered);
+    row_walk_step(r, rule, 4u, lo, hi, w, at, covered);
+    row_walk_step(r, rule, 5u, lo, hi, w, at, covered);
+    row_walk_step(r, rule, 6u, lo, hi, w, at, covered);
+    row_walk_step(r, rule, 7u, lo, hi, w, at, covered);
     if (r.more) {
         r.start = at;
-        r.winding = w;  // just right of the new start: what a transformed row carries to its next pass
-    } else if (w != 0) {
+        r.winding = w.x;  // just right of the new start: what a transformed row carries to its next pass
+        r.winding_b = w.y;
+    } else if (row_covers(rule, w.x, w.y)) {
         row_cover(covered, at, r.end, lo, hi);
     }
     return covered;
@@ -413,7 +445,7 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
         // The bands of this invocation's channels (one where they share a row): a subgroup takes as
         // many steps as its fullest range has curves, not the curves of every range it holds.
 
-        ivec3 w = ivec3(0);
+        ivec3 w = ivec3(0), w_b = ivec3(0);
         for (uint word = 0u; word < item.band_words; ++word) {
             uint bits = 0u;
             for (uint band = lo_band; band <= hi_band; ++band) {
@@ -426,16 +458,142 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
                 vec2 p0 = fonts_points[font].points[first];
                 vec2 p1 = fonts_points[font].points[first + 1u];
                 vec2 p2 = fonts_points[font].points[first + 2u];
+                ivec3 here;
                 if (pc.shared_rows != 0u && !transformed) {
-                    w += winding_row(p0, p1, p2, em[0].y, vec3(em[0].x, em[1].x, em[2].x));
+                    here = winding_row(p0, p1, p2, em[0].y, vec3(em[0].x, em[1].x, em[2].x));
                 } else {
-                    w.r += winding(p0 - em[0], p1 - em[0], p2 - em[0]);
-                    w.g += winding(p0 - em[1], p1 - em[1], p2 - em[1]);
-                    w.b += winding(p0 - em[2], p1 - em[2], p2 - em[2]);
+                    here = ivec3(winding(p0 - em[0], p1 - em[0], p2 - em[0]), winding(p0 - em[1], p1 - em[1], p2 - em[1]),
+                                 winding(p0 - em[2], p1 - em[2], p2 - em[2]));
+                }
+                if (kTwoSetItems != 0u && word * 32u + bit >= item.set_b_first) {
+                    w_b += here;
+                } else {
+                    w += here;
                 }
             }
         }
-        sums += uvec3(notEqual(w, ivec3(0))) * kRasterCoverageOne;
+        for (int c = 0; c < 3; ++c) {
+            if (row_covers(item.cover_rule, w[c], w_b[c])) sums[c] += kRasterCoverageOne;
+        }
+    }
+    return sums;
+}
+
+// One line of a transformed glyph's row sample being walked: its list, its height, the row's
+// Y - y W, its start in em and that start's windings (both sets), found from an em ray in the
+// start's band on the first pass and carried from pass to pass.
+struct RowLine {
+    RowList r;
+    float y;
+    vec3 y_row;
+    vec2 start_em;
+    uint start_band;
+    bool start_inside;
+    ivec2 start_winding;
+    bool pending;  // passes remain
+};
+
+// Sets up line `line` at height h (texels) of the row rect `rect` over the segment [start, end],
+// and widens [lo_band, hi_band] to the bands the segment crosses.
+// The row segment is oblique in em: it walks the bands it crosses. Its crossings past the
+// segment's end lie in other bands, so the winding at its start is not theirs to count: it is the
+// start's own, from a ray along em x in the start's band (winding()), negated where the map to
+// texels reverses orientation, and carried from pass to pass.
+void row_line_begin(inout RowLine line, RasterItem item, RasterTransform m, vec4 rect, uint ty, float h, float start,
+                    float end, inout uint lo_band, inout uint hi_band) {
+    line.y = float(ty) + (rect.y + (rect.w - rect.y) * h);
+    line.y_row = m.to_texel[1].xyz - line.y * m.to_texel[2].xyz;
+    // The start a hair left of the segment, so that it is not on a curve where the segment begins
+    // at one (a stem on the texel's edge): the walk clips to the channels' segments, so the stretch
+    // before them adds nothing.
+    line.r.start = start - kTransformedStartBack;
+    line.r.end = end;
+    line.start_em = texel_em(m, line.r.start, line.y);
+    float yb = texel_em(m, line.r.end, line.y).y;
+    line.start_band = band_of(item, line.start_em.y);
+    // Outside the glyph's bbox the start's winding is 0: no ray to cast.
+    line.start_inside = line.start_em.x >= m.to_texel[1].w && line.start_em.x <= m.to_texel[2].w &&
+                        line.start_em.y >= item.bbox_min_y && line.start_em.y <= item.bbox_max_y;
+    line.start_winding = ivec2(0);
+    line.pending = true;
+    lo_band = min(lo_band, band_of(item, min(line.start_em.y, yb)));
+    hi_band = max(hi_band, band_of(item, max(line.start_em.y, yb)));
+}
+
+// The bits of word `word` of the start's band, for the start's winding (first pass only).
+uint row_line_start_bits(RowLine line, RasterItem item, uint word, bool first_pass) {
+    if (!first_pass || !line.start_inside) return 0u;
+    return fonts_bands[item.font].words[item.band_offset + line.start_band * item.band_words + word];
+}
+
+// One curve (slot `bit` of the word whose start bits are `start_bits`) for the line.
+void row_line_curve(inout RowLine line, RasterTransform m, bool perspective, vec2 p0, vec2 p1, vec2 p2, bool in_b,
+                    uint start_bits, uint bit) {
+    row_curve_transformed(line.r, m, line.y_row, perspective, p0, p1, p2, in_b);
+    if (((start_bits >> bit) & 1u) != 0u) {
+        int wound = winding(p0 - line.start_em, p1 - line.start_em, p2 - line.start_em);
+        line.start_winding += in_b ? ivec2(0, wound) : ivec2(wound, 0);
+    }
+}
+
+// The end of a pass: the line's covered lengths, and whether it needs another pass.
+vec3 row_line_end(inout RowLine line, RasterItem item, RasterTransform m, vec3 lo, vec3 hi, bool first_pass) {
+    ivec2 start = first_pass ? line.start_winding * int(m.to_texel[0].w) : line.start_winding;
+    line.r.winding = start.x;
+    line.r.winding_b = start.y;
+    vec3 covered = row_walk(line.r, item.cover_rule, lo, hi);
+    line.pending = line.r.more;
+    line.start_winding = ivec2(line.r.winding, line.r.winding_b);
+    return covered;
+}
+
+// row_samples() of an axis-aligned item, rows walked in em: each channel's segment [lo, hi] in x,
+// `rows` rows a sample. Each invocation walks the curves of its own band: a subgroup then takes as
+// many steps as its fullest band has curves, where a band range shared by the subgroup took the
+// curves of all its rows' bands (the loads differ between invocations on different rows, a few
+// addresses a step). Its own loop, without the transformed path's lines, so that its registers
+// stay as few as they were before there was one (59 on an H200, against 67 in a loop shared with
+// it: 6 % of its time).
+uvec3 row_samples_axis_aligned(RasterItem item, vec3 lo, vec3 hi, uint rows, uint ty) {
+    uint font = item.font;
+    uvec3 sums = uvec3(0u);
+    for (uint k = 0u; k < item.sample_count; ++k) {
+        uint n = item.first_sample + k;
+        float v = row_height(n);
+        // The R2 x offset of n, free now that rows need no x: the dither of the quantization.
+        float dither = fract(0.5 + float(n) * kRasterR2StepX);
+        vec3 covered = vec3(0.0);
+        for (uint row = 0u; row < rows; ++row) {
+            vec4 rect = pc.channel_rects[row];
+            float y = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
+            // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
+            vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
+            RowList r;
+            r.start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
+            r.end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
+            uint band = band_of(item, y);
+            // A pass per kRasterRowCrossings crossings.
+            bool pending = true;
+            while (pending) {
+                row_begin_pass(r);
+                for (uint word = 0u; word < item.band_words; ++word) {
+                    uint bits = fonts_bands[font].words[item.band_offset + band * item.band_words + word];
+                    while (bits != 0u) {
+                        uint bit = findLSB(bits);
+                        bits &= bits - 1u;
+                        uint first = item.point_offset + 2u * (word * 32u + bit);
+                        vec2 p0 = fonts_points[font].points[first];
+                        vec2 p1 = fonts_points[font].points[first + 1u];
+                        vec2 p2 = fonts_points[font].points[first + 2u];
+                        row_curve(r, p0, p1, p2, y, kTwoSetItems != 0u && word * 32u + bit >= item.set_b_first);
+                    }
+                }
+                covered += row_walk(r, item.cover_rule, lo, hi) * mine;
+                pending = r.more;
+            }
+        }
+        sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),
+                      row_units(covered.z, hi.z - lo.z, dither));
     }
     return sums;
 }
@@ -446,9 +604,6 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
     uint font = item.font;
     // A transformed glyph walks its rows in texels, others in em.
     const bool transformed = kTransformedItems != 0u;
-    RasterTransform m;
-    if (transformed) m = transforms[item.transform];
-    bool perspective = transformed && (m.to_texel[2].x != 0.0 || m.to_texel[2].y != 0.0);
     // Each channel's segment in x, the same for every sample.
     vec3 lo, hi;
     for (int c = 0; c < 3; ++c) {
@@ -459,9 +614,16 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
     // Channels that share their rows (stripes, gray) walk one list over the union of their
     // segments; otherwise each channel is a row of its own, walked in turn.
     uint rows = pc.shared_rows != 0u ? 1u : 3u;
-    // Lines a sample: two for the transformed glyphs whose stems run along the rows (kTwoLines),
-    // walked together: one pass over the curves of both lines' bands serves both lists.
-    const uint lines = kTransformedItems == kRasterTwoLineItems ? 2u : 1u;
+    if (!transformed) return row_samples_axis_aligned(item, lo, hi, rows, ty);
+    RasterTransform m = transforms[item.transform];
+    bool perspective = m.to_texel[2].x != 0.0 || m.to_texel[2].y != 0.0;
+    // Two lines a sample for the transformed glyphs whose stems run along the rows
+    // (kRasterTwoLineItems), at v -+ 1/32, the centres of sixteen strata where v is of eight: walked
+    // together, one pass over the curves of both lines' bands serving both lists. A curve of the
+    // other line's bands crosses a line's segment nowhere (it would be listed in the band it
+    // crosses in), and crossings right of the segment add nothing. Two named lines, not an array,
+    // so that they stay in registers.
+    const bool two_lines = kTransformedItems == kRasterTwoLineItems;
     uvec3 sums = uvec3(0u);
     for (uint k = 0u; k < item.sample_count; ++k) {
         uint n = item.first_sample + k;
@@ -473,79 +635,28 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             vec4 rect = pc.channel_rects[row];
             // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
             vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
-            // Each invocation walks the curves of its own band: a subgroup then takes as many steps
-            // as its fullest band has curves, where a band range shared by the subgroup took the
-            // curves of all its rows' bands (the loads differ between invocations on different
-            // rows, a few addresses a step).
-            // A transformed glyph's row segment is oblique in em: it walks the bands it crosses. Its
-            // crossings past the segment's end lie in other bands, so the winding at its start is
-            // not theirs to count: it is the start's own, from a ray along em x in the start's band
-            // (winding()), negated where the map to texels reverses orientation, and carried from
-            // pass to pass. Two lines walk the union of their bands: a curve of the other line's
-            // bands crosses this line's segment nowhere (it would be listed in the band it crosses
-            // in), and crossings right of the segment add nothing.
-            RowList r[lines];
-            float y[lines];
-            vec3 y_row[lines];
-            vec2 start_em[lines];
-            uint start_band[lines];
-            bool start_inside[lines];
-            int start_winding[lines];
-            bool pending[lines];
+            float start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
+            float end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
             uint lo_band = 0xFFFFFFFFu, hi_band = 0u;
-            for (uint l = 0u; l < lines; ++l) {
-                // Two lines a sample: v -+ 1/32, the centres of sixteen strata where v is of eight.
-                float h = lines == 1u ? v : fract(v + (l == 0u ? -kRasterHalfRowShift : kRasterHalfRowShift));
-                y[l] = float(ty) + (rect.y + (rect.w - rect.y) * h);
-                if (!transformed) y[l] = item.offset_y + item.scale_y * y[l];
-                r[l].start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
-                r[l].end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
-                start_em[l] = vec2(0.0);
-                start_band[l] = 0u;
-                start_inside[l] = false;
-                start_winding[l] = 0;
-                pending[l] = true;
-                y_row[l] = vec3(0.0);
-                if (transformed) {
-                    y_row[l] = m.to_texel[1].xyz - y[l] * m.to_texel[2].xyz;
-                    // The start a hair left of the segment, so that it is not on a curve where the
-                    // segment begins at one (a stem on the texel's edge): the walk clips to the
-                    // channels' segments, so the stretch before them adds nothing.
-                    r[l].start -= kTransformedStartBack;
-                    start_em[l] = texel_em(m, r[l].start, y[l]);
-                    float yb = texel_em(m, r[l].end, y[l]).y;
-                    start_band[l] = band_of(item, start_em[l].y);
-                    // Outside the glyph's bbox the start's winding is 0: no ray to cast.
-                    start_inside[l] = start_em[l].x >= m.to_texel[1].w && start_em[l].x <= m.to_texel[2].w &&
-                                      start_em[l].y >= item.bbox_min_y && start_em[l].y <= item.bbox_max_y;
-                    lo_band = min(lo_band, band_of(item, min(start_em[l].y, yb)));
-                    hi_band = max(hi_band, band_of(item, max(start_em[l].y, yb)));
-                } else {
-                    lo_band = hi_band = band_of(item, y[l]);
-                }
-            }
+            RowLine a, b;
+            row_line_begin(a, item, m, rect, ty, two_lines ? fract(v - kRasterHalfRowShift) : v, start, end, lo_band,
+                           hi_band);
+            b.pending = false;
+            if (two_lines) row_line_begin(b, item, m, rect, ty, fract(v + kRasterHalfRowShift), start, end, lo_band, hi_band);
             // A pass per kRasterRowCrossings crossings.
             bool first_pass = true;
-            while (pending[0] || (lines == 2u && pending[lines - 1u])) {
-                for (uint l = 0u; l < lines; ++l) {
-                    if (pending[l]) row_begin_pass(r[l]);
-                }
+            while (a.pending || b.pending) {
+                if (a.pending) row_begin_pass(a.r);
+                if (b.pending) row_begin_pass(b.r);
                 for (uint word = 0u; word < item.band_words; ++word) {
-                    uint bits = fonts_bands[font].words[item.band_offset + lo_band * item.band_words + word];
-                    uint start_bits[lines];
-                    if (transformed) {
-                        for (uint band = lo_band + 1u; band <= hi_band; ++band) {
-                            bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
-                        }
-                        // Curves flat in em, which no band lists, cross oblique rows.
-                        if (item.flat_row != kRasterNoTransform) bits |= fonts_bands[font].words[item.flat_row + word];
+                    uint bits = 0u;
+                    for (uint band = lo_band; band <= hi_band; ++band) {
+                        bits |= fonts_bands[font].words[item.band_offset + band * item.band_words + word];
                     }
-                    for (uint l = 0u; l < lines; ++l) {
-                        start_bits[l] =
-                            transformed && first_pass && start_inside[l]
-                                ? fonts_bands[font].words[item.band_offset + start_band[l] * item.band_words + word]
-                                : 0u;
-                    }
+                    // Curves flat in em, which no band lists, cross oblique rows.
+                    if (item.flat_row != kRasterNoTransform) bits |= fonts_bands[font].words[item.flat_row + word];
+                    uint start_a = row_line_start_bits(a, item, word, first_pass);
+                    uint start_b = two_lines ? row_line_start_bits(b, item, word, first_pass) : 0u;
                     while (bits != 0u) {
                         uint bit = findLSB(bits);
                         bits &= bits - 1u;
@@ -553,29 +664,17 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
                         vec2 p0 = fonts_points[font].points[first];
                         vec2 p1 = fonts_points[font].points[first + 1u];
                         vec2 p2 = fonts_points[font].points[first + 2u];
-                        for (uint l = 0u; l < lines; ++l) {
-                            if (!pending[l]) continue;
-                            if (transformed) {
-                                row_curve_transformed(r[l], m, y_row[l], perspective, p0, p1, p2);
-                                if (((start_bits[l] >> bit) & 1u) != 0u)
-                                    start_winding[l] += winding(p0 - start_em[l], p1 - start_em[l], p2 - start_em[l]);
-                            } else {
-                                row_curve(r[l], p0, p1, p2, y[l]);
-                            }
-                        }
+                        bool in_b = kTwoSetItems != 0u && word * 32u + bit >= item.set_b_first;
+                        if (a.pending) row_line_curve(a, m, perspective, p0, p1, p2, in_b, start_a, bit);
+                        if (two_lines && b.pending) row_line_curve(b, m, perspective, p0, p1, p2, in_b, start_b, bit);
                     }
                 }
-                for (uint l = 0u; l < lines; ++l) {
-                    if (!pending[l]) continue;
-                    if (transformed) r[l].winding = first_pass ? start_winding[l] * int(m.to_texel[0].w) : start_winding[l];
-                    covered += row_walk(r[l], lo, hi) * mine;
-                    pending[l] = r[l].more;
-                    start_winding[l] = r[l].winding;
-                }
+                if (a.pending) covered += row_line_end(a, item, m, lo, hi, first_pass) * mine;
+                if (two_lines && b.pending) covered += row_line_end(b, item, m, lo, hi, first_pass) * mine;
                 first_pass = false;
             }
         }
-        if (lines == 2u) covered *= 0.5;
+        if (two_lines) covered *= 0.5;
         sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),
                       row_units(covered.z, hi.z - lo.z, dither));
     }

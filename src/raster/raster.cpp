@@ -83,6 +83,8 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
             gpu::RasterItem item{};
             item.transform = gpu::kRasterNoTransform;
             item.flat_row = gpu::kRasterNoTransform;
+            item.set_b_first = gpu::kRasterNoTransform;
+            item.cover_rule = gpu::kRasterCoverA;
             if (is_transformed(w.key)) {
                 const uint32_t row = w.key.glyph < font->flat_rows.size() ? font->flat_rows[w.key.glyph] : kNoFlatRow;
                 if (row != kNoFlatRow) item.flat_row = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + row;
