@@ -884,6 +884,42 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
     expect_no_validation_messages();
 }
 
+// A font's page, once no font uses it, gives its buffers back, and a memory block made for them
+// goes back to the driver: the memory held returns to what it was before the font came.
+TEST(Raster, RemovingTheLastFontOfAPageGivesItsMemoryBack) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    auto renderer = make_renderer(*subpixel_preset("rgb"), 16);
+    ASSERT_TRUE(renderer);
+    const auto frame = [&](const std::vector<GlyphInstance>& glyphs) {
+        renderer->begin_frame();
+        renderer->draw(glyphs);
+        ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+    };
+    frame({});
+    const DeviceMemoryUse before = renderer->device_memory();
+    for (int cycle = 0; cycle < 2; ++cycle) {
+        const std::unique_ptr<Font> font = test::bake_test_font("Hg", 9);
+        ASSERT_TRUE(font);
+        ASSERT_TRUE(renderer->add_font(*font));
+        const Font* fonts[] = {font.get()};
+        auto laid = layout_text(fonts, "Hg", TextStyle{}, LayoutOptions{.origin_x = 2.0f, .origin_y = 20.0f});
+        ASSERT_TRUE(laid);
+        frame(laid->glyphs);
+        const DeviceMemoryUse held = renderer->device_memory();
+        std::printf("[ memory ] before the font %u allocations, %llu bytes; with it %u, %llu\n", before.allocations,
+                    static_cast<unsigned long long>(before.bytes), held.allocations,
+                    static_cast<unsigned long long>(held.bytes));
+        EXPECT_GT(held.bytes, before.bytes);
+        ASSERT_TRUE(renderer->remove_font(9));
+        for (int i = 0; i < 4; ++i) frame({});  // past the frames that may read its ranges
+        const DeviceMemoryUse after = renderer->device_memory();
+        EXPECT_EQ(after.allocations, before.allocations);
+        EXPECT_EQ(after.bytes, before.bytes);
+    }
+    expect_no_validation_messages();
+}
+
 // With a memory budget, an atlas too small for the frame's glyphs grows (its image copied into a
 // larger one) rather than coarsening them; glyphs that had converged before keep their samples
 // through the copy, and a dropped growth frame is grown again by the next one.

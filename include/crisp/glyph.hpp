@@ -60,6 +60,9 @@ inline bool is_transformed(const GlyphKey& key) {
     return key.linear[0] != 0 || key.linear[1] != 0 || key.linear[2] != 0 || key.linear[3] != 0;
 }
 
+// A total order of keys, field by field: negative when a comes first, 0 when they are equal.
+CRISP_API int compare_keys(const GlyphKey& a, const GlyphKey& b);
+
 struct CRISP_API GlyphKeyHash {
     size_t operator()(const GlyphKey& key) const;
 };

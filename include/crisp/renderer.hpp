@@ -323,9 +323,11 @@ public:
 
     // Removes a font at the next begin_frame(): its atlas entries are evicted, its page ranges
     // are freed once the frames that may read them are done (frames_in_flight), and its id may be
-    // added again. The frame already drawn or recorded still shows it; from the next one on its
-    // instances count as unknown_fonts. After that begin_frame() the Font may be destroyed.
-    // Errors: invalid_argument for an id not held (or already being removed); nothing changes.
+    // added again. A font page that no font uses then frees its buffers; of its memory the
+    // renderer keeps at most one block of up to 64 MiB per memory type for the
+    // next buffers, and none made for one larger buffer (device_memory() shows it). The frame already drawn or recorded
+    // still shows it; from the next one on its instances count as unknown_fonts. After that begin_frame() the Font may
+    // be destroyed. Errors: invalid_argument for an id not held (or already being removed); nothing changes.
     Status remove_font(FontId id);
 
     // Replaces the subpixel layout. Every accumulated sample is invalidated: glyphs restart their

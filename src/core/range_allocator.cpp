@@ -4,8 +4,12 @@
 
 namespace crisp {
 
-RangeAllocator::RangeAllocator(uint64_t capacity) {
+RangeAllocator::RangeAllocator(uint64_t capacity) : capacity_(capacity) {
     if (capacity > 0) free_.emplace(0, capacity);
+}
+
+bool RangeAllocator::all_free() const {
+    return capacity_ == 0 || (free_.size() == 1 && free_.begin()->first == 0 && free_.begin()->second == capacity_);
 }
 
 // First fit: the lowest free run that holds the aligned request.

@@ -19,9 +19,12 @@ public:
     std::optional<uint64_t> take(uint64_t size, uint64_t alignment);
     // Gives back a range take() returned (a zero size: nothing).
     void give(uint64_t offset, uint64_t size);
+    // Whether every range taken has been given back (true for one with no room at all).
+    bool all_free() const;
 
 private:
     std::map<uint64_t, uint64_t> free_;  // offset -> size, neighbours merged
+    uint64_t capacity_ = 0;
 };
 
 }  // namespace crisp

@@ -31,7 +31,8 @@ Status FontStore::place(GpuFont& font) {
         font.bands_at = *bands_at;
         return {};
     }
-    if (pages_.size() >= kRendererFontPages) {
+    const auto empty = std::find_if(pages_.begin(), pages_.end(), [](const FontPage& p) { return !p.points.buffer; });
+    if (empty == pages_.end() && pages_.size() >= kRendererFontPages) {
         return Error{ErrorCode::invalid_argument,
                      "renderer: the font does not fit the " + std::to_string(kRendererFontPages) +
                          " font pages, which the fonts added before fill; remove one first"};
@@ -54,7 +55,11 @@ Status FontStore::place(GpuFont& font) {
     }
     page.point_ranges = RangeAllocator(page.points.size);
     page.band_ranges = RangeAllocator(page.bands.size);
-    pages_.push_back(std::move(page));
+    if (empty != pages_.end()) {
+        *empty = std::move(page);
+    } else {
+        pages_.push_back(std::move(page));
+    }
     return place(font);
 }
 
@@ -177,6 +182,14 @@ void FontStore::give_back(const RetiredRanges& ranges) {
     FontPage& page = pages_[ranges.page];
     page.point_ranges.give(ranges.points.offset, ranges.points.size);
     page.band_ranges.give(ranges.bands.offset, ranges.bands.size);
+    // A page that no font uses any more gives its buffers back (the GPU is done with the ranges:
+    // they retire once the frames that may read them are), and its place waits for a new page.
+    if (page.point_ranges.all_free() && page.band_ranges.all_free()) {
+        page.points.reset();
+        page.bands.reset();
+        page.point_ranges = RangeAllocator();
+        page.band_ranges = RangeAllocator();
+    }
 }
 
 }  // namespace crisp::raster

@@ -206,7 +206,7 @@ Status RasterPass::create(uint32_t cells, uint64_t atlas_texels, RetireLists& re
 void RasterPass::write_descriptors(VkDescriptorSet set, VkImageView atlas, std::span<const FontPage> pages) {
     std::array<VkDescriptorBufferInfo, kRendererFontPages> point_infos{}, band_infos{};
     for (uint32_t page = 0; page < kRendererFontPages; ++page) {
-        const bool used = page < pages.size();
+        const bool used = page < pages.size() && pages[page].points.buffer != VK_NULL_HANDLE;
         point_infos[page] = {used ? pages[page].points.buffer : dummy_.buffer, 0, VK_WHOLE_SIZE};
         band_infos[page] = {used ? pages[page].bands.buffer : dummy_.buffer, 0, VK_WHOLE_SIZE};
     }

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <cmath>
 #include <iterator>
+#include <numeric>
 
 namespace crisp::raster {
 
@@ -305,19 +306,32 @@ AtlasLookup FrameRequests::look_up_or_place(const FontAsset& asset, const GlyphI
 // Admits the glyphs drawn in part, each glyph once for the bounding box of its parts.
 void FrameRequests::admit_clipped() {
     if (clipped_.empty()) return;
-    clipped_parts_.clear();
-    for (const Clipped& c : clipped_) {
-        auto [it, added] = clipped_parts_.try_emplace(c.glyph.key, c.part);
-        if (added) continue;
-        TexelRect& box = it->second;
-        const uint32_t x1 = std::max(box.x + box.width, c.part.x + c.part.width);
-        const uint32_t y1 = std::max(box.y + box.height, c.part.y + c.part.height);
-        box.x = std::min(box.x, c.part.x);
-        box.y = std::min(box.y, c.part.y);
-        box.width = x1 - box.x;
-        box.height = y1 - box.y;
+    // The instances of one key, together (sorted: a map of the keys would allocate a node each),
+    // each group's parts bounded by one rect.
+    clipped_order_.resize(clipped_.size());
+    std::iota(clipped_order_.begin(), clipped_order_.end(), 0u);
+    std::sort(clipped_order_.begin(), clipped_order_.end(), [&](uint32_t a, uint32_t b) {
+        const int order = compare_keys(clipped_[a].glyph.key, clipped_[b].glyph.key);
+        return order != 0 ? order < 0 : a < b;
+    });
+    clipped_parts_.resize(clipped_.size());
+    for (size_t first = 0, end = 0; first < clipped_order_.size(); first = end) {
+        const GlyphKey& key = clipped_[clipped_order_[first]].glyph.key;
+        TexelRect box = clipped_[clipped_order_[first]].part;
+        for (end = first + 1; end < clipped_order_.size() && clipped_[clipped_order_[end]].glyph.key == key; ++end) {
+            const TexelRect& part = clipped_[clipped_order_[end]].part;
+            const uint32_t x1 = std::max(box.x + box.width, part.x + part.width);
+            const uint32_t y1 = std::max(box.y + box.height, part.y + part.height);
+            box.x = std::min(box.x, part.x);
+            box.y = std::min(box.y, part.y);
+            box.width = x1 - box.x;
+            box.height = y1 - box.y;
+        }
+        for (size_t i = first; i < end; ++i) clipped_parts_[clipped_order_[i]] = box;
     }
-    for (const Clipped& c : clipped_) admit(c.glyph, clipped_parts_.at(c.glyph.key), c.contrast, &c.part);
+    for (size_t i = 0; i < clipped_.size(); ++i) {
+        admit(clipped_[i].glyph, clipped_parts_[i], clipped_[i].contrast, &clipped_[i].part);
+    }
     clipped_.clear();
 }
 

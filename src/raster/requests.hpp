@@ -117,7 +117,10 @@ private:
     std::vector<Request> requests_;  // this frame's draw()n instances, as asked
     std::vector<Pending> pending_;   // draw()n this frame, before record() knows their samples
     std::vector<Clipped> clipped_;   // draw()n partly visible, admitted in record()
-    std::unordered_map<GlyphKey, TexelRect, GlyphKeyHash> clipped_parts_;  // scratch: bounding parts
+    // Scratch of admit_clipped(), kept so that a warm frame allocates nothing: clipped_ indices in
+    // key order, and each clipped instance's bounding part (over every instance of its key).
+    std::vector<uint32_t> clipped_order_;
+    std::vector<TexelRect> clipped_parts_;
     std::vector<DrawnGlyph> drawn_;
     bool converged_ = true;
     TextContrast contrast_;

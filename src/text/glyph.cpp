@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <tuple>
 
 namespace crisp {
 
@@ -18,6 +19,14 @@ uint64_t mix(uint64_t x) {
 }
 
 }  // namespace
+
+int compare_keys(const GlyphKey& a, const GlyphKey& b) {
+    const auto fields = [](const GlyphKey& k) {
+        return std::tie(k.font, k.glyph, k.size_x, k.size_y, k.subpixel_x, k.subpixel_y, k.linear[0], k.linear[1],
+                        k.linear[2], k.linear[3], k.perspective[0], k.perspective[1]);
+    };
+    return fields(a) < fields(b) ? -1 : fields(b) < fields(a) ? 1 : 0;
+}
 
 size_t GlyphKeyHash::operator()(const GlyphKey& key) const {
     const uint64_t a = (uint64_t{key.font} << 32) | key.glyph;

@@ -98,11 +98,13 @@ void MemoryArena::free(const Range& range) {
     if (block == blocks_.end()) return;
     block->free.give(range.offset, range.size);
     --block->ranges;
-    // An empty block goes back to the driver, unless it is the last of its type (the next buffer of
-    // that type, a frame later, would only allocate it again).
+    // An empty block goes back to the driver, unless it is the last of its type and no larger than
+    // kLargestMemoryBlock (the next buffer of that type, a frame later, would only allocate it
+    // again): a block made for one large buffer (a CJK font's page) leaves with it.
     const uint32_t type = block->type;
     if (block->ranges == 0 &&
-        std::count_if(blocks_.begin(), blocks_.end(), [&](const Block& b) { return b.type == type; }) > 1) {
+        (block->size > kLargestMemoryBlock ||
+         std::count_if(blocks_.begin(), blocks_.end(), [&](const Block& b) { return b.type == type; }) > 1)) {
         fn_.vkFreeMemory(device_, block->memory, allocator_);
         blocks_.erase(block);
     }
