@@ -45,6 +45,14 @@ printf 'existing' > "$work/kept.png"
 expect_exit 4 "an unwritable --coverage-out" -- "$render" "${base[@]}" -o "$work/kept.png" \
   --coverage-out "$work/no/such/dir/c.pfm"
 [ "$(cat "$work/kept.png")" = existing ] || fail "the PNG was replaced though --coverage-out failed"
+# FIFOs as inputs are refused at once (opening one used to wait for a writer for ever).
+mkfifo "$work/in.fifo" "$work/in.fifo.json"
+expect_exit 3 "a FIFO as --font" -- timeout 20 "$render" "${base[@]/$font/$work/in.fifo}" -o fifo.png
+expect_stderr "not a regular file" "a FIFO as --font"
+expect_exit 7 "a FIFO as --scene" -- timeout 20 "$render" --scene "$work/in.fifo" -o fifo.png
+expect_stderr "not a regular file" "a FIFO as --scene"
+expect_exit 6 "a FIFO as --layout" -- timeout 20 "$render" "${base[@]}" --layout "$work/in.fifo.json" -o fifo.png
+expect_stderr "not a regular file" "a FIFO as --layout"
 # More glyphs than one render lays out (4 Mi): refused, exit 7, naming the limit.
 python3 - "$work/many.json" <<'PY'
 import json, sys

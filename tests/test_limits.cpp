@@ -16,10 +16,13 @@
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 namespace crisp {
 namespace {
@@ -213,6 +216,23 @@ TEST(Limits, OutputsAreReplacedTogetherOrNotAtAll) {
     ASSERT_TRUE(write_file_atomically(png, new_png));
     EXPECT_FALSE(fs::exists(stale));
     EXPECT_TRUE(fs::exists(fresh));
+}
+
+// Opening a FIFO for reading waits for a writer: read_file() opens without blocking and refuses it.
+// (A read that blocks is unblocked by a writer after 10 s, so that the test fails rather than hangs.)
+TEST(Limits, AFifoIsRefusedWithoutWaitingForAWriter) {
+    TemporaryDirectory directory;
+    const fs::path fifo = directory.path() / "font.ttf";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    auto read = std::async(std::launch::async, [&] { return read_file(fifo, limits::kFontFileBytes); });
+    if (read.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+        ADD_FAILURE() << "read_file() blocked on a FIFO";
+        const int writer = ::open(fifo.c_str(), O_WRONLY);
+        if (writer >= 0) ::close(writer);
+    }
+    const Result<std::vector<std::byte>> result = read.get();
+    ASSERT_FALSE(result);
+    EXPECT_NE(result.error().message.find("not a regular file"), std::string::npos) << result.error().message;
 }
 
 }  // namespace

@@ -236,7 +236,9 @@ Status write_file_atomically(const std::filesystem::path& path, std::span<const 
 }
 
 Result<std::vector<std::byte>> read_file(const std::filesystem::path& path, uint64_t max_bytes) {
-    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    // O_NONBLOCK: opening a FIFO waits for a writer, for ever if none comes; fstat() below refuses
+    // it, and the flag is cleared for the regular file's reads. O_NOCTTY: a terminal is not adopted.
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
     if (fd < 0) return io_error("cannot read", path, errno);
 
     std::vector<std::byte> bytes;
@@ -255,6 +257,11 @@ Result<std::vector<std::byte>> read_file(const std::filesystem::path& path, uint
         return Error{ErrorCode::io, "cannot read " + path.string() +
                                         ": not a regular file (a device, FIFO or socket has no size to check, and may "
                                         "never end)"};
+    }
+    if (const int flags = ::fcntl(fd, F_GETFL); flags < 0 || ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+        int error = errno;
+        ::close(fd);
+        return io_error("cannot read", path, error);
     }
     auto too_large = [&] {
         return Error{ErrorCode::io, "cannot read " + path.string() + ": larger than the " + std::to_string(max_bytes) +

@@ -13,7 +13,8 @@ namespace crisp {
 
 // Reads a whole regular file of at most `max_bytes` (core/limits.hpp says how much for each kind of
 // input). Errors (ErrorCode::io) name the path and the reason: a directory, device, FIFO or socket
-// is refused before any byte is read, and a larger file before it is read whole.
+// is refused before any byte is read (opened without blocking: a FIFO with no writer does not
+// hang), and a larger file before it is read whole.
 Result<std::vector<std::byte>> read_file(const std::filesystem::path& path, uint64_t max_bytes);
 
 // Writes `bytes` to `path` atomically, as write_files_atomically() below writes several: flushed to
