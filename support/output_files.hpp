@@ -16,14 +16,19 @@ public:
     // `inputs`: the files the run reads, which no output may replace (under any name).
     explicit OutputFiles(std::vector<std::filesystem::path> inputs);
 
-    // Declares the next output and checks it now: an existing non-regular file (a device node, a
-    // directory, a FIFO), a directory that does not exist, or one of the inputs is refused
-    // (ErrorCode::io, naming the path and the reason).
+    // Declares the next output and checks it now: what check_output_path() refuses (an existing
+    // non-regular file or a link to one, a directory that does not exist, a name too long, a
+    // read-only file, one of the inputs), and an output already added under any name (same_file())
+    // is refused (ErrorCode::io, naming the path and the reason).
     Status add(std::filesystem::path path);
 
+    // Declares one more input, known only once the run has read another (the fonts and layout a
+    // scene names): refused, as add() refuses, when it is one of the outputs already added.
+    Status add_input(std::filesystem::path path);
+
     // Writes `contents[i]` to the i-th output added, every file flushed before any is renamed
-    // into place; on failure (ErrorCode::io, naming the path) every existing output is kept.
-    // `contents` has one entry per output added.
+    // into place (write_files_atomically()); on failure (ErrorCode::io, naming the path) every
+    // existing output is kept. `contents` has one entry per output added.
     Status write(std::span<const std::span<const std::byte>> contents) const;
 
 private:

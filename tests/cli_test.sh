@@ -31,7 +31,7 @@ expect_exit 5 "failed glyphs" -- "$bake" "$font" --text "Hello" --max-curves 3 -
 grep -q "failed" "$work/err" || fail "glyph failures are not reported"
 cmp -s "$work/good.crisp" "$work/good.copy" || fail "a failed bake changed an existing asset"
 expect_exit 0 "allow failed" -- "$bake" "$font" --text "Hello" --max-curves 3 --allow-failed -o "$work/partial.crisp" -q
-[ -z "$(ls -A "$work" | grep -E '\.tmp')" ] || fail "temporary files were left behind"
+[ -z "$(ls -A "$work" | grep -E '\.tmp|crisp-tmp')" ] || fail "temporary files were left behind"
 
 # --check on good and bad assets.
 expect_exit 0 "check valid" -- "$bake" --check "$work/good.crisp"
@@ -82,6 +82,48 @@ cp "$font" "$work/input.ttf"
 expect_exit 4 "the input as the output" -- "$bake" "$work/input.ttf" --text a -o "$work/input.ttf"
 cmp -s "$font" "$work/input.ttf" || fail "the input was overwritten"
 grep -q "input" "$work/err" || fail "the refusal does not say why: $(cat "$work/err")"
+# A FIFO as the font or as --check's asset is refused at once: opening it used to wait for a writer.
+mkfifo "$work/in.fifo"
+expect_exit 3 "a FIFO as the font" -- timeout 20 "$bake" "$work/in.fifo" -o "$work/fifo-font.crisp"
+grep -q "not a regular file" "$work/err" || fail "a FIFO as the font: $(cat "$work/err")"
+expect_exit 6 "a FIFO as --check's asset" -- timeout 20 "$bake" --check "$work/in.fifo"
+grep -q "not a regular file" "$work/err" || fail "a FIFO as --check's asset: $(cat "$work/err")"
+# A link to a device, to nothing or to an open descriptor is refused like a device, the link kept
+# (`-o /dev/stdout` as root replaced /dev's link by a file); a link to a file writes the file.
+ln -s /dev/null "$work/null.crisp"
+ln -s "$work/no/such/file.crisp" "$work/dangling.crisp"
+ln -s /proc/self/fd/1 "$work/stdout.crisp"
+for link in null dangling stdout; do
+  expect_exit 4 "a link to $link as the output" -- "$bake" "$font" --text a -o "$work/$link.crisp"
+  [ -L "$work/$link.crisp" ] || fail "the link to $link was replaced"
+done
+ln -s target.crisp "$work/link.crisp"
+printf 'old' > "$work/target.crisp"
+expect_exit 0 "a link to a file as the output" -- "$bake" "$font" --text a -o "$work/link.crisp" -q
+[ -L "$work/link.crisp" ] || fail "the link to a file was replaced"
+expect_exit 0 "the file the link leads to" -- "$bake" --check "$work/target.crisp"
+# A read-only output is refused and left as it was; a writable one keeps its mode (and owner, as root).
+printf 'old' > "$work/read-only.crisp" && chmod 0444 "$work/read-only.crisp"
+expect_exit 4 "a read-only output" -- "$bake" "$font" --text a -o "$work/read-only.crisp"
+grep -q "read-only" "$work/err" || fail "a read-only output: $(cat "$work/err")"
+[ "$(cat "$work/read-only.crisp")" = old ] || fail "the read-only output was replaced"
+printf 'old' > "$work/mode.crisp" && chmod 0640 "$work/mode.crisp"
+[ "$(id -u)" -eq 0 ] && chown 65534:65534 "$work/mode.crisp"
+owner=$(stat -c %u:%g "$work/mode.crisp")
+expect_exit 0 "a writable output of mode 0640" -- "$bake" "$font" --text a -o "$work/mode.crisp" -q
+[ "$(stat -c %a "$work/mode.crisp")" = 640 ] || fail "the mode was not kept: $(stat -c %a "$work/mode.crisp")"
+[ "$(stat -c %u:%g "$work/mode.crisp")" = "$owner" ] || fail "the owner was not kept: $(stat -c %u:%g "$work/mode.crisp")"
+# A name longer than the file system takes fails before the baking; the longest it takes is written.
+name_max=$(getconf NAME_MAX "$work")
+long=$(printf 'n%.0s' $(seq "$name_max"))
+expect_exit 4 "a name of NAME_MAX + 1 bytes" -- "$bake" "$work/missing.ttf" -o "$work/${long}x"
+grep -q "File name too long" "$work/err" || fail "a name too long: $(cat "$work/err")"
+expect_exit 0 "a name of NAME_MAX bytes" -- "$bake" "$font" --text a -o "$work/$long" -q
+[ -f "$work/$long" ] || fail "the NAME_MAX name was not written"
+# Files named as temporaries were (and a killed writer's), which a write used to remove: kept.
+printf 'mine' > "$work/.kept.crisp.tmp-ABCDEF" && touch -d '-2 minutes' "$work/.kept.crisp.tmp-ABCDEF"
+expect_exit 0 "a write beside a user's .NAME.tmp-XXXXXX" -- "$bake" "$font" --text a -o "$work/kept.crisp" -q
+[ -f "$work/.kept.crisp.tmp-ABCDEF" ] || fail "a user's file named like a temporary was removed"
 printf 'wOF2\0\1\0\0xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx' > "$work/font.woff2"
 expect_exit 3 "WOFF2" -- "$bake" "$work/font.woff2" -o "$work/woff2.crisp"
 grep -q "decompress" "$work/err" || fail "WOFF2: no advice: $(cat "$work/err")"

@@ -8,7 +8,8 @@
 # crisp-render accepts it, that the editor exits 0 (so the validation layer stayed silent), and
 # that screenshots of the display before and after the edit show the preview, the magnified pixel
 # and the magnified rendered pixels, each not blank and each changed by the edit. Also: a bad
-# --layout file is reported (not fatal) and the --screenshot mode writes a PNG of the window.
+# --layout file is reported (not fatal) and the --screenshot mode writes a PNG of the window, never
+# onto its own --layout or --font file; FIFOs as --font or --layout are refused without a hang.
 set -uo pipefail
 editor=$1 render=$2 bake=$3 source=$4 work=$5
 
@@ -103,6 +104,31 @@ code=$?
 python3 -c 'import sys; d=open("shot.png","rb").read(); sys.exit(not (d[:8]==b"\x89PNG\r\n\x1a\n" and
 int.from_bytes(d[16:20],"big")==1280 and int.from_bytes(d[20:24],"big")==800))' ||
   fail "--screenshot did not write a 1280 x 800 PNG"
+
+# ---- --screenshot onto its own --layout or --font file, under another name: refused (exit 5) before
+# the window opens, the file kept (it used to be overwritten).
+printf '{"name": "own", "r": [0, 0, 0.25, 1], "g": [0.25, 0, 0.75, 1], "b": [0.75, 0, 1, 1]}' >own.json
+cp own.json own.kept && cp "$source/fonts/DejaVuSans.ttf" own.ttf
+timeout 120 "$editor" --layout own.json --frames 1 --screenshot "$work/own.json" 2>own.err
+code=$?
+[ "$code" -eq 5 ] || fail "--screenshot onto --layout: exit $code, want 5: $(head -c 600 own.err)"
+grep -q "it is the input" own.err || fail "--screenshot onto --layout: stderr does not say why: $(cat own.err)"
+cmp -s own.json own.kept || fail "--screenshot overwrote its --layout file"
+timeout 120 "$editor" --font own.ttf --frames 1 --screenshot ./own.ttf 2>own.err
+code=$?
+[ "$code" -eq 5 ] || fail "--screenshot onto --font: exit $code, want 5: $(head -c 600 own.err)"
+cmp -s own.ttf "$source/fonts/DejaVuSans.ttf" || fail "--screenshot overwrote its --font file"
+# ---- FIFOs as --font (exit 2) and --layout (reported, the editor runs) are refused at once: opening
+# one used to wait for a writer for ever.
+mkfifo font.fifo layout.fifo
+timeout 60 "$editor" --font font.fifo --frames 1 2>fifo.err
+code=$?
+[ "$code" -eq 2 ] || fail "a FIFO as --font: exit $code, want 2: $(head -c 600 fifo.err)"
+grep -q "not a regular file" fifo.err || fail "a FIFO as --font: $(cat fifo.err)"
+timeout 120 "$editor" --validation --layout layout.fifo --frames 1 2>fifo.err
+code=$?
+[ "$code" -eq 0 ] || fail "a FIFO as --layout: exit $code, want 0 (reported, not fatal): $(head -c 600 fifo.err)"
+grep -q "not a regular file" fifo.err || fail "a FIFO as --layout: $(cat fifo.err)"
 
 # ---- A bad layout file: reported (stderr and window), the editor still runs; exit 0.
 printf '{"r": [0, 0, 0.3, 1], "g": [0.3, 0, 0.6], "b": [0.6, 0, 1, 1]}' >bad.json

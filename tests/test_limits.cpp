@@ -3,6 +3,7 @@
 // the baker refuses up front with what to do instead.
 #include "core/file_io.hpp"
 #include "core/limits.hpp"
+#include "output_files.hpp"
 #include "scene.hpp"
 #include "test_support.hpp"
 
@@ -16,10 +17,15 @@
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include <climits>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 namespace crisp {
 namespace {
@@ -187,7 +193,7 @@ TEST(Limits, LongClustersOfMarksAreShapedInRunsOfBoundedLength) {
 }
 
 // A run's outputs are put in place together: when one cannot be written, none is replaced, and no
-// temporary is left; temporaries a killed writer left behind go at the next write.
+// temporary is left; no file is ever removed for its name (a killed writer's temporaries stay).
 TEST(Limits, OutputsAreReplacedTogetherOrNotAtAll) {
     TemporaryDirectory directory;
     const fs::path png = directory.path() / "out.png";
@@ -203,16 +209,156 @@ TEST(Limits, OutputsAreReplacedTogetherOrNotAtAll) {
     EXPECT_EQ(test::read_file(png.string()), new_png);
     EXPECT_EQ(test::read_file(pfm.string()), new_pfm);
 
-    // A temporary of png's pattern, two minutes old (a writer killed mid-write), and a fresh one
-    // (maybe another writer's): the next write of png removes the first only.
-    const fs::path stale = directory.path() / ".out.png.tmp-ABCDEF";
-    const fs::path fresh = directory.path() / ".out.png.tmp-GHIJKL";
-    ASSERT_TRUE(write_file_atomically(stale, bytes_of("x")));
-    ASSERT_TRUE(write_file_atomically(fresh, bytes_of("x")));
-    fs::last_write_time(stale, fs::file_time_type::clock::now() - std::chrono::minutes(2));
+    // A user's files named as temporaries were (`.out.png.tmp-XXXXXX`) and as they are now, two
+    // minutes old: no write removes them (a write used to remove the first two).
+    const fs::path files[] = {directory.path() / ".out.png.tmp-ABCDEF", directory.path() / ".out.png.tmp-GHIJKL",
+                              directory.path() / ".out.png.crisp-tmp-1-ABCDEFGH"};
+    for (const fs::path& file : files) {
+        ASSERT_TRUE(write_file_atomically(file, bytes_of("x")));
+        fs::last_write_time(file, fs::file_time_type::clock::now() - std::chrono::minutes(2));
+    }
     ASSERT_TRUE(write_file_atomically(png, new_png));
-    EXPECT_FALSE(fs::exists(stale));
-    EXPECT_TRUE(fs::exists(fresh));
+    for (const fs::path& file : files) EXPECT_TRUE(fs::exists(file)) << file;
+    EXPECT_EQ(directory.entries().size(), 5u);
+}
+
+// Opening a FIFO for reading waits for a writer: read_file() opens without blocking and refuses it.
+// (A read that blocks is unblocked by a writer after 10 s, so that the test fails rather than hangs.)
+TEST(Limits, AFifoIsRefusedWithoutWaitingForAWriter) {
+    TemporaryDirectory directory;
+    const fs::path fifo = directory.path() / "font.ttf";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    auto read = std::async(std::launch::async, [&] { return read_file(fifo, limits::kFontFileBytes); });
+    if (read.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+        ADD_FAILURE() << "read_file() blocked on a FIFO";
+        const int writer = ::open(fifo.c_str(), O_WRONLY);
+        if (writer >= 0) ::close(writer);
+    }
+    const Result<std::vector<std::byte>> result = read.get();
+    ASSERT_FALSE(result);
+    EXPECT_NE(result.error().message.find("not a regular file"), std::string::npos) << result.error().message;
+}
+
+// An input under any of its names is refused as an output, and two outputs that are one file: a
+// relative and an absolute name, a symbolic link to the directory, a hard link, also for files
+// that do not exist yet.
+TEST(Limits, NoOutputIsAnInputOrAnotherOutputUnderAnyName) {
+    TemporaryDirectory directory;
+    const fs::path real = directory.path() / "real";
+    fs::create_directory(real);
+    const fs::path alias = directory.path() / "alias";
+    fs::create_directory_symlink(real, alias);
+    const fs::path asset = real / "a.crisp";
+    ASSERT_TRUE(write_file_atomically(asset, bytes_of("asset")));
+    const fs::path hard = directory.path() / "hard.crisp";
+    fs::create_hard_link(asset, hard);
+    const fs::path inputs[] = {asset, real / "layout.json"};  // the layout does not exist
+    for (const fs::path& name :
+         {alias / "a.crisp", hard, fs::path(alias / ".." / "real" / "a.crisp"), alias / "layout.json"}) {
+        const Status checked = check_output_path(name, inputs);
+        ASSERT_FALSE(checked) << name;
+        EXPECT_NE(checked.error().message.find("it is the input"), std::string::npos) << checked.error().message;
+    }
+    EXPECT_TRUE(check_output_path(alias / "b.crisp", inputs));
+
+    // Relative names, from wherever the test runs.
+    const fs::path here = fs::relative(real, fs::current_path());
+    ASSERT_TRUE(here.is_relative());
+    EXPECT_TRUE(same_file(here / "x.png", real / "x.png"));
+    EXPECT_TRUE(same_file(here / "a.crisp", hard));
+    EXPECT_FALSE(same_file(here / "x.png", here / "y.png"));
+    OutputFiles outputs({});
+    ASSERT_TRUE(outputs.add(here / "x.png"));
+    const Status twice = outputs.add(alias / "x.png");
+    ASSERT_FALSE(twice);
+    EXPECT_NE(twice.error().message.find("also the output " + (here / "x.png").string()), std::string::npos)
+        << twice.error().message;
+    EXPECT_TRUE(outputs.add(here / "x.pfm"));
+    // An input known later (a scene's font) is checked against the outputs declared before.
+    EXPECT_FALSE(outputs.add_input(real / "x.pfm"));
+    EXPECT_TRUE(outputs.add_input(here / "a.crisp"));
+}
+
+// A symbolic link is written through to the regular file it leads to, and kept; a link to a
+// device, a FIFO, nothing or an open descriptor (/dev/stdout) is refused like a device.
+TEST(Limits, OutputLinksLeadToARegularFileOrAreRefused) {
+    TemporaryDirectory directory;
+    const fs::path fifo = directory.path() / "fifo";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const std::pair<fs::path, const char*> refused[] = {{"/dev/null", "not a regular file"},
+                                                        {fifo, "not a regular file"},
+                                                        {directory.path() / "missing" / "x", "leads to no file"},
+                                                        {"/proc/self/fd/1", "open file descriptor"},
+                                                        {"/dev/stdout", "open file descriptor"}};
+    for (const auto& [target, reason] : refused) {
+        const fs::path link = directory.path() / "link";
+        fs::remove(link);
+        fs::create_symlink(target, link);
+        const Status written = write_file_atomically(link, bytes_of("x"));
+        ASSERT_FALSE(written) << target;
+        EXPECT_NE(written.error().message.find(reason), std::string::npos) << written.error().message;
+        EXPECT_TRUE(fs::is_symlink(link));
+    }
+    const fs::path file = directory.path() / "file.png";
+    const fs::path link = directory.path() / "link.png";
+    ASSERT_TRUE(write_file_atomically(file, bytes_of("old")));
+    fs::create_symlink("file.png", link);
+    ASSERT_TRUE(write_file_atomically(link, bytes_of("new")));
+    EXPECT_TRUE(fs::is_symlink(link));
+    EXPECT_EQ(test::read_file(file.string()), bytes_of("new"));
+}
+
+// A read-only file is refused, not replaced; a writable one is replaced with its mode and owner.
+TEST(Limits, ReplacedFilesKeepTheirModeAndOwnerAndReadOnlyOnesAreRefused) {
+    TemporaryDirectory directory;
+    const fs::path read_only = directory.path() / "read-only.crisp";
+    ASSERT_TRUE(write_file_atomically(read_only, bytes_of("old")));
+    ASSERT_EQ(::chmod(read_only.c_str(), 0444), 0);
+    const Status refused = write_file_atomically(read_only, bytes_of("new"));
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("read-only (mode 0444)"), std::string::npos) << refused.error().message;
+    EXPECT_EQ(test::read_file(read_only.string()), bytes_of("old"));
+    EXPECT_FALSE(check_output_path(read_only));
+
+    const fs::path kept = directory.path() / "kept.crisp";
+    ASSERT_TRUE(write_file_atomically(kept, bytes_of("old")));
+    ASSERT_EQ(::chmod(kept.c_str(), 0604), 0);
+    // Root (as in CI's containers) gives the file away and must get it back.
+    const bool root = ::geteuid() == 0;
+    if (root) {
+        ASSERT_EQ(::chown(kept.c_str(), 65534, 65534), 0);
+    }
+    ASSERT_TRUE(write_file_atomically(kept, bytes_of("new")));
+    EXPECT_EQ(test::read_file(kept.string()), bytes_of("new"));
+    struct stat info = {};
+    ASSERT_EQ(::stat(kept.c_str(), &info), 0);
+    EXPECT_EQ(info.st_mode & 07777, 0604u);
+    if (root) {
+        EXPECT_EQ(info.st_uid, 65534u);
+        EXPECT_EQ(info.st_gid, 65534u);
+    }
+}
+
+// A name longer than the file system takes is refused before any work; one that it takes is
+// written, though its temporary's name would be longer still.
+TEST(Limits, OutputNamesAreCheckedAgainstTheFileSystemsLimit) {
+    TemporaryDirectory directory;
+    const long name_max = ::pathconf(directory.path().c_str(), _PC_NAME_MAX);
+    ASSERT_GT(name_max, 16);
+    const fs::path longest = directory.path() / std::string(static_cast<size_t>(name_max), 'n');
+    const fs::path too_long = directory.path() / std::string(static_cast<size_t>(name_max) + 1, 'n');
+    const Status checked = check_output_path(too_long);
+    ASSERT_FALSE(checked);
+    EXPECT_NE(checked.error().message.find("File name too long"), std::string::npos) << checked.error().message;
+    ASSERT_TRUE(check_output_path(longest));
+    ASSERT_TRUE(write_file_atomically(longest, bytes_of("x")));
+    ASSERT_TRUE(write_file_atomically(longest, bytes_of("y")));  // over an existing one: through a hidden name
+    EXPECT_EQ(test::read_file(longest.string()), bytes_of("y"));
+    EXPECT_EQ(directory.entries().size(), 1u);
+    // Past PATH_MAX: refused by name, not by the file system after the work.
+    fs::path deep = directory.path();
+    while (deep.string().size() < PATH_MAX) deep /= std::string(200, 'd');
+    EXPECT_FALSE(check_output_path(deep / "x.png"));
 }
 
 }  // namespace

@@ -44,6 +44,10 @@ constexpr const char* kExitCodes = R"(
 exit codes:
   0 success   2 usage error   3 unreadable or unsupported font   4 output not writable
   5 glyphs failed   6 invalid asset (--check)   1 internal error
+
+the asset is written whole, then renamed into place (docs/limits.md): an existing file is replaced
+keeping its mode and owner; one that is read-only or another user's, the font, a device, FIFO or
+directory, or a link to one is refused (exit 4) before any baking.
 )";
 
 struct Arguments {

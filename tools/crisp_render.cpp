@@ -83,6 +83,11 @@ exit codes:
   0 success   2 usage error   3 font asset cannot be loaded   4 output not writable
   5 Vulkan unavailable or failed, or validation messages   6 bad --layout or scene layout
   7 bad --scene file (unreadable, invalid, or a run the layout refuses)   1 internal error
+
+outputs are written whole, then renamed into place (docs/limits.md): an existing file is replaced
+keeping its mode and owner; one that is read-only or another user's, an input (a scene's fonts and
+layout too), the other output, a device, FIFO or directory, or a link to one is refused (exit 4)
+before any rendering.
 )";
 
 struct Arguments {
@@ -370,12 +375,13 @@ Arguments parse_arguments(int argc, char** argv) {
 }
 
 // The outputs (-o, then --coverage-out), refused before any rendering when one cannot be written
-// (its directory missing), must not be replaced (a device node, directory, FIFO), or is one of
-// the inputs.
+// (its directory missing, its name too long), must not be replaced (a device node, directory,
+// FIFO, a read-only file), is one of the inputs or is the other output. The inputs a scene names
+// are added once it is read (load_job()).
 crisp::OutputFiles declare_outputs(const Arguments& args) {
     std::vector<std::filesystem::path> inputs(args.fonts.begin(), args.fonts.end());
     if (!args.scene.empty()) inputs.emplace_back(args.scene);
-    if (args.layout) inputs.emplace_back(*args.layout);
+    if (args.layout && !crisp::subpixel_preset(*args.layout)) inputs.emplace_back(*args.layout);
     crisp::OutputFiles outputs(std::move(inputs));
     for (const std::string& path : {args.output, args.coverage_output}) {
         if (path.empty()) continue;
@@ -1130,8 +1136,9 @@ void lay_out(const Arguments& args, Job& job) {
 }
 
 // The scene (from --scene, or the one run the command line describes), its subpixel layout and
-// fonts, and its runs laid out; exits on a failure.
-Job load_job(const Arguments& args) {
+// fonts, and its runs laid out; exits on a failure. A scene's fonts and layout file join the
+// inputs no output may be, before any of them is read (`-o a.crisp` used to replace a scene's asset).
+Job load_job(const Arguments& args, crisp::OutputFiles& outputs) {
     Job job;
     if (args.scene.empty()) {
         job.scene = scene_from_arguments(args);
@@ -1139,6 +1146,12 @@ Job load_job(const Arguments& args) {
         crisp::Result<crisp::Scene> scene = crisp::load_scene_file(args.scene);
         if (!scene) fail(kExitScene, scene.error().message);
         job.scene = std::move(*scene);
+        std::vector<std::string> inputs = job.scene.fonts;
+        if (!crisp::subpixel_preset(job.scene.layout)) inputs.push_back(job.scene.layout);
+        for (const std::string& input : inputs) {
+            if (const crisp::Status checked = outputs.add_input(input); !checked)
+                fail(kExitOutput, checked.error().message);
+        }
     }
 
     crisp::Result<crisp::SubpixelLayout> subpixel_layout = crisp::resolve_subpixel_layout(job.scene.layout);
@@ -1224,8 +1237,8 @@ int report_problems(const Arguments& args, const RenderReport& report, const cri
 
 int run(const Arguments& args) {
     const auto start = std::chrono::steady_clock::now();
-    const crisp::OutputFiles outputs = declare_outputs(args);
-    const Job job = load_job(args);
+    crisp::OutputFiles outputs = declare_outputs(args);
+    const Job job = load_job(args, outputs);
 
     RenderReport report;
     crisp::HeadlessContextOptions options;

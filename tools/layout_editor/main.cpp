@@ -6,6 +6,7 @@
 
 #include "cli.hpp"
 #include "image_io.hpp"
+#include "output_files.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
@@ -17,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -45,7 +47,8 @@ lets you drag, nudge and type its rectangles, and previews text rendered by cris
 constexpr const char* kExitCodes = R"(
 Exit codes: 0 success; 1 bad command line; 2 the font could not be loaded; 3 no window or no
 Vulkan device (or a Vulkan failure); 4 the validation layer reported a message; 5 the screenshot
-could not be written.
+could not be written, or must not be (the --font or --layout file, a read-only file, a device:
+refused before the window opens; docs/limits.md).
 )";
 
 struct Args {
@@ -172,13 +175,33 @@ FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
     return stats;
 }
 
-bool write_screenshot(const std::string& path, std::span<const uint8_t> rgba, uint32_t width, uint32_t height) {
+// The --screenshot file, refused before the window opens when it cannot or must not be written:
+// the --font or --layout file under any name (a screenshot used to replace its own layout file).
+std::optional<crisp::OutputFiles> declare_screenshot(const Args& args) {
+    std::vector<std::filesystem::path> inputs = {args.font};
+    if (!crisp::subpixel_preset(args.layout)) inputs.emplace_back(args.layout);
+    crisp::OutputFiles outputs(std::move(inputs));
+    if (crisp::Status status = outputs.add(args.screenshot); !status) {
+        std::fprintf(stderr, "crisp-layout-editor: --screenshot: %s\n", status.error().message.c_str());
+        return std::nullopt;
+    }
+    return outputs;
+}
+
+bool write_screenshot(const crisp::OutputFiles& output, std::span<const uint8_t> rgba, uint32_t width,
+                      uint32_t height) {
     std::vector<float> pixels(size_t{width} * height * 3);
     for (size_t i = 0; i < size_t{width} * height; ++i) {
         for (size_t c = 0; c < 3; ++c)
             pixels[i * 3 + c] = crisp::srgb_to_linear(static_cast<float>(rgba[i * 4 + c]) / 255.0f);
     }
-    if (crisp::Status status = crisp::write_png_srgb8(path, width, height, 3, pixels); !status) {
+    crisp::Result<std::vector<std::byte>> png = crisp::encode_png_srgb8(width, height, 3, pixels);
+    crisp::Status status = png ? crisp::Status{} : crisp::Status{png.error()};
+    if (png) {
+        const std::span<const std::byte> contents[] = {*png};
+        status = output.write(contents);
+    }
+    if (!status) {
         std::fprintf(stderr, "crisp-layout-editor: --screenshot: %s\n", status.error().message.c_str());
         return false;
     }
@@ -187,7 +210,8 @@ bool write_screenshot(const std::string& path, std::span<const uint8_t> rgba, ui
 
 // The window's life: returns the exit code. Everything Vulkan is gone when it returns, except the
 // window, whose validation count the caller reads.
-int run(const Args& args, VulkanWindow& window, const crisp::Font& font, LayoutModel& model, EditorView& view) {
+int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, VulkanWindow& window,
+        const crisp::Font& font, LayoutModel& model, EditorView& view) {
     crisp::Result<std::unique_ptr<GpuFrame>> created = GpuFrame::create(window, font, model.layout(), model.contrast());
     if (!created) {
         std::fprintf(stderr, "crisp-layout-editor: Vulkan: %s\n", created.error().message.c_str());
@@ -251,8 +275,7 @@ int run(const Args& args, VulkanWindow& window, const crisp::Font& font, LayoutM
         std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
         return kExitVulkan;
     }
-    if (!args.screenshot.empty() &&
-        !write_screenshot(args.screenshot, gpu.previous_frame(), window.width(), window.height())) {
+    if (screenshot && !write_screenshot(*screenshot, gpu.previous_frame(), window.width(), window.height())) {
         return kExitScreenshot;
     }
     return kExitOk;
@@ -265,6 +288,12 @@ int main(int argc, char** argv) {
     if (args.print_geometry) {
         std::printf("%s\n", EditorView::geometry_json().c_str());
         return kExitOk;
+    }
+
+    std::optional<crisp::OutputFiles> screenshot;
+    if (!args.screenshot.empty()) {
+        screenshot = declare_screenshot(args);
+        if (!screenshot) return kExitScreenshot;
     }
 
     // The starting layout: a preset by name, else a file. A file that fails to load is reported
@@ -300,7 +329,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "crisp-layout-editor: %s\n", window.error().message.c_str());
         return kExitVulkan;
     }
-    const int code = run(args, **window, *font, model, view);
+    const int code = run(args, screenshot, **window, *font, model, view);
     const uint32_t messages = (*window)->validation_messages();
     window->reset();  // the instance's teardown is validated too
     if (code != kExitOk) return code;
