@@ -144,6 +144,9 @@ PFN_vkGetInstanceProcAddr HeadlessContext::get_instance_proc_addr() const {
 VkInstance HeadlessContext::instance() const {
     return state_->instance.handle();
 }
+uint32_t HeadlessContext::instance_api_version() const {
+    return state_->instance.api_version();
+}
 VkPhysicalDevice HeadlessContext::physical_device() const {
     return state_->physical.handle;
 }
@@ -251,6 +254,7 @@ Status HeadlessContext::submit_and_wait(const std::function<void(VkCommandBuffer
 RendererCreateInfo renderer_create_info(const HeadlessContext& context) {
     RendererCreateInfo info;
     info.instance = context.instance();
+    info.instance_api_version = context.instance_api_version();
     info.get_instance_proc_addr = context.get_instance_proc_addr();
     info.physical_device = context.physical_device();
     info.device = context.device();
@@ -263,6 +267,7 @@ RendererCreateInfo renderer_create_info(const HeadlessContext& context) {
 CompositorCreateInfo compositor_create_info(const HeadlessContext& context) {
     CompositorCreateInfo info;
     info.instance = context.instance();
+    info.instance_api_version = context.instance_api_version();
     info.get_instance_proc_addr = context.get_instance_proc_addr();
     info.physical_device = context.physical_device();
     info.device = context.device();

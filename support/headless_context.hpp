@@ -149,6 +149,7 @@ public:
 
     // The objects a renderer is created from.
     VkInstance instance() const;
+    uint32_t instance_api_version() const;  // the apiVersion the instance was created with
     VkPhysicalDevice physical_device() const;
     VkDevice device() const;
     uint32_t queue_family() const;

@@ -251,6 +251,7 @@ ValidationMessages ValidationLog::snapshot() const {
 struct VulkanInstance::State {
     vk::Functions fn;
     VkInstance instance = VK_NULL_HANDLE;
+    uint32_t api_version = 0;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
     PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger = nullptr;
 
@@ -338,6 +339,7 @@ Result<VulkanInstance> VulkanInstance::create(const InstanceOptions& options) {
     application.pApplicationName = options.application_name;
     application.pEngineName = "crisp";
     application.apiVersion = options.api_version;
+    s.api_version = options.api_version;
     VkInstanceCreateInfo instance_info{};
     instance_info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     // Chained here too so that messages from vkCreateInstance and vkDestroyInstance are counted.
@@ -373,6 +375,9 @@ VulkanInstance::~VulkanInstance() = default;
 
 VkInstance VulkanInstance::handle() const {
     return state_ ? state_->instance : VK_NULL_HANDLE;
+}
+uint32_t VulkanInstance::api_version() const {
+    return state_ ? state_->api_version : 0;
 }
 const vk::Functions& VulkanInstance::functions() const {
     return state_->fn;

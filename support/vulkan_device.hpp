@@ -93,6 +93,8 @@ public:
     ~VulkanInstance();
 
     VkInstance handle() const;
+    // The VkApplicationInfo::apiVersion it was created with (RendererCreateInfo::instance_api_version).
+    uint32_t api_version() const;
     // The functions the instance was made and is used through (stable while it lives).
     const vk::Functions& functions() const;
 

@@ -40,6 +40,16 @@ TEST(Compositor, RejectsBadCreateInfo) {
     info = compositor_info();
     info.device = VK_NULL_HANDLE;
     EXPECT_EQ(Compositor::create(info).error().code, ErrorCode::invalid_argument);
+    // An instance older than Vulkan 1.2, or one whose version is not given, cannot run crisp's SPIR-V.
+    for (const uint32_t version : {0u, VK_API_VERSION_1_0, VK_API_VERSION_1_1}) {
+        info = compositor_info();
+        info.instance_api_version = version;
+        auto old = Compositor::create(info);
+        ASSERT_FALSE(old);
+        EXPECT_EQ(old.error().code, ErrorCode::invalid_argument);
+        EXPECT_NE(old.error().message.find("compositor: instance_api_version is "), std::string::npos)
+            << old.error().message;
+    }
     // Without the reference modes the size is not looked at, and no per-pixel memory is made.
     info = compositor_info();
     info.reference_modes = false;

@@ -314,6 +314,17 @@ TEST(Raster, BadConfigurationsAreRefused) {
     auto refused = Renderer::create(unknown_kind);
     ASSERT_FALSE(refused);
     EXPECT_EQ(refused.error().code, ErrorCode::invalid_argument);
+    // An instance created for Vulkan 1.1 (or of a version not given) cannot run crisp's SPIR-V,
+    // whatever the device offers.
+    for (const uint32_t version : {0u, VK_API_VERSION_1_1}) {
+        RendererCreateInfo old = renderer_create_info(*f.context);
+        old.instance_api_version = version;
+        auto made = Renderer::create(old);
+        ASSERT_FALSE(made);
+        EXPECT_EQ(made.error().code, ErrorCode::invalid_argument);
+        EXPECT_NE(made.error().message.find(version == 0 ? "not given" : "Vulkan 1.1"), std::string::npos)
+            << made.error().message;
+    }
     SubpixelLayout bad = *subpixel_preset("rgb");
     bad.channels[0].x1 = 5.0f;
     EXPECT_FALSE(make_renderer(bad, 16));

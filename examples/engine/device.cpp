@@ -146,7 +146,7 @@ crisp::Status Device::create_instance(bool validation, std::atomic<uint32_t>* me
     VkApplicationInfo application{};
     application.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
     application.pApplicationName = "crisp-engine-example";
-    application.apiVersion = VK_API_VERSION_1_3;
+    application.apiVersion = kInstanceApiVersion;
     VkInstanceCreateInfo info{};
     info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     info.pNext = validation ? &messenger : nullptr;  // so that instance creation is reported too

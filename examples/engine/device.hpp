@@ -43,6 +43,8 @@ public:
 
     GLFWwindow* window() const { return window_; }
     VkInstance instance() const { return instance_; }
+    // The VkApplicationInfo::apiVersion the instance is created with: crisp checks it.
+    static constexpr uint32_t kInstanceApiVersion = VK_API_VERSION_1_3;
     VkPhysicalDevice physical_device() const { return physical_device_; }
     VkDevice device() const { return device_; }
     VkSurfaceKHR surface() const { return surface_; }

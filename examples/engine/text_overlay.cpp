@@ -103,6 +103,7 @@ crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& de
     std::unique_ptr<TextOverlay> self(new TextOverlay(std::move(fonts)));
     crisp::RendererCreateInfo renderer_info;
     renderer_info.instance = device.instance();
+    renderer_info.instance_api_version = Device::kInstanceApiVersion;
     renderer_info.get_instance_proc_addr = vkGetInstanceProcAddr;  // volk's: crisp calls what the engine calls
     renderer_info.physical_device = device.physical_device();
     renderer_info.device = device.device();
@@ -120,6 +121,7 @@ crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& de
 
     crisp::CompositorCreateInfo compositor_info;
     compositor_info.instance = device.instance();
+    compositor_info.instance_api_version = Device::kInstanceApiVersion;
     compositor_info.get_instance_proc_addr = vkGetInstanceProcAddr;
     compositor_info.physical_device = device.physical_device();
     compositor_info.device = device.device();

@@ -80,6 +80,9 @@ struct CompositorCreateInfo {
     // system loader's).
     VkInstance instance = VK_NULL_HANDLE;
     PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
+    // Required: the apiVersion `instance` was created with, as RendererCreateInfo's: below
+    // VK_API_VERSION_1_2, or 0, create() fails (invalid_argument).
+    uint32_t instance_api_version = 0;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkDevice device = VK_NULL_HANDLE;
     const VkAllocationCallbacks* allocator = nullptr;

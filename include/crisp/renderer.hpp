@@ -78,6 +78,10 @@ struct RendererCreateInfo {
     // create() (vulkan), naming it.
     VkInstance instance = VK_NULL_HANDLE;
     PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
+    // Required: the VkApplicationInfo::apiVersion `instance` was created with. crisp's shaders are
+    // SPIR-V for Vulkan 1.2, which an instance of an older apiVersion may not use whatever the
+    // device offers: below VK_API_VERSION_1_2, or 0 (not given), create() fails (invalid_argument).
+    uint32_t instance_api_version = 0;
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkDevice device = VK_NULL_HANDLE;
     uint32_t queue_family = 0;  // the family of the queue the caller submits crisp's work on

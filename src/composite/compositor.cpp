@@ -53,6 +53,7 @@ Status check_create_info(const CompositorCreateInfo& info) {
     if (!info.instance || !info.device || !info.physical_device) {
         return invalid("an instance, a physical device and a device are required");
     }
+    if (Status s = vk::check_instance_version(info.instance_api_version, "compositor"); !s) return s;
     if (info.frames_in_flight < 1 || info.frames_in_flight > 8) return invalid("frames_in_flight must be 1 to 8");
     if (info.tile_capacity < 4 || info.tile_capacity > kMaxTileCapacity || !std::has_single_bit(info.tile_capacity)) {
         return invalid("tile_capacity must be a power of two from 4 to " + std::to_string(kMaxTileCapacity));

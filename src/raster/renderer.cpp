@@ -67,6 +67,7 @@ Result<Renderer> Renderer::create(const RendererCreateInfo& info) {
     if (!info.instance || !info.device || !info.physical_device) {
         return Error{ErrorCode::invalid_argument, "renderer: an instance, a physical device and a device are required"};
     }
+    if (Status s = vk::check_instance_version(info.instance_api_version, "renderer"); !s) return s.error();
     if (info.frames_in_flight < 1 || info.frames_in_flight > 8) {
         return Error{ErrorCode::invalid_argument, "renderer: frames_in_flight must be 1 to 8"};
     }

@@ -4,6 +4,16 @@
 
 namespace crisp::vk {
 
+Status check_instance_version(uint32_t instance_api_version, const char* who) {
+    if (instance_api_version >= VK_API_VERSION_1_2) return {};
+    const std::string given =
+        instance_api_version == 0 ? "not given (0)" : "Vulkan " + version_string(instance_api_version);
+    return Error{ErrorCode::invalid_argument,
+                 std::string(who) + ": instance_api_version is " + given +
+                     ": crisp's shaders are SPIR-V for Vulkan 1.2, so the instance must be created with apiVersion "
+                     "VK_API_VERSION_1_2 or later, and instance_api_version set to it"};
+}
+
 Context::Context(const Functions& functions, const VkPhysicalDeviceProperties& device_properties,
                  const DeviceFeatures& features, const ContextCreateInfo& info)
     : fn(functions),

@@ -32,6 +32,10 @@ struct ContextCreateInfo {
     const char* who = "";          // "renderer", "compositor": what every message starts with
 };
 
+// invalid_argument, from `who`, unless `instance_api_version` (what the caller's instance was
+// created with) is at least Vulkan 1.2, the version crisp's SPIR-V is built for.
+Status check_instance_version(uint32_t instance_api_version, const char* who);
+
 // Heap-held and never moved: `ref` points at `fn` and `arena`, and every part made from `ref`
 // points at it. Declared first in its owner's state, so that it is destroyed last.
 class Context {

@@ -104,6 +104,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
     // The interface's text: the neutral gray subpixel layout, whatever is being edited.
     RendererCreateInfo renderer_info;
     renderer_info.instance = window.instance();
+    renderer_info.instance_api_version = window.instance_api_version();
     renderer_info.physical_device = window.physical_device();
     renderer_info.device = window.device();
     renderer_info.queue_family = window.queue_family();
@@ -128,6 +129,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
 
     CompositorCreateInfo compositor_info;
     compositor_info.instance = window.instance();
+    compositor_info.instance_api_version = window.instance_api_version();
     compositor_info.physical_device = window.physical_device();
     compositor_info.device = window.device();
     compositor_info.frames_in_flight = 1;

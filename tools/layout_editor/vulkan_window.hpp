@@ -50,6 +50,7 @@ public:
     ~VulkanWindow();
 
     VkInstance instance() const { return instance_.handle(); }
+    uint32_t instance_api_version() const { return instance_.api_version(); }
     VkPhysicalDevice physical_device() const { return physical_.handle; }
     VkDevice device() const { return device_.handle(); }
     uint32_t queue_family() const { return physical_.queue_family; }
