@@ -1,5 +1,7 @@
 #include "core/file_io.hpp"
 
+#include "core/utf8.hpp"
+
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -21,7 +23,8 @@ std::string errno_text(int error) {
 }
 
 Error io_error(std::string_view what, const std::filesystem::path& path, int error) {
-    return Error{ErrorCode::io, std::string(what) + " " + path.string() + ": " + errno_text(error)};
+    return Error{ErrorCode::io,
+                 std::string(what) + " " + printable(path.string(), kPrintablePath) + ": " + errno_text(error)};
 }
 
 // Unpredictability is not needed: O_EXCL refuses an existing name (and a planted symlink), and a
