@@ -1,9 +1,12 @@
-// Messages that quote an input (issue 28, items 17 and 18): what they quote is escaped and short,
-// and numbers out of range say which end.
+// Messages that quote an input (issue 28, items 17 to 19): what they quote is escaped and short,
+// numbers out of range say which end, FreeType's errors have words, and a font's faults name the
+// table.
+#include "bake/outline.hpp"
 #include "cli.hpp"
 #include "core/json.hpp"
 #include "core/utf8.hpp"
 #include "scene.hpp"
+#include "test_support.hpp"
 
 #include <crisp/bake.hpp>
 #include <crisp/subpixel.hpp>
@@ -169,6 +172,39 @@ TEST(Messages, NumbersPastTheirRangeSayWhichEnd) {
     Result<Variation> escape = parse_variation("\x1b[2J");
     ASSERT_FALSE(escape);
     EXPECT_FALSE(has_control(escape.error().message)) << escape.error().message;
+}
+
+TEST(Messages, FreeTypeErrorsHaveWords) {
+    EXPECT_EQ(freetype_error(8), "FreeType error 8 (broken table)");
+    EXPECT_EQ(freetype_error(10), "FreeType error 10 (array allocation size too large)");
+    EXPECT_EQ(freetype_error(20), "FreeType error 20 (invalid outline)");
+    EXPECT_EQ(freetype_error(21), "FreeType error 21 (invalid composite glyph)");
+    EXPECT_EQ(freetype_error(250), "FreeType error 250");
+}
+
+TEST(Messages, FontFaultsNameTheTable) {
+    const std::vector<std::byte> font = test::read_file(test::kDejaVuSans);
+    for (const size_t percent : {25u, 50u, 99u}) {
+        const std::vector<std::byte> cut(font.begin(), font.begin() + static_cast<long>(font.size() * percent / 100));
+        Result<BakeResult> baked = bake_font(cut, BakeOptions{});
+        ASSERT_FALSE(baked) << percent;
+        EXPECT_EQ(baked.error().code, ErrorCode::font_unreadable);
+        EXPECT_NE(baked.error().message.find("' table ("), std::string::npos) << baked.error().message;
+        EXPECT_NE(baked.error().message.find("the font is truncated"), std::string::npos) << baked.error().message;
+    }
+    const std::byte bare_cff[] = {std::byte{1}, std::byte{0}, std::byte{4}, std::byte{2}, std::byte{0}, std::byte{1}};
+    const Status bare = check_font_container(bare_cff);
+    ASSERT_FALSE(bare);
+    EXPECT_EQ(bare.error().code, ErrorCode::font_unsupported);
+    EXPECT_NE(bare.error().message.find("a bare CFF font"), std::string::npos) << bare.error().message;
+    const std::byte zeros[16] = {};
+    const Status none = check_font_container(zeros);
+    ASSERT_FALSE(none);
+    EXPECT_EQ(none.error().code, ErrorCode::font_unreadable);
+    EXPECT_NE(none.error().message.find("not a TrueType or OpenType font: it starts with 0x00000000"),
+              std::string::npos)
+        << none.error().message;
+    EXPECT_TRUE(check_font_container(font));
 }
 
 }  // namespace
