@@ -12,10 +12,8 @@ from fontTools.ttLib import TTFont
 from fontTools.ttLib.scaleUpem import scale_upem
 
 
-def main():
-    if len(sys.argv) != 5:
-        sys.exit(__doc__)
-    source, text, upem, out = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
+def subset_font(source, text):
+    """The glyphs of FONT that TEXT needs, without names (also tests/make_font_faults.py's)."""
     logging.getLogger("fontTools").setLevel(logging.ERROR)  # tables it drops are expected
     font = TTFont(source)
     options = subset.Options()
@@ -24,6 +22,14 @@ def main():
     subsetter = subset.Subsetter(options)
     subsetter.populate(text=text)
     subsetter.subset(font)
+    return font
+
+
+def main():
+    if len(sys.argv) != 5:
+        sys.exit(__doc__)
+    source, text, upem, out = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
+    font = subset_font(source, text)
     scale_upem(font, upem)
     font.save(out)
 

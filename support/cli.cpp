@@ -8,6 +8,14 @@
 
 namespace crisp::cli {
 
+std::string printable(std::string_view text, size_t max) {
+    return crisp::printable(text, max);
+}
+
+std::string printable_path(std::string_view path) {
+    return crisp::printable(path, kPrintablePath);
+}
+
 std::vector<std::string_view> split(std::string_view text, char separator) {
     std::vector<std::string_view> parts;
     for (;;) {

@@ -19,58 +19,56 @@ namespace crisp::cli {
 
 // The whole of `text` as a number of type T; nullopt when it is empty, malformed, has trailing
 // characters, is out of T's range (for floating point: its magnitude too large or too small for
-// T, other than zero), or is not finite. `why`, when given, receives the reason as a phrase ("is
-// not a number", "is out of range for a 32-bit float", ...).
+// T, subnormal included, other than zero; for an unsigned T: negative), or is not finite. `why`,
+// when given, receives the reason as a phrase ("is not a number", "is out of range for a 32-bit
+// float (too large)", "is negative", ...).
 template <class T>
 std::optional<T> parse_number(std::string_view text, std::string* why = nullptr) {
-    auto refuse = [&](const char* reason) -> std::optional<T> {
-        if (why) *why = reason;
+    auto refuse = [&](std::string reason) -> std::optional<T> {
+        if (why) *why = std::move(reason);
         return std::nullopt;
     };
     T value{};
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || (ec != std::errc() && ec != std::errc::result_out_of_range) ||
-        end != text.data() + text.size()) {
-        return refuse("is not a number");
+    const bool whole = !text.empty() && end == text.data() + text.size();
+    if constexpr (std::is_unsigned_v<T>) {
+        long long negative = 0;
+        const auto [signed_end, signed_ec] = std::from_chars(text.data(), text.data() + text.size(), negative);
+        if (!text.empty() && text.front() == '-' && signed_end == text.data() + text.size() &&
+            signed_ec != std::errc::invalid_argument) {
+            return refuse("is negative");
+        }
     }
-    if (ec == std::errc::result_out_of_range) {
-        if constexpr (std::is_same_v<T, float>) return refuse("is out of range for a 32-bit float");
-        if constexpr (std::is_same_v<T, double>) return refuse("is out of range for a 64-bit float");
-        return refuse("is out of range");
-    }
+    if (!whole || (ec != std::errc() && ec != std::errc::result_out_of_range)) return refuse("is not a number");
     if constexpr (std::is_floating_point_v<T>) {
+        const char* type = std::is_same_v<T, float> ? "a 32-bit float" : "a 64-bit float";
+        if (ec == std::errc::result_out_of_range) {
+            // Which end it passed: the magnitude in a wider type (past even that, it is too large
+            // or too small for any, and the exponent's sign says which).
+            long double wide = 0;
+            const auto wide_ec = std::from_chars(text.data(), text.data() + text.size(), wide).ec;
+            const size_t exponent = text.find_first_of("eE");
+            const bool small = wide_ec == std::errc()
+                                   ? std::fabs(wide) < 1.0L
+                                   : exponent != std::string_view::npos && text.substr(exponent + 1).starts_with('-');
+            return refuse(std::string("is out of range for ") + type + (small ? " (too small)" : " (too large)"));
+        }
         if (!std::isfinite(value)) return refuse("is not finite");
+        if (value != 0 && std::fabs(value) < std::numeric_limits<T>::min()) {
+            return refuse(std::string("is out of range for ") + type + " (too small)");
+        }
+    } else {
+        if (ec == std::errc::result_out_of_range) return refuse("is out of range");
     }
     return value;
 }
 
-// `text` safe to print on a terminal: control characters (C0, DEL, and the C1 controls U+0080 to
-// U+009F in UTF-8), which could move the cursor or set the window title, become \xNN escapes, and
-// so does a backslash; everything else, UTF-8 included, is kept.
-inline std::string printable(std::string_view text) {
-    std::string out;
-    out.reserve(text.size());
-    auto escape = [&](unsigned char byte) {
-        static constexpr char kHex[] = "0123456789abcdef";
-        out += "\\x";
-        out += kHex[byte >> 4];
-        out += kHex[byte & 15];
-    };
-    for (size_t i = 0; i < text.size(); ++i) {
-        const auto byte = static_cast<unsigned char>(text[i]);
-        const bool c1 = byte == 0xC2 && i + 1 < text.size() && static_cast<unsigned char>(text[i + 1]) >= 0x80 &&
-                        static_cast<unsigned char>(text[i + 1]) <= 0x9F;
-        if (c1) {
-            escape(byte);
-            escape(static_cast<unsigned char>(text[++i]));
-        } else if (byte < 0x20 || byte == 0x7F || byte == '\\') {
-            escape(byte);
-        } else {
-            out += text[i];
-        }
-    }
-    return out;
-}
+// `text` from an input as a message shows it: crisp::printable (src/core/utf8.hpp), for the tools
+// that do not see src/: control characters, bidirectional controls, a backslash and ill-formed
+// UTF-8 escaped, and longer than `max` characters shortened around "...".
+std::string printable(std::string_view text, size_t max = 80);
+// A path so: printable at crisp::kPrintablePath characters.
+std::string printable_path(std::string_view path);
 
 // `text` cut at every `separator`: "a,,b" is {"a", "", "b"}; "" is {""}.
 std::vector<std::string_view> split(std::string_view text, char separator);

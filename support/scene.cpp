@@ -3,6 +3,7 @@
 #include "core/file_io.hpp"
 #include "core/limits.hpp"
 #include "core/json.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/renderer.hpp>
@@ -41,7 +42,7 @@ std::optional<Error> unknown_member(const json::Value& object, const std::string
         if (found) continue;
         std::string list;
         for (const std::string_view name : known) list += (list.empty() ? "" : ", ") + std::string(name);
-        std::string what = "unknown member \"" + member.name + "\" (known: " + list + ")";
+        std::string what = "unknown member \"" + printable(member.name) + "\" (known: " + list + ")";
         if (path.empty()) return Error{ErrorCode::invalid_argument, "scene: " + what};
         return fault(path, what);
     }
@@ -120,7 +121,8 @@ std::optional<Error> read_contrast(const json::Value& value, const std::string& 
         } else if (mode->type == Type::string && mode->string == "corrected") {
             contrast.mode = ContrastMode::corrected;
         } else {
-            const std::string got = mode->type == Type::string ? "\"" + mode->string + "\"" : mode->type_name();
+            const std::string got =
+                mode->type == Type::string ? "\"" + printable(mode->string) + "\"" : mode->type_name();
             return fault(path + ".mode", "expected \"linear\" or \"corrected\", got " + got);
         }
     }
@@ -303,7 +305,8 @@ Result<Scene> load_scene_file(const std::filesystem::path& path) {
     if (!bytes) return bytes.error();
     const std::string_view text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
     auto scene = parse_scene(text);
-    if (!scene) return Error{scene.error().code, path.string() + ": " + scene.error().message};
+    if (!scene)
+        return Error{scene.error().code, printable(path.string(), kPrintablePath) + ": " + scene.error().message};
     // Fonts sit beside the scene, wherever it is run from; an empty parent is the working directory.
     const std::filesystem::path directory = path.parent_path();
     for (std::string& font : scene->fonts) {

@@ -30,6 +30,12 @@ expect_exit 2 "unknown sample kind" -- "$bench" --sample-kind lines
 expect_exit 2 "--steps not a power of two" -- "$bench" --steps 3
 expect_exit 2 "compositing warm-up below its frames in flight" -- "$bench" --suite compositing --warmup 1
 
+# ---- From another directory: the default fonts come from the source tree it was built from.
+mkdir -p "$work/elsewhere"
+expect_exit 0 "--suite atlas from another directory" -- env -C "$work/elsewhere" "$bench" --quick --suite atlas \
+  --no-plots --out "$work/elsewhere/results" --name elsewhere
+[ -s "$work/elsewhere/results/elsewhere.json" ] || fail "--suite atlas from another directory wrote no JSON"
+
 # ---- --quick, every suite, validation layer on.
 validate=()
 if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.json' 2>/dev/null)" ]; then

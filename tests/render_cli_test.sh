@@ -30,6 +30,15 @@ expect_exit 2 "no canvas" -- "$render" --font "$font" --text Hi --size 20 --orig
 expect_exit 2 "no output" -- "$render" "${base[@]}"
 expect_exit 2 "--size below the float range" -- "$render" "${base[@]}" --size 1e-46 -o x.png
 expect_stderr "out of range" "--size 1e-46"
+# Item 18 of issue 28: numbers past their range say so, and why; not "0", not "not a number".
+expect_exit 2 "--size 1e-45 (a subnormal float)" -- "$render" "${base[@]}" --size 1e-45 -o x.png
+expect_stderr "too small" "--size 1e-45"
+! grep -q " is 0" "$work/err" || fail "--size 1e-45 is reported as 0: $(cat "$work/err")"
+expect_exit 2 "--canvas -1,32" -- "$render" "${base[@]}" --canvas -1,32 -o x.png
+expect_stderr "'-1' is negative" "--canvas -1,32"
+printf '{"r": [1e308, 0, 0.34, 1], "g": [0.33, 0, 0.67, 1], "b": [0.67, 0, 1, 1]}' > "$work/huge.json"
+expect_exit 6 "a layout number of 1e308" -- "$render" "${base[@]}" --layout "$work/huge.json" -o x.png
+expect_stderr "r[0]: expected a number, at most 1e6 in magnitude: 1e+308 is out of range" "a layout number of 1e308"
 # Bounded inputs and safe outputs (docs/limits.md), before any GPU work.
 expect_exit 3 "/dev/zero as the font" -- timeout 20 "$render" "${base[@]/$font//dev/zero}" -o "$work/zero.png"
 expect_stderr "not a regular file" "/dev/zero as the font"
@@ -230,6 +239,9 @@ if strace -o /dev/null true 2>/dev/null; then
 else
   echo "note: strace cannot trace here: the kill between the renames is not checked" >&2
 fi
+
+# --size takes (0, 4096] as documented: below glyph keys' 1/256 px it is drawn at 1/256 px (nothing shows).
+expect_exit 0 "--size 0.001" -- "$render" "${base[@]}" --size 0.001 -o "$work/tiny.png"
 
 # ---- End to end: "Hi" at 20 px on a 48x32 canvas.
 expect_exit 0 "render" -- "$render" "${base[@]}" -o "$work/hi.png" --coverage-out "$work/hi.pfm" --json

@@ -329,7 +329,7 @@ TEST_F(Layout, RefusesBadArguments) {
     };
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const float inf = std::numeric_limits<float>::infinity();
-    for (float size : {0.0f, -1.0f, nan, inf, -inf, 4097.0f, 0.001f}) {
+    for (float size : {0.0f, -1.0f, nan, inf, -inf, 4097.0f, -1e-45f}) {
         refused({.size = size}, {}, fonts, "size");
         refused({.size = 16, .size_y = size == 0.0f ? -1.0f : size}, {}, fonts, "size_y");
     }
@@ -338,6 +338,17 @@ TEST_F(Layout, RefusesBadArguments) {
     EXPECT_NE(nan_size.error().message.find("size"), std::string::npos) << nan_size.error().message;
     EXPECT_TRUE(layout_text(fonts, "abc", {.size = 4096}, {}));
     EXPECT_TRUE(layout_text(fonts, "", {.size = 4096}, {}));
+    // The value as it is (the smallest subnormal float), not rounded to 0 by a fixed six decimals.
+    Result<TextLayout> negative = layout_text(fonts, "abc", {.size = -1e-45f}, {});
+    ASSERT_FALSE(negative);
+    EXPECT_NE(negative.error().message.find("style.size is -1e-45;"), std::string::npos) << negative.error().message;
+    // (0, 4096] as documented: below the 1/256 px of glyph keys a size is laid out at 1/256 px.
+    for (float tiny : {0.001f, 1e-45f}) {
+        Result<TextLayout> small = layout_text(fonts, "abc", {.size = tiny}, {});
+        ASSERT_TRUE(small) << tiny << ": " << small.error().message;
+        ASSERT_EQ(small->glyphs.size(), 3u);
+        for (const GlyphInstance& glyph : small->glyphs) EXPECT_EQ(glyph.key.size_x, 1u) << tiny;
+    }
 
     refused({}, {.origin_x = nan}, fonts, "origin_x");
     refused({}, {.origin_y = inf}, fonts, "origin_y");

@@ -21,6 +21,10 @@
 
 namespace {
 
+// What the report keeps of crisp's own sentences about a font (colour notes, fallbacks): they
+// quote the font only in tags and numbers, so they are escaped but seldom shortened.
+constexpr size_t kSentenceChars = 1000;
+
 // Exit codes, documented in --help and docs/crisp-bake.md.
 enum ExitCode : int {
     kExitOk = 0,
@@ -99,7 +103,8 @@ void declare_options(crisp::cli::CommandLine& cli, Arguments& args, std::vector<
     cli.positional([&args](std::string_view font) -> crisp::Status {
         if (!args.font.empty()) {
             return crisp::Error{crisp::ErrorCode::invalid_argument,
-                                "more than one font given ('" + args.font + "' and '" + std::string(font) + "')"};
+                                "more than one font given ('" + crisp::cli::printable_path(args.font) + "' and '" +
+                                    crisp::cli::printable_path(font) + "')"};
         }
         args.font = font;
         return {};
@@ -160,7 +165,7 @@ std::string axes_text(const crisp::FontInfo& info) {
     for (const crisp::AxisValue& axis : info.axes) {
         char buffer[96];
         std::snprintf(buffer, sizeof buffer, "%s%s=%g [%g..%g]", text.empty() ? "" : ", ",
-                      crisp::tag_to_string(axis.tag).c_str(), static_cast<double>(axis.value),
+                      crisp::cli::printable(crisp::tag_to_string(axis.tag)).c_str(), static_cast<double>(axis.value),
                       static_cast<double>(axis.minimum), static_cast<double>(axis.maximum));
         text += buffer;
     }
@@ -184,7 +189,8 @@ void write_axes(crisp::JsonWriter& json, const crisp::FontInfo& info) {
 int run_check(const Arguments& args) {
     auto asset = crisp::load_asset_file(args.check);
     if (!asset) {
-        std::fprintf(stderr, "crisp-bake: %s: %s\n", args.check.c_str(), asset.error().message.c_str());
+        std::fprintf(stderr, "crisp-bake: %s: %s\n", crisp::cli::printable_path(args.check).c_str(),
+                     asset.error().message.c_str());
         if (args.json) {
             crisp::JsonWriter json;
             json.begin_object()
@@ -232,7 +238,8 @@ int run_check(const Arguments& args) {
             .end_object();
         std::fputs(json.line().c_str(), stdout);
     } else if (!args.quiet) {
-        std::printf("%s: valid crisp asset (version %u)\n", args.check.c_str(), crisp::kAssetVersion);
+        std::printf("%s: valid crisp asset (version %u)\n", crisp::cli::printable_path(args.check).c_str(),
+                    crisp::kAssetVersion);
         std::printf("  font        %s %s, face %u, %u units per em%s\n", crisp::cli::printable(info.family).c_str(),
                     crisp::cli::printable(info.style).c_str(), info.face_index, info.units_per_em,
                     (info.flags & crisp::kFontCubic) ? ", cubic outlines" : "");
@@ -322,7 +329,8 @@ void print_report(const Arguments& args, const crisp::FontInfo& info, const cris
         return;
     }
     if (args.quiet) return;
-    std::printf("%s -> %s\n", args.font.c_str(), args.output.c_str());
+    std::printf("%s -> %s\n", crisp::cli::printable_path(args.font).c_str(),
+                crisp::cli::printable_path(args.output).c_str());
     std::printf("  font          %s %s, face %u, %u units per em\n", crisp::cli::printable(info.family).c_str(),
                 crisp::cli::printable(info.style).c_str(), info.face_index, info.units_per_em);
     if (!info.axes.empty()) std::printf("  axes          %s\n", axes_text(info).c_str());
@@ -350,9 +358,9 @@ void print_report(const Arguments& args, const crisp::FontInfo& info, const cris
     if (has_colour(r)) {
         std::printf("  colour        %u glyphs, %u layers, %u synthetic outlines; %u fell back%s%s\n", r.colour_glyphs,
                     r.colour_layers, r.synthetic_glyphs, r.colour_fallbacks, r.colour_fallbacks ? ", first: " : "",
-                    crisp::cli::printable(r.first_colour_fallback).c_str());
+                    crisp::cli::printable(r.first_colour_fallback, kSentenceChars).c_str());
         for (const std::string& note : r.colour_notes)
-            std::printf("                %s\n", crisp::cli::printable(note).c_str());
+            std::printf("                %s\n", crisp::cli::printable(note, kSentenceChars).c_str());
     }
     std::printf("  asset         %s\n", human_bytes(static_cast<double>(r.asset_bytes)).c_str());
     std::printf("  time          %.2f s, peak memory %s\n", r.seconds, human_bytes(peak_rss_bytes()).c_str());
@@ -393,7 +401,8 @@ int main(int argc, char** argv) {
 
     auto baked = crisp::bake_font_file(args.font, args.bake);
     if (!baked) {
-        std::fprintf(stderr, "crisp-bake: %s: %s\n", args.font.c_str(), baked.error().message.c_str());
+        std::fprintf(stderr, "crisp-bake: %s: %s\n", crisp::cli::printable_path(args.font).c_str(),
+                     baked.error().message.c_str());
         return exit_code_for(baked.error().code);
     }
     crisp::BakeResult& result = *baked;

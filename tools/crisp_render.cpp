@@ -132,13 +132,13 @@ crisp::Result<std::array<float, 4>> parse_color(std::string_view option, std::st
     if (!values) return values.error();
     auto refuse = [&](const std::string& why) { return crisp::Error{crisp::ErrorCode::invalid_argument, why}; };
     if (values->size() != 3 && values->size() != 4) {
-        return refuse(std::string(option) + " takes R,G,B or R,G,B,A, not '" + std::string(text) + "'");
+        return refuse(std::string(option) + " takes R,G,B or R,G,B,A, not '" + crisp::cli::printable(text) + "'");
     }
     std::array<float, 4> color = {0.0f, 0.0f, 0.0f, 1.0f};
     for (size_t i = 0; i < values->size(); ++i) {
         if (!((*values)[i] >= 0.0f && (*values)[i] <= 1.0f)) {
             return refuse(std::string(option) + ": components are in [0, 1] (sRGB, straight alpha); '" +
-                          std::string(text) + "' is not");
+                          crisp::cli::printable(text) + "' is not");
         }
         color[i] = (*values)[i];
     }
@@ -150,10 +150,10 @@ crisp::Result<std::array<float, 4>> parse_transform(std::string_view text) {
     const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>("--transform", text);
     if (!values) return values.error();
     auto refuse = [&](const std::string& why) { return crisp::Error{crisp::ErrorCode::invalid_argument, why}; };
-    if (values->size() != 4) return refuse("--transform takes A,B,C,D, not '" + std::string(text) + "'");
+    if (values->size() != 4) return refuse("--transform takes A,B,C,D, not '" + crisp::cli::printable(text) + "'");
     const std::array<float, 4> m = {(*values)[0], (*values)[1], (*values)[2], (*values)[3]};
     if (!crisp::valid_transform({m[0], m[1], m[2], m[3], 0.0f, 0.0f})) {
-        return refuse("--transform '" + std::string(text) +
+        return refuse("--transform '" + crisp::cli::printable(text) +
                       "': entries must be finite and at most 65536, and |A D - B C| at least 2^-16");
     }
     return m;
@@ -174,7 +174,8 @@ crisp::Result<std::array<float, 2>> parse_origin(std::string_view text) {
     const crisp::Result<std::vector<float>> xy = crisp::cli::parse_number_list<float>("--origin", text);
     if (!xy) return xy.error();
     if (xy->size() != 2)
-        return crisp::Error{crisp::ErrorCode::invalid_argument, "--origin takes X,Y, not '" + std::string(text) + "'"};
+        return crisp::Error{crisp::ErrorCode::invalid_argument,
+                            "--origin takes X,Y, not '" + crisp::cli::printable(text) + "'"};
     return std::array<float, 2>{(*xy)[0], (*xy)[1]};
 }
 
@@ -182,10 +183,10 @@ crisp::Result<std::array<uint32_t, 2>> parse_canvas(std::string_view text) {
     const crisp::Result<std::vector<uint32_t>> wh = crisp::cli::parse_number_list<uint32_t>("--canvas", text);
     if (!wh) return wh.error();
     auto refuse = [&](const std::string& why) { return crisp::Error{crisp::ErrorCode::invalid_argument, why}; };
-    if (wh->size() != 2) return refuse("--canvas takes W,H, not '" + std::string(text) + "'");
+    if (wh->size() != 2) return refuse("--canvas takes W,H, not '" + crisp::cli::printable(text) + "'");
     const uint32_t w = (*wh)[0], h = (*wh)[1];
     if (w < 1 || w > kMaxCanvas || h < 1 || h > kMaxCanvas) {
-        return refuse("--canvas: width and height are each 1..16384, not '" + std::string(text) + "'");
+        return refuse("--canvas: width and height are each 1..16384, not '" + crisp::cli::printable(text) + "'");
     }
     return std::array<uint32_t, 2>{w, h};
 }
@@ -710,7 +711,8 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
     for (const crisp::Font& font : job.fonts) {
         if (crisp::Status status = renderer.add_font(font); !status) {
             std::fprintf(stderr, "crisp-render: cannot add font %u (%s): %s\n", font.id(),
-                         job.scene.fonts[font.id() - 1].c_str(), status.error().message.c_str());
+                         crisp::cli::printable_path(job.scene.fonts[font.id() - 1]).c_str(),
+                         status.error().message.c_str());
             return exit_code_for_vulkan(status.error());
         }
     }
@@ -1027,9 +1029,10 @@ void print_human(const Summary& s) {
     const RenderReport& r = *s.render;
     double frame_total = 0.0;
     for (const double ms : r.frame_ms) frame_total += ms;
-    std::printf("%s (%ux%u)%s%s\n", args.output.c_str(), job.scene.width, job.scene.height,
+    std::printf("%s (%ux%u)%s%s\n", crisp::cli::printable_path(args.output).c_str(), job.scene.width, job.scene.height,
                 args.coverage_output.empty() ? "" : ", coverage in ", args.coverage_output.c_str());
-    if (!args.scene.empty()) std::printf("  scene    %s, %zu runs\n", args.scene.c_str(), job.scene.runs.size());
+    if (!args.scene.empty())
+        std::printf("  scene    %s, %zu runs\n", crisp::cli::printable_path(args.scene).c_str(), job.scene.runs.size());
     std::printf("  device   %s (%s, %s)\n", s.context->device_name().c_str(), s.context->driver_name().c_str(),
                 s.context->driver_info().c_str());
     std::printf("  layout   %s, %u samples per texel and channel\n",
@@ -1156,8 +1159,8 @@ Job load_job(const Arguments& args, crisp::OutputFiles& outputs) {
 
     crisp::Result<crisp::SubpixelLayout> subpixel_layout = crisp::resolve_subpixel_layout(job.scene.layout);
     if (!subpixel_layout) {
-        fail(kExitLayout, (args.scene.empty() ? "--layout " : args.scene + ": layout ") + job.scene.layout + ": " +
-                              subpixel_layout.error().message);
+        fail(kExitLayout, (args.scene.empty() ? "--layout " : crisp::cli::printable_path(args.scene) + ": layout ") +
+                              crisp::cli::printable_path(job.scene.layout) + ": " + subpixel_layout.error().message);
     }
     job.subpixel_layout = std::move(*subpixel_layout);
     job.contrast = !args.contrast_given && job.subpixel_layout.contrast ? *job.subpixel_layout.contrast : args.contrast;
@@ -1166,9 +1169,9 @@ Job load_job(const Arguments& args, crisp::OutputFiles& outputs) {
     for (size_t i = 0; i < job.scene.fonts.size(); ++i) {
         const std::string& path = job.scene.fonts[i];
         crisp::Result<crisp::FontAsset> asset = crisp::load_asset_file(path);
-        if (!asset) fail(kExitFont, path + ": " + asset.error().message);
+        if (!asset) fail(kExitFont, crisp::cli::printable_path(path) + ": " + asset.error().message);
         crisp::Result<crisp::Font> font = crisp::Font::create(std::move(*asset), static_cast<crisp::FontId>(i + 1));
-        if (!font) fail(kExitFont, path + ": " + font.error().message);
+        if (!font) fail(kExitFont, crisp::cli::printable_path(path) + ": " + font.error().message);
         job.fonts.push_back(std::move(*font));
     }
     lay_out(args, job);

@@ -119,20 +119,25 @@ struct BakeResult {
 };
 
 // Bakes a font held in memory. Errors: ErrorCode::font_unreadable (FreeType cannot open the
-// bytes, or face_index is past the collection), font_unsupported (a WOFF, WOFF2 or Type 1 font, as
-// check_font_container says; neither scalable outlines nor colour bitmaps; a variation on a face
-// without axes or an unknown axis tag), invalid_argument (a tolerance outside
-// (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be converted, or a colour
-// glyph's paint graph is malformed: a cycle, a limit passed, a bad offset or palette index; with
-// allow_failed false, the message names the first glyph and why). A COLR or CPAL table that
+// bytes, they are not an sfnt, face_index is past the collection, a table lies past the end of
+// the bytes (a truncated font), or maxp's glyph count is not the CFF table's or loca's: the
+// message names the table), font_unsupported (a WOFF, WOFF2, Type 1 or bare CFF font, as
+// check_font_container says; neither scalable outlines nor colour bitmaps; units per em outside
+// 16..16384; a variation on a face without axes or an unknown axis tag), invalid_argument (a
+// tolerance outside (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be
+// converted, its advance or bearing is past +-64 em, or a colour glyph's paint graph is malformed:
+// a cycle, a limit passed, a bad offset or palette index; with allow_failed false, the message
+// names the first glyph and why). A COLR or CPAL table that
 // cannot be read at all is font_unreadable naming the table, unless allow_failed. Layers of the
 // requested colour glyphs are baked even when `codepoints` does not reach them. Hostile font
 // bytes never crash the baker.
 CRISP_API Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options);
 
 // font_unsupported, with what to do instead, for the font containers crisp does not bake though
-// FreeType could open them: WOFF, WOFF2 (decompress them first) and PostScript Type 1 (PFA, PFB:
-// convert them to OpenType CFF); success for anything else (TrueType, OpenType, collections).
+// FreeType could open them: WOFF, WOFF2 (decompress them first), PostScript Type 1 (PFA, PFB:
+// convert them to OpenType CFF) and a bare CFF table (make it OpenType CFF); font_unreadable,
+// naming its first bytes, for anything else that does not start as an sfnt (0x00010000, 'OTTO',
+// 'true', 'typ1') or a collection ('ttcf'); success for those.
 CRISP_API Status check_font_container(std::span<const std::byte> font_bytes);
 
 // Reads the file, then bake_font. An unreadable file returns ErrorCode::io: a file that is not a

@@ -187,11 +187,11 @@ public:
     // Bad input: invalid UTF-8 becomes U+FFFD, shaped as such; empty text gives an empty layout
     // (no lines, no glyphs) and success. Returns ErrorCode::invalid_argument, with `out` emptied,
     // when: `fonts` is empty, holds a null pointer, more than 65535 fonts, or two different Fonts
-    // with one FontId; a size or size_y is NaN, infinite, <= 0 (size_y: < 0), above kMaxTextSize
-    // or below 1/256 px; an origin, wrap width, color or depth is not finite, or the wrap width is
-    // negative; subpixel_steps is not a power of two in [1, 256]; the text is longer than
-    // kMaxTextBytes; or HarfBuzz runs out of memory. Hostile text never crashes; it is O(n) in
-    // time and memory.
+    // with one FontId; a size or size_y is NaN, infinite, <= 0 (size_y: < 0) or above kMaxTextSize
+    // (a size below the 1/256 px glyph keys resolve is laid out and drawn at 1/256 px per em); an
+    // origin, wrap width, color or depth is not finite, or the wrap width is negative;
+    // subpixel_steps is not a power of two in [1, 256]; the text is longer than kMaxTextBytes; or
+    // HarfBuzz runs out of memory. Hostile text never crashes; it is O(n) in time and memory.
     Status layout(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
                   const LayoutOptions& options, TextLayout& out);
 

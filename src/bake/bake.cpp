@@ -1,8 +1,10 @@
 #include "bake/bands.hpp"
 #include "bake/bitmap.hpp"
 #include "bake/colr.hpp"
+#include "bake/font_file.hpp"
 #include "core/file_io.hpp"
 #include "core/limits.hpp"
+#include "core/utf8.hpp"
 #include "bake/outline.hpp"
 
 #include <crisp/bake.hpp>
@@ -17,7 +19,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
+#include <optional>
+#include <string>
+#include <utility>
 
 namespace crisp {
 
@@ -89,24 +95,26 @@ Status apply_variations(FT_Library library, FT_Face face, const BakeOptions& opt
     for (FT_UInt i = 0; i < mm->num_axis; ++i) {
         const FT_Var_Axis& axis = mm->axis[i];
         coords[i] = axis.def;
-        axis_names += (i ? ", " : "") + tag_to_string(static_cast<uint32_t>(axis.tag));
+        axis_names += (i ? ", " : "") + printable(tag_to_string(static_cast<uint32_t>(axis.tag)));
     }
     Status status;
     for (const Variation& variation : options.variations) {
         FT_UInt i = 0;
         while (i < mm->num_axis && static_cast<uint32_t>(mm->axis[i].tag) != variation.tag) ++i;
         if (i == mm->num_axis) {
-            status = Error{ErrorCode::font_unsupported,
-                           "the face has no axis '" + tag_to_string(variation.tag) + "'; its axes are " + axis_names};
+            status =
+                Error{ErrorCode::font_unsupported, "the face has no axis '" + printable(tag_to_string(variation.tag)) +
+                                                       "'; its axes are " + axis_names};
             break;
         }
         const FT_Var_Axis& axis = mm->axis[i];
         const double minimum = fixed_to_double(axis.minimum), maximum = fixed_to_double(axis.maximum);
         const auto value = static_cast<double>(variation.value);
         if (!std::isfinite(value) || value < minimum || value > maximum) {
-            status = Error{ErrorCode::invalid_argument,
-                           "axis '" + tag_to_string(variation.tag) + "' value " + std::to_string(variation.value) +
-                               " is outside [" + std::to_string(minimum) + ", " + std::to_string(maximum) + "]"};
+            status =
+                Error{ErrorCode::invalid_argument, "axis '" + printable(tag_to_string(variation.tag)) + "' value " +
+                                                       std::to_string(variation.value) + " is outside [" +
+                                                       std::to_string(minimum) + ", " + std::to_string(maximum) + "]"};
             break;
         }
         coords[i] = static_cast<FT_Fixed>(std::lround(value * 65536.0));
@@ -128,6 +136,19 @@ Status apply_variations(FT_Library library, FT_Face face, const BakeOptions& opt
     }
     FT_Done_MM_Var(library, mm);
     return status;
+}
+
+// Why a record's advance or bearings cannot be stored (not finite, or past kMaxEmCoordinate), or nullopt.
+std::optional<std::string> metrics_out_of_range(const GlyphRecord& record) {
+    const std::pair<const char*, float> metrics[] = {
+        {"advance", record.advance}, {"bearing_x", record.bearing_x}, {"bearing_y", record.bearing_y}};
+    for (const auto& [name, value] : metrics) {
+        if (std::isfinite(value) && std::fabs(value) <= kMaxEmCoordinate) continue;
+        char text[96];
+        std::snprintf(text, sizeof text, "%s %.7g em, beyond the asset's +-64 em", name, static_cast<double>(value));
+        return std::string(text);
+    }
+    return std::nullopt;
 }
 
 struct GlyphOutcome {
@@ -234,6 +255,10 @@ GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em,
                                    !std::isfinite(record.advance) || std::fabs(record.advance) > kMaxEmCoordinate)) {
         return {true, "coordinates beyond +-64 em"};
     }
+    // An empty glyph's metrics too (an advance of 65535 units at 16 per em; a CFF glyph whose
+    // zero-length curve, dropped, left FreeType's bearing far out): the asset holds every
+    // record's within the same bound.
+    if (std::optional<std::string> why = metrics_out_of_range(record)) return {true, std::move(*why)};
 
     counters.lines += glyph_counters.lines;
     counters.quadratics += glyph_counters.quadratics;
@@ -264,41 +289,6 @@ GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em,
 }
 
 }  // namespace
-
-namespace {
-
-bool starts_with(std::span<const std::byte> bytes, std::string_view prefix) {
-    if (bytes.size() < prefix.size()) return false;
-    for (size_t i = 0; i < prefix.size(); ++i) {
-        if (bytes[i] != static_cast<std::byte>(prefix[i])) return false;
-    }
-    return true;
-}
-
-}  // namespace
-
-Status check_font_container(std::span<const std::byte> font_bytes) {
-    // FreeType opens these, but HarfBuzz (shaping, from the asset's font bytes) does not, and the
-    // asset must hold bytes it can shape: refused up front, saying what to do instead.
-    if (starts_with(font_bytes, "wOFF")) {
-        return Error{ErrorCode::font_unsupported,
-                     "a WOFF font: crisp bakes TrueType and OpenType; decompress it first (fontTools: "
-                     "python3 -c \"from fontTools.ttLib import TTFont; f = TTFont('in.woff'); f.flavor = None; "
-                     "f.save('out.otf')\")"};
-    }
-    if (starts_with(font_bytes, "wOF2")) {
-        return Error{ErrorCode::font_unsupported,
-                     "a WOFF2 font: crisp bakes TrueType and OpenType; decompress it first (woff2_decompress from "
-                     "the woff2 package, or fontTools with brotli)"};
-    }
-    if ((font_bytes.size() >= 2 && font_bytes[0] == std::byte{0x80} && font_bytes[1] == std::byte{0x01}) ||
-        starts_with(font_bytes, "%!PS-AdobeFont") || starts_with(font_bytes, "%!FontType1")) {
-        return Error{ErrorCode::font_unsupported,
-                     "a PostScript Type 1 font: crisp bakes TrueType and OpenType; convert it to OpenType CFF first "
-                     "(FontForge, for one)"};
-    }
-    return {};
-}
 
 namespace {
 
@@ -362,11 +352,7 @@ Status check_face(FT_Face face) {
         return Error{ErrorCode::font_unsupported,
                      "the face has no scalable outlines and no colour bitmaps (bitmap-only font)"};
     }
-    const uint32_t units_per_em = face_metrics(face).units_per_em;
-    if (units_per_em < 16 || units_per_em > 16384) {
-        return Error{ErrorCode::font_unsupported,
-                     "units per em is " + std::to_string(units_per_em) + ", outside the 16 to 16384 OpenType allows"};
-    }
+    if (Status status = check_units_per_em(face_metrics(face).units_per_em); !status) return status;
     const auto glyph_count = static_cast<uint32_t>(face->num_glyphs);
     if (glyph_count == 0 || glyph_count > 65536) {
         return Error{ErrorCode::font_unsupported, "the face holds " + std::to_string(glyph_count) + " glyphs"};
@@ -484,10 +470,13 @@ void finish_report(const OutlineCounters& counters, BakeReport& report) {
 Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options) {
     const auto started = std::chrono::steady_clock::now();
     if (Status status = check_options(font_bytes, options); !status) return status.error();
+    if (Status status = check_font_tables(font_bytes, options.face_index); !status) return status.error();
     Result<OpenedFace> opened = open_face(font_bytes, options);
     if (!opened) return opened.error();
     const FT_Face face = opened->face.get();
     if (Status status = check_face(face); !status) return status.error();
+    const auto face_glyphs = static_cast<uint32_t>(face->num_glyphs);
+    if (Status status = check_glyph_count(font_bytes, options.face_index, face_glyphs); !status) return status.error();
 
     BakeResult result;
     FontAsset& asset = result.asset;

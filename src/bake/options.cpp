@@ -1,5 +1,7 @@
 // Small text parsers of the baker's options, shared with the tools: code point ranges, axis values,
 // tags.
+#include "core/utf8.hpp"
+
 #include <crisp/bake.hpp>
 
 #include <algorithm>
@@ -46,7 +48,7 @@ Result<std::vector<uint32_t>> parse_codepoint_ranges(std::string_view text) {
                                                              parse_codepoint(item.substr(dash + 1), last, base);
         if (!ok || first > last) {
             return Error{ErrorCode::invalid_argument,
-                         "code point ranges: bad item '" + std::string(item) +
+                         "code point ranges: bad item '" + printable(item) +
                              "' (expected N, N-M, U+XXXX or 0xXXXX, at most U+10FFFF, first <= last)"};
         }
         if (out.size() + (last - first + 1) > 0x110000) {
@@ -82,15 +84,19 @@ Result<Variation> parse_variation(std::string_view text) {
         !std::all_of(tag.begin(), tag.end(), [](char c) { return c >= 0x20 && c <= 0x7E; })) {
         return Error{
             ErrorCode::invalid_argument,
-            "variation '" + std::string(text) + "': expected TAG=VALUE with a tag of 1 to 4 characters, e.g. wght=700"};
+            "variation '" + printable(text) + "': expected TAG=VALUE with a tag of 1 to 4 characters, e.g. wght=700"};
     }
     const std::string value_text(trim(text.substr(equals + 1)));
     float value = 0.0f;
     const auto [end, ec] = std::from_chars(value_text.data(), value_text.data() + value_text.size(), value);
-    if (value_text.empty() || ec != std::errc() || end != value_text.data() + value_text.size() ||
-        !std::isfinite(value)) {
-        return Error{ErrorCode::invalid_argument,
-                     "variation '" + std::string(text) + "': value '" + value_text + "' is not a finite number"};
+    const bool whole = !value_text.empty() && end == value_text.data() + value_text.size();
+    if (whole && ec == std::errc::result_out_of_range) {
+        return Error{ErrorCode::invalid_argument, "variation '" + printable(text) + "': value '" +
+                                                      printable(value_text) + "' is out of range for a 32-bit float"};
+    }
+    if (!whole || ec != std::errc() || !std::isfinite(value)) {
+        return Error{ErrorCode::invalid_argument, "variation '" + printable(text) + "': value '" +
+                                                      printable(value_text) + "' is not a finite number"};
     }
     return Variation{make_tag(tag), value};
 }

@@ -127,14 +127,32 @@ bool decompose_outline(const FT_Outline_& outline, OutlineBuilder& builder, std:
     FT_Outline copy = outline;  // FT_Outline_Decompose takes a non-const pointer but only reads
     const FT_Error status = FT_Outline_Decompose(&copy, &funcs, &builder);
     if (status != 0) {
-        error = "FreeType could not walk the outline (error " + std::to_string(status) + ")";
+        error = "FreeType could not walk the outline: " + freetype_error(status);
         return false;
     }
     return true;
 }
 
+namespace {
+
+// FreeType's words for its error codes, from its own list (the switch fterrors.h documents):
+// FT_Error_String has them only in a FreeType built with FT_CONFIG_OPTION_ERROR_STRINGS, which
+// Debian's is not, and a bare "FreeType error 8" says nothing to a user.
+const char* freetype_error_text(int error_code) {
+#undef FTERRORS_H_
+#define FT_ERROR_START_LIST switch (FT_ERROR_BASE(error_code)) {
+#define FT_ERRORDEF(e, v, s) \
+    case v:                  \
+        return s;
+#define FT_ERROR_END_LIST }
+#include FT_ERRORS_H
+    return nullptr;
+}
+
+}  // namespace
+
 std::string freetype_error(int error) {
-    const char* text = FT_Error_String(error);
+    const char* text = freetype_error_text(error);
     return "FreeType error " + std::to_string(error) + (text ? std::string(" (") + text + ")" : std::string());
 }
 

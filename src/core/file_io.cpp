@@ -1,5 +1,7 @@
 #include "core/file_io.hpp"
 
+#include "core/utf8.hpp"
+
 #include <algorithm>
 #include <cerrno>
 #include <climits>
@@ -25,7 +27,8 @@ std::string errno_text(int error) {
 }
 
 Error io_error(std::string_view what, const std::filesystem::path& path, int error) {
-    return Error{ErrorCode::io, std::string(what) + " " + path.string() + ": " + errno_text(error)};
+    return Error{ErrorCode::io,
+                 std::string(what) + " " + printable(path.string(), kPrintablePath) + ": " + errno_text(error)};
 }
 
 // The random part of a temporary's name. O_EXCL already refuses an existing name (and a planted

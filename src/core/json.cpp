@@ -151,7 +151,8 @@ private:
                 return literal("null");
             default:
                 if (peek() == '-' || (peek() >= '0' && peek() <= '9')) return parse_number(value);
-                error_ = at_end() ? "unexpected end of text" : std::string("unexpected character '") + peek() + "'";
+                error_ = at_end() ? "unexpected end of text"
+                                  : "unexpected character '" + printable(text_.substr(pos_, 1)) + "'";
                 return false;
         }
     }
@@ -366,7 +367,7 @@ private:
             if (!parse_string(key)) return false;
             if (value.find(key)) {
                 pos_ = key_pos;
-                error_ = "duplicate member \"" + key + "\"";
+                error_ = "duplicate member \"" + printable(key) + "\"";
                 return false;
             }
             skip_space();

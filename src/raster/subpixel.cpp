@@ -1,6 +1,7 @@
 #include "core/file_io.hpp"
 #include "core/limits.hpp"
 #include "core/json.hpp"
+#include "core/utf8.hpp"
 
 #include <crisp/glyph.hpp>
 #include <crisp/subpixel.hpp>
@@ -25,6 +26,16 @@ SubpixelLayout make(std::string_view name, SampleRect r, SampleRect g, SampleRec
     layout.name = std::string(name);
     layout.channels = {r, g, b};
     return layout;
+}
+
+// Past this magnitude a layout's number means nothing (its rectangles lie within [-1, 2], its
+// contrast settings within a few units): refused as out of range before it becomes a float.
+constexpr double kMaxNumber = 1e6;
+
+std::string out_of_range(double value) {
+    std::string text = "expected a number, at most 1e6 in magnitude: ";
+    json::append_number(text, value);
+    return text + " is out of range";
 }
 
 Error bad_contrast(const std::string& what) {
@@ -52,11 +63,11 @@ Result<TextContrast> parse_contrast(const json::Value& value) {
                        : key == "stem_darkening" ? &contrast.stem_darkening
                                                  : nullptr;
         if (!field) {
-            return bad_contrast(": unknown member \"" + key + "\" (expected mode, gamma, contrast, stem_darkening)");
+            return bad_contrast(": unknown member \"" + printable(key) +
+                                "\" (expected mode, gamma, contrast, stem_darkening)");
         }
-        if (member.type != json::Value::Type::number || std::fabs(member.number) > 1e6) {
-            return bad_contrast("." + key + ": expected a number");
-        }
+        if (member.type != json::Value::Type::number) return bad_contrast("." + key + ": expected a number");
+        if (std::fabs(member.number) > kMaxNumber) return bad_contrast("." + key + ": " + out_of_range(member.number));
         *field = static_cast<float>(member.number);
     }
     return contrast;
@@ -93,7 +104,7 @@ Result<SubpixelLayout> subpixel_preset(std::string_view name) {
     std::string known;
     for (const std::string_view preset : kPresetNames) known += (known.empty() ? "" : ", ") + std::string(preset);
     return Error{ErrorCode::invalid_argument,
-                 "unknown subpixel layout '" + std::string(name) + "' (presets: " + known + "; or give a layout file)"};
+                 "unknown subpixel layout '" + printable(name) + "' (presets: " + known + "; or give a layout file)"};
 }
 
 Status validate_subpixel_layout(const SubpixelLayout& layout) {
@@ -149,8 +160,8 @@ Result<SubpixelLayout> parse_subpixel_layout(std::string_view text) {
             if (key == kChannelNames[c]) channel = c;
         }
         if (channel == 3) {
-            return Error{ErrorCode::invalid_argument,
-                         "subpixel layout: unknown member \"" + key + "\" (expected name, r, g, b, contrast)"};
+            return Error{ErrorCode::invalid_argument, "subpixel layout: unknown member \"" + printable(key) +
+                                                          "\" (expected name, r, g, b, contrast)"};
         }
         if (value.type != json::Value::Type::array || value.array.size() != 4) {
             return Error{ErrorCode::invalid_argument,
@@ -159,9 +170,12 @@ Result<SubpixelLayout> parse_subpixel_layout(std::string_view text) {
         float coordinates[4];
         for (size_t i = 0; i < 4; ++i) {
             const json::Value& number = value.array[i];
-            if (number.type != json::Value::Type::number || std::fabs(number.number) > 1e6) {
-                return Error{ErrorCode::invalid_argument,
-                             "subpixel layout: " + key + "[" + std::to_string(i) + "]: expected a number"};
+            const std::string where = "subpixel layout: " + key + "[" + std::to_string(i) + "]: ";
+            if (number.type != json::Value::Type::number) {
+                return Error{ErrorCode::invalid_argument, where + "expected a number"};
+            }
+            if (std::fabs(number.number) > kMaxNumber) {
+                return Error{ErrorCode::invalid_argument, where + out_of_range(number.number)};
             }
             coordinates[i] = static_cast<float>(number.number);
         }
@@ -182,7 +196,8 @@ Result<SubpixelLayout> load_subpixel_layout_file(const std::filesystem::path& pa
     if (!bytes) return bytes.error();
     const std::string_view text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
     auto layout = parse_subpixel_layout(text);
-    if (!layout) return Error{layout.error().code, path.string() + ": " + layout.error().message};
+    if (!layout)
+        return Error{layout.error().code, printable(path.string(), kPrintablePath) + ": " + layout.error().message};
     return layout;
 }
 

@@ -5,6 +5,7 @@
 #include <hb.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -21,29 +22,31 @@ Error invalid(std::string message) {
     return Error{ErrorCode::invalid_argument, std::move(message)};
 }
 
-std::string show(double value) {
+// The shortest text that reads back as `value` (1.4e-45, not the 0 of a fixed six decimals).
+std::string show(float value) {
     if (std::isnan(value)) return "NaN";
     if (std::isinf(value)) return value > 0 ? "infinity" : "-infinity";
-    std::string text = std::to_string(value);
-    while (text.size() > 1 && text.back() == '0') text.pop_back();
-    if (!text.empty() && text.back() == '.') text.pop_back();
-    return text;
+    char text[32];
+    const auto written = std::to_chars(text, text + sizeof text, value);
+    return std::string(text, written.ptr);
 }
 
 Status check_size(const char* name, float size) {
     if (!std::isfinite(size) || !(size > 0.0f) || size > kMaxTextSize)
-        return invalid(std::string("layout: ") + name + " is " + show(static_cast<double>(size)) +
+        return invalid(std::string("layout: ") + name + " is " + show(size) +
                        "; it must be a finite number of pixels per em in (0, 4096]");
-    if (std::lround(static_cast<double>(size) * kSizeOne) == 0)
-        return invalid(std::string("layout: ") + name + " is " + show(static_cast<double>(size)) +
-                       " pixels per em, below the 1/256 px that glyph keys resolve");
     return {};
+}
+
+// A size in glyph keys' 1/256 px, at least one: a size below it is laid out and drawn as 1/256 px
+// per em (far below a pixel either way), as transformed keys are.
+uint32_t key_size(double size) {
+    return std::max(1u, static_cast<uint32_t>(std::lround(size * kSizeOne)));
 }
 
 Status check_finite(const char* name, float value) {
     if (!std::isfinite(value))
-        return invalid(std::string("layout: ") + name + " is " + show(static_cast<double>(value)) +
-                       "; it must be finite");
+        return invalid(std::string("layout: ") + name + " is " + show(value) + "; it must be finite");
     return {};
 }
 
@@ -75,7 +78,7 @@ Status validate(std::span<const Font* const> fonts, std::string_view utf8, const
         if (Status status = check_finite(name, value); !status) return status;
     }
     if (options.wrap_width < 0.0f)
-        return invalid("layout: options.wrap_width is " + show(static_cast<double>(options.wrap_width)) +
+        return invalid("layout: options.wrap_width is " + show(options.wrap_width) +
                        "; it must be 0 (no wrapping) or positive");
     const uint32_t steps = options.subpixel_steps;
     if (steps == 0 || steps > kSubpixelSteps || (steps & (steps - 1)) != 0)
@@ -261,8 +264,7 @@ void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
     float color[4];
     for (int c = 0; c < 3; ++c) color[c] = srgb_to_linear(std::clamp(style.color[c], 0.0f, 1.0f));
     color[3] = std::clamp(style.color[3], 0.0f, 1.0f);
-    const auto size_x_fixed = static_cast<uint32_t>(std::lround(size_x * kSizeOne));
-    const auto size_y_fixed = static_cast<uint32_t>(std::lround(size_y * kSizeOne));
+    const uint32_t size_x_fixed = key_size(size_x), size_y_fixed = key_size(size_y);
 
     out.glyphs.reserve(placed.size());
     out.shaped_glyphs = static_cast<uint32_t>(std::min<size_t>(placed.size(), UINT32_MAX));
@@ -367,9 +369,9 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
     options = &layout_options;
     failed = false;
     mark_splits = 0;
-    size_x = static_cast<double>(std::lround(static_cast<double>(style.size) * kSizeOne)) / kSizeOne;
+    size_x = static_cast<double>(key_size(static_cast<double>(style.size))) / kSizeOne;
     const float size_y_asked = style.size_y == 0.0f ? style.size : style.size_y;
-    size_y = static_cast<double>(std::lround(static_cast<double>(size_y_asked) * kSizeOne)) / kSizeOne;
+    size_y = static_cast<double>(key_size(static_cast<double>(size_y_asked))) / kSizeOne;
     language = layout_options.language != nullptr && layout_options.language[0] != '\0'
                    ? hb_language_from_string(layout_options.language, -1)
                    : nullptr;

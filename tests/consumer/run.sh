@@ -19,6 +19,9 @@ done
 test -f "$prefix/lib/cmake/crisp/crispConfig.cmake"
 test -f "$prefix/lib/cmake/crisp/crispConfigVersion.cmake"
 test -x "$prefix/bin/crisp-bake"
+for tool in crisp-render crisp-bench crisp-layout-editor; do  # every tool this build made is installed
+  [ ! -x "$build/tools/$tool" ] || [ -x "$prefix/bin/$tool" ] || fail "$tool is built but not installed"
+done
 test ! -e "$prefix/include/crisp/../bands.hpp"   # nothing private is installed
 test ! -e "$prefix/lib/libcrisp_support.a"       # nor the tools' support library
 

@@ -116,7 +116,7 @@ QuantizationError quantization_error(freetype::Face& face, const Font& font, con
 
 void run_atlas(Session& session) {
     const Options& o = session.options;
-    const std::string font_path = o.fonts.empty() ? "fonts/DejaVuSans.ttf" : o.fonts.front();
+    const std::string font_path = o.fonts.empty() ? data_file("fonts/DejaVuSans.ttf") : o.fonts.front();
     const float size = o.size.value_or(16.0f);
     const size_t error_glyphs = o.quick ? 12 : 200;
     std::vector<uint32_t> steps = o.steps;

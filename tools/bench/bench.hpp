@@ -20,6 +20,12 @@
 
 namespace crisp::bench {
 
+// `relative`, a file of the source tree ("fonts/DejaVuSans.ttf"), where this run finds it: from
+// the working directory where it is there, else in the source tree crisp-bench was built from
+// (CRISP_SOURCE_DIR), so that it runs from anywhere; as given where neither holds it (the error
+// that follows names it).
+std::string data_file(const std::string& relative);
+
 // The command line. Options several suites read are optional: each suite has its own default,
 // which it uses where the option was not given (the --help text lists them).
 struct Options {
@@ -72,8 +78,8 @@ struct Options {
     std::vector<std::string> variants = {"static", "changed", "moving"};
 
     // cpu
-    std::string dejavu = "fonts/DejaVuSans.ttf";
-    std::string inter = "fonts/Inter-Regular.otf";
+    std::string dejavu = data_file("fonts/DejaVuSans.ttf");
+    std::string inter = data_file("fonts/Inter-Regular.otf");
     std::string cjk = "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc";
     std::optional<int> runs;
     std::string only;

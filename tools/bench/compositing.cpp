@@ -69,7 +69,7 @@ constexpr uint32_t kTargetBytesPerPixel = 16;  // RGBA32F
 constexpr uint32_t kMaxConvergeFrames = 4096;
 
 struct Args {
-    std::string font = "fonts/DejaVuSans.ttf";
+    std::string font = crisp::bench::data_file("fonts/DejaVuSans.ttf");
     std::string layout = "rgb";
     float size = 18.0f;
     uint32_t width = 512, height = 256;

@@ -52,19 +52,29 @@ const char* const kDejaVuSerifItalic = "/usr/share/fonts/truetype/dejavu/DejaVuS
 std::vector<GlyphSpec> glyph_set(const Options& options) {
     std::vector<GlyphSpec> set;
     if (options.quick) {
-        set = {{"fonts/DejaVuSans.ttf", 0, {}, "g", 13.0f, "TrueType"},
-               {"fonts/Inter-Regular.otf", 0, {}, "S", 9.0f, "CFF"},
-               {"fonts/Inter-roman.var.ttf", 0, {{tag("wght"), 100.0f}}, "k", 12.0f, "variable, wght 100 (hairline)"}};
+        set = {{data_file("fonts/DejaVuSans.ttf"), 0, {}, "g", 13.0f, "TrueType"},
+               {data_file("fonts/Inter-Regular.otf"), 0, {}, "S", 9.0f, "CFF"},
+               {data_file("fonts/Inter-roman.var.ttf"),
+                0,
+                {{tag("wght"), 100.0f}},
+                "k",
+                12.0f,
+                "variable, wght 100 (hairline)"}};
     } else {
         set = {
-            {"fonts/DejaVuSans.ttf", 0, {}, "g@", 13.0f, "TrueType"},
-            {"fonts/DejaVuSans.ttf", 0, {}, "e&", 4.0f, "TrueType, 4 px"},
-            {"fonts/DejaVuSans.ttf", 0, {}, "a", 48.0f, "TrueType"},
-            {"fonts/DejaVuSans.ttf", 0, {}, "e", 240.0f, "TrueType, 240 px"},
-            {"fonts/Inter-Regular.otf", 0, {}, "Sa", 9.0f, "CFF"},
-            {"fonts/Inter-Regular.otf", 0, {}, "R", 16.0f, "CFF"},
-            {"fonts/Inter-roman.var.ttf", 0, {{tag("wght"), 100.0f}}, "kM", 16.0f, "variable, wght 100 (hairline)"},
-            {"fonts/Inter-roman.var.ttf", 0, {}, "Ak$", 20.0f, "variable, overlapping contours"},
+            {data_file("fonts/DejaVuSans.ttf"), 0, {}, "g@", 13.0f, "TrueType"},
+            {data_file("fonts/DejaVuSans.ttf"), 0, {}, "e&", 4.0f, "TrueType, 4 px"},
+            {data_file("fonts/DejaVuSans.ttf"), 0, {}, "a", 48.0f, "TrueType"},
+            {data_file("fonts/DejaVuSans.ttf"), 0, {}, "e", 240.0f, "TrueType, 240 px"},
+            {data_file("fonts/Inter-Regular.otf"), 0, {}, "Sa", 9.0f, "CFF"},
+            {data_file("fonts/Inter-Regular.otf"), 0, {}, "R", 16.0f, "CFF"},
+            {data_file("fonts/Inter-roman.var.ttf"),
+             0,
+             {{tag("wght"), 100.0f}},
+             "kM",
+             16.0f,
+             "variable, wght 100 (hairline)"},
+            {data_file("fonts/Inter-roman.var.ttf"), 0, {}, "Ak$", 20.0f, "variable, overlapping contours"},
             {kDejaVuSerifItalic, 0, {}, "fy", 18.0f, "italic"},
             {kNotoCjk, 0, {}, "\u6c38", 13.0f, "CJK, CFF"},
             {kNotoCjk, 0, {}, "\u9f98", 24.0f, "CJK, hundreds of curves"},

@@ -35,8 +35,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Args {
-    std::string dejavu = "fonts/DejaVuSans.ttf";
-    std::string inter = "fonts/Inter-Regular.otf";
+    std::string dejavu = crisp::bench::data_file("fonts/DejaVuSans.ttf");
+    std::string inter = crisp::bench::data_file("fonts/Inter-Regular.otf");
     std::string cjk = "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc";
     int runs = 21;
     int warmup = 3;

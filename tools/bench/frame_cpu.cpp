@@ -58,7 +58,7 @@ constexpr VkFormat kTargetFormat = VK_FORMAT_R8G8B8A8_UNORM;
 // ---- Options
 
 struct Args {
-    std::string font = "fonts/DejaVuSans.ttf";
+    std::string font = crisp::bench::data_file("fonts/DejaVuSans.ttf");
     uint32_t width = 1920, height = 1080;
     float size = 16.0f;
     uint32_t warmup = 100;

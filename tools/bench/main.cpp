@@ -24,6 +24,13 @@ void fail(std::string_view suite, const std::string& message) {
     std::exit(1);
 }
 
+std::string data_file(const std::string& relative) {
+    std::error_code ec;
+    if (std::filesystem::exists(relative, ec)) return relative;
+    const std::filesystem::path built = std::filesystem::path(CRISP_SOURCE_DIR) / relative;
+    return std::filesystem::exists(built, ec) ? built.string() : relative;
+}
+
 void progress(std::string_view suite, const std::string& message) {
     std::fprintf(stderr, "[%.*s] %s\n", static_cast<int>(suite.size()), suite.data(), message.c_str());
 }

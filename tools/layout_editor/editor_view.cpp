@@ -523,8 +523,9 @@ void EditorView::draw_side_text(std::vector<TextItem>& text) const {
                     kMargin, 490.0f, 13.0f, kPanelText});
     float y = 514.0f;
     for (const Message& message : messages_) {
+        // A message is crisp's sentence, wrapped below: escaped, but kept whole.
         text.push_back(
-            {cli::printable(message.text), kMargin, y, 11.0f, message.error ? kErrorText : kDimText, 330.0f});
+            {cli::printable(message.text, 1000), kMargin, y, 11.0f, message.error ? kErrorText : kDimText, 330.0f});
         y += 28.0f;
     }
     const char* help[] = {
