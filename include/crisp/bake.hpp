@@ -45,6 +45,23 @@ inline constexpr float kBandOverlap = 1.0f / 256.0f;
 inline constexpr uint32_t kMaxPaintDepth = 64;
 inline constexpr uint32_t kMaxPaintNodes = 16384;
 
+// Limits on a TrueType glyph as FreeType would expand it, read from glyf before it is loaded
+// (docs/limits.md): a glyph past one fails, naming it. Composites nest a base and its accents a
+// level or two deep; a glyph of more points than twice kMaxCurvesPerGlyph has more curves than
+// it (a curve takes at least two points), short of zero-length ones.
+inline constexpr uint32_t kMaxCompositeDepth = 8;     // levels of composites above a simple glyph
+inline constexpr uint32_t kMaxCompositeParts = 1024;  // component references in one glyph's tree
+inline constexpr uint32_t kMaxGlyphPoints = 2 * kMaxCurvesPerGlyph;
+// Points of all the glyphs one bake loads: twice what kMaxAssetPointBytes holds.
+inline constexpr uint64_t kMaxBakePoints = uint64_t{1} << 25;
+
+// The asset's curve points, and its band words with the renderer's flat rows (one per glyph at
+// most), each fit one storage buffer of the range every Vulkan device has (maxStorageBufferRange
+// is at least 2^27): the bake stops with font_unsupported at the glyph that would pass either, or
+// the 1 GiB an asset file may be (docs/limits.md).
+inline constexpr uint64_t kMaxAssetPointBytes = uint64_t{1} << 27;
+inline constexpr uint64_t kMaxAssetBandBytes = uint64_t{1} << 27;
+
 struct Variation {
     uint32_t tag = 0;  // OpenType axis tag
     float value = 0.0f;
@@ -121,7 +138,8 @@ struct BakeResult {
 // Bakes a font held in memory. Errors: ErrorCode::font_unreadable (FreeType cannot open the
 // bytes, or face_index is past the collection), font_unsupported (a WOFF, WOFF2 or Type 1 font, as
 // check_font_container says; neither scalable outlines nor colour bitmaps; a variation on a face
-// without axes or an unknown axis tag), invalid_argument (a tolerance outside
+// without axes or an unknown axis tag; an asset that would pass kMaxAssetPointBytes, kMaxAssetBandBytes
+// or 1 GiB, at the glyph that would pass it), invalid_argument (a tolerance outside
 // (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be converted, or a colour
 // glyph's paint graph is malformed: a cycle, a limit passed, a bad offset or palette index; with
 // allow_failed false, the message names the first glyph and why). A COLR or CPAL table that
