@@ -1,9 +1,10 @@
 // Small inputs that used to take minutes or gigabytes (docs/limits.md): TrueType composites that
-// expand a thousandfold a level, and fonts whose glyphs fill an asset past what a renderer holds.
-// The fonts are made at build time by make_hostile_fonts.py.
+// expand a thousandfold a level, fonts whose glyphs fill an asset past what a renderer holds, and
+// text of deeply nested bidi controls. The fonts are made at build time by make_hostile_fonts.py.
 #include "test_support.hpp"
 
 #include <crisp/bake.hpp>
+#include <crisp/layout.hpp>
 
 #include <gtest/gtest.h>
 
@@ -86,6 +87,51 @@ TEST(InputBounds, AnAssetPastWhatARendererHoldsIsRefusedEarly) {
     auto baked = bake_font_file(CRISP_HOSTILE_CURVES_FONT, options);
     ASSERT_TRUE(baked) << baked.error().message;
     EXPECT_EQ(baked->report.max_curves_per_glyph, kMaxCurvesPerGlyph);
+}
+
+// 300,000 RLI then 300,000 PDI took 99 s to lay out: HarfBuzz removes a row of default-ignorable
+// characters at a run's start in time quadratic in it. Past kMaxIgnorablesPerRun a new run starts.
+TEST(InputBounds, RowsOfIgnorablesAreLaidOutInLinearTime) {
+    auto font = test::bake_test_font("a\u05d0");
+    ASSERT_TRUE(font);
+    const Font* fonts[] = {font.get()};
+    const uint32_t count = 300000;
+    // RLI and PDI, RLE and PDF, zero-width spaces: what is left is the two letters and the alef.
+    const std::pair<const char*, const char*> rows[] = {
+        {"\u2067", "\u2069"}, {"\u202b", "\u202c"}, {"\u200b", "\u200b"}};
+    for (const auto& [open, close] : rows) {
+        std::string text = "a";
+        for (uint32_t i = 0; i < count; ++i) text += open;
+        text += "\u05d0";
+        for (uint32_t i = 0; i < count; ++i) text += close;
+        text += "a";
+        const auto start = std::chrono::steady_clock::now();
+        auto laid = layout_text(fonts, text, TextStyle{}, LayoutOptions{});
+        const double seconds = seconds_since(start);
+        ASSERT_TRUE(laid) << laid.error().message;
+        EXPECT_EQ(laid->shaped_glyphs, 3u);
+        EXPECT_GE(laid->ignorable_splits, count / kMaxIgnorablesPerRun);  // of 2 x count, some cut by levels
+        ASSERT_EQ(laid->glyphs.size(), 3u);
+        // Left to right: a, alef, a.
+        EXPECT_LT(laid->glyphs[0].pen_x, laid->glyphs[1].pen_x);
+        EXPECT_LT(laid->glyphs[1].pen_x, laid->glyphs[2].pen_x);
+        EXPECT_EQ(laid->glyphs[0].key.glyph, laid->glyphs[2].key.glyph);
+        EXPECT_NE(laid->glyphs[0].key.glyph, laid->glyphs[1].key.glyph);
+        std::printf("2 x 300,000 of U+%04X, U+%04X laid out in %.3f s\n", decode_utf8(open)[0], decode_utf8(close)[0],
+                    seconds);  // not asserted: a test holds no timing
+    }
+    // One row in one run: cut every kMaxIgnorablesPerRun.
+    std::string text = "a";
+    for (uint32_t i = 0; i < count; ++i) text += "\u200b";
+    text += "a";
+    auto laid = layout_text(fonts, text, TextStyle{}, LayoutOptions{});
+    ASSERT_TRUE(laid) << laid.error().message;
+    EXPECT_EQ(laid->ignorable_splits, (count + kMaxIgnorablesPerRun - 1) / kMaxIgnorablesPerRun - 1);
+    EXPECT_EQ(laid->glyphs.size(), 2u);
+    // A row within the limit is not cut.
+    auto short_row = layout_text(fonts, "a\u200b\u200b\u2067\u2069a", TextStyle{}, LayoutOptions{});
+    ASSERT_TRUE(short_row);
+    EXPECT_EQ(short_row->ignorable_splits, 0u);
 }
 
 }  // namespace
