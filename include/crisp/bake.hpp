@@ -45,6 +45,23 @@ inline constexpr float kBandOverlap = 1.0f / 256.0f;
 inline constexpr uint32_t kMaxPaintDepth = 64;
 inline constexpr uint32_t kMaxPaintNodes = 16384;
 
+// Limits on a TrueType glyph as FreeType would expand it, read from glyf before it is loaded
+// (docs/limits.md): a glyph past one fails, naming it. Composites nest a base and its accents a
+// level or two deep; a glyph of more points than twice kMaxCurvesPerGlyph has more curves than
+// it (a curve takes at least two points), short of zero-length ones.
+inline constexpr uint32_t kMaxCompositeDepth = 8;     // levels of composites above a simple glyph
+inline constexpr uint32_t kMaxCompositeParts = 1024;  // component references in one glyph's tree
+inline constexpr uint32_t kMaxGlyphPoints = 2 * kMaxCurvesPerGlyph;
+// Points of all the glyphs one bake loads: twice what kMaxAssetPointBytes holds.
+inline constexpr uint64_t kMaxBakePoints = uint64_t{1} << 25;
+
+// The asset's curve points, and its band words with the renderer's flat rows (one per glyph at
+// most), each fit one storage buffer of the range every Vulkan device has (maxStorageBufferRange
+// is at least 2^27): the bake stops with font_unsupported at the glyph that would pass either, or
+// the 1 GiB an asset file may be (docs/limits.md).
+inline constexpr uint64_t kMaxAssetPointBytes = uint64_t{1} << 27;
+inline constexpr uint64_t kMaxAssetBandBytes = uint64_t{1} << 27;
+
 struct Variation {
     uint32_t tag = 0;  // OpenType axis tag
     float value = 0.0f;
@@ -123,11 +140,12 @@ struct BakeResult {
 // the bytes (a truncated font), or maxp's glyph count is not the CFF table's or loca's: the
 // message names the table), font_unsupported (a WOFF, WOFF2, Type 1 or bare CFF font, as
 // check_font_container says; neither scalable outlines nor colour bitmaps; units per em outside
-// 16..16384; a variation on a face without axes or an unknown axis tag), invalid_argument (a
-// tolerance outside (0, 0.1] or a non-finite axis value), glyph_failed (a glyph could not be
-// converted, its advance or bearing is past +-64 em, or a colour glyph's paint graph is malformed:
-// a cycle, a limit passed, a bad offset or palette index; with allow_failed false, the message
-// names the first glyph and why). A COLR or CPAL table that
+// 16..16384; a variation on a face without axes or an unknown axis tag; an asset that would pass
+// kMaxAssetPointBytes, kMaxAssetBandBytes or 1 GiB, at the glyph that would pass it),
+// invalid_argument (a tolerance outside (0, 0.1] or a non-finite axis value), glyph_failed (a
+// glyph could not be converted, its advance or bearing is past +-64 em, or a colour glyph's paint
+// graph is malformed: a cycle, a limit passed, a bad offset or palette index; with allow_failed
+// false, the message names the first glyph and why). A COLR or CPAL table that
 // cannot be read at all is font_unreadable naming the table, unless allow_failed. Layers of the
 // requested colour glyphs are baked even when `codepoints` does not reach them. Hostile font
 // bytes never crash the baker.

@@ -57,6 +57,12 @@ inline constexpr size_t kMaxTextBytes = size_t{16} << 20;
 // marks took 21 s. Real text stacks a handful (Vietnamese, Tibetan, Indic up to about 10; the
 // longest emoji sequences, families with skin tones, 10); "Zalgo" text dozens.
 inline constexpr uint32_t kMaxMarksPerCluster = 64;
+// Default-ignorable characters in a row (bidi controls, zero-width spaces, soft hyphens, ...) in one
+// shaping run: past this many a new run starts. HarfBuzz removes them in time quadratic in a row of
+// them at a run's start: 300,000 RLI and as many PDI took 99 s. The run's neighbours are passed to
+// HarfBuzz as context, and what is cut is invisible, so the text looks the same
+// (TextLayout::ignorable_splits counts the cuts).
+inline constexpr uint32_t kMaxIgnorablesPerRun = 64;
 // Layer instances one layout expands colour glyphs into: past this many, further colour glyphs
 // are drawn as their plain outline (as with LayoutOptions::colour_glyphs off), so that a long text
 // in a font of many-layered glyphs (up to kMaxColourLayers each) stays within memory.
@@ -164,6 +170,7 @@ struct TextLayout {
     uint32_t blank_glyphs = 0;         // glyphs without an outline (dropped unless keep_blank_glyphs)
     uint32_t out_of_range_glyphs = 0;  // not emitted: pen beyond kMaxCoordinate
     uint32_t mark_splits = 0;          // clusters cut after kMaxMarksPerCluster combining marks
+    uint32_t ignorable_splits = 0;     // runs cut after kMaxIgnorablesPerRun default ignorables in a row
     uint32_t colour_glyphs = 0;        // shaped glyphs drawn in colour (as layers)
     uint32_t colour_layers = 0;        // the instances they became
     uint32_t next_paint_order = 0;     // first_paint_order + glyphs.size()

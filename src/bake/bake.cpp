@@ -1,6 +1,8 @@
 #include "bake/bands.hpp"
 #include "bake/bitmap.hpp"
 #include "bake/colr.hpp"
+#include "asset/asset_format.hpp"
+#include "bake/composite.hpp"
 #include "bake/font_file.hpp"
 #include "core/file_io.hpp"
 #include "core/limits.hpp"
@@ -154,7 +156,41 @@ std::optional<std::string> metrics_out_of_range(const GlyphRecord& record) {
 struct GlyphOutcome {
     bool failed = false;
     std::string reason;
+    bool asset_full = false;  // the glyph would take the asset past a limit: the bake stops (reason says which)
 };
+
+// What one bake has spent of its limits (docs/limits.md), checked before each glyph is loaded
+// and before it is added, so that a small font cannot grow the asset past what a renderer holds.
+struct BakeBudget {
+    CompositeBounds composites;
+    uint64_t fixed_bytes = 0;     // the asset's font bytes and glyph records
+    uint64_t flat_row_words = 0;  // the renderer's flat rows (FontStore::add): a glyph's band_words at most
+};
+
+// Why adding the glyph would pass a limit of the asset, or nullopt.
+std::optional<std::string> asset_room(const FontAsset& asset, const PackedGlyph& packed, const GlyphBands& bands,
+                                      BakeBudget& budget) {
+    const uint64_t point_bytes = (asset.points.size() + packed.points.size()) * asset_format::kPointSize;
+    const uint64_t band_bytes =
+        (asset.band_words.size() + bands.words.size() + budget.flat_row_words + bands.band_words) *
+        asset_format::kBandWordSize;
+    const uint64_t file_bytes = budget.fixed_bytes + point_bytes + band_bytes + asset.image_bytes.size();
+    const auto past = [](const char* what, uint64_t bytes, uint64_t limit) {
+        return std::string("the asset's ") + what + " would reach " + std::to_string(bytes) +
+               " bytes, more than the limit of " + std::to_string(limit);
+    };
+    if (point_bytes > kMaxAssetPointBytes) return past("curve points", point_bytes, kMaxAssetPointBytes);
+    if (band_bytes > kMaxAssetBandBytes) return past("band words", band_bytes, kMaxAssetBandBytes);
+    if (file_bytes > limits::kAssetFileBytes) return past("file", file_bytes, limits::kAssetFileBytes);
+    budget.flat_row_words += bands.band_words;
+    return std::nullopt;
+}
+
+// The bake's error for a glyph that asset_room() refused.
+Error asset_full(uint32_t glyph, const std::string& reason) {
+    return Error{ErrorCode::font_unsupported, "glyph " + std::to_string(glyph) + ": " + reason +
+                                                  " (docs/limits.md); bake fewer glyphs (--text, --codepoints)"};
+}
 
 // The largest factor by which the linear part of `t` stretches a length (its largest singular value).
 double stretch(const Affine& t) {
@@ -198,9 +234,10 @@ std::vector<Contour> transform_contours(const std::vector<Contour>& contours, co
 // Converts one glyph into record `record_index` of the asset: its own record, or with `transform`
 // a synthetic record of its outline under that map (em to em).
 GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em, const BakeOptions& options,
-                        OutlineCounters& counters, FontAsset& asset, BakeReport& report, uint32_t record_index,
-                        const Affine* transform = nullptr) {
+                        BakeBudget& budget, OutlineCounters& counters, FontAsset& asset, BakeReport& report,
+                        uint32_t record_index, const Affine* transform = nullptr) {
     GlyphRecord& record = asset.glyphs[record_index];
+    if (std::optional<std::string> reason = budget.composites.check(glyph_index)) return {true, std::move(*reason)};
     const FT_Error error = FT_Load_Glyph(face, glyph_index, FT_LOAD_NO_HINTING | FT_LOAD_NO_BITMAP);
     if (error != 0) return {true, freetype_error(error)};
     const FT_GlyphSlot slot = face->glyph;
@@ -276,6 +313,8 @@ GlyphOutcome bake_glyph(FT_Face face, uint32_t glyph_index, double units_per_em,
         return {};
     }
     const GlyphBands bands = build_bands(packed, kTargetCurvesPerBand, kMaxBands, kBandOverlap);
+    if (std::optional<std::string> full = asset_room(asset, packed, bands, budget))
+        return {true, std::move(*full), true};
     append_glyph(packed, bands, record, asset);
 
     report.curve_count += packed.real_curves;
@@ -386,9 +425,10 @@ Status read_font_info(FT_Library library, FT_Face face, const BakeOptions& optio
 
 // Bakes every wanted glyph (every glyph when `wanted` is empty) into the asset (its colour bitmap,
 // its outline), a failed one as an empty record flagged failed, and reports progress; returns how
-// many glyphs were requested.
-uint32_t bake_glyphs(FT_Face face, const BakeOptions& options, const std::vector<uint8_t>& wanted,
-                     BitmapGlyphs& bitmaps, OutlineCounters& counters, FontAsset& asset, BakeReport& report) {
+// many glyphs were requested. A glyph that would take the asset past a limit stops the bake.
+Result<uint32_t> bake_glyphs(FT_Face face, const BakeOptions& options, const std::vector<uint8_t>& wanted,
+                             BitmapGlyphs& bitmaps, BakeBudget& budget, OutlineCounters& counters, FontAsset& asset,
+                             BakeReport& report) {
     const auto glyph_count = static_cast<uint32_t>(face->num_glyphs);
     const uint32_t units_per_em = asset.info.units_per_em;
     const bool all = wanted.empty();
@@ -403,7 +443,8 @@ uint32_t bake_glyphs(FT_Face face, const BakeOptions& options, const std::vector
         if (std::optional<std::string> reason = bitmaps.bake(glyph, asset, report))
             outcome = {true, std::move(*reason)};
         else if (!bitmaps.bitmap_only())
-            outcome = bake_glyph(face, glyph, units_per_em, options, counters, asset, report, glyph);
+            outcome = bake_glyph(face, glyph, units_per_em, options, budget, counters, asset, report, glyph);
+        if (outcome.asset_full) return asset_full(glyph, outcome.reason);
         if (outcome.failed) {
             asset.glyphs[glyph] = GlyphRecord{};
             asset.glyphs[glyph].flags = kGlyphBaked | kGlyphFailed;
@@ -423,16 +464,19 @@ uint32_t bake_glyphs(FT_Face face, const BakeOptions& options, const std::vector
 // Appends the outlines of transformed colour layers after the face's glyphs, each its face
 // glyph's outline under the layer's transform, converted and banded as any glyph is. Returns why
 // each failed (empty where it did not): an asset holds no failed synthetic glyph, so the colour
-// glyphs on a failed one are dropped (ColourAssembler::drop_failed_outlines).
-std::vector<std::string> bake_synthetic_glyphs(FT_Face face, const BakeOptions& options,
-                                               const std::vector<SyntheticOutline>& outlines, OutlineCounters& counters,
-                                               FontAsset& asset, BakeReport& report) {
+// glyphs on a failed one are dropped (ColourAssembler::drop_failed_outlines). One that would take
+// the asset past a limit stops the bake.
+Result<std::vector<std::string>> bake_synthetic_glyphs(FT_Face face, const BakeOptions& options,
+                                                       const std::vector<SyntheticOutline>& outlines,
+                                                       BakeBudget& budget, OutlineCounters& counters, FontAsset& asset,
+                                                       BakeReport& report) {
     std::vector<std::string> failures;
     for (const SyntheticOutline& outline : outlines) {
         const auto record = static_cast<uint32_t>(asset.glyphs.size());
         asset.glyphs.emplace_back();
-        const GlyphOutcome outcome = bake_glyph(face, outline.glyph, asset.info.units_per_em, options, counters, asset,
-                                                report, record, &outline.transform);
+        const GlyphOutcome outcome = bake_glyph(face, outline.glyph, asset.info.units_per_em, options, budget, counters,
+                                                asset, report, record, &outline.transform);
+        if (outcome.asset_full) return asset_full(outline.glyph, outcome.reason);
         if (outcome.failed) {
             asset.glyphs[record] = GlyphRecord{};
             asset.glyphs[record].flags = kGlyphSynthetic;
@@ -494,10 +538,14 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     Result<BitmapGlyphs> bitmaps = BitmapGlyphs::open(face, info.units_per_em);
     if (!bitmaps) return bitmaps.error();
     OutlineCounters counters;
-    const uint32_t to_do = bake_glyphs(face, options, wanted, *bitmaps, counters, asset, report);
-    const std::vector<std::string> failures =
-        bake_synthetic_glyphs(face, options, colour->synthetic(), counters, asset, report);
-    if (Status status = colour->drop_failed_outlines(failures, options.allow_failed, asset, report); !status) {
+    BakeBudget budget{CompositeBounds(font_bytes, options.face_index, face),
+                      font_bytes.size() + uint64_t{glyph_count} * asset_format::kGlyphRecordSize};
+    const Result<uint32_t> to_do = bake_glyphs(face, options, wanted, *bitmaps, budget, counters, asset, report);
+    if (!to_do) return to_do.error();
+    const Result<std::vector<std::string>> failures =
+        bake_synthetic_glyphs(face, options, colour->synthetic(), budget, counters, asset, report);
+    if (!failures) return failures.error();
+    if (Status status = colour->drop_failed_outlines(*failures, options.allow_failed, asset, report); !status) {
         return status.error();
     }
     // COLR's colour glyphs first: a bitmap gives way to them, and its rectangles follow their outlines.
@@ -512,7 +560,7 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     finish_report(counters, report);
 
     if (report.failed_glyphs > 0 && !options.allow_failed) {
-        return Error{ErrorCode::glyph_failed, std::to_string(report.failed_glyphs) + " of " + std::to_string(to_do) +
+        return Error{ErrorCode::glyph_failed, std::to_string(report.failed_glyphs) + " of " + std::to_string(*to_do) +
                                                   " glyphs failed; first: " + report.first_failure};
     }
     if (Status status = validate_asset(asset); !status) {

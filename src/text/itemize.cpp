@@ -130,6 +130,17 @@ bool is_hyphen(uint32_t cp) {
 
 }  // namespace
 
+bool is_default_ignorable(uint32_t cp) {
+    const auto in = [cp](uint32_t first, uint32_t last) { return cp >= first && cp <= last; };
+    if (cp < 0x2000) {
+        return cp == 0xAD || cp == 0x34F || cp == 0x61C || in(0x115F, 0x1160) || in(0x17B4, 0x17B5) ||
+               in(0x180B, 0x180F);
+    }
+    return in(0x200B, 0x200F) || in(0x202A, 0x202E) || in(0x2060, 0x206F) || cp == 0x3164 || in(0xFE00, 0xFE0F) ||
+           cp == 0xFEFF || cp == 0xFFA0 || in(0xFFF0, 0xFFF8) || in(0x1BCA0, 0x1BCA3) || in(0x1D173, 0x1D17A) ||
+           in(0xE0000, 0xE0FFF);
+}
+
 void classify(std::span<const uint32_t> text, std::span<uint8_t> flags) {
     hb_unicode_funcs_t* unicode = hb_unicode_funcs_get_default();
     const size_t n = text.size();

@@ -35,6 +35,9 @@ inline bool is_hard_break(uint32_t cp) {
     return (cp >= 0x0A && cp <= 0x0D) || cp == 0x85 || cp == 0x2028 || cp == 0x2029;
 }
 
+// Unicode's Default_Ignorable_Code_Point: what HarfBuzz removes from the glyphs it makes.
+bool is_default_ignorable(uint32_t cp);
+
 // Fills `flags` (same length as `text`, one paragraph) with the first group of CharFlags.
 void classify(std::span<const uint32_t> text, std::span<uint8_t> flags);
 

@@ -109,6 +109,7 @@ void reset(TextLayout& out, uint32_t first_paint_order) {
     out.lines.clear();
     out.x = out.y = out.width = out.height = out.line_height = 0.0f;
     out.shaped_glyphs = out.missing_glyphs = out.blank_glyphs = out.out_of_range_glyphs = out.mark_splits = 0;
+    out.ignorable_splits = 0;
     out.colour_glyphs = out.colour_layers = 0;
     out.next_paint_order = first_paint_order;
 }
@@ -206,19 +207,25 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     // marks in time quadratic in their number, so past kMaxMarksPerCluster a new run starts. What
     // continues an emoji sequence counts too: HarfBuzz makes the whole sequence one cluster.
     uint32_t attached = (flags[p0] & kCharAttached) != 0 ? 1 : 0;
+    // Default ignorables in a row at the end of the run: HarfBuzz removes a row of them at a run's
+    // start in time quadratic in its length, so past kMaxIgnorablesPerRun a new run starts.
+    uint32_t ignorables = is_default_ignorable(codepoints[p0]) ? 1 : 0;
     for (uint32_t i = p0 + 1; i <= p1; ++i) {
-        bool split = false;
+        bool split = false, cut = false;
         if (i < p1) {
             attached = (flags[i] & (kCharAttached | kCharEmojiNext)) != 0 ? attached + 1 : 0;
             split = attached > kMaxMarksPerCluster;
+            ignorables = is_default_ignorable(codepoints[i]) ? ignorables + 1 : 0;
+            cut = ignorables > kMaxIgnorablesPerRun;
         }
-        if (i < p1 && !split && levels[i] == levels[i - 1] && scripts[i] == scripts[i - 1] &&
+        if (i < p1 && !split && !cut && levels[i] == levels[i - 1] && scripts[i] == scripts[i - 1] &&
             font_of[i] == font_of[i - 1])
             continue;
         if (split) {
             ++mark_splits;
             attached = 1;  // the mark at i starts the next run
         }
+        if (cut) ++ignorable_splits;
         Run run;
         run.begin = run_begin;
         run.end = i;
@@ -233,6 +240,7 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
         run.glyph_end = shaped.size();
         runs.push_back(run);
         run_begin = i;
+        ignorables = i < p1 && is_default_ignorable(codepoints[i]) ? 1 : 0;
     }
     for (const ShapedGlyph& glyph : shaped) {
         flags[glyph.cluster] |= kCharClusterStart;
@@ -269,6 +277,7 @@ void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
     out.glyphs.reserve(placed.size());
     out.shaped_glyphs = static_cast<uint32_t>(std::min<size_t>(placed.size(), UINT32_MAX));
     out.mark_splits = mark_splits;
+    out.ignorable_splits = ignorable_splits;
     size_t p = 0;
     for (size_t i = 0; i < lines.size(); ++i) {
         TextLine& record = out.lines[i];
@@ -368,7 +377,7 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
     }
     options = &layout_options;
     failed = false;
-    mark_splits = 0;
+    mark_splits = ignorable_splits = 0;
     size_x = static_cast<double>(key_size(static_cast<double>(style.size))) / kSizeOne;
     const float size_y_asked = style.size_y == 0.0f ? style.size : style.size_y;
     size_y = static_cast<double>(key_size(static_cast<double>(size_y_asked))) / kSizeOne;

@@ -92,8 +92,9 @@ struct CRISP_HIDDEN Layouter::State {
     double size_x = 0.0, size_y = 0.0;  // the key's quantized sizes, pixels per em
     double tab_width = 0.0;             // pixels; 0: tabs are spaces
     hb_language_t language = nullptr;
-    bool failed = false;       // HarfBuzz ran out of memory
-    uint32_t mark_splits = 0;  // clusters cut after kMaxMarksPerCluster attached characters
+    bool failed = false;            // HarfBuzz ran out of memory
+    uint32_t mark_splits = 0;       // clusters cut after kMaxMarksPerCluster attached characters
+    uint32_t ignorable_splits = 0;  // runs cut after kMaxIgnorablesPerRun default ignorables in a row
 
     // Whole text.
     std::vector<uint32_t> codepoints;
