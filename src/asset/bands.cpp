@@ -1,4 +1,4 @@
-#include "bake/bands.hpp"
+#include "asset/bands.hpp"
 
 #include <algorithm>
 #include <cassert>

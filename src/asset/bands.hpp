@@ -2,7 +2,7 @@
 // the horizontal bands that tell a sample ray which curves it must test.
 #pragma once
 
-#include "bake/outline.hpp"
+#include "asset/curves.hpp"
 
 #include <crisp/asset.hpp>
 
