@@ -25,6 +25,9 @@ struct PackedGlyph {
 // copy of the previous end) joins it to the contour before.
 PackedGlyph pack_contours(const std::vector<Contour>& contours);
 
+// Sets curve_count from is_curve and the bbox from every point, after slots are added by hand.
+void update_extent(PackedGlyph& glyph);
+
 struct GlyphBands {
     uint16_t band_count = 0;
     uint16_t band_words = 0;
