@@ -375,6 +375,40 @@ TEST(Stroke, DerivedGlyphPacksPiecesThenTheGlyph) {
     EXPECT_EQ(bare.value().record.curve_count, glyph.curve_count);
 }
 
+// The per-texel form the GPU tests compare with: a glyph rect's texels (y down) mapped to em by
+// texel_to_em(), each channel's rectangle of the layout.
+TEST(Stroke, ReferenceTexelsAreTheChannelsRectangles) {
+    const Font& f = font();
+    const uint32_t index = f.nominal_glyph('o');
+    const GlyphRecord& o = *f.glyph_record(index);
+    const StrokeReference reference(glyph_contours(f.asset(), o), StrokeJoin::round, 0.05, 4.0, StrokeOp::a_not_b);
+    const GlyphKey key = test::key_at(index, 16, 0, 0);
+    const GlyphRect rect = glyph_rect(o, key);
+    const TexelToEm map = texel_to_em(rect, key);
+    const SubpixelLayout rgb = *subpixel_preset("rgb");
+    int partial = 0;
+    for (uint32_t ty = 0; ty < rect.height; ++ty) {
+        for (uint32_t tx = 0; tx < rect.width; ++tx) {
+            const std::array<double, 3> got = reference.texel(map, rgb, tx, ty);
+            for (size_t c = 0; c < 3; ++c) {
+                const SampleRect& r = rgb.channels[c];
+                const auto em_x = [&](double x) {
+                    return static_cast<double>(map.offset_x) + static_cast<double>(map.scale_x) * x;
+                };
+                const auto em_y = [&](double y) {
+                    return static_cast<double>(map.offset_y) + static_cast<double>(map.scale_y) * y;
+                };
+                const double want =
+                    reference.coverage(em_x(tx + static_cast<double>(r.x0)), em_y(ty + static_cast<double>(r.y1)),
+                                       em_x(tx + static_cast<double>(r.x1)), em_y(ty + static_cast<double>(r.y0)));
+                EXPECT_NEAR(got[c], want, 1e-12);
+                if (want > 0.01 && want < 0.99) ++partial;
+            }
+        }
+    }
+    EXPECT_GT(partial, 50);
+}
+
 // FreeType's stroker (round caps and joins) on 'o', 'M' and '4' at 48 px beside the reference's
 // centred round stroke, per texel. Its curves approximate the offsets differently (and it strokes
 // the outline FreeType loads, at 26.6 precision), so the check is loose; the figures are reported.
