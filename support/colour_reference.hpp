@@ -21,7 +21,7 @@
 // so hand-made paints fail with invalid_argument rather than reading out of bounds.
 #pragma once
 
-#include "bake/curves.hpp"
+#include "asset/curves.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/glyph.hpp>

@@ -18,7 +18,7 @@
 // index its points and band words without further checks.
 #pragma once
 
-#include "bake/curves.hpp"
+#include "asset/curves.hpp"
 
 #include <crisp/asset.hpp>
 #include <crisp/glyph.hpp>

@@ -2,8 +2,8 @@
 // glyphs placed by hand.
 #pragma once
 
-#include "bake/bands.hpp"
-#include "bake/curves.hpp"
+#include "asset/bands.hpp"
+#include "asset/curves.hpp"
 #include "test_support.hpp"
 #include "core/utf8.hpp"
 

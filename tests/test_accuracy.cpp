@@ -1,7 +1,7 @@
 // The GPU rasterizer's accuracy against exact area coverage, and its hard cases (docs/accuracy.md), on
 // lavapipe with validation on. Each texel channel's coverage (hits / samples) is compared with the
 // exact area fraction of that channel's sample rectangle covered by the glyph (nonzero rule).
-#include "bake/bands.hpp"
+#include "asset/bands.hpp"
 #include "coverage.hpp"
 #include "headless_context.hpp"
 #include "shape_support.hpp"

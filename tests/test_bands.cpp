@@ -1,4 +1,4 @@
-#include "bake/bands.hpp"
+#include "asset/bands.hpp"
 #include "bake/outline.hpp"
 #include "test_support.hpp"
 

@@ -1,7 +1,7 @@
 // The two coverage references: the Slug sample function (double, float, banded, unbanded) and the
 // exact area coverage, held to analytic truths, to each other, and to independent crossing tests.
 // docs/coverage.md explains what each test shows and records the numbers measured here.
-#include "bake/bands.hpp"
+#include "asset/bands.hpp"
 #include "coverage.hpp"
 #include "bake/outline.hpp"
 #include "test_support.hpp"

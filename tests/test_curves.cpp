@@ -1,4 +1,4 @@
-#include "bake/curves.hpp"
+#include "asset/curves.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "bake/bands.hpp"
+#include "asset/bands.hpp"
 #include "bake/bitmap.hpp"
 #include "bake/colr.hpp"
 #include "asset/asset_format.hpp"

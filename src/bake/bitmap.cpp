@@ -1,5 +1,5 @@
 #include "bake/bitmap.hpp"
-#include "bake/bands.hpp"
+#include "asset/bands.hpp"
 #include "bake/outline.hpp"
 
 #include <ft2build.h>

@@ -2,7 +2,7 @@
 // contours of quadratic curves in em units.
 #pragma once
 
-#include "bake/curves.hpp"
+#include "asset/curves.hpp"
 
 #include <cstdint>
 #include <string>
@@ -23,8 +23,6 @@ struct OutlineCounters {
     double max_deviation = 0.0;       // em
     double seed_max_deviation = 0.0;  // em, the seed's split in two, measured the same way
 };
-
-using Contour = std::vector<Quad>;
 
 struct OutlineOptions {
     double scale = 1.0;               // input units to em

@@ -21,4 +21,11 @@ inline constexpr uint64_t kSceneFileBytes = uint64_t{64} << 20;
 // A PFM coverage image of the largest canvas, 16384 x 16384 x 3 floats, plus its header.
 inline constexpr uint64_t kImageFileBytes = uint64_t{16384} * 16384 * 3 * 4 + 4096;
 
+// Curves of one glyph's stroke pieces (src/text/stroke.hpp): a glyph of a few hundred curves
+// stroked at a quarter em makes a few thousand; each is tested by every sample of its bands.
+inline constexpr uint32_t kMaxStrokeCurves = 65536;
+// A stroke's half-width in em: an outline 8 em wide is far past any effect's use, and its pieces
+// would reach far outside the glyph's rect.
+inline constexpr double kMaxStrokeHalfWidthEm = 4.0;
+
 }  // namespace crisp::limits

@@ -1,5 +1,6 @@
 // Quadratic and cubic Bezier curves in double precision, and the conversions the baker needs:
-// lines to quadratics, cubics to quadratics within a tolerance, and splits at y-extrema.
+// lines to quadratics, cubics to quadratics within a tolerance, and splits at y-extrema. Part of
+// crisp (the run time) since effect layers' stroke geometry uses them too.
 #pragma once
 
 #include <cstddef>
@@ -31,6 +32,9 @@ struct Quad {
     Vec2 p0, p1, p2;
     friend bool operator==(const Quad&, const Quad&) = default;
 };
+
+// A closed contour: each curve's p2 is the next one's p0, the last one's the first one's p0.
+using Contour = std::vector<Quad>;
 
 struct Cubic {
     Vec2 p0, p1, p2, p3;

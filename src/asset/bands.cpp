@@ -1,4 +1,4 @@
-#include "bake/bands.hpp"
+#include "asset/bands.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -48,6 +48,11 @@ PackedGlyph pack_contours(const std::vector<Contour>& contours) {
             ++glyph.real_curves;
         }
     }
+    update_extent(glyph);
+    return glyph;
+}
+
+void update_extent(PackedGlyph& glyph) {
     glyph.curve_count = static_cast<uint32_t>(glyph.is_curve.size());
     assert(glyph.points.empty() || glyph.points.size() == 2 * glyph.curve_count + 1);
     if (!glyph.points.empty()) {
@@ -60,7 +65,6 @@ PackedGlyph pack_contours(const std::vector<Contour>& contours) {
             glyph.max_y = std::max(glyph.max_y, p.y);
         }
     }
-    return glyph;
 }
 
 void curve_y_extent(std::span<const Point> points, uint32_t slot, float& min_y, float& max_y) {

@@ -2,7 +2,7 @@
 // the horizontal bands that tell a sample ray which curves it must test.
 #pragma once
 
-#include "bake/outline.hpp"
+#include "asset/curves.hpp"
 
 #include <crisp/asset.hpp>
 
@@ -24,6 +24,9 @@ struct PackedGlyph {
 // contour after the first starts on an even point index, so one pad slot (its control point a
 // copy of the previous end) joins it to the contour before.
 PackedGlyph pack_contours(const std::vector<Contour>& contours);
+
+// Sets curve_count from is_curve and the bbox from every point, after slots are added by hand.
+void update_extent(PackedGlyph& glyph);
 
 struct GlyphBands {
     uint16_t band_count = 0;
