@@ -895,6 +895,45 @@ TEST(Raster, ManyFontsShareThePagesAndRemovedFontsLeave) {
     expect_no_validation_messages();
 }
 
+// record() without begin_frame() before it, or twice in a frame, is refused and changes nothing:
+// the frames after it are those of a renderer never misused.
+TEST(Raster, RecordWithoutBeginFrameOrTwiceInAFrameIsRefused) {
+    Fixture& f = fixture();
+    ASSERT_TRUE(f.context);
+    auto renderer = make_renderer(*subpixel_preset("rgb"), 16);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*f.font));
+    const Font* fonts[] = {f.font.get()};
+    auto laid = layout_text(fonts, "Hg", TextStyle{}, LayoutOptions{.origin_x = 2.0f, .origin_y = 20.0f});
+    ASSERT_TRUE(laid);
+    const auto record_refused = [&](const char* why) {
+        ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) {
+            const Status s = renderer->record(cb);
+            ASSERT_FALSE(s);
+            EXPECT_EQ(s.error().code, ErrorCode::invalid_argument);
+            EXPECT_NE(s.error().message.find(why), std::string::npos) << s.error().message;
+        }));
+    };
+    record_refused("without begin_frame()");
+    for (int frame = 0; frame < 3; ++frame) {
+        renderer->begin_frame();
+        renderer->draw(laid->glyphs);
+        ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));
+        EXPECT_EQ(renderer->stats().samples, frame == 0 ? 16u : frame == 1 ? 8u : 4u);  // the ramp goes on
+        record_refused("twice in one frame");
+    }
+    // An abandoned frame must begin again. (Its command buffer is submitted all the same, since
+    // the context has no other way: the texels it adds are not looked at.)
+    renderer->begin_frame();
+    renderer->draw(laid->glyphs);
+    ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) {
+        ASSERT_TRUE(renderer->record(cb));
+        renderer->abandon_frame();
+    }));
+    record_refused("without begin_frame()");
+    expect_no_validation_messages();
+}
+
 // A font's page, once no font uses it, gives its buffers back, and a memory block made for them
 // goes back to the driver: the memory held returns to what it was before the font came.
 TEST(Raster, RemovingTheLastFontOfAPageGivesItsMemoryBack) {

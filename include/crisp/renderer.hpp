@@ -373,7 +373,9 @@ public:
     // Records this frame's work into `command_buffer` (which must be recording, outside a render
     // pass, on a queue of RendererCreateInfo::queue_family): pending font uploads, the work list,
     // one compute dispatch, and a barrier that makes the atlas readable. Call once per frame after
-    // the draws. Errors (ErrorCode::vulkan) leave the command buffer without crisp's commands.
+    // the draws. Errors: invalid_argument for a record() without begin_frame() before it (also
+    // after abandon_frame()) or a second one in a frame, recording nothing and changing nothing;
+    // vulkan, which leaves the command buffer without crisp's commands.
     Status record(VkCommandBuffer command_buffer);
 
     // Takes back what record() committed for a frame that will never be submitted (a swapchain out

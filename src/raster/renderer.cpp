@@ -43,6 +43,7 @@ struct CRISP_HIDDEN Renderer::State {
 
     uint64_t frame = 0;
     bool recorded = false;  // record() since begin_frame(): abandon_frame() has a frame to take back
+    bool begun = false;     // begin_frame() since the last record() or abandon_frame(): record() may run
 
     State(std::unique_ptr<vk::Context> vk_context, GlyphAtlas glyph_atlas, SubpixelLayout subpixel_layout,
           const RendererCreateInfo& info)
@@ -192,6 +193,7 @@ void Renderer::begin_frame() {
     State& s = *state_;
     s.motion.begin_frame();
     s.recorded = false;
+    s.begun = true;
     s.coarsening_begun = s.coarsening;
     s.atlas.begin_frame();  // unpins last frame's glyphs, so that removed fonts' entries can go
     for (FontId id : s.fonts.pending_removals()) s.bitmaps.forget_font(id);
@@ -232,6 +234,18 @@ Status Renderer::State::prepare_atlas_image(VkCommandBuffer command_buffer, uint
 
 Status Renderer::record(VkCommandBuffer command_buffer) {
     State& s = *state_;
+    // Misuse the renderer can see: its frame counter and the atlas's turn would move on twice, and
+    // the second command buffer would reuse the first's per-frame resources.
+    if (s.recorded) {
+        return Error{
+            ErrorCode::invalid_argument,
+            "renderer: record() called twice in one frame: call begin_frame() and draw() before each record()"};
+    }
+    if (!s.begun) {
+        return Error{ErrorCode::invalid_argument,
+                     "renderer: record() without begin_frame(): call begin_frame() and draw() before each record()"};
+    }
+    s.begun = false;
     s.requests.settle(s.limits);
     const std::span<const RasterWork> work = s.atlas.schedule();
     s.requests.collect_drawn();
