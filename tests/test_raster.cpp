@@ -800,7 +800,7 @@ TEST(Raster, DroppedFramesDoNotCountTowardsALabelsRest) {
                 renderer->begin_frame();
                 renderer->draw(label.glyphs, options);
                 EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
-                renderer->abandon_frame();
+                EXPECT_TRUE(renderer->abandon_frame(renderer->frame()));
             }
             renderer->begin_frame();
             renderer->draw(label.glyphs, options);
@@ -928,7 +928,7 @@ TEST(Raster, RecordWithoutBeginFrameOrTwiceInAFrameIsRefused) {
     renderer->draw(laid->glyphs);
     ASSERT_TRUE(f.context->submit_and_wait([&](VkCommandBuffer cb) {
         ASSERT_TRUE(renderer->record(cb));
-        renderer->abandon_frame();
+        EXPECT_TRUE(renderer->abandon_frame(renderer->frame()));
     }));
     record_refused("without begin_frame()");
     expect_no_validation_messages();
@@ -1190,7 +1190,7 @@ TEST(Raster, AnAtlasWithABudgetGrowsInsteadOfCoarsening) {
     renderer->draw(glyphs);
     EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
     EXPECT_EQ(renderer->stats().atlas_grown, 1u);
-    renderer->abandon_frame();
+    EXPECT_TRUE(renderer->abandon_frame(renderer->frame()));
     renderer->begin_frame();
     renderer->draw(glyphs);
     ASSERT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { ASSERT_TRUE(renderer->record(cb)); }));

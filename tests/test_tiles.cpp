@@ -847,15 +847,15 @@ TEST(TileCompositor, RefusesBinsPastTheStorageBufferRange) {
     EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) {
         EXPECT_TRUE(compositor->record(cb, scene.renderer->drawn_frame().with_glyphs(fitting), target));
     }));
-    compositor->abandon_frame();
+    EXPECT_TRUE(compositor->abandon_frame(scene.renderer->frame()));
     expect_no_validation_messages();
 }
 
 // Issue 9: frames an engine records and then drops. A run that drops frames at random (the first
-// one, and frames whose glyphs or quads are new among them) and abandons them must end with the
-// image of the run that dropped none, bit for bit. The atlas is tiny, so glyphs evict each other
-// and new ones land in cells that held others; the text changes every few frames, so the tile
-// path's bins are made and reused across dropped frames.
+// one, and frames whose glyphs or quads are new among them; some after the renderer, before the
+// compositor) and abandons them must end with the image of the run that dropped none, bit for bit. The atlas is tiny,
+// so glyphs evict each other and new ones land in cells that held others; the text changes every few frames, so the
+// tile path's bins are made and reused across dropped frames.
 std::vector<std::byte> run_with_drops(const std::vector<bool>& drops, uint32_t& frames) {
     Fixture& f = fixture();
     HeadlessContext& context = *f.context;
@@ -905,9 +905,18 @@ std::vector<std::byte> run_with_drops(const std::vector<bool>& drops, uint32_t& 
             EXPECT_TRUE(context.upload(t.image, t.initial, VK_IMAGE_LAYOUT_GENERAL));
         }
         if (scripted && drops[i]) {
-            EXPECT_TRUE(dropped.record_and_drop(record));
-            renderer->abandon_frame();
-            compositor->abandon_frame();
+            // Every other drop comes between the renderer and the compositor: the compositor is told
+            // of a frame it never recorded, and refuses, keeping the record of the frame the GPU
+            // may still run. An earlier frame is refused by the renderer too.
+            const bool before_compositor = i % 2 == 1;
+            if (before_compositor) {
+                EXPECT_TRUE(dropped.record_and_drop([&](VkCommandBuffer cb) { EXPECT_TRUE(renderer->record(cb)); }));
+            } else {
+                EXPECT_TRUE(dropped.record_and_drop(record));
+            }
+            EXPECT_FALSE(renderer->abandon_frame(renderer->frame() - 1));
+            EXPECT_TRUE(renderer->abandon_frame(renderer->frame()));
+            EXPECT_EQ(compositor->abandon_frame(renderer->frame()).ok(), !before_compositor);
             continue;
         }
         EXPECT_TRUE(context.submit_and_wait(record));

@@ -180,7 +180,6 @@ crisp::Status TextOverlay::lay_out_static() {
 
 const OverlayFrame& TextOverlay::draw(uint64_t frame, VkExtent2D extent, const SceneState& scene) {
     renderer_->begin_frame();
-    composited_ = false;
     frame_.panels.assign({hud_, list_box_, spinner_panel_});
     frame_.boxes.clear();
     draw_hud(frame, extent);
@@ -372,17 +371,18 @@ crisp::Status TextOverlay::record_composite(VkCommandBuffer command_buffer, cons
     target.extent = targets.color.extent;
     target.rect = {{0, 0}, targets.color.extent};
     crisp::Status status = compositor_->record(command_buffer, renderer_->drawn_frame(), target);
-    composited_ = status.ok();
     return status;
 }
 
-// The renderer's abandon_frame() knows its frame (begin_frame() starts one); the compositor's takes
-// back its most recent record(), which, where this frame's failed or never came, was the last
-// submitted frame's: so it is called only for a record() of this frame.
+// Both take back this frame only, named by the renderer's number for it: where this frame's
+// compositing failed or never came, the compositor's last record is the last submitted frame's,
+// and it refuses (keeping it) rather than take that one back.
 void TextOverlay::abandon_frame() {
-    renderer_->abandon_frame();
-    if (composited_) compositor_->abandon_frame();
-    composited_ = false;
+    const uint64_t frame = renderer_->frame();
+    const crisp::Status renderer_taken = renderer_->abandon_frame(frame);      // the current frame: never refused
+    const crisp::Status compositor_taken = compositor_->abandon_frame(frame);  // refused when not composited
+    (void)renderer_taken;
+    (void)compositor_taken;
 }
 
 void TextOverlay::frame_submitted() {

@@ -125,7 +125,6 @@ private:
     GlyphCounts submitted_glyphs_;
     bool have_stats_ = false;
     OverlayFrame frame_;
-    bool composited_ = false;  // the compositor recorded this frame
 };
 
 }  // namespace engine

@@ -262,9 +262,13 @@ public:
     // statistics are not waited for, the reference target's first layout change is recorded
     // again, and it does not count towards frames_in_flight. Call it before the next record
     // call and discard the command buffer unsubmitted; only the most recent call can be taken
-    // back, and a second abandon_frame() does nothing. (Renderer::abandon_frame() is the same for
-    // the renderer; a dropped frame needs both.)
-    void abandon_frame();
+    // back. `frame` is the renderer's frame being dropped (Renderer::frame(), DrawnFrame::frame):
+    // the most recent call is taken back only when it composited that frame. Errors:
+    // invalid_argument, taking nothing back, when it composited another frame (a frame dropped
+    // before it reached the compositor: the one it did composite may be on the GPU) or was taken
+    // back already, or there was none. (Renderer::abandon_frame() is the same for the renderer;
+    // a dropped frame needs both, the compositor's only where it recorded the frame.)
+    Status abandon_frame(uint64_t frame);
 
     // True when record() can composite into an image of `format` seen through a view of
     // `view_format` (VK_FORMAT_UNDEFINED: the same format).

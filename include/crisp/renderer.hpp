@@ -246,12 +246,15 @@ struct DrawnFrame {
     // Required by the compositor (a renderer always has one, a single blank layer until it draws a
     // bitmap glyph).
     VkImageView images = VK_NULL_HANDLE;
+    // The renderer's frame these come from (Renderer::frame()), which Compositor::abandon_frame()
+    // names; 0 for a DrawnFrame made by hand.
+    uint64_t frame = 0;
 
     // The same frame with other glyphs (a subset of these, say): the atlas, paints and images kept.
     DrawnFrame with_glyphs(std::span<const DrawnGlyph> other) const {
-        DrawnFrame frame = *this;
-        frame.glyphs = other;
-        return frame;
+        DrawnFrame same = *this;
+        same.glyphs = other;
+        return same;
     }
 };
 
@@ -346,8 +349,13 @@ public:
     Status set_contrast(const TextContrast& contrast);
     const TextContrast& contrast() const;
 
-    // Starts a frame: unpins the atlas and forgets last frame's drawn glyphs.
+    // Starts a frame: unpins the atlas and forgets last frame's drawn glyphs. The frame gets the
+    // next number (frame()).
     void begin_frame();
+    // The number of the frame begin_frame() started last: 1, 2, ... (0 before the first). Each
+    // begin_frame() takes a new one, an abandoned frame's included: it names the frame to
+    // abandon_frame() here and, through DrawnFrame::frame, to Compositor::abandon_frame().
+    uint64_t frame() const;
 
     // Draws glyph instances this frame: finds or places each in the atlas and pins it (the
     // instances are copied). Where the atlas has no room for every glyph of the frame, record()
@@ -381,12 +389,15 @@ public:
     // Takes back what record() committed for a frame that will never be submitted (a swapchain out
     // of date, a minimized window, any frame an engine drops): font uploads wait for the next
     // record(), the atlas image's first layout change is recorded again, and the atlas forgets the
-    // samples and the turn this frame scheduled (see GlyphAtlas::abandon_frame). Call it after
-    // record() and before the next begin_frame(), and discard the command buffer unsubmitted. The
-    // abandoned frame does not count towards frames_in_flight. Without a record() since
-    // begin_frame() it does nothing. A frame neither abandoned nor submitted is a programmer error:
-    // its samples count as if they were in the atlas image, and their texels stay wrong.
-    void abandon_frame();
+    // samples and the turn this frame scheduled (see GlyphAtlas::abandon_frame). `frame` is the
+    // frame to take back (frame()): call it after record() and before the next begin_frame(), and
+    // discard the command buffer unsubmitted. The abandoned frame does not count towards
+    // frames_in_flight. For the current frame without a record() since begin_frame() it does
+    // nothing. Errors: invalid_argument, taking nothing back, for any other frame (an earlier one,
+    // which may be on the GPU, or one already abandoned). A frame neither abandoned nor submitted
+    // is a programmer error: its samples count as if they were in the atlas image, and their
+    // texels stay wrong.
+    Status abandon_frame(uint64_t frame);
 
     // The glyphs draw()n this frame that hold samples once this frame's work has run, with their
     // atlas positions (valid after record()).

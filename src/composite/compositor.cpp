@@ -149,7 +149,8 @@ struct CRISP_HIDDEN Compositor::State {
     std::vector<std::string> warnings;
     std::vector<gpu::CompositeQuad> quads;
     enum class Last { none, tiles, draw, reference };
-    Last last = Last::none;  // the path of the last record call, until abandon_frame()
+    Last last = Last::none;   // the path of the last record call, until abandon_frame()
+    uint64_t last_frame = 0;  // the DrawnFrame::frame it composited
 
     void take(const composite::TileCounts& counts, uint64_t frame);
 };
@@ -262,6 +263,7 @@ Status Compositor::record(VkCommandBuffer command_buffer, const DrawnFrame& fram
     }
     if (measured_frame != 0) s.take(counts, measured_frame);
     s.last = State::Last::tiles;
+    s.last_frame = frame.frame;
     s.stats.mode = CompositeMode::tiled;
     s.stats.path = QuadPath::compute;
     s.stats.quads = static_cast<uint32_t>(s.quads.size());
@@ -271,8 +273,16 @@ Status Compositor::record(VkCommandBuffer command_buffer, const DrawnFrame& fram
     return {};
 }
 
-void Compositor::abandon_frame() {
+Status Compositor::abandon_frame(uint64_t frame) {
     State& s = *state_;
+    if (s.last == State::Last::none || s.last_frame != frame) {
+        return Error{
+            ErrorCode::invalid_argument,
+            "compositor: abandon_frame(" + std::to_string(frame) + "): " +
+                (s.last == State::Last::none ? std::string("no record to take back")
+                                             : "its last record was of frame " + std::to_string(s.last_frame)) +
+                ": nothing taken back"};
+    }
     switch (s.last) {
         case State::Last::tiles:
             s.tiles.abandon_frame();
@@ -286,8 +296,9 @@ void Compositor::abandon_frame() {
         case State::Last::none:
             break;
     }
-    if (s.last != State::Last::none) s.paints.abandon_frame();
+    s.paints.abandon_frame();
     s.last = State::Last::none;
+    return {};
 }
 
 Status Compositor::record_draw(VkCommandBuffer command_buffer, const DrawnFrame& frame, const VkRect2D& rect) {
@@ -309,6 +320,7 @@ Status Compositor::record_draw(VkCommandBuffer command_buffer, const DrawnFrame&
         return bytes.error();
     }
     s.last = State::Last::draw;
+    s.last_frame = frame.frame;
     s.stats.mode = CompositeMode::draw;
     s.stats.path = QuadPath::raster;
     s.stats.quads = static_cast<uint32_t>(s.quads.size());
@@ -325,6 +337,7 @@ Status Compositor::record_reference(VkCommandBuffer command_buffer, const DrawnF
     Status status = s.reference->record(command_buffer, frame, s.paints, params, s.stats);
     if (status) {
         s.last = State::Last::reference;
+        s.last_frame = frame.frame;
     } else {
         s.paints.abandon_frame();
     }

@@ -42,8 +42,9 @@ struct CRISP_HIDDEN Renderer::State {
     raster::BitmapLayers bitmaps;
 
     uint64_t frame = 0;
-    bool recorded = false;  // record() since begin_frame(): abandon_frame() has a frame to take back
-    bool begun = false;     // begin_frame() since the last record() or abandon_frame(): record() may run
+    bool recorded = false;      // record() since begin_frame(): abandon_frame() has a frame to take back
+    bool begun = false;         // begin_frame() since the last record() or abandon_frame(): record() may run
+    uint64_t frame_number = 0;  // frame(): begin_frame()s so far
 
     State(std::unique_ptr<vk::Context> vk_context, GlyphAtlas glyph_atlas, SubpixelLayout subpixel_layout,
           const RendererCreateInfo& info)
@@ -173,9 +174,14 @@ const TextContrast& Renderer::contrast() const {
     return state_->requests.contrast();
 }
 
-void Renderer::abandon_frame() {
+Status Renderer::abandon_frame(uint64_t frame) {
     State& s = *state_;
-    if (!s.recorded) return;
+    if (frame != s.frame_number || s.frame_number == 0) {
+        return Error{ErrorCode::invalid_argument, "renderer: abandon_frame(" + std::to_string(frame) +
+                                                      ") for a frame that is not the current one (" +
+                                                      std::to_string(s.frame_number) + "): nothing taken back"};
+    }
+    if (!s.recorded) return {};
     s.recorded = false;
     s.atlas.abandon_frame();
     s.image.abandon_frame(s.retired);
@@ -187,6 +193,7 @@ void Renderer::abandon_frame() {
     s.fonts.abandon_uploads(s.retired, s.frame - 1);
     --s.frame;  // an abandoned frame does not count towards frames_in_flight
     s.requests.abandon_frame();
+    return {};
 }
 
 void Renderer::begin_frame() {
@@ -194,6 +201,7 @@ void Renderer::begin_frame() {
     s.motion.begin_frame();
     s.recorded = false;
     s.begun = true;
+    ++s.frame_number;
     s.coarsening_begun = s.coarsening;
     s.atlas.begin_frame();  // unpins last frame's glyphs, so that removed fonts' entries can go
     for (FontId id : s.fonts.pending_removals()) s.bitmaps.forget_font(id);
@@ -273,7 +281,15 @@ std::span<const DrawnGlyph> Renderer::drawn() const {
     return state_->requests.drawn();
 }
 DrawnFrame Renderer::drawn_frame() const {
-    return DrawnFrame{drawn(), atlas_view(), state_->paints.paints(), state_->paints.stops(), state_->bitmaps.view()};
+    return DrawnFrame{drawn(),
+                      atlas_view(),
+                      state_->paints.paints(),
+                      state_->paints.stops(),
+                      state_->bitmaps.view(),
+                      state_->frame_number};
+}
+uint64_t Renderer::frame() const {
+    return state_->frame_number;
 }
 bool Renderer::converged() const {
     return state_->requests.converged();

@@ -219,8 +219,9 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
     // A failed record leaves a frame that is never submitted: the renderers take theirs back.
     auto fail = [&](const Error& error) -> Status {
         vkEndCommandBuffer(cb);
-        interface_renderer_->abandon_frame();
-        preview_renderer_->abandon_frame();
+        // Each renderer's current frame: never refused.
+        (void)interface_renderer_->abandon_frame(interface_renderer_->frame());
+        (void)preview_renderer_->abandon_frame(preview_renderer_->frame());
         return error;
     };
     if (Status s = interface_renderer_->record(cb); !s) return fail(s.error());
