@@ -392,9 +392,9 @@ public:
     // samples and the turn this frame scheduled (see GlyphAtlas::abandon_frame). `frame` is the
     // frame to take back (frame()): call it after record() and before the next begin_frame(), and
     // discard the command buffer unsubmitted. The abandoned frame does not count towards
-    // frames_in_flight. For the current frame without a record() since begin_frame() it does
-    // nothing. Errors: invalid_argument, taking nothing back, for any other frame (an earlier one,
-    // which may be on the GPU, or one already abandoned). A frame neither abandoned nor submitted
+    // frames_in_flight. For the current frame without a record() since begin_frame(), or already
+    // taken back, it does nothing. Errors: invalid_argument, taking nothing back, for any other
+    // frame (an earlier one, which may be on the GPU). A frame neither abandoned nor submitted
     // is a programmer error: its samples count as if they were in the atlas image, and their
     // texels stay wrong.
     Status abandon_frame(uint64_t frame);
