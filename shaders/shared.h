@@ -203,7 +203,7 @@ struct CompositeQuad {
     float contrast_darkening;
     vec4 color;  // linear, straight alpha
     uint paint;  // a colour layer's fill: an index in the QuadPaint buffer; kNoQuadPaint: `color`
-    uint padding0;
+    uint stack;  // DrawnGlyph::stack: its place among the layers of its depth and paint order
     uint padding1;
     uint padding2;
 };

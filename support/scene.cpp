@@ -20,8 +20,10 @@ namespace {
 using Type = json::Value::Type;
 
 constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "contrast", "palette", "runs"};
-constexpr std::string_view kRunMembers[] = {"font",  "text",     "size",    "origin",   "color",
-                                            "depth", "contrast", "palette", "transform"};
+constexpr std::string_view kRunMembers[] = {"font",     "text",    "size",      "origin", "color",   "depth",
+                                            "contrast", "palette", "transform", "weight", "outline", "shadow"};
+constexpr std::string_view kOutlineMembers[] = {"width", "placement", "join", "miter_limit", "color"};
+constexpr std::string_view kShadowMembers[] = {"offset", "color"};
 constexpr std::string_view kContrastMembers[] = {"mode", "gamma", "contrast", "stem_darkening"};
 
 Error fault(const std::string& path, const std::string& what) {
@@ -151,6 +153,90 @@ std::optional<Error> read_contrast(const json::Value& value, const std::string& 
     return std::nullopt;
 }
 
+// A run's "weight", "outline" and "shadow" (include/crisp/effects.hpp) into `effects`; nullopt
+// effects where it has none of them. Ranges as validate_text_effects() at the run's size.
+std::optional<Error> read_effects(const json::Value& value, const std::string& path, float size,
+                                  std::optional<TextEffects>& out) {
+    const json::Value* weight = value.find("weight");
+    const json::Value* outline = value.find("outline");
+    const json::Value* shadow = value.find("shadow");
+    if (!weight && !outline && !shadow) return std::nullopt;
+    TextEffects effects;
+    const auto finite = [](const json::Value& v) {
+        return v.type == Type::number && std::fabs(v.number) <= static_cast<double>(kMaxEffectWidth);
+    };
+    if (weight) {
+        if (!finite(*weight)) return fault(path + ".weight", "expected a number of pixels in [-4096, 4096]");
+        effects.weight = static_cast<float>(weight->number);
+    }
+    if (outline) {
+        const std::string at = path + ".outline";
+        if (outline->type != Type::object) return fault(at, "expected an object");
+        if (auto error = unknown_member(*outline, at, kOutlineMembers)) return error;
+        TextOutline o;
+        const json::Value* width = outline->find("width");
+        if (!width) return fault(at, "the \"width\" member is missing");
+        if (!finite(*width) || width->number < 0.0) return fault(at + ".width", "expected pixels in [0, 4096]");
+        o.width = static_cast<float>(width->number);
+        const auto named = [&](const char* member, auto parse, auto& field,
+                               const char* expected) -> std::optional<Error> {
+            const json::Value* v = outline->find(member);
+            if (!v) return std::nullopt;
+            const auto parsed = parse(v->type == Type::string ? std::string_view(v->string) : std::string_view());
+            if (!parsed) return fault(at + "." + member, std::string("expected ") + expected);
+            field = *parsed;
+            return std::nullopt;
+        };
+        if (auto error =
+                named("placement", parse_outline_placement, o.placement, "\"outside\", \"inside\" or \"centred\"")) {
+            return error;
+        }
+        if (auto error = named("join", parse_line_join, o.join, "\"round\", \"miter\" or \"bevel\"")) return error;
+        if (const json::Value* limit = outline->find("miter_limit")) {
+            if (limit->type != Type::number ||
+                !(limit->number >= 1.0 && limit->number <= static_cast<double>(kMaxMiterLimit))) {
+                return fault(at + ".miter_limit", "expected a number in [1, 128]");
+            }
+            o.miter_limit = static_cast<float>(limit->number);
+        }
+        if (const json::Value* color = outline->find("color")) {
+            float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+            if (auto error = read_color(*color, at + ".color", c)) return error;
+            std::copy(std::begin(c), std::end(c), o.color.begin());
+        }
+        effects.outline = o;
+    }
+    if (shadow) {
+        const std::string at = path + ".shadow";
+        if (shadow->type != Type::object) return fault(at, "expected an object");
+        if (auto error = unknown_member(*shadow, at, kShadowMembers)) return error;
+        TextShadow sh;
+        if (const json::Value* offset = shadow->find("offset")) {
+            const auto within = [](const json::Value& v) {
+                return v.type == Type::number && std::fabs(v.number) <= static_cast<double>(kMaxShadowOffset);
+            };
+            if (offset->type != Type::array || offset->array.size() != 2 || !within(offset->array[0]) ||
+                !within(offset->array[1])) {
+                return fault(at + ".offset", "expected [dx, dy], pixels in [-4096, 4096]");
+            }
+            sh.offset_x = static_cast<float>(offset->array[0].number);
+            sh.offset_y = static_cast<float>(offset->array[1].number);
+        }
+        if (const json::Value* color = shadow->find("color")) {
+            float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+            if (auto error = read_color(*color, at + ".color", c)) return error;
+            std::copy(std::begin(c), std::end(c), sh.color.begin());
+        }
+        effects.shadow = sh;
+    }
+    if (Status valid = validate_text_effects(effects, size); !valid) {
+        const std::string& message = valid.error().message;
+        return fault(path, message.substr(message.find(": ") + 2));
+    }
+    out = effects;
+    return std::nullopt;
+}
+
 std::optional<Error> read_run(const json::Value& value, const std::string& path, const Scene& scene, SceneRun& run) {
     if (value.type != Type::object) return fault(path, "expected an object, got " + std::string(value.type_name()));
     if (auto error = unknown_member(value, path, kRunMembers)) return error;
@@ -236,7 +322,7 @@ std::optional<Error> read_run(const json::Value& value, const std::string& path,
         }
         run.transform = m;
     }
-    return std::nullopt;
+    return read_effects(value, path, run.size, run.effects);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <crisp/contrast.hpp>
+#include <crisp/effects.hpp>
 #include <crisp/result.hpp>
 
 #include <array>
@@ -43,6 +44,9 @@ struct SceneRun {
     // The 2x2 linear part of a transform applied about the run's origin (y down: x' = a x + b y,
     // y' = c x + d y; DrawOptions::transform): "transform": [a, b, c, d]. nullopt: none.
     std::optional<std::array<float, 4>> transform;
+    // Its effects (DrawOptions::effects): "weight" (pixels), "outline" {"width", "placement",
+    // "join", "miter_limit", "color"} and "shadow" {"offset": [dx, dy], "color"}; nullopt: none.
+    std::optional<TextEffects> effects;
     friend bool operator==(const SceneRun&, const SceneRun&) = default;
 };
 

@@ -84,6 +84,22 @@ inline Contour circle(double cx, double cy, double r, bool clockwise) {
     return contour;
 }
 
+// A five-pointed star, clockwise in y-up (TrueType's outer direction): sharp convex tips and
+// concave notches.
+inline std::vector<Contour> star() {
+    std::vector<Vec2> corners;
+    const double pi = 3.14159265358979323846;
+    for (int i = 0; i < 10; ++i) {
+        const double a = pi / 2 - i * pi / 5;
+        const double radius = i % 2 == 0 ? 0.35 : 0.14;
+        corners.push_back({0.4 + radius * std::cos(a), 0.37 + radius * std::sin(a)});
+    }
+    Contour contour;
+    for (size_t i = 0; i < corners.size(); ++i)
+        contour.push_back(line_to_quad(corners[i], corners[(i + 1) % corners.size()]));
+    return {contour};
+}
+
 // A glyph of `font` laid out by hand at (x, y) at `size` px per em, its pen kept for transforms.
 inline GlyphInstance place(const Font& font, uint32_t glyph_index, float size, float x, float y) {
     GlyphInstance g;

@@ -134,7 +134,62 @@ TEST(Scene, BadTransformsNameTheRunAndTheLimit) {
     // A run's unknown member lists transform among the known ones.
     auto scene = parse_scene(with_run(R"({"text": "a", "size": 9, "origin": [0, 0], "transfrom": [1, 0, 0, 1]})"));
     ASSERT_FALSE(scene);
-    EXPECT_NE(scene.error().message.find("palette, transform)"), std::string::npos) << scene.error().message;
+    EXPECT_NE(scene.error().message.find("palette, transform, weight"), std::string::npos) << scene.error().message;
+}
+
+TEST(Scene, ARunsEffectsAreItsWeightOutlineAndShadow) {
+    auto scene = parse_scene(with_run(
+        R"({"text": "a", "size": 20, "origin": [0, 0], "weight": -0.5,
+            "outline": {"width": 2, "placement": "centred", "join": "miter", "miter_limit": 8, "color": [1, 0, 0]},
+            "shadow": {"offset": [3, -1.5], "color": [0, 0, 1, 0.25]}},
+           {"text": "b", "size": 20, "origin": [0, 0], "outline": {"width": 1}},
+           {"text": "c", "size": 20, "origin": [0, 0]})"));
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_EQ(scene->runs.size(), 3u);
+    const std::optional<TextEffects>& e = scene->runs[0].effects;
+    ASSERT_TRUE(e && e->outline && e->shadow);
+    EXPECT_EQ(e->weight, -0.5f);
+    EXPECT_EQ(e->outline->width, 2.0f);
+    EXPECT_EQ(e->outline->placement, OutlinePlacement::centred);
+    EXPECT_EQ(e->outline->join, LineJoin::miter);
+    EXPECT_EQ(e->outline->miter_limit, 8.0f);
+    EXPECT_EQ(e->outline->color, (std::array<float, 4>{1.0f, 0.0f, 0.0f, 1.0f}));
+    EXPECT_EQ(e->shadow->offset_x, 3.0f);
+    EXPECT_EQ(e->shadow->offset_y, -1.5f);
+    EXPECT_EQ(e->shadow->color, (std::array<float, 4>{0.0f, 0.0f, 1.0f, 0.25f}));
+    // Defaults: outside, round, black; no effects at all where a run names none.
+    const std::optional<TextEffects>& b = scene->runs[1].effects;
+    ASSERT_TRUE(b && b->outline);
+    EXPECT_EQ(b->outline->placement, OutlinePlacement::outside);
+    EXPECT_EQ(b->outline->join, LineJoin::round);
+    EXPECT_FALSE(b->shadow);
+    EXPECT_FALSE(scene->runs[2].effects);
+
+    struct {
+        const char* members;
+        const char* fragment;
+    } cases[] = {
+        {R"("weight": "1")", "scene: runs[0].weight: expected a number of pixels in [-4096, 4096]"},
+        {R"("weight": 5000)", "scene: runs[0].weight: expected a number"},
+        {R"("outline": 2)", "scene: runs[0].outline: expected an object"},
+        {R"("outline": {})", "scene: runs[0].outline: the \"width\" member is missing"},
+        {R"("outline": {"width": -1})", "scene: runs[0].outline.width: expected pixels in [0, 4096]"},
+        {R"("outline": {"width": 1, "join": "square"})", "scene: runs[0].outline.join: expected \"round\""},
+        {R"("outline": {"width": 1, "placement": 0})", "scene: runs[0].outline.placement: expected \"outside\""},
+        {R"("outline": {"width": 1, "miter_limit": 0.5})", "scene: runs[0].outline.miter_limit: expected a number"},
+        {R"("outline": {"width": 1, "color": [2, 0, 0]})", "scene: runs[0].outline.color[0]: expected a number"},
+        {R"("outline": {"width": 1, "blur": 2})", "scene: runs[0].outline: unknown member \"blur\""},
+        {R"("outline": {"width": 81})", "scene: runs[0]: outline width 81 px reaches past 4 em at 20 px per em"},
+        {R"("shadow": {"offset": [1]})", "scene: runs[0].shadow.offset: expected [dx, dy]"},
+        {R"("shadow": {"offset": [1, 1e9]})", "scene: runs[0].shadow.offset: expected [dx, dy]"},
+        {R"("shadow": {"blur": 3})", "scene: runs[0].shadow: unknown member \"blur\" (known: offset, color)"},
+    };
+    for (const auto& c : cases) {
+        auto bad = parse_scene(with_run(R"({"text": "a", "size": 20, "origin": [0, 0], )" + std::string(c.members) + "}"));
+        ASSERT_FALSE(bad) << c.members;
+        EXPECT_NE(bad.error().message.find(c.fragment), std::string::npos)
+            << "message: " << bad.error().message << "\nexpected: " << c.fragment;
+    }
 }
 
 TEST(Scene, MemberOrderDoesNotMatter) {
@@ -201,7 +256,7 @@ TEST(Scene, BadScenesNameTheirFault) {
         {with_run(
              R"({"text": "a", "size": 9, "origin": [0, 0]}, {"text": "a", "size": 9, "origin": [0, 0], "colour": [0, 0, 0]})"),
          "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth, contrast, "
-         "palette, transform)"},
+         "palette, transform, weight, outline, shadow)"},
         // runs[].font
         {with_run(R"({"font": -1, "text": "a", "size": 9, "origin": [0, 0]})"),
          "scene: runs[0].font: expected an index into fonts (an integer from 0)"},

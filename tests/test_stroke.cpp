@@ -37,21 +37,6 @@ std::vector<Contour> glyph_of(char32_t c) {
     return glyph_contours(f.asset(), *f.glyph_record(f.nominal_glyph(c)));
 }
 
-// A five-pointed star, clockwise in y-up (TrueType's outer direction): sharp convex tips and
-// concave notches.
-std::vector<Contour> star() {
-    std::vector<Vec2> corners;
-    for (int i = 0; i < 10; ++i) {
-        const double a = std::numbers::pi / 2 - i * std::numbers::pi / 5;
-        const double radius = i % 2 == 0 ? 0.35 : 0.14;
-        corners.push_back({0.4 + radius * std::cos(a), 0.37 + radius * std::sin(a)});
-    }
-    Contour contour;
-    for (size_t i = 0; i < corners.size(); ++i)
-        contour.push_back(line_to_quad(corners[i], corners[(i + 1) % corners.size()]));
-    return {contour};
-}
-
 std::vector<Quad> flattened(const std::vector<Contour>& contours) {
     std::vector<Quad> out;
     for (const Contour& c : contours) out.insert(out.end(), c.begin(), c.end());
@@ -172,7 +157,7 @@ constexpr JoinCase kJoins[] = {
 
 TEST(Stroke, CentredStrokeMatchesReferenceAtSmallSizes) {
     const std::pair<const char*, std::vector<Contour>> shapes[] = {
-        {"star", star()}, {"M", glyph_of('M')}, {"W", glyph_of('W')}, {"4", glyph_of('4')}, {"o", glyph_of('o')}};
+        {"star", test::star()}, {"M", glyph_of('M')}, {"W", glyph_of('W')}, {"4", glyph_of('4')}, {"o", glyph_of('o')}};
     for (const auto& [name, glyph] : shapes) {
         for (const JoinCase& j : kJoins) {
             for (double r : {0.002, 0.03, 0.125}) {
@@ -184,7 +169,7 @@ TEST(Stroke, CentredStrokeMatchesReferenceAtSmallSizes) {
 
 TEST(Stroke, CentredStrokeMatchesReferenceAt48Pixels) {
     const std::pair<const char*, std::vector<Contour>> shapes[] = {
-        {"star", star()}, {"M", glyph_of('M')}, {"W", glyph_of('W')}, {"4", glyph_of('4')}, {"o", glyph_of('o')}};
+        {"star", test::star()}, {"M", glyph_of('M')}, {"W", glyph_of('W')}, {"4", glyph_of('4')}, {"o", glyph_of('o')}};
     for (const auto& [name, glyph] : shapes) {
         for (const JoinCase& j : kJoins) {
             for (double r : {0.002, 0.125}) expect_case({name, glyph, j.join, j.limit, r, StrokeOp::a}, 48.0);
@@ -193,7 +178,7 @@ TEST(Stroke, CentredStrokeMatchesReferenceAt48Pixels) {
 }
 
 TEST(Stroke, CentredStrokeMatchesReferenceAt200Pixels) {
-    expect_case({"star", star(), StrokeJoin::miter, 4.0, 0.03, StrokeOp::a}, 200.0);
+    expect_case({"star", test::star(), StrokeJoin::miter, 4.0, 0.03, StrokeOp::a}, 200.0);
     expect_case({"M", glyph_of('M'), StrokeJoin::round, 4.0, 0.03, StrokeOp::a}, 200.0);
     expect_case({"4", glyph_of('4'), StrokeJoin::bevel, 4.0, 0.01, StrokeOp::a}, 200.0);
     expect_case({"o", glyph_of('o'), StrokeJoin::round, 4.0, 0.125, StrokeOp::a}, 200.0);
@@ -216,13 +201,13 @@ TEST(Stroke, EveryOpMatchesReference) {
             expect_case({"o", glyph_of('o'), StrokeJoin::round, 4.0, op == StrokeOp::b_not_a ? 0.015 : 0.05, op},
                         pixels);
             expect_case({"M", glyph_of('M'), StrokeJoin::miter, 4.0, 0.03, op}, pixels);
-            expect_case({"star", star(), StrokeJoin::bevel, 4.0, 0.06, op}, pixels);
+            expect_case({"star", test::star(), StrokeJoin::bevel, 4.0, 0.06, op}, pixels);
         }
     }
 }
 
 TEST(Stroke, PiecesWindClockwiseAndNeverCancel) {
-    for (const auto& glyph : {star(), glyph_of('M'), glyph_of('o'), glyph_of('@')}) {
+    for (const auto& glyph : {test::star(), glyph_of('M'), glyph_of('o'), glyph_of('@')}) {
         for (StrokeJoin join : {StrokeJoin::round, StrokeJoin::miter, StrokeJoin::bevel}) {
             for (double r : {0.005, 0.05, 0.25}) {
                 StrokeStyle style{r, join, 4.0, 1e-4};
@@ -281,7 +266,7 @@ TEST(Stroke, PieceCounts) {
 TEST(Stroke, RefusesBadParameters) {
     const std::vector<Contour> glyph = glyph_of('o');
     const auto refused = [&](StrokeStyle style, const char* names) {
-        std::vector<Contour> pieces{star()[0]};
+        std::vector<Contour> pieces{test::star()[0]};
         const Status status = stroke_pieces(glyph, style, pieces);
         EXPECT_FALSE(status);
         if (!status) {

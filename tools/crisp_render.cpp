@@ -13,6 +13,7 @@
 #include <crisp/atlas.hpp>
 #include <crisp/compositor.hpp>
 #include <crisp/contrast.hpp>
+#include <crisp/effects.hpp>
 #include <crisp/font.hpp>
 #include <crisp/glyph.hpp>
 #include <crisp/layout.hpp>
@@ -103,6 +104,14 @@ struct Arguments {
     std::optional<uint32_t> palette;                // TextStyle::palette of the command line's text
     std::optional<std::array<float, 4>> transform;  // the 2x2 of DrawOptions::transform, about the origin
     bool no_colour = false;                         // LayoutOptions::colour_glyphs off: colour glyphs as plain outlines
+    // The command line's text's effects: --outline, --shadow and --weight, with the outline's
+    // placement and join.
+    std::optional<crisp::TextOutline> outline;
+    std::optional<crisp::TextShadow> shadow;
+    std::optional<float> weight;
+    crisp::OutlinePlacement outline_placement = crisp::OutlinePlacement::outside;
+    crisp::LineJoin outline_join = crisp::LineJoin::round;
+    float miter_limit = 4.0f;
     std::string scene;
     crisp::CompositeMode composite = crisp::CompositeMode::tiled;
     std::string backdrop = "flat";
@@ -143,6 +152,85 @@ crisp::Result<std::array<float, 4>> parse_color(std::string_view option, std::st
         color[i] = (*values)[i];
     }
     return color;
+}
+
+// `values` from `first` on as a colour (R,G,B or R,G,B,A) into `color`, where there are any.
+crisp::Status colour_after(std::string_view option, std::string_view text, const std::vector<float>& values,
+                           size_t first, std::array<float, 4>& color) {
+    if (values.size() == first) return {};
+    const size_t n = values.size() - first;
+    if (n != 3 && n != 4) {
+        return crisp::Error{crisp::ErrorCode::invalid_argument,
+                            std::string(option) + ": the colour after " + std::to_string(first) +
+                                (first == 1 ? " number" : " numbers") + " is R,G,B or R,G,B,A, not '" +
+                                crisp::cli::printable(text) + "'"};
+    }
+    for (size_t i = 0; i < n; ++i) {
+        if (!(values[first + i] >= 0.0f && values[first + i] <= 1.0f)) {
+            return crisp::Error{crisp::ErrorCode::invalid_argument,
+                                std::string(option) + ": colour components are in [0, 1] (sRGB, straight alpha); '" +
+                                    crisp::cli::printable(text) + "' is not"};
+        }
+        color[i] = values[first + i];
+    }
+    if (n == 3) color[3] = 1.0f;
+    return {};
+}
+
+// "WIDTH[,R,G,B[,A]]": an outline (its placement and join come from their own options).
+crisp::Result<crisp::TextOutline> parse_outline(std::string_view text) {
+    const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>("--outline", text);
+    if (!values) return values.error();
+    crisp::TextOutline outline;
+    if (values->empty() || !((*values)[0] >= 0.0f && (*values)[0] <= crisp::kMaxEffectWidth)) {
+        return crisp::Error{crisp::ErrorCode::invalid_argument,
+                            "--outline: WIDTH is pixels in [0, 4096], not '" + crisp::cli::printable(text) + "'"};
+    }
+    outline.width = (*values)[0];
+    if (crisp::Status s = colour_after("--outline", text, *values, 1, outline.color); !s) return s.error();
+    return outline;
+}
+
+// "DX,DY,BLUR[,R,G,B[,A]]": a drop shadow; BLUR must be 0 (a hard shadow) until blurred ones are built.
+crisp::Result<crisp::TextShadow> parse_shadow(std::string_view text) {
+    const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>("--shadow", text);
+    if (!values) return values.error();
+    if (values->size() < 3) {
+        return crisp::Error{crisp::ErrorCode::invalid_argument,
+                            "--shadow takes DX,DY,BLUR[,R,G,B[,A]], not '" + crisp::cli::printable(text) + "'"};
+    }
+    crisp::TextShadow shadow;
+    for (size_t i = 0; i < 2; ++i) {
+        if (!(std::abs((*values)[i]) <= crisp::kMaxShadowOffset)) {
+            return crisp::Error{
+                crisp::ErrorCode::invalid_argument,
+                "--shadow: DX and DY are pixels in [-4096, 4096], not '" + crisp::cli::printable(text) + "'"};
+        }
+    }
+    shadow.offset_x = (*values)[0];
+    shadow.offset_y = (*values)[1];
+    if ((*values)[2] != 0.0f) {
+        return crisp::Error{crisp::ErrorCode::invalid_argument,
+                            "--shadow: BLUR must be 0: blurred shadows are not built yet (docs/effects.md), only hard "
+                            "ones"};
+    }
+    if (crisp::Status s = colour_after("--shadow", text, *values, 3, shadow.color); !s) return s.error();
+    return shadow;
+}
+
+// The command line's text's effects; nullopt where none was asked for.
+std::optional<crisp::TextEffects> effects_of(const Arguments& args) {
+    if (!args.outline && !args.shadow && !args.weight) return std::nullopt;
+    crisp::TextEffects effects;
+    effects.weight = args.weight.value_or(0.0f);
+    effects.outline = args.outline;
+    if (effects.outline) {
+        effects.outline->placement = args.outline_placement;
+        effects.outline->join = args.outline_join;
+        effects.outline->miter_limit = args.miter_limit;
+    }
+    effects.shadow = args.shadow;
+    return effects;
 }
 
 // "A,B,C,D": a 2x2 linear part that valid_transform() accepts.
@@ -273,6 +361,46 @@ void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
                "degrees clockwise, -1,0,0,1 mirrors it; |A D - B C| at least 2^-16\n"
                "(docs/transforms.md)",
                store(args.transform, [](std::string_view text) { return parse_transform(text); }));
+    cli.option("--outline", "WIDTH[,R,G,B[,A]]",
+               "an outline WIDTH pixels wide in the colour (as --color; default\n"
+               "0,0,0,1), outside the glyph (the band between its edge and its edge\n"
+               "grown by WIDTH), drawn under it; exact at every size (docs/effects.md)",
+               store(args.outline, [](std::string_view text) { return parse_outline(text); }));
+    cli.choice<crisp::OutlinePlacement>(
+        "--outline-placement", "outside|inside|centred",
+        "where the outline lies: outside the glyph (default, under it), inside\n"
+        "it, or centred on its edge (both over it)",
+        args.outline_placement,
+        {crisp::OutlinePlacement::outside, crisp::OutlinePlacement::inside, crisp::OutlinePlacement::centred},
+        [](const crisp::OutlinePlacement& p) { return std::string(crisp::outline_placement_name(p)); });
+    cli.choice<crisp::LineJoin>("--outline-join", "round|miter|bevel",
+                                "how the outline turns corners (default round; miter keeps them sharp\n"
+                                "up to --miter-limit)",
+                                args.outline_join,
+                                {crisp::LineJoin::round, crisp::LineJoin::miter, crisp::LineJoin::bevel},
+                                [](const crisp::LineJoin& j) { return std::string(crisp::line_join_name(j)); });
+    cli.number<float>("--miter-limit", "L",
+                      "miter joins: corners whose miter ratio 1/sin(angle/2) passes L are\n"
+                      "bevelled, in [1, 128] (default 4)",
+                      args.miter_limit, {1.0f, crisp::kMaxMiterLimit});
+    cli.option("--shadow", "DX,DY,BLUR[,R,G,B[,A]]",
+               "a drop shadow: the text (with its outline) moved by DX,DY pixels, in\n"
+               "the colour (default 0,0,0,0.5), under it; BLUR must be 0 (blurred\n"
+               "shadows are not built yet)",
+               store(args.shadow, [](std::string_view text) { return parse_shadow(text); }));
+    cli.option("--weight", "PX",
+               "grow (positive) or shrink (negative) every stem by PX pixels on each\n"
+               "side: bolder or thinner text from the same font",
+               store(args.weight, [](std::string_view text) -> crisp::Result<float> {
+                   const crisp::Result<std::vector<float>> v = crisp::cli::parse_number_list<float>("--weight", text);
+                   if (!v) return v.error();
+                   if (v->size() != 1 || !(std::abs((*v)[0]) <= crisp::kMaxEffectWidth)) {
+                       return crisp::Error{
+                           crisp::ErrorCode::invalid_argument,
+                           "--weight: PX is pixels in [-4096, 4096], not '" + crisp::cli::printable(text) + "'"};
+                   }
+                   return (*v)[0];
+               }));
     cli.flag("--no-colour",
              "draw colour glyphs (COLR layers, bitmap emoji) as their plain outline in\n"
              "the text colour, as fonts without colour tables are drawn",
@@ -317,7 +445,8 @@ void check_text_source(const crisp::cli::CommandLine& cli, const Arguments& args
         // The scene says all of these; a second source would leave one of them ignored.
         std::string given;
         for (const char* name : {"--font", "--text", "--size", "--origin", "--canvas", "--color", "--background",
-                                 "--palette", "--layout", "--transform"}) {
+                                 "--palette", "--layout", "--transform", "--outline", "--outline-placement",
+                                 "--outline-join", "--miter-limit", "--shadow", "--weight"}) {
             if (cli.given(name)) given += std::string(given.empty() ? "" : ", ") + name;
         }
         if (!given.empty()) {
@@ -335,6 +464,14 @@ void check_text_source(const crisp::cli::CommandLine& cli, const Arguments& args
     if (!args.size) cli.fail("no --size given");
     if (!args.origin) cli.fail("no --origin given");
     if (!args.canvas) cli.fail("no --canvas given");
+    if (!args.outline &&
+        (cli.given("--outline-placement") || cli.given("--outline-join") || cli.given("--miter-limit")))
+        cli.fail("--outline-placement, --outline-join and --miter-limit shape --outline: give it too");
+    if (const std::optional<crisp::TextEffects> effects = effects_of(args)) {
+        if (crisp::Status valid = crisp::validate_text_effects(*effects, *args.size); !valid) {
+            cli.fail(valid.error().message);
+        }
+    }
 }
 
 Arguments parse_arguments(int argc, char** argv) {
@@ -447,6 +584,7 @@ struct Job {
         size_t first = 0, count = 0;  // in glyphs
         std::optional<crisp::TextContrast> contrast;
         std::optional<crisp::TextTransform> transform;  // a run's, about its origin
+        std::optional<crisp::TextEffects> effects;      // a run's
     };
     std::vector<Draw> draws;
     size_t laid_out = 0;  // instances the text layouts produced, culled ones included
@@ -698,7 +836,26 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
     info.layout = job.subpixel_layout;
     info.atlas.max_samples = args.samples;
     for (uint32_t& samples : info.atlas.ramp) samples = std::min(samples, args.samples);
-    report.atlas_side = atlas_side_for(job.glyphs);
+    // Effect layers take atlas entries of their own: the outline's and the shadow's (the glyph with
+    // its outline), each as large as the glyph grown by the outline's reach.
+    std::vector<crisp::GlyphInstance> entries = job.glyphs;
+    for (const Job::Draw& draw : job.draws) {
+        if (!draw.effects) continue;
+        const crisp::TextEffects& e = *draw.effects;
+        const float reach = (e.outline ? e.outline->width : 0.0f) + std::max(e.weight, 0.0f);
+        const auto grow = static_cast<uint32_t>(2.0f * std::ceil(reach) + 2.0f);
+        for (size_t i = draw.first; i < draw.first + draw.count; ++i) {
+            for (uint32_t layer = 1; layer <= 2; ++layer) {
+                crisp::GlyphInstance g = job.glyphs[i];
+                if (g.width == 0 || g.height == 0) continue;
+                g.key.effect = layer;  // a key apart from the glyph's
+                g.width += grow;
+                g.height += grow;
+                entries.push_back(g);
+            }
+        }
+    }
+    report.atlas_side = atlas_side_for(entries);
     info.atlas.width = info.atlas.height = report.atlas_side;
     info.contrast = job.contrast;
 
@@ -726,7 +883,7 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
             const VkRect2D canvas{{0, 0}, {job.scene.width, job.scene.height}};
             for (const Job::Draw& draw : job.draws) {
                 const std::span<const crisp::GlyphInstance> glyphs(job.glyphs.data() + draw.first, draw.count);
-                if (!draw.contrast && !draw.transform) {
+                if (!draw.contrast && !draw.transform && !draw.effects) {
                     renderer.draw(glyphs, canvas);
                     continue;
                 }
@@ -734,6 +891,7 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
                 options.visible = canvas;
                 options.contrast = draw.contrast;
                 options.transform = draw.transform;
+                options.effects = draw.effects;
                 renderer.draw(glyphs, options);
             }
         },
@@ -900,6 +1058,13 @@ void write_glyphs_and_timings(crisp::JsonWriter& json, const Summary& s) {
         .field("blank", job.blank)
         .field("out_of_range", job.out_of_range)
         .end_object();
+    json.key("effects").begin_object();
+    json.field("layers", last.effect_layers)
+        .field("texels", last.effect_texels)
+        .field("failed", last.failed_effects)
+        .field("derived_glyphs", last.derived_glyphs)
+        .field("derived_bytes", last.derived_bytes)
+        .end_object();
     json.key("colour").begin_object();
     json.field("enabled", !s.args->no_colour)
         .field("glyphs", job.colour_glyphs)
@@ -1044,6 +1209,12 @@ void print_human(const Summary& s) {
                     job.colour_glyphs, job.colour_layers, r.last_frame.colour_layers, r.last_frame.frame_paints,
                     static_cast<unsigned long long>(r.total_bitmap_uploads), r.max_bitmap_misses);
     }
+    if (r.last_frame.effect_layers > 0 || r.last_frame.failed_effects > 0) {
+        std::printf("  effects  %u layers (%llu texels), %u derived outlines (%llu bytes), %u failed\n",
+                    r.last_frame.effect_layers, static_cast<unsigned long long>(r.last_frame.effect_texels),
+                    r.last_frame.derived_glyphs, static_cast<unsigned long long>(r.last_frame.derived_bytes),
+                    r.last_frame.failed_effects);
+    }
     std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)\n", static_cast<unsigned long long>(r.frames),
                 frame_total, r.frames ? frame_total / static_cast<double>(r.frames) : 0.0);
     std::printf("  blend    %s\n", human_composite(args, r.composite).c_str());
@@ -1072,6 +1243,7 @@ crisp::Scene scene_from_arguments(const Arguments& args) {
     if (args.color) std::copy(args.color->begin(), args.color->end(), run.color);
     scene.palette = run.palette = args.palette.value_or(0);
     run.transform = args.transform;
+    run.effects = effects_of(args);
     scene.runs.push_back(std::move(run));
     return scene;
 }
@@ -1126,8 +1298,9 @@ void lay_out(const Arguments& args, Job& job) {
             const auto& m = *run.transform;
             transform = crisp::TextTransform{m[0], m[1], m[2], m[3], run.origin_x, run.origin_y};
         }
-        if (job.draws.empty() || job.draws.back().contrast != run.contrast || transform || job.draws.back().transform) {
-            job.draws.push_back({job.glyphs.size(), 0, run.contrast, transform});
+        if (job.draws.empty() || job.draws.back().contrast != run.contrast || transform || job.draws.back().transform ||
+            run.effects != job.draws.back().effects) {
+            job.draws.push_back({job.glyphs.size(), 0, run.contrast, transform, run.effects});
         }
         const size_t before = job.glyphs.size();
         for (const crisp::GlyphInstance& glyph : text.glyphs) {

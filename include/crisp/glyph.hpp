@@ -52,6 +52,10 @@ struct GlyphKey {
     // axis-aligned key, so it shares entries with untransformed text.
     int32_t linear[4] = {};
     int32_t perspective[2] = {};
+    // 0: the glyph's own outline. Otherwise an effect layer's outline derived from it (an outline,
+    // a weight: include/crisp/effects.hpp, docs/effects.md), its shape coded by the renderer:
+    // keys of the same glyph, size and offset with equal codes share their atlas entry.
+    uint32_t effect = 0;
     friend bool operator==(const GlyphKey&, const GlyphKey&) = default;
 };
 

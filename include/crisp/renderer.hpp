@@ -27,6 +27,7 @@
 #include <crisp/atlas.hpp>
 #include <crisp/contrast.hpp>
 #include <crisp/device_features.hpp>
+#include <crisp/effects.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 #include <crisp/result.hpp>
@@ -174,6 +175,14 @@ struct DrawOptions {
     // valid_plane() refuses, or a plane together with a transform, draws nothing (skipped_glyphs).
     // Glyphs already transformed (a key with a linear part) are not transformed again: skipped.
     std::optional<TextPlane> plane;
+    // An outline, a hard drop shadow and a weight for every glyph (effects.hpp, docs/effects.md):
+    // each a layer of the glyph at its depth, under or over it (DrawnGlyph::stack), its outline
+    // derived from the glyph's on the CPU and cached per glyph and shape in em until its font is
+    // removed. Effects validate_text_effects() refuses draw nothing (skipped_glyphs); a glyph whose
+    // effect reaches past kMaxEffectReachEm, or whose stroke passes limits::kMaxStrokeCurves, is
+    // drawn without that layer (failed_effects). Colour glyphs' layers take no effects (a bitmap
+    // glyph has no outline): they are drawn as they are, and count in failed_effects.
+    std::optional<TextEffects> effects;
 };
 
 // Subpixel steps per pixel of moving text (DrawOptions::id).
@@ -208,6 +217,13 @@ struct FrameStop {
     float offset = 0.0f;
 };
 
+// DrawnGlyph::stack, back to front: at equal depth and paint order a layer of a smaller stack lies
+// behind one of a larger.
+inline constexpr uint32_t kStackShadow = 0;        // a drop shadow (TextEffects::shadow)
+inline constexpr uint32_t kStackOutlineUnder = 2;  // an outside outline
+inline constexpr uint32_t kStackGlyph = 3;         // the glyph (or its colour layers), weighted or not
+inline constexpr uint32_t kStackOutlineOver = 4;   // an inside or centred outline
+
 // A glyph drawn this frame whose rect holds samples: where its texels are in the atlas.
 // A glyph drawn clipped (draw() with a visible rect) shows only the texels inside that rect:
 // `instance` then describes that part (x, y, width and height narrowed to it), and part_x, part_y
@@ -227,6 +243,10 @@ struct DrawnGlyph {
     GlyphContrast contrast;
     // A colour layer's fill: an index in DrawnFrame::paints; kNoPaint: instance.color.
     uint32_t paint = kNoPaint;
+    // Where it lies among the layers of its depth and paint order (kStack*): effect layers under
+    // their glyph take the paint order of their draw's first glyph, those over it its last, so
+    // that every shadow and outside outline of a draw lies under every glyph of it.
+    uint32_t stack = kStackGlyph;
 };
 
 // What a recorded frame hands the compositor (Renderer::drawn_frame(), Compositor::record()): the
@@ -299,6 +319,16 @@ struct RendererStats {
     uint64_t curve_tests = 0;     // the atlas's estimate of this frame's curve tests (at most the
                                   // atlas frame_budget, or one texel's sample)
     uint64_t upload_bytes = 0;    // bytes copied into GPU buffers while recording this frame
+    // Effects (DrawOptions::effects): the effect layers drawn this frame (among drawn_glyphs) and
+    // the atlas texels their rects take; layers not drawn (past kMaxEffectReachEm, a stroke past
+    // limits::kMaxStrokeCurves, a colour glyph's layer); and the derived outlines held for them,
+    // those made this frame and their bytes on the GPU.
+    uint32_t effect_layers = 0;
+    uint64_t effect_texels = 0;
+    uint32_t failed_effects = 0;
+    uint32_t derived_glyphs = 0;
+    uint32_t derived_made = 0;
+    uint64_t derived_bytes = 0;
 };
 
 class CRISP_API Renderer {

@@ -41,6 +41,7 @@ gpu::CompositeQuad make_quad(const DrawnGlyph& glyph, size_t paint_count) {
     q.contrast_darkening = used.darkening;
     // A paint index past the frame's paints (a DrawnGlyph made by hand) fills with the colour.
     q.paint = glyph.paint < paint_count ? glyph.paint : gpu::kNoQuadPaint;
+    q.stack = glyph.stack;
     return q;
 }
 
@@ -56,7 +57,7 @@ bool reaches(const GlyphInstance& g, uint32_t width, uint32_t height) {
 
 // Everything a quad's fragments depend on, most significant first: the sort key.
 auto content(const gpu::CompositeQuad& q) {
-    return std::make_tuple(q.key_depth, ~q.rank, q.y, q.x, q.height, q.width, q.atlas_y, q.atlas_x, q.color.w,
+    return std::make_tuple(q.key_depth, ~q.rank, ~q.stack, q.y, q.x, q.height, q.width, q.atlas_y, q.atlas_x, q.color.w,
                            q.color.x, q.color.y, q.color.z, q.paint);
 }
 
@@ -98,6 +99,7 @@ void rank_quads(std::span<const DrawnGlyph> glyphs, size_t paint_count, std::vec
     struct Order {
         uint32_t depth;
         uint32_t paint_order;
+        uint32_t stack;
         uint32_t quad;
     };
     std::vector<Order> orders;
@@ -105,20 +107,21 @@ void rank_quads(std::span<const DrawnGlyph> glyphs, size_t paint_count, std::vec
     for (const DrawnGlyph& glyph : glyphs) {
         const GlyphInstance& instance = glyph.instance;
         if (instance.width == 0 || instance.height == 0) continue;
-        orders.push_back({depth_bits(instance.depth, 32), instance.paint_order, static_cast<uint32_t>(out.size())});
+        orders.push_back(
+            {depth_bits(instance.depth, 32), instance.paint_order, glyph.stack, static_cast<uint32_t>(out.size())});
         out.push_back(make_quad(glyph, paint_count));
     }
     // Paint orders become dense ranks within each depth plane; each block of 256 ranks is also one
     // depth step nearer, as the first compositor's 8-bit paint-order keys needed.
     std::sort(orders.begin(), orders.end(), [](const Order& a, const Order& b) {
-        return std::tie(a.depth, a.paint_order) < std::tie(b.depth, b.paint_order);
+        return std::tie(a.depth, a.paint_order, a.stack) < std::tie(b.depth, b.paint_order, b.stack);
     });
     uint32_t rank = 0;
     for (size_t i = 0; i < orders.size(); ++i) {
         const Order& o = orders[i];
         if (i == 0 || o.depth != orders[i - 1].depth) {
             rank = 0;
-        } else if (o.paint_order != orders[i - 1].paint_order) {
+        } else if (o.paint_order != orders[i - 1].paint_order || o.stack != orders[i - 1].stack) {
             ++rank;
         }
         gpu::CompositeQuad& q = out[o.quad];

@@ -23,7 +23,8 @@ uint32_t depth_bits(float depth, int bits);
 gpu::CompositeQuad make_quad(const DrawnGlyph& glyph, size_t paint_count);
 
 // The glyphs whose rects reach [0, width) x [0, height), as quads sorted front to back: depth
-// ascending, then paint order descending (later in front), then by content (rect, atlas position,
+// ascending, then paint order descending (later in front), then stack descending (DrawnGlyph::stack: an
+// effect layer under its glyph behind it), then by content (rect, atlas position,
 // colour, paint), so that the order, and with it a quad's index, depends only on the set of glyphs and
 // never on their submission order. A quad's index in `out` is then its compositing key. Rects
 // wider or taller than 65535 are left out (the renderer's are at most a few thousand).
@@ -35,7 +36,7 @@ void sort_front_to_back(std::span<const DrawnGlyph> glyphs, size_t paint_count, 
 uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height);
 
 // The reference modes' quads, in submission order, with the exact mode's key: paint orders become
-// dense ranks per depth plane.
+// dense ranks of (paint order, stack) per depth plane.
 void rank_quads(std::span<const DrawnGlyph> glyphs, size_t paint_count, std::vector<gpu::CompositeQuad>& out);
 
 }  // namespace crisp::composite

@@ -1,5 +1,7 @@
 #include "raster/font_store.hpp"
 
+#include "text/effect_code.hpp"
+
 #include <algorithm>
 #include <cstring>
 #include <optional>
@@ -63,18 +65,8 @@ Status FontStore::place(GpuFont& font) {
     return place(font);
 }
 
-Status FontStore::add(const Font& font) {
-    if (font_slot_.count(font.id()) && std::find(removals_.begin(), removals_.end(), font.id()) == removals_.end()) {
-        return Error{ErrorCode::invalid_argument,
-                     "renderer: a font with id " + std::to_string(font.id()) + " was added already"};
-    }
-    if (font_slot_.count(font.id())) {
-        return Error{ErrorCode::invalid_argument, "renderer: the font with id " + std::to_string(font.id()) +
-                                                      " is removed at the next begin_frame(); add it after that"};
-    }
-    const FontAsset& asset = font.asset();
-    GpuFont gpu;
-    gpu.asset = &asset;
+Status FontStore::stage(GpuFont& gpu) {
+    const FontAsset& asset = *gpu.asset;
     gpu.points_bytes = asset.points.size() * sizeof(Point);
     gpu.flat_row_of.assign(asset.glyphs.size(), kNoFlatRow);
     for (size_t g = 0; g < asset.glyphs.size(); ++g) {
@@ -108,6 +100,10 @@ Status FontStore::add(const Font& font) {
         std::memcpy(bytes + gpu.points_bytes + asset_band_bytes, gpu.flat_words.data(),
                     gpu.flat_words.size() * sizeof(uint32_t));
     }
+    return {};
+}
+
+uint32_t FontStore::keep(GpuFont&& gpu) {
     // A removed font's place is taken again before the list grows.
     const auto free_place = std::find_if(fonts_.begin(), fonts_.end(), [](const GpuFont& f) { return !f.asset; });
     const auto index = static_cast<uint32_t>(free_place - fonts_.begin());
@@ -116,7 +112,88 @@ Status FontStore::add(const Font& font) {
     } else {
         *free_place = std::move(gpu);
     }
-    font_slot_[font.id()] = index;
+    return index;
+}
+
+Status FontStore::add(const Font& font) {
+    if (font_slot_.count(font.id()) && std::find(removals_.begin(), removals_.end(), font.id()) == removals_.end()) {
+        return Error{ErrorCode::invalid_argument,
+                     "renderer: a font with id " + std::to_string(font.id()) + " was added already"};
+    }
+    if (font_slot_.count(font.id())) {
+        return Error{ErrorCode::invalid_argument, "renderer: the font with id " + std::to_string(font.id()) +
+                                                      " is removed at the next begin_frame(); add it after that"};
+    }
+    GpuFont gpu;
+    gpu.asset = &font.asset();
+    if (Status staged = stage(gpu); !staged) return staged;
+    font_slot_[font.id()] = keep(std::move(gpu));
+    return {};
+}
+
+HeldGlyph FontStore::glyph(const GlyphKey& key) const {
+    if (key.effect == 0) return HeldFonts::glyph(key);
+    HeldGlyph held;
+    const auto slot = derived_slot_.find({key.font, key.glyph, key.effect, effect_octave(key)});
+    if (slot == derived_slot_.end()) return held;
+    const GpuFont& font = fonts_[slot->second];
+    held.font = &font;
+    held.record = &font.derived->glyphs.front();
+    held.flat_row = font.flat_rows.empty() ? kNoFlatRow : font.flat_rows.front();
+    held.set_b_first = font.set_b_first;
+    held.op = font.op;
+    held.derived = true;
+    return held;
+}
+
+Status FontStore::derive(const GlyphKey& key) {
+    const DerivedKey id{key.font, key.glyph, key.effect, effect_octave(key)};
+    if (const auto held = derived_slot_.find(id); held != derived_slot_.end()) {
+        fonts_[held->second].last_used = frame_;
+        return {};
+    }
+    const HeldFont* source = find(key.font);
+    if (key.effect == 0 || !source || !source->asset || key.glyph >= source->asset->glyphs.size()) {
+        return Error{ErrorCode::invalid_argument, "renderer: no glyph " + std::to_string(key.glyph) + " of font " +
+                                                      std::to_string(key.font) + " to derive an effect from"};
+    }
+    Result<DerivedGlyph> made =
+        derive_effect_glyph(*source->asset, source->asset->glyphs[key.glyph], key.effect, effect_tolerance(id.octave));
+    if (!made) return made.error();
+    const uint64_t bytes = made->points.size() * sizeof(Point) + made->band_words.size() * sizeof(uint32_t);
+    // Room: derived glyphs not drawn this frame go, least lately drawn first.
+    while (derived_bytes_ + bytes > kMaxDerivedBytes || derived_slot_.size() >= kMaxDerivedGlyphs) {
+        uint32_t oldest = UINT32_MAX;
+        for (const auto& [k, slot] : derived_slot_) {
+            if (fonts_[slot].last_used < frame_ &&
+                (oldest == UINT32_MAX || fonts_[slot].last_used < fonts_[oldest].last_used)) {
+                oldest = slot;
+            }
+        }
+        if (oldest == UINT32_MAX || !retired_) {
+            return Error{ErrorCode::invalid_argument,
+                         "renderer: this frame's derived glyphs (effects) take all of their " +
+                             std::to_string(kMaxDerivedBytes >> 20) + " MiB"};
+        }
+        forget_derived(oldest, *retired_, frame_);
+    }
+    auto asset = std::make_unique<FontAsset>();
+    made->record.point_offset = 0;
+    made->record.band_offset = 0;
+    asset->glyphs.push_back(made->record);
+    asset->points = std::move(made->points);
+    asset->band_words = std::move(made->band_words);
+    GpuFont gpu;
+    gpu.asset = asset.get();
+    gpu.derived = std::move(asset);
+    gpu.source = key.font;
+    gpu.set_b_first = made->set_b_first;
+    gpu.op = decode_effect(key.effect).op;
+    gpu.last_used = frame_;
+    if (Status staged = stage(gpu); !staged) return staged;
+    derived_bytes_ += gpu.points_bytes + gpu.bands_bytes;
+    ++derived_made_;
+    derived_slot_[id] = keep(std::move(gpu));
     return {};
 }
 
@@ -128,19 +205,42 @@ Status FontStore::remove(FontId id) {
     return {};
 }
 
+void FontStore::release(uint32_t slot, RetireLists& retired, uint64_t frame) {
+    GpuFont& font = fonts_[slot];
+    if (font.staging.buffer) retired.buffers.push_back({std::move(font.staging), frame});
+    retired.ranges.push_back(
+        {font.page, {font.points_at, font.points_bytes}, {font.bands_at, font.bands_bytes}, frame});
+    font = GpuFont{};
+}
+
+void FontStore::forget_derived(uint32_t slot, RetireLists& retired, uint64_t frame) {
+    const GpuFont& font = fonts_[slot];
+    derived_bytes_ -= font.points_bytes + font.bands_bytes;
+    std::erase_if(derived_slot_, [&](const auto& d) { return d.second == slot; });
+    release(slot, retired, frame);
+}
+
 void FontStore::apply_removals(GlyphAtlas& atlas, RetireLists& retired, uint64_t frame) {
     for (FontId id : removals_) {
         const auto slot = font_slot_.find(id);
         if (slot == font_slot_.end()) continue;
-        GpuFont& font = fonts_[slot->second];
-        atlas.evict_font(id);
-        if (font.staging.buffer) retired.buffers.push_back({std::move(font.staging), frame});
-        retired.ranges.push_back(
-            {font.page, {font.points_at, font.points_bytes}, {font.bands_at, font.bands_bytes}, frame});
-        font = GpuFont{};
+        atlas.evict_font(id);  // its effect layers' entries too: their keys name it
+        release(slot->second, retired, frame);
         font_slot_.erase(slot);
+        for (uint32_t i = 0; i < fonts_.size(); ++i) {
+            if (fonts_[i].derived && fonts_[i].source == id) forget_derived(i, retired, frame);
+        }
     }
     removals_.clear();
+}
+
+void FontStore::begin_frame(RetireLists& retired, uint64_t frame) {
+    retired_ = &retired;
+    frame_ = frame;
+    derived_made_ = 0;
+    for (uint32_t i = 0; i < fonts_.size(); ++i) {
+        if (fonts_[i].derived && frame > fonts_[i].last_used + kForgetDerivedFrames) forget_derived(i, retired, frame);
+    }
 }
 
 bool FontStore::record_uploads(VkCommandBuffer command_buffer, uint64_t this_frame, RetireLists& retired,

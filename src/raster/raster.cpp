@@ -54,6 +54,23 @@ float orientation(const Projective& map) {
     return det > 0.0 ? 1.0f : -1.0f;
 }
 
+// The truth table raster.comp covers by for a derived glyph of `op`.
+uint32_t cover_rule(StrokeOp op) {
+    switch (op) {
+        case StrokeOp::a:
+            return gpu::kRasterCoverA;
+        case StrokeOp::a_not_b:
+            return gpu::kRasterCoverAOutsideB;
+        case StrokeOp::a_and_b:
+            return gpu::kRasterCoverAInsideB;
+        case StrokeOp::a_or_b:
+            return gpu::kRasterCoverAOrB;
+        case StrokeOp::b_not_a:
+            return gpu::kRasterCoverBOutsideA;
+    }
+    return gpu::kRasterCoverA;
+}
+
 }  // namespace
 
 uint32_t item_kind(const GlyphKey& key) {
@@ -76,17 +93,19 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
     for (uint32_t kind = 0; kind < kRasterItemKinds; ++kind) {
         const uint32_t first_workgroup = workgroups;
         for (const RasterWork& w : work) {
-            const HeldFont* font = fonts.find(w.key.font);
-            if (!font || w.sample_count == 0 || item_kind(w.key) != kind) continue;
-            const GlyphRecord& glyph = font->asset->glyphs[w.key.glyph];
+            if (w.sample_count == 0 || item_kind(w.key) != kind % kRasterGeometryKinds) continue;
+            const HeldGlyph held = fonts.glyph(w.key);
+            if (!held.font || (kind >= kRasterGeometryKinds) != held.derived) continue;
+            const HeldFont* font = held.font;
+            const GlyphRecord& glyph = *held.record;
             const GlyphRect rect = glyph_rect(glyph, w.key);
             gpu::RasterItem item{};
             item.transform = gpu::kRasterNoTransform;
             item.flat_row = gpu::kRasterNoTransform;
-            item.set_b_first = gpu::kRasterNoTransform;
-            item.cover_rule = gpu::kRasterCoverA;
+            item.set_b_first = held.derived ? held.set_b_first : gpu::kRasterNoTransform;
+            item.cover_rule = held.derived ? cover_rule(held.op) : gpu::kRasterCoverA;
             if (is_transformed(w.key)) {
-                const uint32_t row = w.key.glyph < font->flat_rows.size() ? font->flat_rows[w.key.glyph] : kNoFlatRow;
+                const uint32_t row = held.flat_row;
                 if (row != kNoFlatRow) item.flat_row = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + row;
                 const Projective to_texel = em_to_texel(rect, w.key);
                 const Projective to_em = inverse(to_texel);
@@ -189,16 +208,35 @@ Status RasterPass::create(uint32_t cells, uint64_t atlas_texels, RetireLists& re
         return s;
     }
     // Three pipelines of one shader (kTransformedItems, item_kind()): axis-aligned items,
-    // transformed ones, and transformed ones that walk two lines a sample.
-    static constexpr const char* kNames[kRasterItemKinds] = {"raster.comp", "raster.comp (transformed)",
-                                                             "raster.comp (transformed, two lines)"};
+    // transformed ones, and transformed ones that walk two lines a sample. Derived glyphs' three
+    // wait for the first frame that draws one (prepare_pipelines()).
+    for (uint32_t kind = 0; kind < kRasterGeometryKinds; ++kind) {
+        if (Status s = make_pipeline(kind); !s) return s;
+    }
+    return {};
+}
+
+Status RasterPass::make_pipeline(uint32_t kind) {
+    static constexpr const char* kNames[kRasterItemKinds] = {"raster.comp",
+                                                             "raster.comp (transformed)",
+                                                             "raster.comp (transformed, two lines)",
+                                                             "raster.comp (two sets)",
+                                                             "raster.comp (transformed, two sets)",
+                                                             "raster.comp (transformed, two lines, two sets)"};
+    const uint32_t constants[2] = {kind % kRasterGeometryKinds, kind >= kRasterGeometryKinds ? 1u : 0u};
+    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}};
+    const VkSpecializationInfo specialization{2, entries, sizeof constants, constants};
+    Result<VkPipeline> made =
+        vk::create_compute_pipeline(ref_, shader_, descriptors_.pipeline_layout, &specialization, kNames[kind]);
+    if (!made) return made.error();
+    pipelines_[kind] = objects_.keep(ref_, *made);
+    return {};
+}
+
+Status RasterPass::prepare_pipelines() {
     for (uint32_t kind = 0; kind < kRasterItemKinds; ++kind) {
-        const VkSpecializationMapEntry entry{0, 0, sizeof kind};
-        const VkSpecializationInfo specialization{1, &entry, sizeof kind, &kind};
-        Result<VkPipeline> made =
-            vk::create_compute_pipeline(ref_, shader_, descriptors_.pipeline_layout, &specialization, kNames[kind]);
-        if (!made) return made.error();
-        pipelines_[kind] = objects_.keep(ref_, *made);
+        if (kind_workgroups_[kind] == 0 || pipelines_[kind] != VK_NULL_HANDLE) continue;
+        if (Status s = make_pipeline(kind); !s) return s;
     }
     return {};
 }

@@ -23,8 +23,11 @@
 
 namespace crisp::raster {
 
-// The kinds of work item, each rasterized by its own pipeline (raster.comp's kTransformedItems).
-inline constexpr uint32_t kRasterItemKinds = 3;
+// The kinds of work item, each rasterized by its own pipeline: item_kind() (raster.comp's
+// kTransformedItems) for a glyph's own outline, plus kRasterGeometryKinds for a derived glyph's
+// (an effect layer's: two sets of curves, kTwoSetItems).
+inline constexpr uint32_t kRasterGeometryKinds = 3;
+inline constexpr uint32_t kRasterItemKinds = 2 * kRasterGeometryKinds;
 
 // The kind of a glyph's items: 0 for an axis-aligned key, gpu::kRasterTwoLineItems for a
 // transformed one whose em y axis lies within 15 degrees of the rows (its stems run along them,
@@ -62,6 +65,9 @@ public:
     uint32_t build(std::span<const RasterWork> work, const HeldFonts& fonts, const GlyphAtlas& atlas,
                    RendererStats& stats);
     bool has_items() const { return !item_data_.empty(); }
+    // Makes the pipelines of the kinds this frame's items need that are not made yet (derived
+    // glyphs' pipelines are made at the first frame that draws one).
+    Status prepare_pipelines();
     void record_upload(VkCommandBuffer command_buffer, uint64_t this_frame, bool fonts_uploaded, RendererStats& stats);
     void record_dispatch(VkCommandBuffer command_buffer, uint64_t this_frame, VkImageView atlas,
                          std::span<const FontPage> pages, const SubpixelLayout& subpixel);
@@ -72,6 +78,7 @@ private:
     // changes.
     Status make_item_buffers(uint32_t capacity, uint64_t atlas_texels, uint64_t retire_at, RetireLists& retired);
     void write_descriptors(VkDescriptorSet set, VkImageView atlas, std::span<const FontPage> pages);
+    Status make_pipeline(uint32_t kind);
 
     const vk::DeviceRef& ref_;
     RasterOptions options_;
@@ -93,7 +100,8 @@ private:
     vk::DeviceObjects objects_;  // the shader module and the pipeline
     VkShaderModule shader_ = VK_NULL_HANDLE;
     vk::DescriptorSets descriptors_;  // one set per frame in flight
-    // By item_kind(): axis-aligned items, transformed ones, transformed ones of two lines a sample.
+    // By kind: axis-aligned items, transformed ones, transformed ones of two lines a sample; then
+    // the same of derived glyphs.
     std::array<VkPipeline, kRasterItemKinds> pipelines_{};
     std::array<uint32_t, kRasterItemKinds> kind_workgroups_{};  // this frame's workgroups of each kind
 };

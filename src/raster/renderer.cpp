@@ -206,6 +206,7 @@ void Renderer::begin_frame() {
     s.atlas.begin_frame();  // unpins last frame's glyphs, so that removed fonts' entries can go
     for (FontId id : s.fonts.pending_removals()) s.bitmaps.forget_font(id);
     s.fonts.apply_removals(s.atlas, s.retired, s.frame);
+    s.fonts.begin_frame(s.retired, s.frame);
     s.bitmaps.begin_frame(s.frame);
     s.requests.begin_frame();
     s.stats = {};
@@ -257,6 +258,9 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     s.requests.settle(s.limits);
     const std::span<const RasterWork> work = s.atlas.schedule();
     s.requests.collect_drawn();
+    s.stats.derived_glyphs = s.fonts.derived_glyphs();
+    s.stats.derived_made = s.fonts.derived_made();
+    s.stats.derived_bytes = s.fonts.derived_bytes();
     s.paints.resolve(s.requests.drawn_to_fill(), s.fonts, &s.bitmaps, s.stats);
 
     s.recorded = true;
@@ -266,6 +270,7 @@ Status Renderer::record(VkCommandBuffer command_buffer) {
     if (Status prepared = s.prepare_atlas_image(command_buffer, frame); !prepared) return prepared;
     if (Status images = s.bitmaps.record(command_buffer, frame, s.retired, s.stats); !images) return images;
     s.raster.build(work, s.fonts, s.atlas, s.stats);
+    if (Status made = s.raster.prepare_pipelines(); !made) return made;
     s.raster.record_upload(command_buffer, frame, fonts_uploaded, s.stats);
     if (s.raster.has_items()) {
         s.raster.record_dispatch(command_buffer, frame, s.image.image().view, s.fonts.pages(), s.subpixel);

@@ -1,5 +1,7 @@
 #include "raster/requests.hpp"
 
+#include "text/effect_code.hpp"
+
 #include <algorithm>
 #include <cstring>
 #include <cmath>
@@ -12,7 +14,11 @@ bool moved(const FontAsset* asset, GlyphInstance& glyph, double dx, double dy) {
     if (dx == 0.0 && dy == 0.0) return true;
     if (!asset) return true;  // admit() counts it
     if (glyph.key.glyph >= asset->glyphs.size()) return true;
-    const GlyphRecord& record = asset->glyphs[glyph.key.glyph];
+    return moved(asset->glyphs[glyph.key.glyph], glyph, dx, dy);
+}
+
+bool moved(const GlyphRecord& record, GlyphInstance& glyph, double dx, double dy) {
+    if (dx == 0.0 && dy == 0.0) return true;
     const GlyphRect old_rect = glyph_rect(record, glyph.key);
     const double pens[2] = {static_cast<double>(glyph.pen_x) + dx, static_cast<double>(glyph.pen_y) + dy};
     int32_t whole[2] = {glyph.x - old_rect.x, glyph.y - old_rect.y};
@@ -106,13 +112,14 @@ uint64_t shape_of(const DrawOptions& options) {
 
 }  // namespace
 
-FrameRequests::FrameRequests(GlyphAtlas& atlas, const HeldFonts& fonts, Coarsening& coarsening, RendererStats& stats)
+FrameRequests::FrameRequests(GlyphAtlas& atlas, HeldFonts& fonts, Coarsening& coarsening, RendererStats& stats)
     : atlas_(atlas), fonts_(fonts), coarsening_(coarsening), stats_(stats) {}
 
 void FrameRequests::begin_frame() {
     pending_.clear();
     clipped_.clear();
     requests_.clear();
+    effects_.clear();
     atlas_full_ = 0;
     unplaceable_ = 0;
     drawn_.clear();
@@ -126,8 +133,8 @@ void FrameRequests::add(const GlyphInstance& glyph, const VkRect2D* visible, uin
 void FrameRequests::add(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps,
                         const TextContrast& contrast) {
     const GlyphContrast resolved = resolve_contrast(contrast, static_cast<float>(glyph.key.size_x) / 256.0f);
-    requests_.push_back({glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps, resolved});
-    request(glyph, visible, steps, resolved);
+    requests_.push_back({glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps, resolved, kNoEffects});
+    request(glyph, visible, steps, resolved, kNoEffects);
 }
 
 void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions& options, MotionTracker& motion) {
@@ -136,7 +143,8 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
     const bool bad_transform = (options.transform && !valid_transform(*options.transform)) ||
                                (options.plane && !valid_plane(*options.plane)) || (options.transform && options.plane);
     if (!std::isfinite(dx) || !std::isfinite(dy) || bad_transform ||
-        (options.contrast && !validate_text_contrast(*options.contrast))) {
+        (options.contrast && !validate_text_contrast(*options.contrast)) ||
+        (options.effects && !validate_text_effects(*options.effects))) {
         const auto count = static_cast<uint32_t>(std::min<size_t>(glyphs.size(), UINT32_MAX));
         stats_.skipped_glyphs += count;
         unplaceable_ += count;
@@ -162,6 +170,23 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
         }
     }
     const VkRect2D* visible = options.visible ? &*options.visible : nullptr;
+    uint32_t effects = kNoEffects;
+    if (options.effects) {
+        // Layers under the draw's glyphs take its first paint order, those over them its last.
+        DrawEffects fx{*options.effects, UINT32_MAX, 0, {}, {}};
+        for (const GlyphInstance& g : glyphs) {
+            fx.first_order = std::min(fx.first_order, g.paint_order);
+            fx.last_order = std::max(fx.last_order, g.paint_order);
+        }
+        const auto linear = [](const std::array<float, 4>& c, std::array<float, 4>& out) {
+            for (size_t i = 0; i < 3; ++i) out[i] = srgb_to_linear(c[i]);
+            out[3] = c[3];
+        };
+        if (fx.effects.outline) linear(fx.effects.outline->color, fx.outline_color);
+        if (fx.effects.shadow) linear(fx.effects.shadow->color, fx.shadow_color);
+        effects = static_cast<uint32_t>(effects_.size());
+        effects_.push_back(fx);
+    }
     for (const GlyphInstance& asked : glyphs) {
         GlyphInstance glyph = asked;
         float depth = glyph.depth;
@@ -179,7 +204,10 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
         if (options.color) std::copy(std::begin(color), std::end(color), std::begin(glyph.color));
         if (options.depth) glyph.depth = *options.depth;
         if (options.palette) glyph.palette = *options.palette;
-        add(glyph, visible, steps, options.contrast ? *options.contrast : contrast_);
+        const GlyphContrast contrast = resolve_contrast(options.contrast ? *options.contrast : contrast_,
+                                                        static_cast<float>(glyph.key.size_x) / 256.0f);
+        requests_.push_back({glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps, contrast, effects});
+        request(glyph, visible, steps, contrast, effects);
     }
 }
 
@@ -222,11 +250,146 @@ FrameRequests::Placed FrameRequests::place(GlyphInstance& glyph, const DrawOptio
 // One draw()n instance: at the frame's subpixel steps, then culled, admitted whole, or kept
 // for admit_clipped() with its visible part.
 void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps,
-                            const GlyphContrast& contrast) {
-    const GlyphInstance glyph = coarsened(fonts_.asset(asked.key.font), asked, std::min(coarsening_.steps(), steps));
+                            const GlyphContrast& contrast, uint32_t effects) {
+    const uint32_t frame_steps = std::min(coarsening_.steps(), steps);
+    const GlyphInstance glyph = coarsened(fonts_.asset(asked.key.font), asked, frame_steps);
     if (glyph.key != asked.key) ++stats_.coarsened_glyphs;
+    if (effects == kNoEffects) {
+        submit(glyph, visible, contrast, kStackGlyph);
+    } else {
+        request_effects(glyph, visible, frame_steps, contrast, effects_[effects]);
+    }
+}
+
+namespace {
+
+// The effect code of (S(half_width px) op G) at `size` px per em; 0 where the stroke is empty.
+uint32_t effect_code(StrokeOp op, LineJoin join, float miter_limit, double half_width, double size) {
+    if (!(half_width > 0.0)) return 0;
+    EffectShape shape;
+    shape.op = op;
+    shape.join = static_cast<StrokeJoin>(join);
+    shape.miter_limit = miter_limit;
+    shape.half_width = half_width / size;
+    return encode_effect(shape);
+}
+
+static_assert(static_cast<int>(LineJoin::round) == static_cast<int>(StrokeJoin::round) &&
+              static_cast<int>(LineJoin::miter) == static_cast<int>(StrokeJoin::miter) &&
+              static_cast<int>(LineJoin::bevel) == static_cast<int>(StrokeJoin::bevel));
+
+}  // namespace
+
+// A glyph of a draw with effects: its shadow, its outline and its face (weighted), each a layer.
+void FrameRequests::request_effects(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps,
+                                    const GlyphContrast& contrast, const DrawEffects& fx) {
+    const TextEffects& e = fx.effects;
+    const HeldGlyph own = fonts_.glyph(glyph.key);
+    if (!own.record || glyph.width == 0 || glyph.height == 0) {
+        submit(glyph, visible, contrast, kStackGlyph);  // admit() counts it
+        return;
+    }
+    // A colour glyph's layers (and a bitmap glyph) are drawn as they are.
+    if (glyph.paint != kNoPaint || glyph.colour_glyph != kNoColourGlyph) {
+        ++stats_.failed_effects;
+        submit(glyph, visible, contrast, kStackGlyph);
+        return;
+    }
+    const double size = std::sqrt(static_cast<double>(glyph.key.size_x) * glyph.key.size_y) / kSizeOne;
+    const double reach_limit = static_cast<double>(kMaxEffectReachEm) * size;
+    const double weight = static_cast<double>(e.weight), grown = std::max(weight, 0.0);
+    const uint32_t face = std::abs(weight) <= reach_limit
+                              ? effect_code(weight > 0.0 ? StrokeOp::a_or_b : StrokeOp::b_not_a, LineJoin::miter, 4.0f,
+                                            std::abs(weight), size)
+                              : 0;
+    if (face == 0 && weight != 0.0 && std::abs(weight) > reach_limit) ++stats_.failed_effects;
+    // The outline's layer, and the shadow's source: the face with its outline.
+    uint32_t outline = 0, shadow = face;
+    uint32_t outline_stack = kStackOutlineUnder;
+    if (const auto& o = e.outline) {
+        double r = 0.0;
+        StrokeOp op = StrokeOp::a;
+        switch (o->placement) {
+            case OutlinePlacement::outside:
+                r = static_cast<double>(o->width) + grown;
+                op = StrokeOp::a_not_b;
+                break;
+            case OutlinePlacement::inside:
+                r = static_cast<double>(o->width);
+                op = StrokeOp::a_and_b;
+                outline_stack = kStackOutlineOver;
+                break;
+            case OutlinePlacement::centred:
+                r = static_cast<double>(o->width) / 2.0;
+                op = StrokeOp::a;
+                outline_stack = kStackOutlineOver;
+                break;
+        }
+        if (r > reach_limit) {
+            ++stats_.failed_effects;
+        } else {
+            outline = effect_code(op, o->join, o->miter_limit, r, size);
+            if (o->placement != OutlinePlacement::inside && outline != 0) {
+                shadow = effect_code(StrokeOp::a_or_b, o->join, o->miter_limit, std::max(r, grown), size);
+            }
+        }
+    }
+    if (const auto& sh = e.shadow) {
+        // The offset on the glyph's subpixel grid, so that the shadow takes the glyph's steps.
+        const double dx = std::round(static_cast<double>(sh->offset_x) * steps) / steps;
+        const double dy = std::round(static_cast<double>(sh->offset_y) * steps) / steps;
+        submit_layer(glyph, shadow, fx.shadow_color, fx.first_order, kStackShadow, dx, dy, visible, contrast);
+    }
+    if (outline != 0) {
+        const uint32_t order = outline_stack == kStackOutlineUnder ? fx.first_order : fx.last_order;
+        submit_layer(glyph, outline, fx.outline_color, order, outline_stack, 0.0, 0.0, visible, contrast);
+    }
+    if (face == 0) {
+        submit(glyph, visible, contrast, kStackGlyph);
+    } else {
+        const std::array<float, 4> colour{glyph.color[0], glyph.color[1], glyph.color[2], glyph.color[3]};
+        submit_layer(glyph, face, colour, glyph.paint_order, kStackGlyph, 0.0, 0.0, visible, contrast);
+    }
+}
+
+// A layer of `glyph`: its outline derived by `effect` (0: its own), in `colour`, at `order` and
+// `stack`, moved by (dx, dy) pixels.
+void FrameRequests::submit_layer(const GlyphInstance& glyph, uint32_t effect, const std::array<float, 4>& colour,
+                                 uint32_t order, uint32_t stack, double dx, double dy, const VkRect2D* visible,
+                                 const GlyphContrast& contrast) {
+    const HeldGlyph own = fonts_.glyph(glyph.key);
+    GlyphInstance layer = glyph;
+    layer.key.effect = effect;
+    if (effect != 0 && !fonts_.derive(layer.key)) {
+        ++stats_.failed_effects;
+        return;
+    }
+    const HeldGlyph held = effect != 0 ? fonts_.glyph(layer.key) : own;
+    if (!held.record) {
+        ++stats_.failed_effects;
+        return;
+    }
+    // The derived outline's rect about the same pen.
+    const GlyphRect own_rect = glyph_rect(*own.record, glyph.key), rect = glyph_rect(*held.record, layer.key);
+    layer.x = glyph.x - own_rect.x + rect.x;
+    layer.y = glyph.y - own_rect.y + rect.y;
+    layer.width = rect.width;
+    layer.height = rect.height;
+    if (!moved(*held.record, layer, dx, dy)) {
+        ++stats_.failed_effects;
+        return;
+    }
+    std::copy(colour.begin(), colour.end(), std::begin(layer.color));
+    layer.paint_order = order;
+    submit(layer, visible, contrast, stack);
+}
+
+// One instance at its final key: culled, admitted whole, or kept for admit_clipped() with its
+// visible part.
+void FrameRequests::submit(const GlyphInstance& glyph, const VkRect2D* visible, const GlyphContrast& contrast,
+                           uint32_t stack) {
     if (!visible) {
-        admit(glyph, TexelRect{0, 0, glyph.width, glyph.height}, contrast);
+        admit(glyph, TexelRect{0, 0, glyph.width, glyph.height}, contrast, stack);
         return;
     }
     if (glyph.width == 0 || glyph.height == 0) return;
@@ -243,10 +406,10 @@ void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible,
     const TexelRect part{static_cast<uint32_t>(x0), static_cast<uint32_t>(y0), static_cast<uint32_t>(x1 - x0),
                          static_cast<uint32_t>(y1 - y0)};
     if (part.width == glyph.width && part.height == glyph.height) {
-        admit(glyph, part, contrast);
+        admit(glyph, part, contrast, stack);
     } else {
         ++stats_.clipped_glyphs;
-        clipped_.push_back({glyph, part, contrast});
+        clipped_.push_back({glyph, part, contrast, stack});
     }
 }
 
@@ -255,19 +418,15 @@ void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible,
 // `shown` (within `part`; nullptr: all the atlas holds) is what drawn() reports of it: a
 // clipped glyph shows only its visible texels, though the atlas holds a margin around them.
 void FrameRequests::admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
-                          const TexelRect* shown) {
+                          uint32_t stack, const TexelRect* shown) {
     if (glyph.width == 0 || glyph.height == 0) return;
-    const FontAsset* asset = fonts_.asset(glyph.key.font);
-    if (!asset) {
-        ++stats_.unknown_fonts;
+    const HeldGlyph outline = fonts_.glyph(glyph.key);
+    if (!outline.record) {
+        if (!fonts_.find(glyph.key.font)) ++stats_.unknown_fonts;
         ++stats_.skipped_glyphs;
         return;
     }
-    if (glyph.key.glyph >= asset->glyphs.size()) {
-        ++stats_.skipped_glyphs;
-        return;
-    }
-    const AtlasLookup lookup = look_up_or_place(*asset, glyph, part);
+    const AtlasLookup lookup = look_up_or_place(*outline.font->asset, *outline.record, glyph, part);
     if (lookup.status == AtlasStatus::placed) {
         const TexelRect& held = lookup.part;
         TexelRect show = held;
@@ -280,6 +439,7 @@ void FrameRequests::admit(const GlyphInstance& glyph, const TexelRect& part, con
         }
         DrawnGlyph placed{glyph,   lookup.x + (show.x - held.x), lookup.y + (show.y - held.y), 0, show.x, show.y,
                           contrast};
+        placed.stack = stack;
         placed.instance.x += static_cast<int32_t>(show.x);
         placed.instance.y += static_cast<int32_t>(show.y);
         placed.instance.width = show.width;
@@ -294,12 +454,13 @@ void FrameRequests::admit(const GlyphInstance& glyph, const TexelRect& part, con
 
 // GlyphAtlas::acquire for one instance whose `part` is visible, with the curve tests it costs
 // where the atlas may place it anew.
-AtlasLookup FrameRequests::look_up_or_place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part) {
+AtlasLookup FrameRequests::look_up_or_place(const FontAsset& asset, const GlyphRecord& record,
+                                            const GlyphInstance& glyph, const TexelRect& part) {
     // Only a glyph the atlas may place anew needs its cost: a new one, or one held in part.
     uint64_t cost = 0;
     const AtlasEntry* resident = atlas_.entry(atlas_.find(glyph.key));
     if (!resident || resident->part.width != resident->width || resident->part.height != resident->height)
-        cost = curve_tests_per_sample(asset, asset.glyphs[glyph.key.glyph], glyph.key);
+        cost = curve_tests_per_sample(asset, record, glyph.key);
     return atlas_.acquire(glyph.key, glyph.width, glyph.height, cost, part);
 }
 
@@ -330,7 +491,7 @@ void FrameRequests::admit_clipped() {
         for (size_t i = first; i < end; ++i) clipped_parts_[clipped_order_[i]] = box;
     }
     for (size_t i = 0; i < clipped_.size(); ++i) {
-        admit(clipped_[i].glyph, clipped_parts_[i], clipped_[i].contrast, &clipped_[i].part);
+        admit(clipped_[i].glyph, clipped_parts_[i], clipped_[i].contrast, clipped_[i].stack, &clipped_[i].part);
     }
     clipped_.clear();
 }
@@ -357,7 +518,9 @@ void FrameRequests::settle(const AtlasLimits& limits) {
         stats_.atlas_grown = asked.atlas_grown;
         stats_.skipped_glyphs = unplaceable_;
         atlas_full_ = 0;
-        for (const Request& r : requests_) request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps, r.contrast);
+        for (const Request& r : requests_) {
+            request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps, r.contrast, r.effects);
+        }
         admit_clipped();
     }
     stats_.subpixel_steps = coarsening_.steps();
@@ -377,6 +540,10 @@ void FrameRequests::collect_drawn() {
         if (d.samples > 0) {
             drawn_.push_back(d);
             ++stats_.drawn_glyphs;
+            if (d.stack != kStackGlyph || d.instance.key.effect != 0) {
+                ++stats_.effect_layers;
+                stats_.effect_texels += uint64_t{d.instance.width} * d.instance.height;
+            }
         } else {
             ++stats_.skipped_glyphs;
         }

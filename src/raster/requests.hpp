@@ -8,9 +8,11 @@
 #include "raster/held_fonts.hpp"
 
 #include <crisp/atlas.hpp>
+#include <crisp/effects.hpp>
 #include <crisp/renderer.hpp>
 #include <crisp/transform.hpp>
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -24,6 +26,8 @@ namespace crisp::raster {
 // follow on each axis that moves. False when the new pen is not finite or out of range. `asset`
 // is its font's; null (a font not held) or a glyph the asset does not have: true, unmoved.
 bool moved(const FontAsset* asset, GlyphInstance& glyph, double dx, double dy);
+// The same for a glyph whose outline is `record` (an effect layer's derived one).
+bool moved(const GlyphRecord& record, GlyphInstance& glyph, double dx, double dy);
 
 // Where each named draw (DrawOptions::id) was, to tell moving text from static text.
 class MotionTracker {
@@ -55,7 +59,7 @@ private:
 // coarsening and stats are the renderer's, and outlive it.
 class FrameRequests {
 public:
-    FrameRequests(GlyphAtlas& atlas, const HeldFonts& fonts, Coarsening& coarsening, RendererStats& stats);
+    FrameRequests(GlyphAtlas& atlas, HeldFonts& fonts, Coarsening& coarsening, RendererStats& stats);
 
     void begin_frame();
     // One draw()n instance, at the frame's subpixel steps or `steps` (moving text: fewer) where
@@ -84,12 +88,23 @@ public:
     bool converged() const { return converged_; }
 
 private:
+    static constexpr uint32_t kNoEffects = 0xFFFFFFFFu;
+    // A draw's effects (DrawOptions::effects): their colours in linear light, and the paint orders
+    // of the layers under and over its glyphs.
+    struct DrawEffects {
+        TextEffects effects;
+        uint32_t first_order = 0;
+        uint32_t last_order = 0;
+        std::array<float, 4> outline_color{};
+        std::array<float, 4> shadow_color{};
+    };
     struct Request {
         GlyphInstance glyph;  // moved, recoloured and at its depth as the draw's options asked
         bool has_visible = false;
         VkRect2D visible{};
         uint32_t steps = kSubpixelSteps;  // the finest subpixel steps it may take (moving text: fewer)
         GlyphContrast contrast;           // the draw's, resolved for the glyph's size
+        uint32_t effects = kNoEffects;    // its draw's in effects_
     };
     struct Pending {
         DrawnGlyph glyph;
@@ -99,24 +114,33 @@ private:
         GlyphInstance glyph;
         TexelRect part;  // visible texels of its rect
         GlyphContrast contrast;
+        uint32_t stack = kStackGlyph;
     };
 
     enum class Placed { placed, refused, culled };
     Placed place(GlyphInstance& glyph, const DrawOptions& options, const TransformSteps& steps, double dx, double dy,
                  float& depth);
-    void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps, const GlyphContrast& contrast);
-    void admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast,
+    void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps, const GlyphContrast& contrast,
+                 uint32_t effects);
+    void request_effects(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps,
+                         const GlyphContrast& contrast, const DrawEffects& fx);
+    void submit_layer(const GlyphInstance& glyph, uint32_t effect, const std::array<float, 4>& colour, uint32_t order,
+                      uint32_t stack, double dx, double dy, const VkRect2D* visible, const GlyphContrast& contrast);
+    void submit(const GlyphInstance& glyph, const VkRect2D* visible, const GlyphContrast& contrast, uint32_t stack);
+    void admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast, uint32_t stack,
                const TexelRect* shown = nullptr);
-    AtlasLookup look_up_or_place(const FontAsset& asset, const GlyphInstance& glyph, const TexelRect& part);
+    AtlasLookup look_up_or_place(const FontAsset& asset, const GlyphRecord& record, const GlyphInstance& glyph,
+                                 const TexelRect& part);
     void admit_clipped();
 
     GlyphAtlas& atlas_;
-    const HeldFonts& fonts_;
+    HeldFonts& fonts_;
     Coarsening& coarsening_;
     RendererStats& stats_;
-    std::vector<Request> requests_;  // this frame's draw()n instances, as asked
-    std::vector<Pending> pending_;   // draw()n this frame, before record() knows their samples
-    std::vector<Clipped> clipped_;   // draw()n partly visible, admitted in record()
+    std::vector<Request> requests_;     // this frame's draw()n instances, as asked
+    std::vector<DrawEffects> effects_;  // this frame's draws' effects
+    std::vector<Pending> pending_;      // draw()n this frame, before record() knows their samples
+    std::vector<Clipped> clipped_;      // draw()n partly visible, admitted in record()
     // Scratch of admit_clipped(), kept so that a warm frame allocates nothing: clipped_ indices in
     // key order, and each clipped instance's bounding part (over every instance of its key).
     std::vector<uint32_t> clipped_order_;

@@ -23,7 +23,7 @@ uint64_t mix(uint64_t x) {
 int compare_keys(const GlyphKey& a, const GlyphKey& b) {
     const auto fields = [](const GlyphKey& k) {
         return std::tie(k.font, k.glyph, k.size_x, k.size_y, k.subpixel_x, k.subpixel_y, k.linear[0], k.linear[1],
-                        k.linear[2], k.linear[3], k.perspective[0], k.perspective[1]);
+                        k.linear[2], k.linear[3], k.perspective[0], k.perspective[1], k.effect);
     };
     return fields(a) < fields(b) ? -1 : fields(b) < fields(a) ? 1 : 0;
 }
@@ -32,7 +32,7 @@ size_t GlyphKeyHash::operator()(const GlyphKey& key) const {
     const uint64_t a = (uint64_t{key.font} << 32) | key.glyph;
     const uint64_t b =
         (uint64_t{key.size_x} << 40) ^ (uint64_t{key.size_y} << 16) ^ (uint64_t{key.subpixel_x} << 8) ^ key.subpixel_y;
-    uint64_t h = mix(a ^ mix(b));
+    uint64_t h = mix(a ^ mix(b) ^ (uint64_t{key.effect} * 0x9E3779B97F4A7C15ull));
     if (is_transformed(key) || key.perspective[0] != 0 || key.perspective[1] != 0) {
         const auto word = [](int32_t v) { return static_cast<uint64_t>(static_cast<uint32_t>(v)); };
         h = mix(h ^ ((word(key.linear[0]) << 32) | word(key.linear[1])));

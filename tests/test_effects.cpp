@@ -1,0 +1,374 @@
+// Text effects (docs/effects.md) on lavapipe with validation on: every outline placement and join
+// and both weights converge, texel by texel, on the exact stroked area (support/stroke_reference);
+// shadows are the glyph (with its outline) moved; the layers stack under and over their glyph;
+// bad parameters are refused with their names; the atlas cost is counted.
+#include "headless_context.hpp"
+#include "shape_support.hpp"
+#include "stroke_reference.hpp"
+#include "test_support.hpp"
+
+#include "text/effect_code.hpp"
+#include "text/stroke.hpp"
+
+#include <crisp/effects.hpp>
+#include <crisp/font.hpp>
+#include <crisp/layout.hpp>
+#include <crisp/renderer.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+
+namespace crisp {
+namespace {
+
+HeadlessContext* context() {
+    static test::GpuFixture fixture = test::make_gpu_fixture({}, false, "");
+    return fixture.context.get();
+}
+
+#define REQUIRE_GPU() \
+    if (!context()) GTEST_FAIL() << "no Vulkan device (lavapipe is installed by scripts/setup.sh)"
+
+using test::Texel;
+
+// Three hairlines 1/200 em wide.
+std::vector<Contour> hairlines() {
+    return {test::polygon({{0.1, 0}, {0.105, 0}, {0.105, 0.7}, {0.1, 0.7}}),
+            test::polygon({{0, 0.4}, {0.6, 0.4}, {0.6, 0.405}, {0, 0.405}}),
+            test::polygon({{0.2, 0.0}, {0.605, 0.7}, {0.6, 0.7}, {0.195, 0.0}})};
+}
+
+struct Worst {
+    double max = 0.0;   // the largest error of any texel channel of an effect layer
+    double mean = 0.0;  // over channels with coverage
+    uint64_t channels = 0;
+    uint32_t layers = 0;  // effect layers compared
+};
+
+std::unique_ptr<Renderer> make_renderer(const char* layout, uint32_t samples) {
+    RendererCreateInfo info = renderer_create_info(*context());
+    info.atlas.width = info.atlas.height = 1024;
+    info.atlas.max_samples = samples;
+    info.atlas.frame_budget = uint64_t{1} << 40;
+    info.layout = *subpixel_preset(layout);
+    auto renderer = Renderer::create(info);
+    EXPECT_TRUE(renderer) << renderer.error().message;
+    return renderer ? std::make_unique<Renderer>(std::move(*renderer)) : nullptr;
+}
+
+// Draws `glyphs` with `effects` until converged and holds every derived layer's texels to the
+// exact stroked area of its shape.
+Worst converge_and_compare(const Font& font, std::span<const GlyphInstance> glyphs, const TextEffects& effects,
+                           uint32_t samples, const char* layout = "gray") {
+    Worst worst;
+    auto renderer = make_renderer(layout, samples);
+    if (!renderer) return worst;
+    EXPECT_TRUE(renderer->add_font(font));
+    DrawOptions options;
+    options.effects = effects;
+    const Result<uint32_t> frames =
+        test::render_until_converged(*context(), *renderer, 4000, [&] { renderer->draw(glyphs, options); });
+    EXPECT_TRUE(frames) << frames.error().message;
+    EXPECT_TRUE(renderer->converged());
+    EXPECT_EQ(renderer->stats().failed_effects, 0u);
+    Result<std::vector<Texel>> texels = test::read_atlas(*context(), *renderer);
+    EXPECT_TRUE(texels) << texels.error().message;
+    if (!texels) return worst;
+    const uint32_t atlas_width = renderer->atlas().config().width;
+    const SubpixelLayout& sub = *subpixel_preset(layout);
+    double sum = 0.0;
+    for (const DrawnGlyph& d : renderer->drawn()) {
+        const GlyphKey& key = d.instance.key;
+        if (key.effect == 0) continue;
+        const GlyphRecord& own = font.asset().glyphs[key.glyph];
+        const Result<DerivedGlyph> derived =
+            derive_effect_glyph(font.asset(), own, key.effect, effect_tolerance(effect_octave(key)));
+        EXPECT_TRUE(derived);
+        if (!derived) continue;
+        const EffectShape shape = decode_effect(key.effect);
+        const StrokeReference reference(glyph_contours(font.asset(), own), shape.join, shape.half_width,
+                                        shape.miter_limit, shape.op);
+        const TexelToEm map = texel_to_em(glyph_rect(derived->record, key), key);
+        ++worst.layers;
+        for (uint32_t ty = 0; ty < d.instance.height; ++ty) {
+            for (uint32_t tx = 0; tx < d.instance.width; ++tx) {
+                const Texel& t = (*texels)[size_t{d.atlas_y + ty} * atlas_width + d.atlas_x + tx];
+                EXPECT_EQ(t.count, samples);
+                const std::array<double, 3> want = reference.texel(map, sub, tx + d.part_x, ty + d.part_y);
+                const uint16_t sums[3] = {t.r, t.g, t.b};
+                for (size_t c = 0; c < 3; ++c) {
+                    const double got = static_cast<double>(sums[c]) / (kCoverageOne * std::max<uint32_t>(t.count, 1));
+                    if (got == 0.0 && want[c] == 0.0) continue;
+                    const double error = std::abs(got - want[c]);
+                    worst.max = std::max(worst.max, error);
+                    sum += error;
+                    ++worst.channels;
+                }
+            }
+        }
+    }
+    if (worst.channels) worst.mean = sum / static_cast<double>(worst.channels);
+    const ValidationMessages messages = context()->validation_messages();
+    EXPECT_EQ(messages.errors + messages.warnings, 0u);
+    for (const std::string& text : messages.recent) ADD_FAILURE() << text;
+    return worst;
+}
+
+std::vector<GlyphInstance> lay_out(const Font& font, std::string_view text, float size, float x, float y) {
+    const Font* fonts[] = {&font};
+    LayoutOptions options;
+    options.origin_x = x;
+    options.origin_y = y;
+    auto layout = layout_text(fonts, text, {.size = size}, options);
+    EXPECT_TRUE(layout);
+    return layout ? layout->glyphs : std::vector<GlyphInstance>{};
+}
+
+TextEffects outline(float width, OutlinePlacement placement, LineJoin join, float weight = 0.0f) {
+    TextEffects e;
+    e.weight = weight;
+    e.outline = TextOutline{width, placement, join, 4.0f, {0.0f, 0.0f, 0.0f, 1.0f}};
+    return e;
+}
+
+// The converged coverage's target: 1/128 per texel channel of the exact stroked area.
+constexpr double kTarget = 1.0 / 128.0;
+
+TEST(Effects, OutlinesOfEveryPlacementAndJoinMatchTheExactStroke) {
+    REQUIRE_GPU();
+    auto font = test::bake_subset(test::kDejaVuSans, "MW4");
+    ASSERT_TRUE(font);
+    for (const float size : {8.0f, 16.0f, 48.0f}) {
+        const std::vector<GlyphInstance> glyphs = lay_out(*font, "MW4", size, 3.3f, 4.0f + size);
+        for (const OutlinePlacement placement :
+             {OutlinePlacement::outside, OutlinePlacement::inside, OutlinePlacement::centred}) {
+            for (const LineJoin join : {LineJoin::round, LineJoin::miter, LineJoin::bevel}) {
+                // 48 px (lavapipe's time): one join per placement.
+                if (size > 40.0f && static_cast<int>(join) != static_cast<int>(placement)) continue;
+                const float width = std::max(1.0f, size / 16.0f);
+                const Worst w = converge_and_compare(*font, glyphs, outline(width, placement, join), 256);
+                std::printf("[ effects ] MW4 %2.0f px, %s %s outline %.1f px: max %.4f, mean %.5f over %llu channels\n",
+                            static_cast<double>(size), outline_placement_name(placement), line_join_name(join),
+                            static_cast<double>(width), w.max, w.mean, static_cast<unsigned long long>(w.channels));
+                EXPECT_EQ(w.layers, 3u);
+                EXPECT_LE(w.max, kTarget)
+                    << size << " px " << outline_placement_name(placement) << " " << line_join_name(join);
+            }
+        }
+    }
+}
+
+TEST(Effects, SharpCornersStaySharpOnAStarAndHairlinesAt200Pixels) {
+    REQUIRE_GPU();
+    struct Shape {
+        const char* name;
+        std::vector<Contour> contours;
+    };
+    for (const Shape& shape : {Shape{"star", test::star()}, Shape{"hairlines", hairlines()}}) {
+        uint32_t index = 0;
+        auto font = test::with_shape(shape.contours, index);
+        ASSERT_TRUE(font);
+        for (const float size : {8.0f, 16.0f, 48.0f, 200.0f}) {
+            const GlyphInstance glyph = test::place(*font, index, size, 2.25f, 2.0f + size);
+            const LineJoin joins[] = {LineJoin::miter, LineJoin::round};
+            for (const LineJoin join : joins) {
+                // From 48 px (lavapipe's time) miter joins only, at 200 px with fewer samples.
+                if (size > 40.0f && join != LineJoin::miter) continue;
+                const Worst w =
+                    converge_and_compare(*font, {&glyph, 1}, outline(size / 24.0f, OutlinePlacement::outside, join),
+                                         size > 100.0f ? 128 : 256);
+                std::printf("[ effects ] %s %3.0f px, %s outline %.2f px: max %.4f, mean %.5f\n", shape.name,
+                            static_cast<double>(size), line_join_name(join), static_cast<double>(size / 24.0f), w.max,
+                            w.mean);
+                EXPECT_EQ(w.layers, 1u);
+                EXPECT_LE(w.max, kTarget) << shape.name << " " << size << " px";
+            }
+        }
+    }
+}
+
+TEST(Effects, WeightGrowsAndShrinksTheFaceExactly) {
+    REQUIRE_GPU();
+    auto font = test::bake_subset(test::kDejaVuSans, "MW4");
+    ASSERT_TRUE(font);
+    for (const float weight : {0.75f, -0.5f}) {
+        for (const char* layout : {"gray", "rgb"}) {
+            const std::vector<GlyphInstance> glyphs = lay_out(*font, "MW4", 16.0f, 2.6f, 20.0f);
+            TextEffects e;
+            e.weight = weight;
+            const Worst w = converge_and_compare(*font, glyphs, e, 256, layout);
+            std::printf("[ effects ] MW4 16 px %s, weight %+.2f px: max %.4f, mean %.5f\n", layout,
+                        static_cast<double>(weight), w.max, w.mean);
+            EXPECT_EQ(w.layers, 3u);
+            EXPECT_LE(w.max, kTarget) << weight;
+        }
+    }
+}
+
+// Runs one frame of `draw` and returns the drawn glyphs (each with samples after one frame).
+std::vector<DrawnGlyph> one_frame(Renderer& renderer, const std::function<void()>& draw) {
+    const Result<uint32_t> frames = test::render_until_converged(*context(), renderer, 1, draw);
+    EXPECT_TRUE(frames) << frames.error().message;
+    const auto drawn = renderer.drawn();
+    return {drawn.begin(), drawn.end()};
+}
+
+TEST(Effects, LayersStackShadowOutlineFaceInThatOrder) {
+    REQUIRE_GPU();
+    auto font = test::bake_subset(test::kDejaVuSans, "MW4");
+    ASSERT_TRUE(font);
+    auto renderer = make_renderer("rgb", 8);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*font));
+    std::vector<GlyphInstance> glyphs = lay_out(*font, "MW4", 16.0f, 3.0f, 20.0f);
+    for (GlyphInstance& g : glyphs) g.paint_order += 10;  // 10, 11, 12
+    DrawOptions options;
+    options.effects = outline(1.5f, OutlinePlacement::outside, LineJoin::round);
+    options.effects->shadow = TextShadow{2.0f, 3.0f, {0.0f, 0.0f, 0.0f, 0.5f}};
+    const std::vector<DrawnGlyph> drawn = one_frame(*renderer, [&] { renderer->draw(glyphs, options); });
+    ASSERT_EQ(drawn.size(), 9u);
+    std::map<uint32_t, uint32_t> per_stack;
+    for (const DrawnGlyph& d : drawn) {
+        ++per_stack[d.stack];
+        if (d.stack == kStackGlyph) {
+            EXPECT_EQ(d.instance.key.effect, 0u);
+            EXPECT_GE(d.instance.paint_order, 10u);
+        } else {
+            // Under every glyph of the draw: its first paint order, a smaller stack.
+            EXPECT_EQ(d.instance.paint_order, 10u);
+            EXPECT_NE(d.instance.key.effect, 0u);  // the shadow is the glyph with its outline
+        }
+        if (d.stack == kStackShadow) {
+            // Moved by (2, 3) px: the same subpixel offset as its glyph, 2 and 3 px further.
+            const auto glyph = std::find_if(drawn.begin(), drawn.end(), [&](const DrawnGlyph& g) {
+                return g.stack == kStackGlyph && g.instance.cluster == d.instance.cluster;
+            });
+            ASSERT_NE(glyph, drawn.end());
+            EXPECT_EQ(d.instance.key.subpixel_x, glyph->instance.key.subpixel_x);
+            EXPECT_FLOAT_EQ(d.instance.pen_x, glyph->instance.pen_x + 2.0f);
+            EXPECT_FLOAT_EQ(d.instance.pen_y, glyph->instance.pen_y + 3.0f);
+            EXPECT_FLOAT_EQ(d.instance.color[3], 0.5f);
+        }
+    }
+    EXPECT_EQ(per_stack[kStackShadow], 3u);
+    EXPECT_EQ(per_stack[kStackOutlineUnder], 3u);
+    EXPECT_EQ(per_stack[kStackGlyph], 3u);
+    const RendererStats& stats = renderer->stats();
+    EXPECT_EQ(stats.effect_layers, 6u);
+    EXPECT_GT(stats.effect_texels, 0u);
+    EXPECT_EQ(stats.derived_glyphs, 6u);  // per glyph: the outline, the shadow's outlined glyph
+    EXPECT_EQ(stats.derived_made, 6u);
+    EXPECT_GT(stats.derived_bytes, 0u);
+    // Centred and inside outlines lie over the glyph, at the draw's last paint order.
+    options.effects = outline(1.0f, OutlinePlacement::centred, LineJoin::bevel);
+    const std::vector<DrawnGlyph> over = one_frame(*renderer, [&] { renderer->draw(glyphs, options); });
+    ASSERT_EQ(over.size(), 6u);
+    for (const DrawnGlyph& d : over) {
+        if (d.stack != kStackGlyph) {
+            EXPECT_EQ(d.stack, kStackOutlineOver);
+            EXPECT_EQ(d.instance.paint_order, 12u);
+        }
+    }
+    // The derived glyphs leave with their font.
+    ASSERT_TRUE(renderer->remove_font(font->id()));
+    one_frame(*renderer, [] {});
+    EXPECT_EQ(renderer->stats().derived_glyphs, 0u);
+    const ValidationMessages messages = context()->validation_messages();
+    EXPECT_EQ(messages.errors + messages.warnings, 0u);
+}
+
+TEST(Effects, EffectsPastTheGlyphsLimitsAreLeftOutAndCounted) {
+    REQUIRE_GPU();
+    auto font = test::bake_subset(test::kDejaVuSans, "MW4");
+    ASSERT_TRUE(font);
+    auto renderer = make_renderer("gray", 8);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*font));
+    const std::vector<GlyphInstance> glyphs = lay_out(*font, "M", 4.0f, 3.0f, 20.0f);
+    DrawOptions options;
+    options.effects = outline(17.0f, OutlinePlacement::outside, LineJoin::round);  // 4.25 em at 4 px
+    const std::vector<DrawnGlyph> drawn = one_frame(*renderer, [&] { renderer->draw(glyphs, options); });
+    EXPECT_EQ(drawn.size(), 1u);  // the glyph, without its outline
+    EXPECT_EQ(renderer->stats().failed_effects, 1u);
+    EXPECT_FALSE(validate_text_effects(*options.effects, 4.0f));
+    EXPECT_TRUE(validate_text_effects(*options.effects, 8.0f));
+    // Effects validate_text_effects() refuses draw nothing.
+    options.effects->outline->width = -1.0f;
+    const std::vector<DrawnGlyph> none = one_frame(*renderer, [&] { renderer->draw(glyphs, options); });
+    EXPECT_TRUE(none.empty());
+    EXPECT_EQ(renderer->stats().skipped_glyphs, 1u);
+}
+
+TEST(Effects, BadParametersAreRefusedByName) {
+    const auto message = [](const TextEffects& e) {
+        const Status s = validate_text_effects(e);
+        return s ? std::string() : s.error().message;
+    };
+    TextEffects e;
+    EXPECT_EQ(message(e), "");
+    e.weight = std::nanf("");
+    EXPECT_NE(message(e).find("weight nan"), std::string::npos) << message(e);
+    e.weight = 1e6f;
+    EXPECT_NE(message(e).find("weight"), std::string::npos) << message(e);
+    e = outline(-2.0f, OutlinePlacement::outside, LineJoin::round);
+    EXPECT_NE(message(e).find("outline width -2 is negative"), std::string::npos) << message(e);
+    e.outline->width = std::numeric_limits<float>::infinity();
+    EXPECT_NE(message(e).find("outline width inf is not finite"), std::string::npos) << message(e);
+    e.outline->width = 1.0f;
+    e.outline->miter_limit = 0.5f;
+    EXPECT_NE(message(e).find("miter_limit 0.5"), std::string::npos) << message(e);
+    e.outline->miter_limit = 4.0f;
+    e.outline->color[1] = 2.0f;
+    EXPECT_NE(message(e).find("outline color"), std::string::npos) << message(e);
+    e.outline->color[1] = 0.0f;
+    e.outline->join = static_cast<LineJoin>(7);
+    EXPECT_NE(message(e).find("outline join 7"), std::string::npos) << message(e);
+    e.outline->join = LineJoin::round;
+    e.outline->placement = static_cast<OutlinePlacement>(9);
+    EXPECT_NE(message(e).find("outline placement 9"), std::string::npos) << message(e);
+    e.outline->placement = OutlinePlacement::centred;
+    e.shadow = TextShadow{std::nanf(""), 0.0f, {0.0f, 0.0f, 0.0f, 1.0f}};
+    EXPECT_NE(message(e).find("shadow offset nan"), std::string::npos) << message(e);
+    e.shadow->offset_x = 5000.0f;
+    EXPECT_NE(message(e).find("shadow offset 5000"), std::string::npos) << message(e);
+    e.shadow->offset_x = 1.0f;
+    EXPECT_EQ(message(e), "");
+    // Per size: the reach in em.
+    e.outline->width = 100.0f;  // centred: 50 px either side
+    EXPECT_TRUE(validate_text_effects(e, 12.5f));
+    EXPECT_FALSE(validate_text_effects(e, 12.0f));
+    EXPECT_FALSE(validate_text_effects(e, 0.0f));
+    EXPECT_NE(validate_text_effects(e, 12.0f).error().message.find("outline width 100 px reaches past 4 em"),
+              std::string::npos);
+}
+
+TEST(Effects, CodesKeepTheShapeToTheirSteps) {
+    for (const StrokeOp op : {StrokeOp::a, StrokeOp::a_not_b, StrokeOp::a_and_b, StrokeOp::a_or_b, StrokeOp::b_not_a}) {
+        for (const StrokeJoin join : {StrokeJoin::round, StrokeJoin::miter, StrokeJoin::bevel}) {
+            for (const double r : {1.0 / 262144.0, 0.0625, 1.0 / 3.0, 3.99}) {
+                const EffectShape shape{op, join, r, 4.0};
+                const uint32_t code = encode_effect(shape);
+                EXPECT_NE(code, 0u);
+                const EffectShape back = decode_effect(code);
+                EXPECT_EQ(back.op, op);
+                EXPECT_EQ(back.join, join);
+                EXPECT_NEAR(back.half_width, r, kEffectWidthUnit / 2);
+                if (join == StrokeJoin::miter) {
+                    EXPECT_NEAR(back.miter_limit, 4.0, 1e-12);
+                }
+            }
+        }
+    }
+    // Miter limits keep to 2^(1/16) steps.
+    const EffectShape ten{StrokeOp::a, StrokeJoin::miter, 0.1, 10.0};
+    EXPECT_NEAR(decode_effect(encode_effect(ten)).miter_limit, 10.0, 10.0 * (std::exp2(1.0 / 32.0) - 1.0));
+}
+
+}  // namespace
+}  // namespace crisp
