@@ -592,6 +592,69 @@ assert m1 <= 33 and abs((m1 - m0) - (x1 - x0)) <= 2 and (n0, n1) == (y0, y1), ("
 PY
 cmp -s "$work/turned.png" "$work/turned-scene.png" || fail "a scene run's transform differs from --transform"
 
+# ---- Effects (docs/effects.md): --outline, --shadow, --weight. Bad values are usage errors that
+# name the option; a scene's run says the same in "outline", "shadow" and "weight".
+for value in -1 nan 1,2,0,0 1,0,0 1,0,0,0,0,0 5000; do
+  expect_exit 2 "--outline '$value'" -- "$render" "${base[@]}" --outline "$value" -o x.png
+  expect_stderr "--outline" "--outline '$value'"
+done
+expect_exit 2 "--outline 90 at 20 px" -- "$render" "${base[@]}" --outline 90 -o x.png
+expect_stderr "outline width 90 px reaches past 4 em at 20 px per em" "--outline 90 at 20 px"
+for value in 1 1,1 nan,0,0 1,1,0,0,0 9000,0,0; do
+  expect_exit 2 "--shadow '$value'" -- "$render" "${base[@]}" --shadow "$value" -o x.png
+  expect_stderr "--shadow" "--shadow '$value'"
+done
+for value in nan 1,2 -5000; do
+  expect_exit 2 "--weight '$value'" -- "$render" "${base[@]}" --weight "$value" -o x.png
+  expect_stderr "--weight" "--weight '$value'"
+done
+expect_exit 2 "--outline-join without --outline" -- "$render" "${base[@]}" --outline-join miter -o x.png
+expect_stderr "give it too" "--outline-join without --outline"
+expect_exit 2 "--outline-placement sideways" -- "$render" "${base[@]}" --outline 1 --outline-placement sideways -o x.png
+expect_exit 2 "--miter-limit 0.5" -- "$render" "${base[@]}" --outline 1 --miter-limit 0.5 -o x.png
+expect_exit 2 "--scene with --outline" -- "$render" --scene "$work/transform-any.json" --outline 1 -o x.png
+expect_stderr "--outline" "--scene with --outline"
+# Black "Hi" on white with a red outline and a blue shadow: red ink rings the black, blue lies
+# down and right of it; --weight 1 darkens more pixels than the plain text. The same run from a
+# scene is the same image.
+fx=(--font "$font" --text "Hi" --size 16 --origin 6,22 --canvas 48,32 --samples 16 --layout gray)
+expect_exit 0 "render plain" -- "$render" "${fx[@]}" -o "$work/fx-plain.png"
+expect_exit 0 "render --outline --shadow" -- "$render" "${fx[@]}" --outline 2,1,0,0 --outline-join miter \
+  --shadow 4,3,0,0,0,1,1 -o "$work/fx-outlined.png" --json
+python3 -c "import json,sys; e=json.load(open(sys.argv[1]))['effects']; assert e['layers']==4 and e['failed']==0 and e['derived_glyphs']==4 and e['texels']>0, e" \
+  "$work/out" || fail "--json does not count the effect layers"
+expect_exit 0 "render --weight 1" -- "$render" "${fx[@]}" --weight 1 -o "$work/fx-bold.png"
+printf '{"fonts": ["dejavu.crisp"], "canvas": [48, 32], "layout": "gray", "runs": [
+  {"text": "Hi", "size": 16, "origin": [6, 22], "outline": {"width": 2, "join": "miter", "color": [1, 0, 0]},
+   "shadow": {"offset": [4, 3], "color": [0, 0, 1]}}]}' > "$work/fx.json"
+expect_exit 0 "render a scene run's effects" -- "$render" --scene "$work/fx.json" --samples 16 -o "$work/fx-scene.png"
+cmp -s "$work/fx-outlined.png" "$work/fx-scene.png" || fail "a scene run's effects differ from the options'"
+python3 - "$work" <<'PY' || fail "the effects do not land where they should"
+import sys
+from read_png import read_png
+def pixels(name):
+    width, height, channels, data = read_png(sys.argv[1] + "/" + name)
+    return width, height, [tuple(data[i * channels:i * channels + 3]) for i in range(width * height)]
+w, h, plain = pixels("fx-plain.png")
+_, _, fx = pixels("fx-outlined.png")
+_, _, bold = pixels("fx-bold.png")
+dark = lambda p: max(p) < 96
+red = lambda p: p[0] > 160 and p[1] < 96 and p[2] < 96
+blue = lambda p: p[2] > 160 and p[0] < 96 and p[1] < 96
+inked = [i for i, p in enumerate(plain) if dark(p)]
+assert inked, "no ink"
+# The glyph's own ink stays dark (the outline lies outside it, under it).
+assert sum(dark(fx[i]) for i in inked) >= 0.9 * len(inked), "the face lost its ink"
+reds = [i for i, p in enumerate(fx) if red(p)]
+blues = [i for i, p in enumerate(fx) if blue(p)]
+assert len(reds) > len(inked) // 2, ("too little outline", len(reds), len(inked))
+assert blues, "no shadow"
+cx = lambda ids: sum(i % w for i in ids) / len(ids)
+cy = lambda ids: sum(i // w for i in ids) / len(ids)
+assert cx(blues) > cx(inked) + 2 and cy(blues) > cy(inked) + 1.5, ("shadow not down and right", cx(blues), cx(inked))
+assert sum(dark(p) for p in bold) > 1.2 * len(inked), "--weight 1 did not embolden"
+PY
+
 # With the validation layer (when installed), a clean run stays clean.
 if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.json' 2>/dev/null)" ]; then
   expect_exit 0 "render --validate" -- "$render" "${base[@]}" --layout gray --background 1,1,1,0.5 \

@@ -185,7 +185,8 @@ TEST(Scene, ARunsEffectsAreItsWeightOutlineAndShadow) {
         {R"("shadow": {"blur": 3})", "scene: runs[0].shadow: unknown member \"blur\" (known: offset, color)"},
     };
     for (const auto& c : cases) {
-        auto bad = parse_scene(with_run(R"({"text": "a", "size": 20, "origin": [0, 0], )" + std::string(c.members) + "}"));
+        auto bad =
+            parse_scene(with_run(R"({"text": "a", "size": 20, "origin": [0, 0], )" + std::string(c.members) + "}"));
         ASSERT_FALSE(bad) << c.members;
         EXPECT_NE(bad.error().message.find(c.fragment), std::string::npos)
             << "message: " << bad.error().message << "\nexpected: " << c.fragment;

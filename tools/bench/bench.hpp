@@ -116,6 +116,7 @@ inline constexpr SuiteInfo kSuites[] = {
     {"contrast", "ink dark on light against light on dark per contrast setting and size; FreeType as a peer", true},
     {"colour", "colour glyphs (bitmap emoji, COLRv1) beside monochrome text: frame 1, converged, per layer", true},
     {"transform", "rotated, scaled, sheared and perspective text: GPU ms per frame with its error", true},
+    {"effects", "outlines, shadows and weight beside plain text: frame 1, converged, composite", true},
 };
 
 // Parses argv; prints --help, or exits 2 on a usage error.
@@ -180,5 +181,6 @@ void run_cpu(Session& session);
 void run_contrast(Session& session);
 void run_colour(Session& session);
 void run_transform(Session& session);
+void run_effects(Session& session);
 
 }  // namespace crisp::bench

@@ -34,6 +34,7 @@ struct Frame {
     uint32_t items = 0;
     uint64_t curve_tests = 0;
     double gpu_ms = 0.0;
+    double cpu_ms = 0.0;  // begin_frame, draw and record on the CPU
 };
 
 // A screen of prose: lines of text at args.size, wrapped at the canvas, until the canvas is full.
@@ -44,8 +45,9 @@ std::vector<GlyphInstance> screen_of_text(const FrameArgs& args, const Font& fon
 Renderer make_renderer(const HeadlessContext& context, const FrameArgs& args, const SubpixelLayout& layout,
                        const Font& font);
 
-// Draws the screen frame after frame, each timed on the GPU, until it converges or max_frames.
+// Draws the screen frame after frame (with `options` where given), each timed on the GPU, until it
+// converges or max_frames.
 std::vector<Frame> run_frames(HeadlessContext& context, Renderer& renderer, const std::vector<GlyphInstance>& screen,
-                              uint32_t max_frames);
+                              uint32_t max_frames, const DrawOptions* options = nullptr);
 
 }  // namespace crisp::bench

@@ -15,6 +15,7 @@
 #include <crisp/renderer.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <set>
 #include <string>
@@ -72,17 +73,25 @@ crisp::Renderer make_renderer(const crisp::HeadlessContext& context, const Frame
 }
 
 std::vector<Frame> run_frames(crisp::HeadlessContext& context, crisp::Renderer& renderer,
-                              const std::vector<crisp::GlyphInstance>& screen, uint32_t max_frames) {
+                              const std::vector<crisp::GlyphInstance>& screen, uint32_t max_frames,
+                              const crisp::DrawOptions* options) {
     auto timer = crisp::tools::GpuTimer::create(context);
     if (!timer) fail(timer.error().message);
     std::vector<Frame> frames;
     for (uint32_t f = 0; f < max_frames; ++f) {
-        renderer.begin_frame();
-        renderer.draw(screen);
+        double cpu_ms = 0.0;
         const auto status = context.submit_and_wait([&](VkCommandBuffer cb) {
+            const auto start = std::chrono::steady_clock::now();
+            renderer.begin_frame();
+            if (options) {
+                renderer.draw(screen, *options);
+            } else {
+                renderer.draw(screen);
+            }
             timer->begin(cb);
             if (auto s = renderer.record(cb); !s) fail(s.error().message);
             timer->end(cb);
+            cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         });
         if (!status) fail(status.error().message);
         const crisp::Result<double> gpu_ms = timer->milliseconds();
@@ -93,6 +102,7 @@ std::vector<Frame> run_frames(crisp::HeadlessContext& context, crisp::Renderer& 
         frame.items = renderer.stats().work_items;
         frame.curve_tests = renderer.stats().curve_tests;
         frame.gpu_ms = *gpu_ms;
+        frame.cpu_ms = cpu_ms;
         frames.push_back(frame);
         if (renderer.converged() && frame.items == 0) break;
         if ((f + 1) % 128 == 0) progress(kSuite, "frame " + std::to_string(f + 1));

@@ -119,6 +119,7 @@ void run_suite(Session& session, const std::string& name) {
     if (name == "contrast") return run_contrast(session);
     if (name == "colour") return run_colour(session);
     if (name == "transform") return run_transform(session);
+    if (name == "effects") return run_effects(session);
 }
 
 // The error at each sample count against the GPU ms the frames suite spent reaching that count:
