@@ -193,6 +193,68 @@ TEST(Effects, SharpCornersStaySharpOnAStarAndHairlinesAt200Pixels) {
     }
 }
 
+TEST(Effects, OverlappingContoursAreOutlinedAlongTheFillsEdge) {
+    REQUIRE_GPU();
+    // A plus drawn as two overlapping bars: its inside and centred outlines and its thinning follow
+    // the plus's edge (the twelve-sided polygon the reference is given), not the bars' edges inside it.
+    uint32_t index = 0;
+    auto font = test::with_shape({test::polygon({{0.1, 0.3}, {0.1, 0.5}, {0.7, 0.5}, {0.7, 0.3}}),
+                                  test::polygon({{0.3, 0.1}, {0.3, 0.7}, {0.5, 0.7}, {0.5, 0.1}})},
+                                 index);
+    ASSERT_TRUE(font);
+    const std::vector<Contour> plus = {test::polygon({{0.1, 0.3},
+                                                      {0.1, 0.5},
+                                                      {0.3, 0.5},
+                                                      {0.3, 0.7},
+                                                      {0.5, 0.7},
+                                                      {0.5, 0.5},
+                                                      {0.7, 0.5},
+                                                      {0.7, 0.3},
+                                                      {0.5, 0.3},
+                                                      {0.5, 0.1},
+                                                      {0.3, 0.1},
+                                                      {0.3, 0.3}})};
+    auto renderer = make_renderer("gray", 256);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*font));
+    const GlyphInstance glyph = test::place(*font, index, 40.0f, 2.5f, 42.0f);
+    for (const OutlinePlacement placement : {OutlinePlacement::inside, OutlinePlacement::centred}) {
+        DrawOptions options;
+        options.effects = outline(3.0f, placement, LineJoin::miter);
+        const Result<uint32_t> frames = test::render_until_converged(*context(), *renderer, 4000, [&] {
+            renderer->draw({&glyph, 1}, options);
+        });
+        ASSERT_TRUE(frames) << frames.error().message;
+        Result<std::vector<Texel>> texels = test::read_atlas(*context(), *renderer);
+        ASSERT_TRUE(texels);
+        double worst = 0.0;
+        uint32_t layers = 0;
+        for (const DrawnGlyph& d : renderer->drawn()) {
+            if (d.instance.key.effect == 0) continue;
+            ++layers;
+            const EffectShape shape = decode_effect(d.instance.key.effect);
+            const StrokeReference reference(plus, shape.join, shape.half_width, shape.miter_limit, shape.op);
+            const Result<DerivedGlyph> derived =
+                derive_effect_glyph(font->asset(), font->asset().glyphs[index], d.instance.key.effect,
+                                    effect_tolerance(effect_octave(d.instance.key)));
+            ASSERT_TRUE(derived);
+            const TexelToEm map = texel_to_em(glyph_rect(derived->record, d.instance.key), d.instance.key);
+            const uint32_t side = renderer->atlas().config().width;
+            for (uint32_t ty = 0; ty < d.instance.height; ++ty) {
+                for (uint32_t tx = 0; tx < d.instance.width; ++tx) {
+                    const Texel& t = (*texels)[size_t{d.atlas_y + ty} * side + d.atlas_x + tx];
+                    const double got = static_cast<double>(t.r) / (kCoverageOne * std::max<uint32_t>(t.count, 1));
+                    worst = std::max(worst, std::abs(got - reference.texel(map, *subpixel_preset("gray"), tx, ty)[0]));
+                }
+            }
+        }
+        std::printf("[ effects ] plus of two bars, %s outline 3 px at 40 px: max %.4f\n",
+                    outline_placement_name(placement), worst);
+        EXPECT_EQ(layers, 1u);
+        EXPECT_LE(worst, kTarget) << outline_placement_name(placement);
+    }
+}
+
 TEST(Effects, WeightGrowsAndShrinksTheFaceExactly) {
     REQUIRE_GPU();
     auto font = test::bake_subset(test::kDejaVuSans, "MW4");

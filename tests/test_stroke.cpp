@@ -312,6 +312,81 @@ TEST(Stroke, GlyphContoursAreTheGlyph) {
     }
 }
 
+// Every texel of a 64 px grid over the contours: the boundary's nonzero fill is the contours'.
+double worst_fill_difference(const std::vector<Contour>& contours, const std::vector<Contour>& boundary) {
+    const ExactCoverage a(flattened(contours)), b(flattened(boundary));
+    double worst = 0.0;
+    for (int ty = -16; ty < 80; ++ty) {
+        for (int tx = -16; tx < 80; ++tx) {
+            const double x0 = tx / 64.0, y0 = ty / 64.0;
+            worst = std::max(worst, std::abs(a.coverage(x0, y0, x0 + 1 / 64.0, y0 + 1 / 64.0) -
+                                             b.coverage(x0, y0, x0 + 1 / 64.0, y0 + 1 / 64.0)));
+        }
+    }
+    return worst;
+}
+
+// Every boundary curve has the fill on its right (clockwise in y-up) and not on its left.
+void expect_fill_on_the_right(const std::vector<Contour>& boundary) {
+    const ExactCoverage fill(flattened(boundary));
+    for (const Contour& c : boundary) {
+        EXPECT_EQ(c.front().p0, c.back().p2);
+        for (const Quad& q : c) {
+            const Vec2 m = evaluate(q, 0.5), d = q.p2 - q.p0;
+            const double len = length(d), e = 2e-6;
+            if (len < 1e-6) continue;
+            const Vec2 left{-d.y / len * e, d.x / len * e};
+            const auto covered = [&](Vec2 p) { return fill.coverage(p.x - 5e-7, p.y - 5e-7, p.x + 5e-7, p.y + 5e-7); };
+            EXPECT_LT(covered(m + left), 0.5) << m.x << ", " << m.y;
+            EXPECT_GT(covered(m - left), 0.5) << m.x << ", " << m.y;
+        }
+    }
+}
+
+TEST(Stroke, BoundaryOfOverlappingContoursIsTheFillsEdge) {
+    // A plus of two overlapping bars, both clockwise: one contour of twelve lines.
+    const std::vector<Contour> plus = {test::polygon({{0.1, 0.3}, {0.1, 0.5}, {0.7, 0.5}, {0.7, 0.3}}),
+                                       test::polygon({{0.3, 0.1}, {0.3, 0.7}, {0.5, 0.7}, {0.5, 0.1}})};
+    const std::vector<Contour> b = boundary_contours(plus);
+    ASSERT_EQ(b.size(), 1u);
+    EXPECT_EQ(b[0].size(), 12u);
+    EXPECT_LT(worst_fill_difference(plus, b), 1e-9);
+    expect_fill_on_the_right(b);
+    // A square inside another of the same direction is no edge of the fill; a hole (the other
+    // direction) is.
+    const Contour outer = test::polygon({{0.0, 0.0}, {0.0, 0.8}, {0.8, 0.8}, {0.8, 0.0}});
+    const Contour inner = test::polygon({{0.2, 0.2}, {0.2, 0.6}, {0.6, 0.6}, {0.6, 0.2}});
+    const Contour hole = test::polygon({{0.2, 0.2}, {0.6, 0.2}, {0.6, 0.6}, {0.2, 0.6}});
+    EXPECT_EQ(boundary_contours({outer, inner}).size(), 1u);
+    EXPECT_EQ(boundary_contours({outer, hole}).size(), 2u);
+    // Curves: two overlapping discs, both clockwise: one contour around their union.
+    const std::vector<Contour> discs = {test::circle(0.3, 0.4, 0.25, true), test::circle(0.5, 0.4, 0.25, true)};
+    const std::vector<Contour> lens = boundary_contours(discs);
+    ASSERT_EQ(lens.size(), 1u);
+    EXPECT_LT(worst_fill_difference(discs, lens), 1e-9);
+    expect_fill_on_the_right(lens);
+    // A glyph without overlaps is its own boundary, curve for curve.
+    for (char32_t ch : {U'o', U'M', U'@'}) {
+        const std::vector<Contour> g = glyph_of(ch);
+        EXPECT_EQ(boundary_contours(g), g);
+    }
+}
+
+TEST(Stroke, BoundaryOfAVariableFontsOverlappingGlyphs) {
+    // Inter's variable masters draw 'A', 'Q' and others with overlapping contours.
+    auto inter = test::bake_subset(test::kInterVariable, "AQR8&");
+    ASSERT_TRUE(inter);
+    uint32_t overlapping = 0;
+    for (char32_t ch : {U'A', U'Q', U'R', U'8', U'&'}) {
+        const std::vector<Contour> g = glyph_contours(inter->asset(), *inter->glyph_record(inter->nominal_glyph(ch)));
+        const std::vector<Contour> b = boundary_contours(g);
+        overlapping += b != g;
+        EXPECT_LT(worst_fill_difference(g, b), 1e-7) << static_cast<char>(ch);
+        expect_fill_on_the_right(b);
+    }
+    EXPECT_GT(overlapping, 0u);
+}
+
 TEST(Stroke, DerivedGlyphPacksPiecesThenTheGlyph) {
     const Font& f = font();
     const FontAsset& asset = f.asset();

@@ -183,7 +183,11 @@ Result<DerivedGlyph> derive_effect_glyph(const FontAsset& asset, const GlyphReco
     std::vector<Contour> pieces;
     if (shape.half_width > 0.0) {
         const StrokeStyle style{shape.half_width, shape.join, shape.miter_limit, tolerance};
-        if (Status s = stroke_pieces(glyph_contours(asset, glyph), style, pieces); !s) return s.error();
+        // The stroke follows the fill's boundary: a glyph drawn with overlapping contours (variable
+        // fonts often are) would otherwise be outlined along the edges inside it.
+        if (Status s = stroke_pieces(boundary_contours(glyph_contours(asset, glyph)), style, pieces); !s) {
+            return s.error();
+        }
     }
     return pack_derived_glyph(pieces, asset, glyph);
 }

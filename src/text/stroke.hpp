@@ -53,6 +53,13 @@ struct StrokeStyle {
 // validate_asset passed it).
 std::vector<Contour> glyph_contours(const FontAsset& asset, const GlyphRecord& glyph);
 
+// The boundary of the contours' nonzero fill as closed contours, clockwise in y-up where the fill
+// is inside: each curve cut where another crosses it, the pieces with the fill on one side only
+// kept (the parts of overlapping contours inside the fill, which stroking would outline, go), and
+// chained. Contours that neither overlap nor cross come back as they are; where the pieces cannot be
+// chained (coincident stretches the cuts miss) the contours come back too.
+std::vector<Contour> boundary_contours(const std::vector<Contour>& contours);
+
 // Appends to `pieces` closed contours of quadratics, all wound clockwise in y-up (+1 by the
 // rasterizer's rule), whose nonzero union is S(style.half_width) of `contours` within
 // style.tolerance: each curve's perpendicular sweep (split where it turns by more than 40 degrees
