@@ -147,6 +147,9 @@ struct RowList {
     int winding_b;  // the same for the second set of a two-set item
     uint count;
     bool more;
+    // A transformed row's later pass, which starts at a crossing kept by none before it: crossings
+    // at the start count (the previous pass stopped short of every crossing there).
+    bool from_crossing;
     uint up;
     uint in_b;  // per entry, set: a crossing of the second set
     float x[kRasterRowCrossings];
@@ -187,7 +190,7 @@ void row_begin_pass(inout RowList r) {
 // invocation once their iterations together reach 65535, and this runs per crossing (see "Loops"
 // in docs/rasterizer.md).
 void row_crossing(inout RowList r, float x, int direction, bool in_b) {
-    if (!(x > r.start)) return;
+    if (!(x > r.start) && !(kTransformedItems != 0u && r.from_crossing && x == r.start)) return;
     if (kTwoSetItems != 0u && in_b) {
         r.winding_b += direction;
     } else {
@@ -430,9 +433,9 @@ void row_cover(inout vec3 covered, float from, float to, vec3 lo, vec3 hi, float
 }
 
 // Step i of the walk.
-void row_walk_step(RowList r, uint rule, uint i, vec3 lo, vec3 hi, float blur, inout ivec2 w, inout float at,
-                   inout vec3 covered) {
-    if (i >= r.count) return;
+void row_walk_step(RowList r, uint rule, uint i, vec3 lo, vec3 hi, float blur, float limit, inout ivec2 w,
+                   inout float at, inout vec3 covered) {
+    if (i >= r.count || !(r.x[i] < limit)) return;
     float x = r.x[i];
     if (row_covers(rule, w.x, w.y)) row_cover(covered, at, x, lo, hi, blur);
     int step = (r.up & (1u << i)) != 0u ? -1 : 1;
@@ -453,15 +456,25 @@ vec3 row_walk(inout RowList r, uint rule, vec3 lo, vec3 hi, float blur) {
     ivec2 w = ivec2(r.winding, r.winding_b);
     float at = r.start;
     vec3 covered = vec3(0.0);
-    row_walk_step(r, rule, 0u, lo, hi, blur, w, at, covered);
-    row_walk_step(r, rule, 1u, lo, hi, blur, w, at, covered);
-    row_walk_step(r, rule, 2u, lo, hi, blur, w, at, covered);
-    row_walk_step(r, rule, 3u, lo, hi, blur, w, at, covered);
-    row_walk_step(r, rule, 4u, lo, hi, blur, w, at, covered);
-    row_walk_step(r, rule, 5u, lo, hi, blur, w, at, covered);
-    row_walk_step(r, rule, 6u, lo, hi, blur, w, at, covered);
-    row_walk_step(r, rule, 7u, lo, hi, blur, w, at, covered);
+    // A transformed row carries its winding to the next pass, so a pass that overflowed stops short
+    // of the largest crossing kept: a crossing of the same x may have been dropped, and the next
+    // pass takes them all, from there (unless all eight kept share that x: then as before).
+    const float inf = uintBitsToFloat(0x7F800000u);
+    float limit = kTransformedItems != 0u && r.more && r.x[0] < r.x[7] ? r.x[7] : inf;
+    row_walk_step(r, rule, 0u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 1u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 2u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 3u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 4u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 5u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 6u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 7u, lo, hi, blur, limit, w, at, covered);
     if (r.more) {
+        if (limit < inf) {
+            if (row_covers(rule, w.x, w.y)) row_cover(covered, at, limit, lo, hi, blur);
+            at = limit;
+        }
+        r.from_crossing = limit < inf;
         r.start = at;
         r.winding = w.x;  // just right of the new start: what a transformed row carries to its next pass
         r.winding_b = w.y;
@@ -603,6 +616,7 @@ void row_line_begin(inout RowLine line, RasterItem item, RasterTransform m, vec4
     // at one (a stem on the texel's edge): the walk clips to the channels' segments, so the stretch
     // before them adds nothing.
     line.r.start = start - kTransformedStartBack;
+    line.r.from_crossing = false;
     line.r.end = end;
     line.start_em = texel_em(m, line.r.start, line.y);
     float yb = texel_em(m, line.r.end, line.y).y;
@@ -671,6 +685,7 @@ uvec3 row_samples_axis_aligned(RasterItem item, vec3 lo, vec3 hi, uint rows, uin
             // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
             vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
             RowList r;
+            r.from_crossing = false;
             r.start = (rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row]) - 1.5 * blur;
             r.end = (rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row]) + 1.5 * blur;
             uint band = band_of(item, y);
