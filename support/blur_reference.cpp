@@ -44,29 +44,29 @@ double solve_y(const Quad& q, double t0, double t1, double y) {
     return t;
 }
 
-Quad to_texels(const Quad& q, const TexelToEm& map) {
-    const auto point = [&](Vec2 p) {
-        return Vec2{(p.x - static_cast<double>(map.offset_x)) / static_cast<double>(map.scale_x),
-                    (p.y - static_cast<double>(map.offset_y)) / static_cast<double>(map.scale_y)};
-    };
+Quad to_texels(const Quad& q, const Projective& to_texel) {
+    const double* m = to_texel.m;
+    const auto point = [&](Vec2 p) { return Vec2{m[0] * p.x + m[1] * p.y + m[2], m[3] * p.x + m[4] * p.y + m[5]}; };
     return {point(q.p0), point(q.p1), point(q.p2)};
 }
 
-// The listed slots of a packed glyph (any band's bits), as quads, split at `split` into two sets.
-void listed(const GlyphRecord& record, std::span<const Point> points, std::span<const uint32_t> band_words,
-            uint32_t split, std::vector<Quad>& a, std::vector<Quad>& b) {
-    for (uint32_t word = 0; word < record.band_words; ++word) {
+// The curves of a packed glyph, as quads, split at slot `split` into two sets: the slots some band
+// lists, and the curves flat in em y, which no band lists but which cross a transformed glyph's
+// rows (a slot whose three points share y and whose control point is not its start: a pad slot
+// repeats its start).
+void curves_of(const GlyphRecord& record, std::span<const Point> points, std::span<const uint32_t> band_words,
+               uint32_t split, std::vector<Quad>& a, std::vector<Quad>& b) {
+    for (uint32_t slot = 0; slot < record.curve_count; ++slot) {
+        const uint32_t word = slot / 32, bit = slot % 32;
         uint32_t bits = 0;
         for (uint32_t band = 0; band < record.band_count; ++band) {
             bits |= band_words[size_t{record.band_offset} + size_t{band} * record.band_words + word];
         }
-        for (uint32_t bit = 0; bit < 32; ++bit) {
-            if (((bits >> bit) & 1u) == 0) continue;
-            const uint32_t slot = word * 32 + bit;
-            const Point* p = &points[size_t{record.point_offset} + 2 * size_t{slot}];
-            const Quad q{{p[0].x, p[0].y}, {p[1].x, p[1].y}, {p[2].x, p[2].y}};
-            (slot >= split ? b : a).push_back(q);
-        }
+        const Point* p = &points[size_t{record.point_offset} + 2 * size_t{slot}];
+        const bool flat = p[0].y == p[1].y && p[1].y == p[2].y && !(p[1].x == p[0].x && p[1].y == p[0].y);
+        if (((bits >> bit) & 1u) == 0 && !flat) continue;
+        const Quad q{{p[0].x, p[0].y}, {p[1].x, p[1].y}, {p[2].x, p[2].y}};
+        (slot >= split ? b : a).push_back(q);
     }
 }
 
@@ -77,14 +77,14 @@ BlurReference::BlurReference(std::span<const Quad> set_a, std::span<const Quad> 
 
 BlurReference BlurReference::of_glyph(const FontAsset& asset, const GlyphRecord& glyph) {
     std::vector<Quad> a, b;
-    listed(glyph, asset.points, asset.band_words, UINT32_MAX, a, b);
+    curves_of(glyph, asset.points, asset.band_words, UINT32_MAX, a, b);
     return BlurReference(a);
 }
 
 BlurReference BlurReference::of_derived(const DerivedGlyph& derived, StrokeOp op) {
     std::vector<Quad> a, b;
     GlyphRecord record = derived.record;
-    listed(record, derived.points, derived.band_words, derived.set_b_first, a, b);
+    curves_of(record, derived.points, derived.band_words, derived.set_b_first, a, b);
     return BlurReference(a, b, op);
 }
 
@@ -140,6 +140,15 @@ double BlurReference::row(const std::vector<Piece>& pieces, double y, double x0,
 
 std::array<double, 3> BlurReference::texel(const TexelToEm& map, const SubpixelLayout& layout, uint32_t tx, uint32_t ty,
                                            double w, double tolerance) const {
+    // em = offset + scale * texel, inverted.
+    const double sx = static_cast<double>(map.scale_x), sy = static_cast<double>(map.scale_y);
+    const Projective to_texel{{1.0 / sx, 0.0, -static_cast<double>(map.offset_x) / sx, 0.0, 1.0 / sy,
+                               -static_cast<double>(map.offset_y) / sy, 0.0, 0.0, 1.0}};
+    return texel(to_texel, layout, tx, ty, w, tolerance);
+}
+
+std::array<double, 3> BlurReference::texel(const Projective& map, const SubpixelLayout& layout, uint32_t tx,
+                                           uint32_t ty, double w, double tolerance) const {
     std::vector<Piece> pieces;
     for (const Quad& q : a_) add_pieces(to_texels(q, map), false, pieces);
     for (const Quad& q : b_) add_pieces(to_texels(q, map), true, pieces);

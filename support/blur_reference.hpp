@@ -27,8 +27,8 @@ public:
     // region where `op` holds of (inside A, inside B).
     explicit BlurReference(std::span<const Quad> set_a, std::span<const Quad> set_b = {}, StrokeOp op = StrokeOp::a);
 
-    // A glyph of an asset, and a derived glyph with its op (its slots listed in some band, split at
-    // set_b_first: pads and flat curves bound nothing).
+    // A glyph of an asset, and a derived glyph with its op (its slots some band lists, and those
+    // flat in em y, which cross a transformed glyph's rows; split at set_b_first).
     static BlurReference of_glyph(const FontAsset& asset, const GlyphRecord& glyph);
     static BlurReference of_derived(const DerivedGlyph& derived, StrokeOp op);
 
@@ -38,6 +38,9 @@ public:
     // (Simpson's |S2 - S1| / 15) of any call so far.
     std::array<double, 3> texel(const TexelToEm& map, const SubpixelLayout& layout, uint32_t tx, uint32_t ty, double w,
                                 double tolerance = 1e-6) const;
+    // The same for any key's rect, `to_texel` its em_to_texel() (affine: W must be 1).
+    std::array<double, 3> texel(const Projective& to_texel, const SubpixelLayout& layout, uint32_t tx, uint32_t ty,
+                                double w, double tolerance = 1e-6) const;
     double error() const { return error_; }
 
 private:

@@ -77,13 +77,14 @@ using LayerReference = std::function<TexelReference(const DrawnGlyph&, const Sub
 // `reference_of` gives a reference to that reference.
 Worst converge_and_hold(const Font& font, std::span<const GlyphInstance> glyphs, const TextEffects& effects,
                         uint32_t samples, const char* layout, const LayerReference& reference_of,
-                        SampleKind kind = SampleKind::rows) {
+                        SampleKind kind = SampleKind::rows, std::optional<TextTransform> transform = {}) {
     Worst worst;
     auto renderer = make_renderer(layout, samples, kind);
     if (!renderer) return worst;
     EXPECT_TRUE(renderer->add_font(font));
     DrawOptions options;
     options.effects = effects;
+    options.transform = transform;
     const Result<uint32_t> frames =
         test::render_until_converged(*context(), *renderer, 4000, [&] { renderer->draw(glyphs, options); });
     EXPECT_TRUE(frames) << frames.error().message;
@@ -146,7 +147,8 @@ Worst converge_and_compare(const Font& font, std::span<const GlyphInstance> glyp
 // converge_and_hold() of every blurred layer to the exact blurred coverage of its source (the
 // glyph, or the derived glyph with its op).
 Worst converge_and_compare_blur(const Font& font, std::span<const GlyphInstance> glyphs, const TextEffects& effects,
-                                uint32_t samples, const char* layout, SampleKind kind = SampleKind::rows) {
+                                uint32_t samples, const char* layout, SampleKind kind = SampleKind::rows,
+                                std::optional<TextTransform> transform = {}) {
     return converge_and_hold(
         font, glyphs, effects, samples, layout,
         [&](const DrawnGlyph& d, const SubpixelLayout& sub) -> TexelReference {
@@ -166,7 +168,8 @@ Worst converge_and_compare_blur(const Font& font, std::span<const GlyphInstance>
                     std::make_shared<BlurReference>(BlurReference::of_derived(*derived, decode_effect(key.effect).op));
                 record = derived->record;
             }
-            const TexelToEm map = texel_to_em(glyph_rect(record, key), key);
+            // The rect's map: a transformed key's em_to_texel(), affine in these tests.
+            const Projective map = em_to_texel(glyph_rect(record, key), key);
             const double w = blur_box_width(key.blur * kBlurUnit);
             return [reference, map, &sub, w](uint32_t tx, uint32_t ty) {
                 const std::array<double, 3> want = reference->texel(map, sub, tx, ty, w);
@@ -174,7 +177,7 @@ Worst converge_and_compare_blur(const Font& font, std::span<const GlyphInstance>
                 return want;
             };
         },
-        kind);
+        kind, transform);
 }
 
 std::vector<GlyphInstance> lay_out(const Font& font, std::string_view text, float size, float x, float y) {
@@ -414,7 +417,7 @@ TEST(Effects, GlowsOfOutlinedGlyphsConvergeOnTheExactBlurAndStackUnderTheOutline
     EXPECT_EQ(messages.errors + messages.warnings, 0u);
 }
 
-TEST(Effects, BlurredPointSamplesConvergeAndTransformedBlurredLayersAreCounted) {
+TEST(Effects, BlurredPointSamplesAndTransformedGlyphsConvergeOnTheExactBlur) {
     REQUIRE_GPU();
     auto font = test::bake_subset(test::kDejaVuSans, "M");
     ASSERT_TRUE(font);
@@ -423,23 +426,33 @@ TEST(Effects, BlurredPointSamplesConvergeAndTransformedBlurredLayersAreCounted) 
     // offset, converging as points do (a coverage step per sample, not a covered length).
     TextEffects e;
     e.shadow = TextShadow{1.0f, 1.0f, {0.0f, 0.0f, 0.0f, 0.5f}, 3.0f};
-    const Worst w = converge_and_compare_blur(*font, glyphs, e, 1023, "gray", SampleKind::points);
+    const Worst points = converge_and_compare_blur(*font, glyphs, e, 1023, "gray", SampleKind::points);
     std::printf("[ effects ] M 16 px gray, points, shadow blurred 3 px: max %.4f, mean %.5f over %llu channels\n",
-                w.max, w.mean, static_cast<unsigned long long>(w.channels));
-    EXPECT_EQ(w.layers, 1u);
-    EXPECT_LE(w.max, 2.0 * kTarget);
-    // A transformed glyph's blurred shadow and glow are left out and counted.
-    auto renderer = make_renderer("gray", 8);
-    ASSERT_TRUE(renderer);
-    ASSERT_TRUE(renderer->add_font(*font));
-    DrawOptions options;
-    options.effects = e;
-    options.effects->glow = TextGlow{};
-    options.transform = TextTransform{0.8f, -0.6f, 0.6f, 0.8f, 3.0f, 20.0f};
-    const std::vector<DrawnGlyph> drawn = one_frame(*renderer, [&] { renderer->draw(glyphs, options); });
-    ASSERT_EQ(drawn.size(), 1u);
-    EXPECT_EQ(drawn[0].stack, kStackGlyph);
-    EXPECT_EQ(renderer->stats().failed_effects, 2u);
+                points.max, points.mean, static_cast<unsigned long long>(points.channels));
+    EXPECT_EQ(points.layers, 1u);
+    EXPECT_LE(points.max, 2.0 * kTarget);
+    // Transformed glyphs are blurred in the target's pixels: rotated by 37 degrees (one line a
+    // sample) and by 80 (two lines, stems along the rows), a blurred shadow and a glow each.
+    e.glow = TextGlow{2.0f, {1.0f, 1.0f, 1.0f, 0.75f}};
+    // Outlined, the two-set source is blurred.
+    struct Case {
+        const char* name;
+        TextTransform transform;
+        const char* layout;
+        bool outlined;
+    };
+    for (const Case& c : {Case{"37 degrees", {0.8f, -0.6f, 0.6f, 0.8f, 3.0f, 20.0f}, "gray", false},
+                          Case{"37 degrees", {0.8f, -0.6f, 0.6f, 0.8f, 3.0f, 20.0f}, "rgb", false},
+                          Case{"80 degrees", {0.173648f, -0.984808f, 0.984808f, 0.173648f, 3.0f, 20.0f}, "gray", false},
+                          Case{"37 degrees", {0.8f, -0.6f, 0.6f, 0.8f, 3.0f, 20.0f}, "gray", true}}) {
+        TextEffects fx = e;
+        if (c.outlined) fx.outline = TextOutline{1.0f, OutlinePlacement::outside, LineJoin::round, 4.0f, {0, 0, 0, 1}};
+        const Worst w = converge_and_compare_blur(*font, glyphs, fx, 256, c.layout, SampleKind::rows, c.transform);
+        std::printf("[ effects ] M 16 px %s, rotated %s%s, shadow blurred 3 px, glow 2 px: max %.4f, mean %.5f\n",
+                    c.layout, c.name, c.outlined ? ", outlined 1 px" : "", w.max, w.mean);
+        EXPECT_EQ(w.layers, 2u);
+        EXPECT_LE(w.max, kTarget) << c.name << " " << c.layout;
+    }
 }
 
 TEST(Effects, EffectsPastTheGlyphsLimitsAreLeftOutAndCounted) {

@@ -46,7 +46,7 @@ struct TextOutline {
 // blurred by `blur` and drawn under everything else of the draw. The blur of radius R is exact
 // (not sampled from a texture): per axis three boxes of width 2R/3 (reaching R, sigma R/3)
 // convolved with each texel channel's own sample interval, converged in the atlas like the text.
-// Transformed glyphs' blurred layers are not drawn yet (RendererStats::failed_effects).
+// A transformed glyph's layer is blurred in the target's pixels, after the transform.
 struct TextShadow {
     float offset_x = 2.0f;  // target pixels, y down
     float offset_y = 2.0f;

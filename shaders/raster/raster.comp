@@ -610,7 +610,9 @@ struct RowLine {
 // texels reverses orientation, and carried from pass to pass.
 void row_line_begin(inout RowLine line, RasterItem item, RasterTransform m, vec4 rect, uint ty, float h, float start,
                     float end, inout uint lo_band, inout uint hi_band) {
-    line.y = float(ty) + (rect.y + (rect.w - rect.y) * h);
+    // A blurred row sits where the y filter's CDF is h (texels: row_samples() widened the segment).
+    line.y = kBlurItems != 0u ? blur_inverse_cdf(h, float(ty) + rect.y, float(ty) + rect.w, item.blur_w)
+                              : float(ty) + (rect.y + (rect.w - rect.y) * h);
     line.y_row = m.to_texel[1].xyz - line.y * m.to_texel[2].xyz;
     // The start a hair left of the segment, so that it is not on a curve where the segment begins
     // at one (a stem on the texel's edge): the walk clips to the channels' segments, so the stretch
@@ -651,7 +653,7 @@ vec3 row_line_end(inout RowLine line, RasterItem item, RasterTransform m, vec3 l
     ivec2 start = first_pass ? line.start_winding * int(m.to_texel[0].w) : line.start_winding;
     line.r.winding = start.x;
     line.r.winding_b = start.y;
-    vec3 covered = row_walk(line.r, item.cover_rule, lo, hi, 0.0);
+    vec3 covered = row_walk(line.r, item.cover_rule, lo, hi, kBlurItems != 0u ? item.blur_w : 0.0);
     line.pending = line.r.more;
     line.start_winding = ivec2(line.r.winding, line.r.winding_b);
     return covered;
@@ -754,8 +756,10 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             vec4 rect = pc.channel_rects[row];
             // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
             vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
-            float start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
-            float end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
+            // A blurred segment reaches the x filters' supports, 3w/2 past the channels' intervals.
+            float reach = kBlurItems != 0u ? 1.5 * item.blur_w : 0.0;
+            float start = (rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row]) - reach;
+            float end = (rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row]) + reach;
             uint lo_band = 0xFFFFFFFFu, hi_band = 0u;
             RowLine a, b;
             row_line_begin(a, item, m, rect, ty, two_lines ? fract(v - kRasterHalfRowShift) : v, start, end, lo_band,
@@ -794,8 +798,10 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             }
         }
         if (two_lines) covered *= 0.5;
-        sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),
-                      row_units(covered.z, hi.z - lo.z, dither));
+        // A blurred walk's sums are fractions already.
+        vec3 lengths = kBlurItems != 0u ? vec3(1.0) : hi - lo;
+        sums += uvec3(row_units(covered.x, lengths.x, dither), row_units(covered.y, lengths.y, dither),
+                      row_units(covered.z, lengths.z, dither));
     }
     return sums;
 }

@@ -96,7 +96,6 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
         for (const RasterWork& w : work) {
             if (w.sample_count == 0 || item_kind(w.key) != kind % kRasterGeometryKinds) continue;
             if ((kind >= kRasterBlurKindBase) != (w.key.blur != 0)) continue;
-            if (w.key.blur != 0 && is_transformed(w.key)) continue;
             const HeldGlyph held = fonts.glyph(w.key);
             if (!held.font || (kind % kRasterBlurKindBase >= kRasterGeometryKinds) != held.derived) continue;
             const HeldFont* font = held.font;

@@ -38,8 +38,7 @@ uint32_t item_kind(const GlyphKey& key);
 
 // The rasterizer's work items for `work` into `items`, and into `workgroup_items` the item of
 // each workgroup; returns the workgroups they take. Work of a font not held, or without samples,
-// makes none, nor does blurred work of a transformed key (not drawn yet: the renderer refuses such
-// layers before they reach the atlas). Items come kind after kind (item_kind()), and `kind_workgroups` gets the
+// makes none. Items come kind after kind (item_kind()), and `kind_workgroups` gets the
 // workgroups of each kind. Transformed glyphs' items point into `transforms`, one per such item.
 uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fonts, std::vector<gpu::RasterItem>& items,
                           std::vector<gpu::RasterTransform>& transforms, std::vector<uint32_t>& workgroup_items,

@@ -367,15 +367,10 @@ void FrameRequests::request_effects(const GlyphInstance& glyph, const VkRect2D* 
 }
 
 // A layer of `glyph`: its outline derived by `effect` (0: its own), in `colour`, at `order` and
-// `stack`, moved by (dx, dy) pixels and blurred by `blur` (GlyphKey::blur). A transformed glyph's
-// blurred layer is not drawn (the rasterizer walks blurred rows of axis-aligned keys only).
+// `stack`, moved by (dx, dy) pixels and blurred by `blur` (GlyphKey::blur).
 void FrameRequests::submit_layer(const GlyphInstance& glyph, uint32_t effect, const std::array<float, 4>& colour,
                                  uint32_t order, uint32_t stack, double dx, double dy, const VkRect2D* visible,
                                  const GlyphContrast& contrast, uint16_t blur) {
-    if (blur != 0 && is_transformed(glyph.key)) {
-        ++stats_.failed_effects;
-        return;
-    }
     const HeldGlyph own = fonts_.glyph(glyph.key);
     GlyphInstance layer = glyph;
     layer.key.effect = effect;
