@@ -61,11 +61,13 @@ build/tools/crisp-render --font "$out/DejaVuSans.crisp" --font "$out/NotoColorEm
   --text "Colour glyphs: 😀 👍🏽 ❤️ 🇺🇸 and COLRv1 gradients $(printf '\xee\x80\x82 \xee\x80\x83 \xee\x80\x84')
 The baked subset: $emoji_text" --size 24 --origin 12,34 --canvas 720,90 -o "$out/emoji.png"
 echo
-echo "== crisp-render: a title with an outline and a drop shadow (effects, exact at every size), and the"
-echo "   same text emboldened by --weight"
+echo "== crisp-render: a title with an outline and a blurred drop shadow (effects, exact at every size), a"
+echo "   glow, and text emboldened by --weight"
 build/tools/crisp-render --font "$out/Inter-Bold.crisp" --text "Outlined Title" --size 56 --origin 16,70 \
   --canvas 480,100 --color 1,0.85,0.2 --background 0.25,0.35,0.55 --backdrop gradient \
-  --outline 3,0.1,0.05,0 --shadow 4,4,0,0,0,0,0.6 -o "$out/title.png"
+  --outline 3,0.1,0.05,0 --shadow 4,4,3,0,0,0,0.6 -o "$out/title.png"
+build/tools/crisp-render --font "$out/Inter-Bold.crisp" --text "Glowing" --size 48 --origin 16,60 \
+  --canvas 260,84 --color 1,1,1 --background 0.05,0.05,0.15 --glow 6,0.3,0.7,1,0.9 -o "$out/glow.png" >/dev/null
 build/tools/crisp-render --font "$out/DejaVuSans.crisp" --text "Regular, and --weight 0.6 px" --size 20 \
   --origin 10,28 --canvas 320,40 --weight 0.6 -o "$out/weight.png" >/dev/null
 echo
@@ -82,6 +84,7 @@ echo "$(pwd)/$out/overlap-tiled.png"
 echo "$(pwd)/$out/overlap-unsorted.png"
 echo "Colour glyphs (bitmap emoji and COLRv1 gradients):"
 echo "$(pwd)/$out/emoji.png"
-echo "A title with an outline and a shadow, and emboldened text:"
+echo "A title with an outline and a blurred shadow, a glow, and emboldened text:"
 echo "$(pwd)/$out/title.png"
+echo "$(pwd)/$out/glow.png"
 echo "$(pwd)/$out/weight.png"

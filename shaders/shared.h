@@ -118,6 +118,7 @@ struct RasterItem {
     uint flat_row;         // transformed: first word of its flat curves' row in the band buffer, or kRasterNoTransform
     uint set_b_first;      // two-set items (effect layers): the first curve slot of the second set
     uint cover_rule;       // two-set items: covered where bit (wa != 0) + 2 (wb != 0) is set (kRasterCover*)
+    float blur_w;          // blurred items (kBlurItems): the blur's box width w = 2 R / 3, texels; 0 otherwise
 };
 
 // A transformed glyph's maps (include/crisp/glyph.hpp, em_to_texel): rows of 3x3 projective
@@ -362,7 +363,8 @@ struct TilePushConstants {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(RasterItem) == 104);
+static_assert(sizeof(RasterItem) == 108);
+static_assert(offsetof(RasterItem, blur_w) == 104);
 static_assert(sizeof(RasterTransform) == 96);
 static_assert(sizeof(TileHeader) == kTileHeaderWords * 4);
 static_assert(sizeof(TileBinEntry) == 32);

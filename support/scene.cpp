@@ -20,10 +20,11 @@ namespace {
 using Type = json::Value::Type;
 
 constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "contrast", "palette", "runs"};
-constexpr std::string_view kRunMembers[] = {"font",     "text",    "size",      "origin", "color",   "depth",
-                                            "contrast", "palette", "transform", "weight", "outline", "shadow"};
+constexpr std::string_view kRunMembers[] = {"font",    "text",      "size",   "origin",  "color",  "depth", "contrast",
+                                            "palette", "transform", "weight", "outline", "shadow", "glow"};
 constexpr std::string_view kOutlineMembers[] = {"width", "placement", "join", "miter_limit", "color"};
-constexpr std::string_view kShadowMembers[] = {"offset", "color"};
+constexpr std::string_view kShadowMembers[] = {"offset", "color", "blur"};
+constexpr std::string_view kGlowMembers[] = {"radius", "color"};
 constexpr std::string_view kContrastMembers[] = {"mode", "gamma", "contrast", "stem_darkening"};
 
 Error fault(const std::string& path, const std::string& what) {
@@ -153,14 +154,15 @@ std::optional<Error> read_contrast(const json::Value& value, const std::string& 
     return std::nullopt;
 }
 
-// A run's "weight", "outline" and "shadow" (include/crisp/effects.hpp) into `effects`; nullopt
+// A run's "weight", "outline", "shadow" and "glow" (include/crisp/effects.hpp) into `effects`; nullopt
 // effects where it has none of them. Ranges as validate_text_effects() at the run's size.
 std::optional<Error> read_effects(const json::Value& value, const std::string& path, float size,
                                   std::optional<TextEffects>& out) {
     const json::Value* weight = value.find("weight");
     const json::Value* outline = value.find("outline");
     const json::Value* shadow = value.find("shadow");
-    if (!weight && !outline && !shadow) return std::nullopt;
+    const json::Value* glow = value.find("glow");
+    if (!weight && !outline && !shadow && !glow) return std::nullopt;
     TextEffects effects;
     const auto finite = [](const json::Value& v) {
         return v.type == Type::number && std::fabs(v.number) <= static_cast<double>(kMaxEffectWidth);
@@ -227,7 +229,33 @@ std::optional<Error> read_effects(const json::Value& value, const std::string& p
             if (auto error = read_color(*color, at + ".color", c)) return error;
             std::copy(std::begin(c), std::end(c), sh.color.begin());
         }
+        if (const json::Value* blur = shadow->find("blur")) {
+            if (blur->type != Type::number ||
+                !(blur->number >= 0.0 && blur->number <= static_cast<double>(kMaxEffectBlur))) {
+                return fault(at + ".blur", "expected a radius of pixels in [0, 128]");
+            }
+            sh.blur = static_cast<float>(blur->number);
+        }
         effects.shadow = sh;
+    }
+    if (glow) {
+        const std::string at = path + ".glow";
+        if (glow->type != Type::object) return fault(at, "expected an object");
+        if (auto error = unknown_member(*glow, at, kGlowMembers)) return error;
+        TextGlow g;
+        if (const json::Value* radius = glow->find("radius")) {
+            if (radius->type != Type::number ||
+                !(radius->number > 0.0 && radius->number <= static_cast<double>(kMaxEffectBlur))) {
+                return fault(at + ".radius", "expected a radius of pixels in (0, 128]");
+            }
+            g.radius = static_cast<float>(radius->number);
+        }
+        if (const json::Value* color = glow->find("color")) {
+            float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+            if (auto error = read_color(*color, at + ".color", c)) return error;
+            std::copy(std::begin(c), std::end(c), g.color.begin());
+        }
+        effects.glow = g;
     }
     if (Status valid = validate_text_effects(effects, size); !valid) {
         const std::string& message = valid.error().message;

@@ -45,7 +45,8 @@ struct SceneRun {
     // y' = c x + d y; DrawOptions::transform): "transform": [a, b, c, d]. nullopt: none.
     std::optional<std::array<float, 4>> transform;
     // Its effects (DrawOptions::effects): "weight" (pixels), "outline" {"width", "placement",
-    // "join", "miter_limit", "color"} and "shadow" {"offset": [dx, dy], "color"}; nullopt: none.
+    // "join", "miter_limit", "color"}, "shadow" {"offset": [dx, dy], "color", "blur"} and "glow"
+    // {"radius", "color"}; nullopt: none.
     std::optional<TextEffects> effects;
     friend bool operator==(const SceneRun&, const SceneRun&) = default;
 };

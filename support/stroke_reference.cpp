@@ -396,6 +396,11 @@ std::array<double, 3> StrokeReference::texel(const TexelToEm& map, const Subpixe
     const auto ox = static_cast<double>(map.offset_x), oy = static_cast<double>(map.offset_y);
     for (size_t c = 0; c < 3; ++c) {
         const SampleRect& r = layout.channels[c];
+        // Channels that share a rect (a gray layout's three) share its area.
+        if (c > 0 && r == layout.channels[c - 1]) {
+            out[c] = out[c - 1];
+            continue;
+        }
         const double ax = ox + sx * (tx + static_cast<double>(r.x0)), bx = ox + sx * (tx + static_cast<double>(r.x1));
         const double ay = oy + sy * (ty + static_cast<double>(r.y0)), by = oy + sy * (ty + static_cast<double>(r.y1));
         out[c] = coverage(std::min(ax, bx), std::min(ay, by), std::max(ax, bx), std::max(ay, by));

@@ -604,6 +604,12 @@ for value in 1 1,1 nan,0,0 1,1,0,0,0 9000,0,0; do
   expect_exit 2 "--shadow '$value'" -- "$render" "${base[@]}" --shadow "$value" -o x.png
   expect_stderr "--shadow" "--shadow '$value'"
 done
+for value in 0 -1 200 nan 2,1,0 2,1,0,0,0,0; do
+  expect_exit 2 "--glow '$value'" -- "$render" "${base[@]}" --glow "$value" -o x.png
+  expect_stderr "--glow" "--glow '$value'"
+done
+expect_exit 2 "--shadow with BLUR 200" -- "$render" "${base[@]}" --shadow 1,1,200 -o x.png
+expect_stderr "--shadow" "--shadow with BLUR 200"
 for value in nan 1,2 -5000; do
   expect_exit 2 "--weight '$value'" -- "$render" "${base[@]}" --weight "$value" -o x.png
   expect_stderr "--weight" "--weight '$value'"

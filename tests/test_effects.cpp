@@ -1,12 +1,15 @@
 // Text effects (docs/effects.md) on lavapipe with validation on: every outline placement and join
 // and both weights converge, texel by texel, on the exact stroked area (support/stroke_reference);
-// shadows are the glyph (with its outline) moved; the layers stack under and over their glyph;
+// shadows are the glyph (with its outline) moved; blurred shadows and glows converge on the exact
+// blurred coverage (support/blur_reference); the layers stack under and over their glyph;
 // bad parameters are refused with their names; the atlas cost is counted.
+#include "blur_reference.hpp"
 #include "headless_context.hpp"
 #include "shape_support.hpp"
 #include "stroke_reference.hpp"
 #include "test_support.hpp"
 
+#include "text/blur_kernel.hpp"
 #include "text/effect_code.hpp"
 #include "text/stroke.hpp"
 
@@ -20,8 +23,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace crisp {
@@ -48,11 +53,13 @@ struct Worst {
     double max = 0.0;   // the largest error of any texel channel of an effect layer
     double mean = 0.0;  // over channels with coverage
     uint64_t channels = 0;
-    uint32_t layers = 0;  // effect layers compared
+    uint32_t layers = 0;                   // effect layers compared
+    std::map<uint32_t, double> by_effect;  // the largest error of the layers of each GlyphKey::effect
 };
 
-std::unique_ptr<Renderer> make_renderer(const char* layout, uint32_t samples) {
+std::unique_ptr<Renderer> make_renderer(const char* layout, uint32_t samples, SampleKind kind = SampleKind::rows) {
     RendererCreateInfo info = renderer_create_info(*context());
+    info.sample_kind = kind;
     info.atlas.width = info.atlas.height = 1024;
     info.atlas.max_samples = samples;
     info.atlas.frame_budget = uint64_t{1} << 40;
@@ -62,18 +69,30 @@ std::unique_ptr<Renderer> make_renderer(const char* layout, uint32_t samples) {
     return renderer ? std::make_unique<Renderer>(std::move(*renderer)) : nullptr;
 }
 
-// Draws `glyphs` with `effects` until converged and holds every derived layer's texels to the
-// exact stroked area of its shape.
-Worst converge_and_compare(const Font& font, std::span<const GlyphInstance> glyphs, const TextEffects& effects,
-                           uint32_t samples, const char* layout = "gray") {
+// A layer's exact coverage of texel (tx, ty) of its glyph rect, per channel.
+using TexelReference = std::function<std::array<double, 3>(uint32_t tx, uint32_t ty)>;
+// The reference of a drawn layer; an empty one leaves the layer uncompared.
+using LayerReference = std::function<TexelReference(const DrawnGlyph&, const SubpixelLayout&)>;
+
+// Draws `glyphs` with `effects` until converged and holds the texels of every layer that
+// `reference_of` gives a reference to that reference.
+// Several effects are several draws of the glyphs on one renderer (lavapipe compiles its pipelines
+// anew for every renderer: a few seconds each).
+Worst converge_and_hold(const Font& font, std::span<const GlyphInstance> glyphs, std::span<const TextEffects> effects,
+                        uint32_t samples, const char* layout, const LayerReference& reference_of,
+                        SampleKind kind = SampleKind::rows, std::optional<TextTransform> transform = {}) {
     Worst worst;
-    auto renderer = make_renderer(layout, samples);
+    auto renderer = make_renderer(layout, samples, kind);
     if (!renderer) return worst;
     EXPECT_TRUE(renderer->add_font(font));
     DrawOptions options;
-    options.effects = effects;
-    const Result<uint32_t> frames =
-        test::render_until_converged(*context(), *renderer, 4000, [&] { renderer->draw(glyphs, options); });
+    options.transform = transform;
+    const Result<uint32_t> frames = test::render_until_converged(*context(), *renderer, 4000, [&] {
+        for (const TextEffects& e : effects) {
+            options.effects = e;
+            renderer->draw(glyphs, options);
+        }
+    });
     EXPECT_TRUE(frames) << frames.error().message;
     EXPECT_TRUE(renderer->converged());
     EXPECT_EQ(renderer->stats().failed_effects, 0u);
@@ -84,29 +103,22 @@ Worst converge_and_compare(const Font& font, std::span<const GlyphInstance> glyp
     const SubpixelLayout& sub = *subpixel_preset(layout);
     double sum = 0.0;
     for (const DrawnGlyph& d : renderer->drawn()) {
-        const GlyphKey& key = d.instance.key;
-        if (key.effect == 0) continue;
-        const GlyphRecord& own = font.asset().glyphs[key.glyph];
-        const Result<DerivedGlyph> derived =
-            derive_effect_glyph(font.asset(), own, key.effect, effect_tolerance(effect_octave(key)));
-        EXPECT_TRUE(derived);
-        if (!derived) continue;
-        const EffectShape shape = decode_effect(key.effect);
-        const StrokeReference reference(glyph_contours(font.asset(), own), shape.join, shape.half_width,
-                                        shape.miter_limit, shape.op);
-        const TexelToEm map = texel_to_em(glyph_rect(derived->record, key), key);
+        const TexelReference reference = reference_of(d, sub);
+        if (!reference) continue;
         ++worst.layers;
         for (uint32_t ty = 0; ty < d.instance.height; ++ty) {
             for (uint32_t tx = 0; tx < d.instance.width; ++tx) {
                 const Texel& t = (*texels)[size_t{d.atlas_y + ty} * atlas_width + d.atlas_x + tx];
                 EXPECT_EQ(t.count, samples);
-                const std::array<double, 3> want = reference.texel(map, sub, tx + d.part_x, ty + d.part_y);
+                const std::array<double, 3> want = reference(tx + d.part_x, ty + d.part_y);
                 const uint16_t sums[3] = {t.r, t.g, t.b};
                 for (size_t c = 0; c < 3; ++c) {
                     const double got = static_cast<double>(sums[c]) / (kCoverageOne * std::max<uint32_t>(t.count, 1));
                     if (got == 0.0 && want[c] == 0.0) continue;
                     const double error = std::abs(got - want[c]);
                     worst.max = std::max(worst.max, error);
+                    double& mine = worst.by_effect[d.instance.key.effect];
+                    mine = std::max(mine, error);
                     sum += error;
                     ++worst.channels;
                 }
@@ -118,6 +130,63 @@ Worst converge_and_compare(const Font& font, std::span<const GlyphInstance> glyp
     EXPECT_EQ(messages.errors + messages.warnings, 0u);
     for (const std::string& text : messages.recent) ADD_FAILURE() << text;
     return worst;
+}
+
+// converge_and_hold() of every derived layer to the exact stroked area of its shape.
+Worst converge_and_compare(const Font& font, std::span<const GlyphInstance> glyphs,
+                           std::span<const TextEffects> effects, uint32_t samples, const char* layout = "gray") {
+    return converge_and_hold(
+        font, glyphs, effects, samples, layout, [&](const DrawnGlyph& d, const SubpixelLayout& sub) -> TexelReference {
+            const GlyphKey& key = d.instance.key;
+            if (key.effect == 0) return {};
+            const GlyphRecord& own = font.asset().glyphs[key.glyph];
+            const Result<DerivedGlyph> derived =
+                derive_effect_glyph(font.asset(), own, key.effect, effect_tolerance(effect_octave(key)));
+            EXPECT_TRUE(derived);
+            if (!derived) return {};
+            const EffectShape shape = decode_effect(key.effect);
+            auto reference = std::make_shared<StrokeReference>(glyph_contours(font.asset(), own), shape.join,
+                                                               shape.half_width, shape.miter_limit, shape.op);
+            const TexelToEm map = texel_to_em(glyph_rect(derived->record, key), key);
+            return [reference, map, &sub](uint32_t tx, uint32_t ty) { return reference->texel(map, sub, tx, ty); };
+        });
+}
+
+// converge_and_hold() of every blurred layer to the exact blurred coverage of its source (the
+// glyph, or the derived glyph with its op).
+Worst converge_and_compare_blur(const Font& font, std::span<const GlyphInstance> glyphs, const TextEffects& effects,
+                                uint32_t samples, const char* layout, SampleKind kind = SampleKind::rows,
+                                std::optional<TextTransform> transform = {}) {
+    const TextEffects one[] = {effects};
+    return converge_and_hold(
+        font, glyphs, one, samples, layout,
+        [&](const DrawnGlyph& d, const SubpixelLayout& sub) -> TexelReference {
+            const GlyphKey& key = d.instance.key;
+            if (key.blur == 0) return {};
+            const GlyphRecord& own = font.asset().glyphs[key.glyph];
+            std::shared_ptr<BlurReference> reference;
+            GlyphRecord record = own;
+            if (key.effect == 0) {
+                reference = std::make_shared<BlurReference>(BlurReference::of_glyph(font.asset(), own));
+            } else {
+                const Result<DerivedGlyph> derived =
+                    derive_effect_glyph(font.asset(), own, key.effect, effect_tolerance(effect_octave(key)));
+                EXPECT_TRUE(derived);
+                if (!derived) return {};
+                reference =
+                    std::make_shared<BlurReference>(BlurReference::of_derived(*derived, decode_effect(key.effect).op));
+                record = derived->record;
+            }
+            // The rect's map: a transformed key's em_to_texel(), affine in these tests.
+            const Projective map = em_to_texel(glyph_rect(record, key), key);
+            const double w = blur_box_width(key.blur * kBlurUnit);
+            return [reference, map, &sub, w](uint32_t tx, uint32_t ty) {
+                const std::array<double, 3> want = reference->texel(map, sub, tx, ty, w);
+                EXPECT_LE(reference->error(), 1e-5);
+                return want;
+            };
+        },
+        kind, transform);
 }
 
 std::vector<GlyphInstance> lay_out(const Font& font, std::string_view text, float size, float x, float y) {
@@ -146,20 +215,24 @@ TEST(Effects, OutlinesOfEveryPlacementAndJoinMatchTheExactStroke) {
     ASSERT_TRUE(font);
     for (const float size : {8.0f, 16.0f, 48.0f}) {
         const std::vector<GlyphInstance> glyphs = lay_out(*font, "MW4", size, 3.3f, 4.0f + size);
+        const float width = std::max(1.0f, size / 16.0f);
+        std::vector<TextEffects> all;
         for (const OutlinePlacement placement :
              {OutlinePlacement::outside, OutlinePlacement::inside, OutlinePlacement::centred}) {
             for (const LineJoin join : {LineJoin::round, LineJoin::miter, LineJoin::bevel}) {
-                // 48 px (lavapipe's time): one join per placement.
-                if (size > 40.0f && static_cast<int>(join) != static_cast<int>(placement)) continue;
-                const float width = std::max(1.0f, size / 16.0f);
-                const Worst w = converge_and_compare(*font, glyphs, outline(width, placement, join), 256);
-                std::printf("[ effects ] MW4 %2.0f px, %s %s outline %.1f px: max %.4f, mean %.5f over %llu channels\n",
-                            static_cast<double>(size), outline_placement_name(placement), line_join_name(join),
-                            static_cast<double>(width), w.max, w.mean, static_cast<unsigned long long>(w.channels));
-                EXPECT_EQ(w.layers, 3u);
-                EXPECT_LE(w.max, kTarget)
-                    << size << " px " << outline_placement_name(placement) << " " << line_join_name(join);
+                all.push_back(outline(width, placement, join));
             }
+        }
+        const Worst w = converge_and_compare(*font, glyphs, all, 256);
+        EXPECT_EQ(w.layers, 3u * all.size());
+        EXPECT_EQ(w.by_effect.size(), all.size());
+        for (const auto& [code, max] : w.by_effect) {
+            const EffectShape shape = decode_effect(code);
+            std::printf("[ effects ] MW4 %2.0f px, op %d, %s join, outline %.1f px: max %.4f\n",
+                        static_cast<double>(size), static_cast<int>(shape.op),
+                        line_join_name(static_cast<LineJoin>(shape.join)), static_cast<double>(width), max);
+            EXPECT_LE(max, kTarget) << size << " px, op " << static_cast<int>(shape.op) << " "
+                                    << line_join_name(static_cast<LineJoin>(shape.join));
         }
     }
 }
@@ -176,19 +249,17 @@ TEST(Effects, SharpCornersStaySharpOnAStarAndHairlinesAt200Pixels) {
         ASSERT_TRUE(font);
         for (const float size : {8.0f, 16.0f, 48.0f, 200.0f}) {
             const GlyphInstance glyph = test::place(*font, index, size, 2.25f, 2.0f + size);
-            const LineJoin joins[] = {LineJoin::miter, LineJoin::round};
-            for (const LineJoin join : joins) {
-                // From 48 px (lavapipe's time) miter joins only, at 200 px with fewer samples.
-                if (size > 40.0f && join != LineJoin::miter) continue;
-                const Worst w =
-                    converge_and_compare(*font, {&glyph, 1}, outline(size / 24.0f, OutlinePlacement::outside, join),
-                                         size > 100.0f ? 128 : 256);
-                std::printf("[ effects ] %s %3.0f px, %s outline %.2f px: max %.4f, mean %.5f\n", shape.name,
-                            static_cast<double>(size), line_join_name(join), static_cast<double>(size / 24.0f), w.max,
-                            w.mean);
-                EXPECT_EQ(w.layers, 1u);
-                EXPECT_LE(w.max, kTarget) << shape.name << " " << size << " px";
+            // From 48 px (lavapipe's time) miter joins only, at 200 px with fewer samples.
+            std::vector<TextEffects> joins = {outline(size / 24.0f, OutlinePlacement::outside, LineJoin::miter)};
+            if (size < 40.0f) joins.push_back(outline(size / 24.0f, OutlinePlacement::outside, LineJoin::round));
+            const Worst w = converge_and_compare(*font, {&glyph, 1}, joins, size > 100.0f ? 128 : 256);
+            for (const auto& [code, max] : w.by_effect) {
+                std::printf("[ effects ] %s %3.0f px, %s outline %.2f px: max %.4f\n", shape.name,
+                            static_cast<double>(size), line_join_name(static_cast<LineJoin>(decode_effect(code).join)),
+                            static_cast<double>(size / 24.0f), max);
             }
+            EXPECT_EQ(w.layers, joins.size());
+            EXPECT_LE(w.max, kTarget) << shape.name << " " << size << " px";
         }
     }
 }
@@ -264,7 +335,7 @@ TEST(Effects, WeightGrowsAndShrinksTheFaceExactly) {
             const std::vector<GlyphInstance> glyphs = lay_out(*font, "MW4", 16.0f, 2.6f, 20.0f);
             TextEffects e;
             e.weight = weight;
-            const Worst w = converge_and_compare(*font, glyphs, e, 256, layout);
+            const Worst w = converge_and_compare(*font, glyphs, {&e, 1}, 256, layout);
             std::printf("[ effects ] MW4 16 px %s, weight %+.2f px: max %.4f, mean %.5f\n", layout,
                         static_cast<double>(weight), w.max, w.mean);
             EXPECT_EQ(w.layers, 3u);
@@ -345,6 +416,118 @@ TEST(Effects, LayersStackShadowOutlineFaceInThatOrder) {
     EXPECT_EQ(messages.errors + messages.warnings, 0u);
 }
 
+TEST(Effects, BlurredShadowsConvergeOnTheExactBlur) {
+    REQUIRE_GPU();
+    auto font = test::bake_subset(test::kDejaVuSans, "M");
+    ASSERT_TRUE(font);
+    struct Case {
+        float size, blur;
+        const char* layout;
+    };
+    for (const Case& c : {Case{16.0f, 1.5f, "gray"}, Case{16.0f, 1.5f, "rgb"}, Case{16.0f, 6.0f, "gray"},
+                          Case{16.0f, 6.0f, "rgb"}, Case{48.0f, 1.5f, "rgb"}, Case{48.0f, 6.0f, "gray"}}) {
+        const std::vector<GlyphInstance> glyphs = lay_out(*font, "M", c.size, 3.3f, 4.0f + c.size);
+        TextEffects e;
+        e.shadow = TextShadow{1.5f, 2.25f, {0.0f, 0.0f, 0.0f, 0.5f}, c.blur};
+        const Worst w = converge_and_compare_blur(*font, glyphs, e, 256, c.layout);
+        std::printf("[ effects ] M %2.0f px %s, shadow blurred %.1f px: max %.4f, mean %.5f over %llu channels\n",
+                    static_cast<double>(c.size), c.layout, static_cast<double>(c.blur), w.max, w.mean,
+                    static_cast<unsigned long long>(w.channels));
+        EXPECT_EQ(w.layers, 1u);
+        EXPECT_LE(w.max, kTarget) << c.size << " px " << c.layout << " blur " << c.blur;
+    }
+}
+
+TEST(Effects, GlowsOfOutlinedGlyphsConvergeOnTheExactBlurAndStackUnderTheOutline) {
+    REQUIRE_GPU();
+    auto font = test::bake_subset(test::kDejaVuSans, "o");
+    ASSERT_TRUE(font);
+    const std::vector<GlyphInstance> glyphs = lay_out(*font, "o", 16.0f, 2.6f, 20.0f);
+    for (const char* layout : {"gray", "rgb"}) {
+        TextEffects e = outline(1.0f, OutlinePlacement::outside, LineJoin::round);
+        e.glow = TextGlow{4.0f, {1.0f, 0.8f, 0.2f, 0.75f}};
+        const Worst w = converge_and_compare_blur(*font, glyphs, e, 256, layout);
+        std::printf("[ effects ] o 16 px %s, outline 1 px, glow 4 px: max %.4f, mean %.5f over %llu channels\n", layout,
+                    w.max, w.mean, static_cast<unsigned long long>(w.channels));
+        EXPECT_EQ(w.layers, 1u);
+        EXPECT_LE(w.max, kTarget) << layout;
+    }
+    // Without an outline the glow is the glyph's own outline blurred.
+    TextEffects plain;
+    plain.glow = TextGlow{1.5f, {1.0f, 1.0f, 1.0f, 0.75f}};
+    const Worst w = converge_and_compare_blur(*font, glyphs, plain, 256, "gray");
+    std::printf("[ effects ] o 16 px gray, glow 1.5 px: max %.4f, mean %.5f\n", w.max, w.mean);
+    EXPECT_EQ(w.layers, 1u);
+    EXPECT_LE(w.max, kTarget);
+    // The layers: shadow, glow, outline, face, back to front; the glow unmoved, at the first paint order.
+    auto renderer = make_renderer("gray", 8);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*font));
+    DrawOptions options;
+    options.effects = outline(1.0f, OutlinePlacement::outside, LineJoin::round);
+    options.effects->shadow = TextShadow{2.0f, 2.0f, {0.0f, 0.0f, 0.0f, 0.5f}, 3.0f};
+    options.effects->glow = TextGlow{4.0f, {1.0f, 1.0f, 1.0f, 0.5f}};
+    const std::vector<DrawnGlyph> drawn = one_frame(*renderer, [&] { renderer->draw(glyphs, options); });
+    ASSERT_EQ(drawn.size(), 4u);
+    std::map<uint32_t, const DrawnGlyph*> by_stack;
+    for (const DrawnGlyph& d : drawn) by_stack[d.stack] = &d;
+    ASSERT_EQ(by_stack.size(), 4u);
+    const DrawnGlyph& face = *by_stack[kStackGlyph];
+    const DrawnGlyph& glow = *by_stack[kStackGlow];
+    const DrawnGlyph& shadow = *by_stack[kStackShadow];
+    EXPECT_EQ(glow.instance.key.blur, 4 * 64);
+    EXPECT_EQ(shadow.instance.key.blur, 3 * 64);
+    EXPECT_EQ(glow.instance.key.effect, shadow.instance.key.effect);  // the glyph with its outline
+    EXPECT_NE(glow.instance.key.effect, 0u);
+    EXPECT_EQ(by_stack[kStackOutlineUnder]->instance.key.blur, 0);
+    EXPECT_EQ(face.instance.key.blur, 0);
+    EXPECT_FLOAT_EQ(glow.instance.pen_x, face.instance.pen_x);
+    EXPECT_FLOAT_EQ(glow.instance.pen_y, face.instance.pen_y);
+    EXPECT_FLOAT_EQ(glow.instance.color[3], 0.5f);
+    // The blurred rect reaches ceil(R + 1) texels further on each side than the unblurred source.
+    EXPECT_EQ(glow.instance.width, by_stack[kStackOutlineUnder]->instance.width + 2u * 5u);
+    const ValidationMessages messages = context()->validation_messages();
+    EXPECT_EQ(messages.errors + messages.warnings, 0u);
+}
+
+TEST(Effects, BlurredPointSamplesAndTransformedGlyphsConvergeOnTheExactBlur) {
+    REQUIRE_GPU();
+    auto font = test::bake_subset(test::kDejaVuSans, "M");
+    ASSERT_TRUE(font);
+    const std::vector<GlyphInstance> glyphs = lay_out(*font, "M", 16.0f, 3.3f, 20.0f);
+    // Point samples: each point's x and y the inverse CDFs of its channel's filters at its R2
+    // offset, converging as points do (a coverage step per sample, not a covered length).
+    TextEffects e;
+    e.shadow = TextShadow{1.0f, 1.0f, {0.0f, 0.0f, 0.0f, 0.5f}, 3.0f};
+    const Worst points = converge_and_compare_blur(*font, glyphs, e, 1023, "gray", SampleKind::points);
+    std::printf("[ effects ] M 16 px gray, points, shadow blurred 3 px: max %.4f, mean %.5f over %llu channels\n",
+                points.max, points.mean, static_cast<unsigned long long>(points.channels));
+    EXPECT_EQ(points.layers, 1u);
+    EXPECT_LE(points.max, 2.0 * kTarget);
+    // Transformed glyphs are blurred in the target's pixels: rotated by 37 degrees (one line a
+    // sample) and by 80 (two lines, stems along the rows), a blurred shadow and a glow each.
+    e.glow = TextGlow{2.0f, {1.0f, 1.0f, 1.0f, 0.75f}};
+    // Outlined, the two-set source is blurred.
+    struct Case {
+        const char* name;
+        TextTransform transform;
+        const char* layout;
+        bool outlined;
+    };
+    for (const Case& c : {Case{"37 degrees", {0.8f, -0.6f, 0.6f, 0.8f, 3.0f, 20.0f}, "gray", false},
+                          Case{"37 degrees", {0.8f, -0.6f, 0.6f, 0.8f, 3.0f, 20.0f}, "rgb", false},
+                          Case{"80 degrees", {0.173648f, -0.984808f, 0.984808f, 0.173648f, 3.0f, 20.0f}, "gray", false},
+                          Case{"37 degrees", {0.8f, -0.6f, 0.6f, 0.8f, 3.0f, 20.0f}, "gray", true}}) {
+        TextEffects fx = e;
+        if (c.outlined) fx.outline = TextOutline{1.0f, OutlinePlacement::outside, LineJoin::round, 4.0f, {0, 0, 0, 1}};
+        const Worst w = converge_and_compare_blur(*font, glyphs, fx, 256, c.layout, SampleKind::rows, c.transform);
+        std::printf("[ effects ] M 16 px %s, rotated %s%s, shadow blurred 3 px, glow 2 px: max %.4f, mean %.5f\n",
+                    c.layout, c.name, c.outlined ? ", outlined 1 px" : "", w.max, w.mean);
+        EXPECT_EQ(w.layers, 2u);
+        EXPECT_LE(w.max, kTarget) << c.name << " " << c.layout;
+    }
+}
+
 TEST(Effects, EffectsPastTheGlyphsLimitsAreLeftOutAndCounted) {
     REQUIRE_GPU();
     auto font = test::bake_subset(test::kDejaVuSans, "MW4");
@@ -401,6 +584,22 @@ TEST(Effects, BadParametersAreRefusedByName) {
     EXPECT_NE(message(e).find("shadow offset 5000"), std::string::npos) << message(e);
     e.shadow->offset_x = 1.0f;
     EXPECT_EQ(message(e), "");
+    e.shadow->blur = -1.0f;
+    EXPECT_NE(message(e).find("shadow blur -1"), std::string::npos) << message(e);
+    e.shadow->blur = 200.0f;
+    EXPECT_NE(message(e).find("shadow blur 200"), std::string::npos) << message(e);
+    e.shadow->blur = 6.0f;
+    EXPECT_EQ(message(e), "");
+    e.glow = TextGlow{0.0f, {1.0f, 1.0f, 1.0f, 1.0f}};
+    EXPECT_NE(message(e).find("glow radius 0"), std::string::npos) << message(e);
+    e.glow->radius = std::nanf("");
+    EXPECT_NE(message(e).find("glow radius nan"), std::string::npos) << message(e);
+    e.glow->radius = 4.0f;
+    e.glow->color[3] = -0.5f;
+    EXPECT_NE(message(e).find("glow color"), std::string::npos) << message(e);
+    e.glow->color[3] = 1.0f;
+    EXPECT_EQ(message(e), "");
+    e.glow.reset();
     // Per size: the reach in em.
     e.outline->width = 100.0f;  // centred: 50 px either side
     EXPECT_TRUE(validate_text_effects(e, 12.5f));

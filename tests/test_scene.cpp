@@ -137,12 +137,13 @@ TEST(Scene, BadTransformsNameTheRunAndTheLimit) {
     EXPECT_NE(scene.error().message.find("palette, transform, weight"), std::string::npos) << scene.error().message;
 }
 
-TEST(Scene, ARunsEffectsAreItsWeightOutlineAndShadow) {
+TEST(Scene, ARunsEffectsAreItsWeightOutlineShadowAndGlow) {
     auto scene = parse_scene(with_run(
         R"({"text": "a", "size": 20, "origin": [0, 0], "weight": -0.5,
             "outline": {"width": 2, "placement": "centred", "join": "miter", "miter_limit": 8, "color": [1, 0, 0]},
-            "shadow": {"offset": [3, -1.5], "color": [0, 0, 1, 0.25]}},
-           {"text": "b", "size": 20, "origin": [0, 0], "outline": {"width": 1}},
+            "shadow": {"offset": [3, -1.5], "color": [0, 0, 1, 0.25], "blur": 2.5},
+            "glow": {"radius": 6, "color": [1, 1, 0, 0.5]}},
+           {"text": "b", "size": 20, "origin": [0, 0], "outline": {"width": 1}, "glow": {}},
            {"text": "c", "size": 20, "origin": [0, 0]})"));
     ASSERT_TRUE(scene) << scene.error().message;
     ASSERT_EQ(scene->runs.size(), 3u);
@@ -157,12 +158,19 @@ TEST(Scene, ARunsEffectsAreItsWeightOutlineAndShadow) {
     EXPECT_EQ(e->shadow->offset_x, 3.0f);
     EXPECT_EQ(e->shadow->offset_y, -1.5f);
     EXPECT_EQ(e->shadow->color, (std::array<float, 4>{0.0f, 0.0f, 1.0f, 0.25f}));
-    // Defaults: outside, round, black; no effects at all where a run names none.
+    EXPECT_EQ(e->shadow->blur, 2.5f);
+    ASSERT_TRUE(e->glow);
+    EXPECT_EQ(e->glow->radius, 6.0f);
+    EXPECT_EQ(e->glow->color, (std::array<float, 4>{1.0f, 1.0f, 0.0f, 0.5f}));
+    // Defaults: outside, round, black; a glow of 4 px in white at 0.75; no effects at all where a
+    // run names none.
     const std::optional<TextEffects>& b = scene->runs[1].effects;
     ASSERT_TRUE(b && b->outline);
     EXPECT_EQ(b->outline->placement, OutlinePlacement::outside);
     EXPECT_EQ(b->outline->join, LineJoin::round);
     EXPECT_FALSE(b->shadow);
+    ASSERT_TRUE(b->glow);
+    EXPECT_EQ(*b->glow, TextGlow{});
     EXPECT_FALSE(scene->runs[2].effects);
 
     struct {
@@ -182,7 +190,13 @@ TEST(Scene, ARunsEffectsAreItsWeightOutlineAndShadow) {
         {R"("outline": {"width": 81})", "scene: runs[0]: outline width 81 px reaches past 4 em at 20 px per em"},
         {R"("shadow": {"offset": [1]})", "scene: runs[0].shadow.offset: expected [dx, dy]"},
         {R"("shadow": {"offset": [1, 1e9]})", "scene: runs[0].shadow.offset: expected [dx, dy]"},
-        {R"("shadow": {"blur": 3})", "scene: runs[0].shadow: unknown member \"blur\" (known: offset, color)"},
+        {R"("shadow": {"spread": 3})", "scene: runs[0].shadow: unknown member \"spread\" (known: offset, color, blur)"},
+        {R"("shadow": {"blur": -1})", "scene: runs[0].shadow.blur: expected a radius of pixels in [0, 128]"},
+        {R"("shadow": {"blur": 129})", "scene: runs[0].shadow.blur: expected a radius"},
+        {R"("glow": 4)", "scene: runs[0].glow: expected an object"},
+        {R"("glow": {"radius": 0})", "scene: runs[0].glow.radius: expected a radius of pixels in (0, 128]"},
+        {R"("glow": {"radius": 2, "offset": [1, 1]})", "scene: runs[0].glow: unknown member \"offset\""},
+        {R"("glow": {"color": [0, 2, 0]})", "scene: runs[0].glow.color[1]: expected a number"},
     };
     for (const auto& c : cases) {
         auto bad =
@@ -257,7 +271,7 @@ TEST(Scene, BadScenesNameTheirFault) {
         {with_run(
              R"({"text": "a", "size": 9, "origin": [0, 0]}, {"text": "a", "size": 9, "origin": [0, 0], "colour": [0, 0, 0]})"),
          "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth, contrast, "
-         "palette, transform, weight, outline, shadow)"},
+         "palette, transform, weight, outline, shadow, glow)"},
         // runs[].font
         {with_run(R"({"font": -1, "text": "a", "size": 9, "origin": [0, 0]})"),
          "scene: runs[0].font: expected an index into fonts (an integer from 0)"},

@@ -104,10 +104,11 @@ struct Arguments {
     std::optional<uint32_t> palette;                // TextStyle::palette of the command line's text
     std::optional<std::array<float, 4>> transform;  // the 2x2 of DrawOptions::transform, about the origin
     bool no_colour = false;                         // LayoutOptions::colour_glyphs off: colour glyphs as plain outlines
-    // The command line's text's effects: --outline, --shadow and --weight, with the outline's
-    // placement and join.
+    // The command line's text's effects: --outline, --shadow, --glow and --weight, with the
+    // outline's placement and join.
     std::optional<crisp::TextOutline> outline;
     std::optional<crisp::TextShadow> shadow;
+    std::optional<crisp::TextGlow> glow;
     std::optional<float> weight;
     crisp::OutlinePlacement outline_placement = crisp::OutlinePlacement::outside;
     crisp::LineJoin outline_join = crisp::LineJoin::round;
@@ -191,7 +192,7 @@ crisp::Result<crisp::TextOutline> parse_outline(std::string_view text) {
     return outline;
 }
 
-// "DX,DY,BLUR[,R,G,B[,A]]": a drop shadow; BLUR must be 0 (a hard shadow) until blurred ones are built.
+// "DX,DY,BLUR[,R,G,B[,A]]": a drop shadow, blurred by a radius of BLUR px (0: a hard one).
 crisp::Result<crisp::TextShadow> parse_shadow(std::string_view text) {
     const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>("--shadow", text);
     if (!values) return values.error();
@@ -209,18 +210,33 @@ crisp::Result<crisp::TextShadow> parse_shadow(std::string_view text) {
     }
     shadow.offset_x = (*values)[0];
     shadow.offset_y = (*values)[1];
-    if ((*values)[2] != 0.0f) {
-        return crisp::Error{crisp::ErrorCode::invalid_argument,
-                            "--shadow: BLUR must be 0: blurred shadows are not built yet (docs/effects.md), only hard "
-                            "ones"};
+    if (!((*values)[2] >= 0.0f && (*values)[2] <= crisp::kMaxEffectBlur)) {
+        return crisp::Error{
+            crisp::ErrorCode::invalid_argument,
+            "--shadow: BLUR is a radius in pixels in [0, 128], not '" + crisp::cli::printable(text) + "'"};
     }
+    shadow.blur = (*values)[2];
     if (crisp::Status s = colour_after("--shadow", text, *values, 3, shadow.color); !s) return s.error();
     return shadow;
 }
 
+// "RADIUS[,R,G,B[,A]]": a glow of that blur radius in pixels.
+crisp::Result<crisp::TextGlow> parse_glow(std::string_view text) {
+    const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>("--glow", text);
+    if (!values) return values.error();
+    if (values->empty() || !((*values)[0] > 0.0f && (*values)[0] <= crisp::kMaxEffectBlur)) {
+        return crisp::Error{crisp::ErrorCode::invalid_argument,
+                            "--glow: RADIUS is pixels in (0, 128], not '" + crisp::cli::printable(text) + "'"};
+    }
+    crisp::TextGlow glow;
+    glow.radius = (*values)[0];
+    if (crisp::Status s = colour_after("--glow", text, *values, 1, glow.color); !s) return s.error();
+    return glow;
+}
+
 // The command line's text's effects; nullopt where none was asked for.
 std::optional<crisp::TextEffects> effects_of(const Arguments& args) {
-    if (!args.outline && !args.shadow && !args.weight) return std::nullopt;
+    if (!args.outline && !args.shadow && !args.glow && !args.weight) return std::nullopt;
     crisp::TextEffects effects;
     effects.weight = args.weight.value_or(0.0f);
     effects.outline = args.outline;
@@ -230,6 +246,7 @@ std::optional<crisp::TextEffects> effects_of(const Arguments& args) {
         effects.outline->miter_limit = args.miter_limit;
     }
     effects.shadow = args.shadow;
+    effects.glow = args.glow;
     return effects;
 }
 
@@ -384,10 +401,15 @@ void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
                       "bevelled, in [1, 128] (default 4)",
                       args.miter_limit, {1.0f, crisp::kMaxMiterLimit});
     cli.option("--shadow", "DX,DY,BLUR[,R,G,B[,A]]",
-               "a drop shadow: the text (with its outline) moved by DX,DY pixels, in\n"
-               "the colour (default 0,0,0,0.5), under it; BLUR must be 0 (blurred\n"
-               "shadows are not built yet)",
+               "a drop shadow: the text (with its outline) moved by DX,DY pixels and\n"
+               "blurred by a radius of BLUR pixels (0: hard, up to 128), in the colour\n"
+               "(default 0,0,0,0.5), under it",
                store(args.shadow, [](std::string_view text) { return parse_shadow(text); }));
+    cli.option("--glow", "RADIUS[,R,G,B[,A]]",
+               "a glow: the text (with its outline) blurred by a radius of RADIUS\n"
+               "pixels (up to 128), in the colour (default 1,1,1,0.75), under its\n"
+               "outline and over its shadow",
+               store(args.glow, [](std::string_view text) { return parse_glow(text); }));
     cli.option("--weight", "PX",
                "grow (positive) or shrink (negative) every stem by PX pixels on each\n"
                "side: bolder or thinner text from the same font",
@@ -446,7 +468,7 @@ void check_text_source(const crisp::cli::CommandLine& cli, const Arguments& args
         std::string given;
         for (const char* name : {"--font", "--text", "--size", "--origin", "--canvas", "--color", "--background",
                                  "--palette", "--layout", "--transform", "--outline", "--outline-placement",
-                                 "--outline-join", "--miter-limit", "--shadow", "--weight"}) {
+                                 "--outline-join", "--miter-limit", "--shadow", "--glow", "--weight"}) {
             if (cli.given(name)) given += std::string(given.empty() ? "" : ", ") + name;
         }
         if (!given.empty()) {
@@ -836,16 +858,17 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
     info.layout = job.subpixel_layout;
     info.atlas.max_samples = args.samples;
     for (uint32_t& samples : info.atlas.ramp) samples = std::min(samples, args.samples);
-    // Effect layers take atlas entries of their own: the outline's and the shadow's (the glyph with
-    // its outline), each as large as the glyph grown by the outline's reach.
+    // Effect layers take atlas entries of their own: the outline's, the shadow's and the glow's (the
+    // glyph with its outline), each as large as the glyph grown by the outline's reach and its blur's.
     std::vector<crisp::GlyphInstance> entries = job.glyphs;
     for (const Job::Draw& draw : job.draws) {
         if (!draw.effects) continue;
         const crisp::TextEffects& e = *draw.effects;
         const float reach = (e.outline ? e.outline->width : 0.0f) + std::max(e.weight, 0.0f);
-        const auto grow = static_cast<uint32_t>(2.0f * std::ceil(reach) + 2.0f);
+        const float blur = std::max(e.shadow ? e.shadow->blur : 0.0f, e.glow ? e.glow->radius : 0.0f);
+        const auto grow = static_cast<uint32_t>(2.0f * (std::ceil(reach) + std::ceil(blur + 1.0f)) + 2.0f);
         for (size_t i = draw.first; i < draw.first + draw.count; ++i) {
-            for (uint32_t layer = 1; layer <= 2; ++layer) {
+            for (uint32_t layer = 1; layer <= 3; ++layer) {
                 crisp::GlyphInstance g = job.glyphs[i];
                 if (g.width == 0 || g.height == 0) continue;
                 g.key.effect = layer;  // a key apart from the glyph's

@@ -1,5 +1,6 @@
 // crisp: text effects drawn from the same coverage as the text (docs/effects.md): an outline,
-// a hard drop shadow and a weight (emboldening or thinning), per draw (DrawOptions::effects).
+// a drop shadow (hard or blurred), a glow and a weight (emboldening or thinning), per draw
+// (DrawOptions::effects).
 //
 // Each effect is a layer of the glyph: an outline of its own (the glyph stroked, curves offset into
 // quadratics on the CPU, cached per glyph and width in em) rasterized and converged in the atlas
@@ -41,13 +42,26 @@ struct TextOutline {
     friend bool operator==(const TextOutline&, const TextOutline&) = default;
 };
 
-// A hard drop shadow: the glyph (with its outline, where it has one) in `color`, moved by the
-// offset and drawn under everything else of the draw.
+// A drop shadow: the glyph (with its outline, where it has one) in `color`, moved by the offset,
+// blurred by `blur` and drawn under everything else of the draw. The blur of radius R is exact
+// (not sampled from a texture): per axis three boxes of width 2R/3 (reaching R, sigma R/3)
+// convolved with each texel channel's own sample interval, converged in the atlas like the text.
+// A transformed glyph's layer is blurred in the target's pixels, after the transform.
 struct TextShadow {
     float offset_x = 2.0f;  // target pixels, y down
     float offset_y = 2.0f;
     std::array<float, 4> color{0.0f, 0.0f, 0.0f, 0.5f};  // sRGB, straight alpha
+    float blur = 0.0f;  // radius, target pixels, 0 to kMaxEffectBlur; 0: a hard shadow; kept to 1/64 px
     friend bool operator==(const TextShadow&, const TextShadow&) = default;
+};
+
+// A glow: the glyph (with its outline, where it has one) blurred by `radius` in `color`, unmoved,
+// drawn over the shadow and under the outline and the face (kStackGlow), at the draw's first
+// paint order.
+struct TextGlow {
+    float radius = 4.0f;  // target pixels, more than 0 up to kMaxEffectBlur; kept to 1/64 px
+    std::array<float, 4> color{1.0f, 1.0f, 1.0f, 0.75f};  // sRGB, straight alpha
+    friend bool operator==(const TextGlow&, const TextGlow&) = default;
 };
 
 struct TextEffects {
@@ -58,6 +72,7 @@ struct TextEffects {
     // centred ones, and any with a negative weight, lie about the glyph's own edge.
     std::optional<TextOutline> outline;
     std::optional<TextShadow> shadow;
+    std::optional<TextGlow> glow;
     friend bool operator==(const TextEffects&, const TextEffects&) = default;
 };
 
@@ -71,6 +86,8 @@ inline constexpr float kMaxEffectWidth = 4096.0f;
 // (RendererStats::failed_effects).
 inline constexpr float kMaxEffectReachEm = 4.0f;
 inline constexpr float kMaxMiterLimit = 128.0f;
+// The largest blur radius of a shadow or glow, in pixels.
+inline constexpr float kMaxEffectBlur = 128.0f;
 
 // Names as files and command lines write them: "outside", "inside", "centred"; "round", "miter",
 // "bevel" ("unknown" for a value outside the enum). The parsers return nullopt for any other name.

@@ -44,6 +44,9 @@ struct GlyphKey {
     uint32_t size_y = 0;     // pixels per em, u24.8
     uint8_t subpixel_x = 0;  // pen offset right of the whole pixel, u0.8
     uint8_t subpixel_y = 0;  // pen offset below the whole pixel (y down), u0.8
+    // A blurred layer (a blurred shadow, a glow: include/crisp/effects.hpp): the blur's radius in
+    // 1/64 px; 0 none. Its rect grows by the blur's reach, ceil(R + 1) texels a side.
+    uint16_t blur = 0;
     // A transformed glyph: a point e of its em space (y up) lands at
     //     pen + (L e) / (1 + p . e)   target pixels (y down),
     // L = {linear[0], linear[1]; linear[2], linear[3]} in 1/kLinearOne px per em and p =
@@ -81,10 +84,14 @@ struct GlyphRect {
 };
 
 // The rect of `glyph` at `key`: the pixels its outline bbox touches at the key's size and
-// subpixel offset, plus kGlyphPadding on each side. Empty (0 x 0) for a glyph without curves, and
-// for a transformed key under which some corner of the bbox is not in front of the eye
-// (1 + p . e below kMinPerspectiveW) or lands more than kMaxTransformedExtent pixels away.
+// subpixel offset, plus kGlyphPadding on each side (and a blurred key's reach, blur_reach()). Empty (0 x 0) for a glyph
+// without curves, and for a transformed key under which some corner of the bbox is not in front of the eye (1 + p . e
+// below kMinPerspectiveW) or lands more than kMaxTransformedExtent pixels away.
 CRISP_API GlyphRect glyph_rect(const GlyphRecord& glyph, const GlyphKey& key);
+
+// The texels a blurred key's rect grows by on each side: ceil(R + 1) for a radius of R px
+// (GlyphKey::blur / 64), 0 without blur.
+CRISP_API int32_t blur_reach(const GlyphKey& key);
 
 // How far in front of the eye a transformed glyph's every bbox corner must be: 1 + p . e at least
 // this (a glyph nearer to crossing the eye plane is not drawn).

@@ -220,6 +220,7 @@ struct FrameStop {
 // DrawnGlyph::stack, back to front: at equal depth and paint order a layer of a smaller stack lies
 // behind one of a larger.
 inline constexpr uint32_t kStackShadow = 0;        // a drop shadow (TextEffects::shadow)
+inline constexpr uint32_t kStackGlow = 1;          // a glow (TextEffects::glow)
 inline constexpr uint32_t kStackOutlineUnder = 2;  // an outside outline
 inline constexpr uint32_t kStackGlyph = 3;         // the glyph (or its colour layers), weighted or not
 inline constexpr uint32_t kStackOutlineOver = 4;   // an inside or centred outline

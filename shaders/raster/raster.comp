@@ -37,6 +37,11 @@ layout(constant_id = 0) const uint kTransformedItems = 0u;
 // from RasterItem::set_b_first on the second, covered where the item's cover_rule holds for the
 // two sets' windings; 0: one set, covered where its winding is nonzero.
 layout(constant_id = 1) const uint kTwoSetItems = 0u;
+// 1: this pipeline's items are blurred (a blurred shadow or glow: docs/effects.md, "Blur"), each
+// channel's filter its sample interval convolved with the blur of box width RasterItem::blur_w:
+// a row sample's height is the inverse CDF of the y filter at the row's height, and a covered
+// stretch adds the x filter's CDF across it instead of its length.
+layout(constant_id = 2) const uint kBlurItems = 0u;
 
 layout(push_constant) uniform PushConstants {
     RasterPushConstants pc;
@@ -142,6 +147,9 @@ struct RowList {
     int winding_b;  // the same for the second set of a two-set item
     uint count;
     bool more;
+    // A transformed row's later pass, which starts at a crossing kept by none before it: crossings
+    // at the start count (the previous pass stopped short of every crossing there).
+    bool from_crossing;
     uint up;
     uint in_b;  // per entry, set: a crossing of the second set
     float x[kRasterRowCrossings];
@@ -182,7 +190,7 @@ void row_begin_pass(inout RowList r) {
 // invocation once their iterations together reach 65535, and this runs per crossing (see "Loops"
 // in docs/rasterizer.md).
 void row_crossing(inout RowList r, float x, int direction, bool in_b) {
-    if (!(x > r.start)) return;
+    if (!(x > r.start) && !(kTransformedItems != 0u && r.from_crossing && x == r.start)) return;
     if (kTwoSetItems != 0u && in_b) {
         r.winding_b += direction;
     } else {
@@ -293,6 +301,84 @@ float bernstein(float x0, float x1, float x2, float t) {
     return ((x0 - 2.0 * x1 + x2) * t - 2.0 * (x0 - x1)) * t + x0;
 }
 
+// ---- Blur (src/text/blur_kernel.hpp, operation for operation).
+
+// The CDF of the unit B3 kernel (three unit boxes, support [-3/2, 3/2]) at z.
+float blur_b3_cdf(float z) {
+    float a = abs(z);
+    float upper;  // the CDF at -a
+    if (a >= 1.5) {
+        upper = 0.0;
+    } else if (a >= 0.5) {
+        float s = 1.5 - a;
+        upper = s * s * s / 6.0;
+    } else {
+        upper = 0.5 - a * (0.75 - a * a / 3.0);
+    }
+    return z < 0.0 ? upper : 1.0 - upper;
+}
+
+// The integral of blur_b3_cdf from -infinity to z.
+float blur_h(float z) {
+    float n = -abs(z);
+    float h;
+    if (n <= -1.5) {
+        h = 0.0;
+    } else if (n <= -0.5) {
+        float s = n + 1.5;
+        float s2 = s * s;
+        h = s2 * s2 / 24.0;
+    } else {
+        float s = n + 0.5;
+        float n2 = n * n;
+        h = 1.0 / 24.0 + s / 6.0 + 0.375 * s * s - (n2 * n2 / 4.0 + n / 8.0 + 3.0 / 64.0) / 3.0;
+    }
+    return z > 0.0 ? z + h : h;
+}
+
+// The CDF at t of the box [x0, x1] convolved with the blur of box width w > 0.
+float blur_cdf(float t, float x0, float x1, float w) {
+    float b = x1 - x0;
+    if (!(b > 0.0)) return blur_b3_cdf((t - x0) / w);
+    return (w / b) * (blur_h((t - x0) / w) - blur_h((t - x1) / w));
+}
+
+float blur_density(float t, float x0, float x1, float w) {
+    float b = x1 - x0;
+    if (!(b > 0.0)) return 0.0;
+    return (blur_b3_cdf((t - x0) / w) - blur_b3_cdf((t - x1) / w)) / b;
+}
+
+// One safeguarded Newton step of blur_inverse_cdf().
+void blur_inverse_step(float v, float x0, float x1, float w, inout float lo, inout float hi, inout float t) {
+    float f = blur_cdf(t, x0, x1, w) - v;
+    if (f < 0.0) lo = t;
+    if (f > 0.0) hi = t;
+    float d = blur_density(t, x0, x1, w);
+    float next = d > 0.0 ? t - f / d : lo - 1.0;
+    t = next >= lo && next <= hi ? next : 0.5 * (lo + hi);
+}
+
+// The t where blur_cdf(t, x0, x1, w) = v: kBlurInverseSteps (12) steps, written out (see "Loops"
+// in docs/rasterizer.md).
+float blur_inverse_cdf(float v, float x0, float x1, float w) {
+    float lo = x0 - 1.5 * w, hi = x1 + 1.5 * w;
+    float t = x0 + v * (x1 - x0);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    blur_inverse_step(v, x0, x1, w, lo, hi, t);
+    return t;
+}
+
 // Adds the crossings x1 and x2 that `code` counts. Two roots that meet (a tangent, or a curve
 // that misses the row) cancel exactly: skipping them keeps the walk the same whichever band range
 // the curves come from (the CPU reference reads only the sample's band).
@@ -333,17 +419,25 @@ void row_curve_transformed(inout RowList r, RasterTransform m, vec3 row, bool pe
 
 // Adds the covered stretch [from, to] of the row, clipped to each channel's segment [lo, hi].
 // Inside a channel's segment the clip is exact (min and max pick an operand), so a channel sums
-// the same differences as a walk of its own segment would.
-void row_cover(inout vec3 covered, float from, float to, vec3 lo, vec3 hi) {
+// the same differences as a walk of its own segment would. A blurred item (blur, the box width in
+// the row's units, > 0) adds each channel's filter CDF across the stretch instead: its fraction
+// of the channel's blurred coverage.
+void row_cover(inout vec3 covered, float from, float to, vec3 lo, vec3 hi, float blur) {
+    if (kBlurItems != 0u && blur > 0.0) {
+        covered += vec3(blur_cdf(to, lo.x, hi.x, blur) - blur_cdf(from, lo.x, hi.x, blur),
+                        blur_cdf(to, lo.y, hi.y, blur) - blur_cdf(from, lo.y, hi.y, blur),
+                        blur_cdf(to, lo.z, hi.z, blur) - blur_cdf(from, lo.z, hi.z, blur));
+        return;
+    }
     covered += max(min(vec3(to), hi) - max(vec3(from), lo), vec3(0.0));
 }
 
 // Step i of the walk.
-void row_walk_step(RowList r, uint rule, uint i, vec3 lo, vec3 hi, inout ivec2 w, inout float at,
-                   inout vec3 covered) {
-    if (i >= r.count) return;
+void row_walk_step(RowList r, uint rule, uint i, vec3 lo, vec3 hi, float blur, float limit, inout ivec2 w,
+                   inout float at, inout vec3 covered) {
+    if (i >= r.count || !(r.x[i] < limit)) return;
     float x = r.x[i];
-    if (row_covers(rule, w.x, w.y)) row_cover(covered, at, x, lo, hi);
+    if (row_covers(rule, w.x, w.y)) row_cover(covered, at, x, lo, hi, blur);
     int step = (r.up & (1u << i)) != 0u ? -1 : 1;
     if (kTwoSetItems != 0u && (r.in_b & (1u << i)) != 0u) {
         w.y -= step;
@@ -356,26 +450,36 @@ void row_walk_step(RowList r, uint rule, uint i, vec3 lo, vec3 hi, inout ivec2 w
 // The covered length of each channel's segment [lo, hi] within the part of the row this pass saw:
 // up to its end, or up to its last crossing kept when more follow (start then moves there for the
 // next pass). Sorts the list first. Written out, as the crossings, so that the list's indices are
-// constants.
-vec3 row_walk(inout RowList r, uint rule, vec3 lo, vec3 hi) {
+// constants. `blur`: row_cover()'s.
+vec3 row_walk(inout RowList r, uint rule, vec3 lo, vec3 hi, float blur) {
     row_sort(r);
     ivec2 w = ivec2(r.winding, r.winding_b);
     float at = r.start;
     vec3 covered = vec3(0.0);
-    row_walk_step(r, rule, 0u, lo, hi, w, at, covered);
-    row_walk_step(r, rule, 1u, lo, hi, w, at, covered);
-    row_walk_step(r, rule, 2u, lo, hi, w, at, covered);
-    row_walk_step(r, rule, 3u, lo, hi, w, at, covered);
-    row_walk_step(r, rule, 4u, lo, hi, w, at, covered);
-    row_walk_step(r, rule, 5u, lo, hi, w, at, covered);
-    row_walk_step(r, rule, 6u, lo, hi, w, at, covered);
-    row_walk_step(r, rule, 7u, lo, hi, w, at, covered);
+    // A transformed row carries its winding to the next pass, so a pass that overflowed stops short
+    // of the largest crossing kept: a crossing of the same x may have been dropped, and the next
+    // pass takes them all, from there (unless all eight kept share that x: then as before).
+    const float inf = uintBitsToFloat(0x7F800000u);
+    float limit = kTransformedItems != 0u && r.more && r.x[0] < r.x[7] ? r.x[7] : inf;
+    row_walk_step(r, rule, 0u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 1u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 2u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 3u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 4u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 5u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 6u, lo, hi, blur, limit, w, at, covered);
+    row_walk_step(r, rule, 7u, lo, hi, blur, limit, w, at, covered);
     if (r.more) {
+        if (limit < inf) {
+            if (row_covers(rule, w.x, w.y)) row_cover(covered, at, limit, lo, hi, blur);
+            at = limit;
+        }
+        r.from_crossing = limit < inf;
         r.start = at;
         r.winding = w.x;  // just right of the new start: what a transformed row carries to its next pass
         r.winding_b = w.y;
     } else if (row_covers(rule, w.x, w.y)) {
-        row_cover(covered, at, r.end, lo, hi);
+        row_cover(covered, at, r.end, lo, hi, blur);
     }
     return covered;
 }
@@ -436,6 +540,11 @@ uvec3 point_samples(RasterItem item, uint tx, uint ty) {
         for (int c = 0; c < 3; ++c) {
             vec4 rect = pc.channel_rects[c];
             vec2 p = vec2(float(tx), float(ty)) + mix(rect.xy, rect.zw, r2);
+            // A blurred point: each coordinate the inverse CDF of its axis's filter at r2.
+            if (kBlurItems != 0u) {
+                p = vec2(blur_inverse_cdf(r2.x, float(tx) + rect.x, float(tx) + rect.z, item.blur_w),
+                         blur_inverse_cdf(r2.y, float(ty) + rect.y, float(ty) + rect.w, item.blur_w));
+            }
             em[c] = transformed ? texel_em(m, p.x, p.y)
                                 : vec2(item.offset_x + item.scale_x * p.x, item.offset_y + item.scale_y * p.y);
             uint band = band_of(item, em[c].y);
@@ -501,12 +610,15 @@ struct RowLine {
 // texels reverses orientation, and carried from pass to pass.
 void row_line_begin(inout RowLine line, RasterItem item, RasterTransform m, vec4 rect, uint ty, float h, float start,
                     float end, inout uint lo_band, inout uint hi_band) {
-    line.y = float(ty) + (rect.y + (rect.w - rect.y) * h);
+    // A blurred row sits where the y filter's CDF is h (texels: row_samples() widened the segment).
+    line.y = kBlurItems != 0u ? blur_inverse_cdf(h, float(ty) + rect.y, float(ty) + rect.w, item.blur_w)
+                              : float(ty) + (rect.y + (rect.w - rect.y) * h);
     line.y_row = m.to_texel[1].xyz - line.y * m.to_texel[2].xyz;
     // The start a hair left of the segment, so that it is not on a curve where the segment begins
     // at one (a stem on the texel's edge): the walk clips to the channels' segments, so the stretch
     // before them adds nothing.
     line.r.start = start - kTransformedStartBack;
+    line.r.from_crossing = false;
     line.r.end = end;
     line.start_em = texel_em(m, line.r.start, line.y);
     float yb = texel_em(m, line.r.end, line.y).y;
@@ -541,7 +653,7 @@ vec3 row_line_end(inout RowLine line, RasterItem item, RasterTransform m, vec3 l
     ivec2 start = first_pass ? line.start_winding * int(m.to_texel[0].w) : line.start_winding;
     line.r.winding = start.x;
     line.r.winding_b = start.y;
-    vec3 covered = row_walk(line.r, item.cover_rule, lo, hi);
+    vec3 covered = row_walk(line.r, item.cover_rule, lo, hi, kBlurItems != 0u ? item.blur_w : 0.0);
     line.pending = line.r.more;
     line.start_winding = ivec2(line.r.winding, line.r.winding_b);
     return covered;
@@ -556,6 +668,8 @@ vec3 row_line_end(inout RowLine line, RasterItem item, RasterTransform m, vec3 l
 // it: 6 % of its time).
 uvec3 row_samples_axis_aligned(RasterItem item, vec3 lo, vec3 hi, uint rows, uint ty) {
     uint font = item.font;
+    // The blur's box width in em along x (the filter's CDF is the same in any unit).
+    float blur = kBlurItems != 0u ? item.blur_w * item.scale_x : 0.0;
     uvec3 sums = uvec3(0u);
     for (uint k = 0u; k < item.sample_count; ++k) {
         uint n = item.first_sample + k;
@@ -565,12 +679,17 @@ uvec3 row_samples_axis_aligned(RasterItem item, vec3 lo, vec3 hi, uint rows, uin
         vec3 covered = vec3(0.0);
         for (uint row = 0u; row < rows; ++row) {
             vec4 rect = pc.channel_rects[row];
-            float y = item.offset_y + item.scale_y * (float(ty) + (rect.y + (rect.w - rect.y) * v));
+            // A blurred row sits where the y filter's CDF is v, its segment reaches the x filters'
+            // supports, 3w/2 past the channels' intervals.
+            float row_y = kBlurItems != 0u ? blur_inverse_cdf(v, float(ty) + rect.y, float(ty) + rect.w, item.blur_w)
+                                           : float(ty) + (rect.y + (rect.w - rect.y) * v);
+            float y = item.offset_y + item.scale_y * row_y;
             // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
             vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
             RowList r;
-            r.start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
-            r.end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
+            r.from_crossing = false;
+            r.start = (rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row]) - 1.5 * blur;
+            r.end = (rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row]) + 1.5 * blur;
             uint band = band_of(item, y);
             // A pass per kRasterRowCrossings crossings.
             bool pending = true;
@@ -588,12 +707,14 @@ uvec3 row_samples_axis_aligned(RasterItem item, vec3 lo, vec3 hi, uint rows, uin
                         row_curve(r, p0, p1, p2, y, kTwoSetItems != 0u && word * 32u + bit >= item.set_b_first);
                     }
                 }
-                covered += row_walk(r, item.cover_rule, lo, hi) * mine;
+                covered += row_walk(r, item.cover_rule, lo, hi, blur) * mine;
                 pending = r.more;
             }
         }
-        sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),
-                      row_units(covered.z, hi.z - lo.z, dither));
+        // A blurred walk's sums are fractions already.
+        vec3 lengths = kBlurItems != 0u ? vec3(1.0) : hi - lo;
+        sums += uvec3(row_units(covered.x, lengths.x, dither), row_units(covered.y, lengths.y, dither),
+                      row_units(covered.z, lengths.z, dither));
     }
     return sums;
 }
@@ -635,8 +756,10 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             vec4 rect = pc.channel_rects[row];
             // The channels this row adds to, as factors: 1 keeps a length exactly, 0 adds nothing.
             vec3 mine = rows == 1u ? vec3(1.0) : vec3(equal(uvec3(0u, 1u, 2u), uvec3(row)));
-            float start = rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row];
-            float end = rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row];
+            // A blurred segment reaches the x filters' supports, 3w/2 past the channels' intervals.
+            float reach = kBlurItems != 0u ? 1.5 * item.blur_w : 0.0;
+            float start = (rows == 1u ? min(lo.x, min(lo.y, lo.z)) : lo[row]) - reach;
+            float end = (rows == 1u ? max(hi.x, max(hi.y, hi.z)) : hi[row]) + reach;
             uint lo_band = 0xFFFFFFFFu, hi_band = 0u;
             RowLine a, b;
             row_line_begin(a, item, m, rect, ty, two_lines ? fract(v - kRasterHalfRowShift) : v, start, end, lo_band,
@@ -675,8 +798,10 @@ uvec3 row_samples(RasterItem item, uint tx, uint ty) {
             }
         }
         if (two_lines) covered *= 0.5;
-        sums += uvec3(row_units(covered.x, hi.x - lo.x, dither), row_units(covered.y, hi.y - lo.y, dither),
-                      row_units(covered.z, hi.z - lo.z, dither));
+        // A blurred walk's sums are fractions already.
+        vec3 lengths = kBlurItems != 0u ? vec3(1.0) : hi - lo;
+        sums += uvec3(row_units(covered.x, lengths.x, dither), row_units(covered.y, lengths.y, dither),
+                      row_units(covered.z, lengths.z, dither));
     }
     return sums;
 }

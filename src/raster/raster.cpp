@@ -1,5 +1,6 @@
 #include "raster/raster.hpp"
 
+#include "text/blur_kernel.hpp"
 #include "vk/barriers.hpp"
 #include "vk/bindings.hpp"
 
@@ -94,8 +95,9 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
         const uint32_t first_workgroup = workgroups;
         for (const RasterWork& w : work) {
             if (w.sample_count == 0 || item_kind(w.key) != kind % kRasterGeometryKinds) continue;
+            if ((kind >= kRasterBlurKindBase) != (w.key.blur != 0)) continue;
             const HeldGlyph held = fonts.glyph(w.key);
-            if (!held.font || (kind >= kRasterGeometryKinds) != held.derived) continue;
+            if (!held.font || (kind % kRasterBlurKindBase >= kRasterGeometryKinds) != held.derived) continue;
             const HeldFont* font = held.font;
             const GlyphRecord& glyph = *held.record;
             const GlyphRect rect = glyph_rect(glyph, w.key);
@@ -104,6 +106,7 @@ uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fon
             item.flat_row = gpu::kRasterNoTransform;
             item.set_b_first = held.derived ? held.set_b_first : gpu::kRasterNoTransform;
             item.cover_rule = held.derived ? cover_rule(held.op) : gpu::kRasterCoverA;
+            item.blur_w = static_cast<float>(blur_box_width(w.key.blur * kBlurUnit));
             if (is_transformed(w.key)) {
                 const uint32_t row = held.flat_row;
                 if (row != kNoFlatRow) item.flat_row = static_cast<uint32_t>(font->bands_at / sizeof(uint32_t)) + row;
@@ -222,10 +225,19 @@ Status RasterPass::make_pipeline(uint32_t kind) {
                                                              "raster.comp (transformed, two lines)",
                                                              "raster.comp (two sets)",
                                                              "raster.comp (transformed, two sets)",
-                                                             "raster.comp (transformed, two lines, two sets)"};
-    const uint32_t constants[2] = {kind % kRasterGeometryKinds, kind >= kRasterGeometryKinds ? 1u : 0u};
-    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}};
-    const VkSpecializationInfo specialization{2, entries, sizeof constants, constants};
+                                                             "raster.comp (transformed, two lines, two sets)",
+                                                             "raster.comp (blurred)",
+                                                             "raster.comp (transformed, blurred)",
+                                                             "raster.comp (transformed, two lines, blurred)",
+                                                             "raster.comp (two sets, blurred)",
+                                                             "raster.comp (transformed, two sets, blurred)",
+                                                             "raster.comp (transformed, two lines, two sets, blurred)"};
+    const uint32_t constants[3] = {kind % kRasterGeometryKinds,
+                                   kind % kRasterBlurKindBase >= kRasterGeometryKinds ? 1u : 0u,
+                                   kind >= kRasterBlurKindBase ? 1u : 0u};
+    const VkSpecializationMapEntry entries[3] = {
+        {0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}, {2, 2 * sizeof(uint32_t), sizeof(uint32_t)}};
+    const VkSpecializationInfo specialization{3, entries, sizeof constants, constants};
     Result<VkPipeline> made =
         vk::create_compute_pipeline(ref_, shader_, descriptors_.pipeline_layout, &specialization, kNames[kind]);
     if (!made) return made.error();

@@ -25,9 +25,11 @@ namespace crisp::raster {
 
 // The kinds of work item, each rasterized by its own pipeline: item_kind() (raster.comp's
 // kTransformedItems) for a glyph's own outline, plus kRasterGeometryKinds for a derived glyph's
-// (an effect layer's: two sets of curves, kTwoSetItems).
+// (an effect layer's: two sets of curves, kTwoSetItems), and all of these again plus
+// kRasterBlurKindBase for a blurred key's (kBlurItems: a blurred shadow or glow).
 inline constexpr uint32_t kRasterGeometryKinds = 3;
-inline constexpr uint32_t kRasterItemKinds = 2 * kRasterGeometryKinds;
+inline constexpr uint32_t kRasterBlurKindBase = 2 * kRasterGeometryKinds;
+inline constexpr uint32_t kRasterItemKinds = 2 * kRasterBlurKindBase;
 
 // The kind of a glyph's items: 0 for an axis-aligned key, gpu::kRasterTwoLineItems for a
 // transformed one whose em y axis lies within 15 degrees of the rows (its stems run along them,
@@ -36,9 +38,8 @@ uint32_t item_kind(const GlyphKey& key);
 
 // The rasterizer's work items for `work` into `items`, and into `workgroup_items` the item of
 // each workgroup; returns the workgroups they take. Work of a font not held, or without samples,
-// makes none. Items come kind after kind (item_kind()), and `kind_workgroups` gets the workgroups
-// of each kind.
-// Transformed glyphs' items point into `transforms`, one per such item.
+// makes none. Items come kind after kind (item_kind()), and `kind_workgroups` gets the
+// workgroups of each kind. Transformed glyphs' items point into `transforms`, one per such item.
 uint32_t build_work_items(std::span<const RasterWork> work, const HeldFonts& fonts, std::vector<gpu::RasterItem>& items,
                           std::vector<gpu::RasterTransform>& transforms, std::vector<uint32_t>& workgroup_items,
                           std::array<uint32_t, kRasterItemKinds>& kind_workgroups);
@@ -101,7 +102,7 @@ private:
     VkShaderModule shader_ = VK_NULL_HANDLE;
     vk::DescriptorSets descriptors_;  // one set per frame in flight
     // By kind: axis-aligned items, transformed ones, transformed ones of two lines a sample; then
-    // the same of derived glyphs.
+    // the same of derived glyphs; then all six blurred.
     std::array<VkPipeline, kRasterItemKinds> pipelines_{};
     std::array<uint32_t, kRasterItemKinds> kind_workgroups_{};  // this frame's workgroups of each kind
 };

@@ -1,5 +1,6 @@
 #include "raster/requests.hpp"
 
+#include "text/blur_kernel.hpp"
 #include "text/effect_code.hpp"
 
 #include <algorithm>
@@ -184,6 +185,7 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
         };
         if (fx.effects.outline) linear(fx.effects.outline->color, fx.outline_color);
         if (fx.effects.shadow) linear(fx.effects.shadow->color, fx.shadow_color);
+        if (fx.effects.glow) linear(fx.effects.glow->color, fx.glow_color);
         effects = static_cast<uint32_t>(effects_.size());
         effects_.push_back(fx);
     }
@@ -274,6 +276,12 @@ uint32_t effect_code(StrokeOp op, LineJoin join, float miter_limit, double half_
     return encode_effect(shape);
 }
 
+// GlyphKey::blur of a radius of `radius` px (validated: 0 to kMaxEffectBlur), to 1/64 px.
+uint16_t blur_code(float radius) {
+    return static_cast<uint16_t>(std::lround(static_cast<double>(radius) / kBlurUnit));
+}
+static_assert(double{kMaxEffectBlur} / kBlurUnit <= UINT16_MAX);
+
 static_assert(static_cast<int>(LineJoin::round) == static_cast<int>(StrokeJoin::round) &&
               static_cast<int>(LineJoin::miter) == static_cast<int>(StrokeJoin::miter) &&
               static_cast<int>(LineJoin::bevel) == static_cast<int>(StrokeJoin::bevel));
@@ -338,7 +346,13 @@ void FrameRequests::request_effects(const GlyphInstance& glyph, const VkRect2D* 
         // The offset on the glyph's subpixel grid, so that the shadow takes the glyph's steps.
         const double dx = std::round(static_cast<double>(sh->offset_x) * steps) / steps;
         const double dy = std::round(static_cast<double>(sh->offset_y) * steps) / steps;
-        submit_layer(glyph, shadow, fx.shadow_color, fx.first_order, kStackShadow, dx, dy, visible, contrast);
+        submit_layer(glyph, shadow, fx.shadow_color, fx.first_order, kStackShadow, dx, dy, visible, contrast,
+                     blur_code(sh->blur));
+    }
+    // The glow: the shadow's source, unmoved and blurred.
+    if (const auto& g = e.glow) {
+        submit_layer(glyph, shadow, fx.glow_color, fx.first_order, kStackGlow, 0.0, 0.0, visible, contrast,
+                     blur_code(g->radius));
     }
     if (outline != 0) {
         const uint32_t order = outline_stack == kStackOutlineUnder ? fx.first_order : fx.last_order;
@@ -353,13 +367,14 @@ void FrameRequests::request_effects(const GlyphInstance& glyph, const VkRect2D* 
 }
 
 // A layer of `glyph`: its outline derived by `effect` (0: its own), in `colour`, at `order` and
-// `stack`, moved by (dx, dy) pixels.
+// `stack`, moved by (dx, dy) pixels and blurred by `blur` (GlyphKey::blur).
 void FrameRequests::submit_layer(const GlyphInstance& glyph, uint32_t effect, const std::array<float, 4>& colour,
                                  uint32_t order, uint32_t stack, double dx, double dy, const VkRect2D* visible,
-                                 const GlyphContrast& contrast) {
+                                 const GlyphContrast& contrast, uint16_t blur) {
     const HeldGlyph own = fonts_.glyph(glyph.key);
     GlyphInstance layer = glyph;
     layer.key.effect = effect;
+    layer.key.blur = blur;
     if (effect != 0 && !fonts_.derive(layer.key)) {
         ++stats_.failed_effects;
         return;

@@ -97,6 +97,7 @@ private:
         uint32_t last_order = 0;
         std::array<float, 4> outline_color{};
         std::array<float, 4> shadow_color{};
+        std::array<float, 4> glow_color{};
     };
     struct Request {
         GlyphInstance glyph;  // moved, recoloured and at its depth as the draw's options asked
@@ -125,7 +126,8 @@ private:
     void request_effects(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps,
                          const GlyphContrast& contrast, const DrawEffects& fx);
     void submit_layer(const GlyphInstance& glyph, uint32_t effect, const std::array<float, 4>& colour, uint32_t order,
-                      uint32_t stack, double dx, double dy, const VkRect2D* visible, const GlyphContrast& contrast);
+                      uint32_t stack, double dx, double dy, const VkRect2D* visible, const GlyphContrast& contrast,
+                      uint16_t blur = 0);
     void submit(const GlyphInstance& glyph, const VkRect2D* visible, const GlyphContrast& contrast, uint32_t stack);
     void admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast, uint32_t stack,
                const TexelRect* shown = nullptr);

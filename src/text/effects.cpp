@@ -119,7 +119,16 @@ Status validate_text_effects(const TextEffects& effects) {
                                " px");
             }
         }
+        if (!(sh->blur >= 0.0f && sh->blur <= kMaxEffectBlur)) {
+            return refused("shadow blur " + number(sh->blur) + " is not in [0, " + number(kMaxEffectBlur) + "] px");
+        }
         if (Status s = check_color("shadow", sh->color); !s) return s;
+    }
+    if (const auto& g = effects.glow) {
+        if (!(g->radius > 0.0f && g->radius <= kMaxEffectBlur)) {
+            return refused("glow radius " + number(g->radius) + " is not in (0, " + number(kMaxEffectBlur) + "] px");
+        }
+        if (Status s = check_color("glow", g->color); !s) return s;
     }
     return {};
 }

@@ -22,8 +22,8 @@ uint64_t mix(uint64_t x) {
 
 int compare_keys(const GlyphKey& a, const GlyphKey& b) {
     const auto fields = [](const GlyphKey& k) {
-        return std::tie(k.font, k.glyph, k.size_x, k.size_y, k.subpixel_x, k.subpixel_y, k.linear[0], k.linear[1],
-                        k.linear[2], k.linear[3], k.perspective[0], k.perspective[1], k.effect);
+        return std::tie(k.font, k.glyph, k.size_x, k.size_y, k.subpixel_x, k.subpixel_y, k.blur, k.linear[0],
+                        k.linear[1], k.linear[2], k.linear[3], k.perspective[0], k.perspective[1], k.effect);
     };
     return fields(a) < fields(b) ? -1 : fields(b) < fields(a) ? 1 : 0;
 }
@@ -32,7 +32,7 @@ size_t GlyphKeyHash::operator()(const GlyphKey& key) const {
     const uint64_t a = (uint64_t{key.font} << 32) | key.glyph;
     const uint64_t b =
         (uint64_t{key.size_x} << 40) ^ (uint64_t{key.size_y} << 16) ^ (uint64_t{key.subpixel_x} << 8) ^ key.subpixel_y;
-    uint64_t h = mix(a ^ mix(b) ^ (uint64_t{key.effect} * 0x9E3779B97F4A7C15ull));
+    uint64_t h = mix(a ^ mix(b ^ (uint64_t{key.blur} << 48)) ^ (uint64_t{key.effect} * 0x9E3779B97F4A7C15ull));
     if (is_transformed(key) || key.perspective[0] != 0 || key.perspective[1] != 0) {
         const auto word = [](int32_t v) { return static_cast<uint64_t>(static_cast<uint32_t>(v)); };
         h = mix(h ^ ((word(key.linear[0]) << 32) | word(key.linear[1])));
@@ -75,13 +75,19 @@ GlyphRect transformed_rect(const GlyphRecord& glyph, const GlyphKey& key) {
         lo_y = std::min(lo_y, qy);
         hi_y = std::max(hi_y, qy);
     }
-    const double left = std::floor(lo_x) - kGlyphPadding, right = std::ceil(hi_x) + kGlyphPadding;
-    const double top = std::floor(lo_y) - kGlyphPadding, bottom = std::ceil(hi_y) + kGlyphPadding;
+    const double pad = kGlyphPadding + blur_reach(key);
+    const double left = std::floor(lo_x) - pad, right = std::ceil(hi_x) + pad;
+    const double top = std::floor(lo_y) - pad, bottom = std::ceil(hi_y) + pad;
     return {static_cast<int32_t>(left), static_cast<int32_t>(top), static_cast<uint32_t>(right - left),
             static_cast<uint32_t>(bottom - top)};
 }
 
 }  // namespace
+
+int32_t blur_reach(const GlyphKey& key) {
+    if (key.blur == 0) return 0;
+    return static_cast<int32_t>(std::ceil(key.blur / 64.0 + 1.0));
+}
 
 GlyphRect glyph_rect(const GlyphRecord& glyph, const GlyphKey& key) {
     if (glyph.curve_count == 0) return {};
@@ -90,10 +96,11 @@ GlyphRect glyph_rect(const GlyphRecord& glyph, const GlyphKey& key) {
     const double size_y = static_cast<double>(key.size_y) / kSizeOne;
     const double sub_x = static_cast<double>(key.subpixel_x) / kSubpixelSteps;
     const double sub_y = static_cast<double>(key.subpixel_y) / kSubpixelSteps;
-    const double left = std::floor(sub_x + static_cast<double>(glyph.bbox_min_x) * size_x) - kGlyphPadding;
-    const double right = std::ceil(sub_x + static_cast<double>(glyph.bbox_max_x) * size_x) + kGlyphPadding;
-    const double top = std::floor(sub_y - static_cast<double>(glyph.bbox_max_y) * size_y) - kGlyphPadding;
-    const double bottom = std::ceil(sub_y - static_cast<double>(glyph.bbox_min_y) * size_y) + kGlyphPadding;
+    const double pad = kGlyphPadding + blur_reach(key);
+    const double left = std::floor(sub_x + static_cast<double>(glyph.bbox_min_x) * size_x) - pad;
+    const double right = std::ceil(sub_x + static_cast<double>(glyph.bbox_max_x) * size_x) + pad;
+    const double top = std::floor(sub_y - static_cast<double>(glyph.bbox_max_y) * size_y) - pad;
+    const double bottom = std::ceil(sub_y - static_cast<double>(glyph.bbox_min_y) * size_y) + pad;
     return {static_cast<int32_t>(left), static_cast<int32_t>(top), static_cast<uint32_t>(right - left),
             static_cast<uint32_t>(bottom - top)};
 }

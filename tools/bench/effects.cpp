@@ -1,9 +1,9 @@
 // crisp-bench --suite effects: what text effects cost (docs/effects.md). One screen of prose drawn
-// plain and with each effect: an outside outline, an outline with a hard drop shadow, a centred
-// mitered outline, and a weight. Per screen: frame 1 (every glyph and every derived outline new:
-// begin_frame, draw and record on the CPU, Renderer::record on the GPU), the frames to converge and
-// their GPU time in all, a converged frame, and the tile path's composite of the converged frame
-// (GPU ms), with the effect layers, their atlas texels and the derived outlines made and their bytes.
+// plain and with each effect: an outside outline, an outline with a hard drop shadow and with a
+// blurred one, a glow, a centred mitered outline, and a weight. Per screen: frame 1 (every glyph and every derived
+// outline new: begin_frame, draw and record on the CPU, Renderer::record on the GPU), the frames to converge and their
+// GPU time in all, a converged frame, and the tile path's composite of the converged frame (GPU ms), with the effect
+// layers, their atlas texels and the derived outlines made and their bytes.
 #include "bench.hpp"
 #include "frame_loop.hpp"
 #include "gpu_tools.hpp"
@@ -50,9 +50,15 @@ std::vector<Variant> variants() {
     centred.outline = TextOutline{1.0f, OutlinePlacement::centred, LineJoin::miter, 4.0f, {1.0f, 1.0f, 1.0f, 1.0f}};
     TextEffects bold;
     bold.weight = 0.5f;
+    TextEffects blurred = outline;
+    blurred.shadow = TextShadow{2.0f, 2.0f, {0.0f, 0.0f, 0.0f, 0.5f}, 3.0f};
+    TextEffects glow;
+    glow.glow = TextGlow{3.0f, {1.0f, 1.0f, 1.0f, 0.75f}};
     return {{"plain", std::nullopt},
             {"outline 1 px outside, round", outline},
             {"outline 1 px + shadow (1.5, 1.5)", shadowed},
+            {"outline 1 px + shadow (2, 2) blurred 3 px", blurred},
+            {"glow 3 px", glow},
             {"outline 1 px centred, miter", centred},
             {"weight +0.5 px", bold}};
 }
@@ -189,6 +195,8 @@ void run_effects(Session& session) {
             TextEffects other = *v.effects;
             other.weight *= 0.37f;
             if (other.outline) other.outline->width *= 0.37f;
+            if (other.shadow) other.shadow->blur *= 0.37f;
+            if (other.glow) other.glow->radius *= 0.37f;
             DrawOptions warm;
             warm.effects = other;
             run_frames(context, renderer, {screen.front()}, 1, &warm);
