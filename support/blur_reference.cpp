@@ -65,7 +65,10 @@ void curves_of(const GlyphRecord& record, std::span<const Point> points, std::sp
         const Point* p = &points[size_t{record.point_offset} + 2 * size_t{slot}];
         const bool flat = p[0].y == p[1].y && p[1].y == p[2].y && !(p[1].x == p[0].x && p[1].y == p[0].y);
         if (((bits >> bit) & 1u) == 0 && !flat) continue;
-        const Quad q{{p[0].x, p[0].y}, {p[1].x, p[1].y}, {p[2].x, p[2].y}};
+        const auto v = [](const Point& point) {
+            return Vec2{static_cast<double>(point.x), static_cast<double>(point.y)};
+        };
+        const Quad q{v(p[0]), v(p[1]), v(p[2])};
         (slot >= split ? b : a).push_back(q);
     }
 }

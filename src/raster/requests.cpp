@@ -271,7 +271,7 @@ uint32_t effect_code(StrokeOp op, LineJoin join, float miter_limit, double half_
     EffectShape shape;
     shape.op = op;
     shape.join = static_cast<StrokeJoin>(join);
-    shape.miter_limit = miter_limit;
+    shape.miter_limit = static_cast<double>(miter_limit);
     shape.half_width = half_width / size;
     return encode_effect(shape);
 }
@@ -280,7 +280,7 @@ uint32_t effect_code(StrokeOp op, LineJoin join, float miter_limit, double half_
 uint16_t blur_code(float radius) {
     return static_cast<uint16_t>(std::lround(static_cast<double>(radius) / kBlurUnit));
 }
-static_assert(double{kMaxEffectBlur} / kBlurUnit <= UINT16_MAX);
+static_assert(static_cast<double>(kMaxEffectBlur) / kBlurUnit <= UINT16_MAX);
 
 static_assert(static_cast<int>(LineJoin::round) == static_cast<int>(StrokeJoin::round) &&
               static_cast<int>(LineJoin::miter) == static_cast<int>(StrokeJoin::miter) &&

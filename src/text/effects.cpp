@@ -153,8 +153,8 @@ Status validate_text_effects(const TextEffects& effects, float size) {
 }
 
 // The widest reach rounds to the last code (one unit short of 4 em).
-static_assert(double{kMaxEffectReachEm} <= limits::kMaxStrokeHalfWidthEm);
-static_assert(double{kMaxEffectReachEm} / kEffectWidthUnit <= kEffectWidthCodes);
+static_assert(static_cast<double>(kMaxEffectReachEm) <= limits::kMaxStrokeHalfWidthEm);
+static_assert(static_cast<double>(kMaxEffectReachEm) / kEffectWidthUnit <= kEffectWidthCodes);
 
 uint32_t encode_effect(const EffectShape& shape) {
     const double units = std::round(shape.half_width / kEffectWidthUnit);
