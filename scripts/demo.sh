@@ -68,7 +68,7 @@ build/tools/crisp-render --font "$out/Inter-Bold.crisp" --text "Outlined Title" 
   --outline 3,0.1,0.05,0 --shadow 4,4,3,0,0,0,0.6 -o "$out/title.png"
 build/tools/crisp-render --font "$out/Inter-Bold.crisp" --text "Glowing" --size 48 --origin 16,60 \
   --canvas 260,84 --color 1,1,1 --background 0.05,0.05,0.15 --glow 6,0.3,0.7,1,0.9 -o "$out/glow.png" >/dev/null
-build/tools/crisp-render --font "$out/DejaVuSans.crisp" --text "Regular, and --weight 0.6 px" --size 20 \
+build/tools/crisp-render --font "$out/DejaVuSans.crisp" --text "Emboldened by --weight 0.6 px" --size 20 \
   --origin 10,28 --canvas 320,40 --weight 0.6 -o "$out/weight.png" >/dev/null
 echo
 echo "The assets are in $(pwd)/$out:"
