@@ -45,10 +45,6 @@ Vec2 to_paint_space(const Affine& m, Vec2 em) {
 
 namespace {
 
-double dot(Vec2 a, Vec2 b) {
-    return a.x * b.x + a.y * b.y;
-}
-
 // The two-point conical gradient: |q - c(t)| = r(t) with c(t) = c0 + t (c1 - c0), r(t) = r0 + t
 // (r1 - r0), i.e. a t^2 - 2 b t + c = 0, solved without cancellation (q = b + sign(b) sqrt(b^2 - a c)
 // gives the roots q / a and c / q), so that nearly touching circles (a near 0) keep their finite root.

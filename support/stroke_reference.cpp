@@ -8,13 +8,6 @@ namespace crisp {
 
 namespace {
 
-double dot(Vec2 a, Vec2 b) {
-    return a.x * b.x + a.y * b.y;
-}
-double cross(Vec2 a, Vec2 b) {
-    return a.x * b.y - a.y * b.x;
-}
-
 // The unit tangent of q at t; at an end whose control point sits on it, the chord's direction
 // (the limit of the tangent there).
 Vec2 tangent_at(const Quad& q, double t) {
@@ -128,66 +121,78 @@ std::vector<Quad> elements_of(const Contour& contour) {
 
 StrokeReference::StrokeReference(const std::vector<Contour>& glyph, StrokeJoin join, double half_width,
                                  double miter_limit, StrokeOp op)
+    : StrokeReference(std::vector<std::vector<Contour>>{glyph}, join, half_width, miter_limit, op) {}
+
+StrokeReference::StrokeReference(const std::vector<std::vector<Contour>>& fills, StrokeJoin join, double half_width,
+                                 double miter_limit, StrokeOp op)
     : join_(join), r_(half_width), miter_limit_(miter_limit), op_(op) {
-    for (const Contour& contour : glyph) glyph_curves_.insert(glyph_curves_.end(), contour.begin(), contour.end());
-    glyph_ = std::make_unique<ExactCoverage>(glyph_curves_);
-    for (const Quad& q : glyph_curves_) add_offset(q, 0.0);
-    for (const Contour& contour : glyph) {
-        const std::vector<Quad> elements = elements_of(contour);
-        if (elements.empty()) continue;
-        for (const Quad& q : elements) {
-            Element e{q, std::min({q.p0.x, q.p1.x, q.p2.x}) - r_, std::min({q.p0.y, q.p1.y, q.p2.y}) - r_,
-                      std::max({q.p0.x, q.p1.x, q.p2.x}) + r_, std::max({q.p0.y, q.p1.y, q.p2.y}) + r_};
-            elements_.push_back(e);
-            add_offset(q, r_);
-            add_offset(q, -r_);
-            add_segment(offset_at(q, 0.0, -r_), offset_at(q, 0.0, r_));
-            add_segment(offset_at(q, 1.0, -r_), offset_at(q, 1.0, r_));
-        }
-        const bool closed = elements.back().p2 == elements.front().p0;
-        for (size_t i = 0; i < elements.size(); ++i) {
-            if (i + 1 == elements.size() && !closed) break;
-            const Quad& in = elements[i];
-            const Quad& out = elements[(i + 1) % elements.size()];
-            const Vec2 corner = in.p2, d_in = tangent_at(in, 1.0), d_out = tangent_at(out, 0.0);
-            double angle = std::atan2(cross(d_in, d_out), dot(d_in, d_out));
-            if (join_ == StrokeJoin::round) {
-                joins_.push_back({corner, {}});
-                Boundary top{{corner, corner, corner},
-                             r_,
-                             0.0,
-                             1.0,
-                             true,
-                             corner.y,
-                             corner.y + r_,
-                             corner.x - r_,
-                             corner.x + r_};
-                Boundary bottom = top;
-                bottom.y_lo = corner.y - r_;
-                bottom.y_hi = corner.y;
-                boundary_.push_back(top);
-                boundary_.push_back(bottom);
-                continue;
+    for (const std::vector<Contour>& fill : fills) {
+        std::vector<Quad>& curves = fill_curves_.emplace_back();
+        for (const Contour& contour : fill) curves.insert(curves.end(), contour.begin(), contour.end());
+    }
+    for (const std::vector<Quad>& curves : fill_curves_) {
+        fills_.push_back(std::make_unique<ExactCoverage>(curves));
+        for (const Quad& q : curves) add_offset(q, 0.0);
+    }
+    for (const std::vector<Contour>& fill : fills) {
+        for (const Contour& contour : fill) {
+            const std::vector<Quad> elements = elements_of(contour);
+            if (elements.empty()) continue;
+            for (const Quad& q : elements) {
+                Element e{q, std::min({q.p0.x, q.p1.x, q.p2.x}) - r_, std::min({q.p0.y, q.p1.y, q.p2.y}) - r_,
+                          std::max({q.p0.x, q.p1.x, q.p2.x}) + r_, std::max({q.p0.y, q.p1.y, q.p2.y}) + r_};
+                elements_.push_back(e);
+                add_offset(q, r_);
+                add_offset(q, -r_);
+                add_segment(offset_at(q, 0.0, -r_), offset_at(q, 0.0, r_));
+                add_segment(offset_at(q, 1.0, -r_), offset_at(q, 1.0, r_));
             }
-            if (std::abs(angle) <= 1e-9) continue;
-            if (std::abs(cross(d_in, d_out)) <= 1e-15 && dot(d_in, d_out) < 0.0) angle = std::numbers::pi;
-            const double outer = angle > 0.0 ? -1.0 : 1.0;
-            const Vec2 n_in = outer * Vec2{-d_in.y, d_in.x}, n_out = outer * Vec2{-d_out.y, d_out.x};
-            const Vec2 a = corner + r_ * n_in, b = corner + r_ * n_out;
-            std::vector<Vec2> polygon{corner, a};
-            // The miter ratio 1 / sin(alpha / 2), alpha = pi - |angle| the angle between the segments.
-            const double ratio = 1.0 / std::sin(0.5 * (std::numbers::pi - std::abs(angle)));
-            if (join_ == StrokeJoin::miter && std::abs(angle) < std::numbers::pi && ratio <= miter_limit_) {
-                const Vec2 mid = n_in + n_out;
-                polygon.push_back(corner + (r_ * ratio / length(mid)) * mid);
+            const bool closed = elements.back().p2 == elements.front().p0;
+            for (size_t i = 0; i < elements.size(); ++i) {
+                if (i + 1 == elements.size() && !closed) break;
+                const Quad& in = elements[i];
+                const Quad& out = elements[(i + 1) % elements.size()];
+                const Vec2 corner = in.p2, d_in = tangent_at(in, 1.0), d_out = tangent_at(out, 0.0);
+                double angle = std::atan2(cross(d_in, d_out), dot(d_in, d_out));
+                if (join_ == StrokeJoin::round) {
+                    joins_.push_back({corner, {}});
+                    Boundary top{{corner, corner, corner},
+                                 r_,
+                                 0.0,
+                                 1.0,
+                                 true,
+                                 corner.y,
+                                 corner.y + r_,
+                                 corner.x - r_,
+                                 corner.x + r_};
+                    Boundary bottom = top;
+                    bottom.y_lo = corner.y - r_;
+                    bottom.y_hi = corner.y;
+                    boundary_.push_back(top);
+                    boundary_.push_back(bottom);
+                    continue;
+                }
+                if (std::abs(angle) <= 1e-9) continue;
+                if (std::abs(cross(d_in, d_out)) <= 1e-15 && dot(d_in, d_out) < 0.0) angle = std::numbers::pi;
+                const double outer = angle > 0.0 ? -1.0 : 1.0;
+                const Vec2 n_in = outer * Vec2{-d_in.y, d_in.x}, n_out = outer * Vec2{-d_out.y, d_out.x};
+                const Vec2 a = corner + r_ * n_in, b = corner + r_ * n_out;
+                std::vector<Vec2> polygon{corner, a};
+                // The miter ratio 1 / sin(alpha / 2), alpha = pi - |angle| the angle between the segments.
+                const double ratio = 1.0 / std::sin(0.5 * (std::numbers::pi - std::abs(angle)));
+                if (join_ == StrokeJoin::miter && std::abs(angle) < std::numbers::pi && ratio <= miter_limit_) {
+                    const Vec2 mid = n_in + n_out;
+                    polygon.push_back(corner + (r_ * ratio / length(mid)) * mid);
+                }
+                polygon.push_back(b);
+                double area = 0.0;
+                for (size_t k = 0; k < polygon.size(); ++k)
+                    area += cross(polygon[k], polygon[(k + 1) % polygon.size()]);
+                if (!(std::abs(area) > 0.0)) continue;
+                if (area < 0.0) std::reverse(polygon.begin(), polygon.end());
+                for (size_t k = 0; k < polygon.size(); ++k) add_segment(polygon[k], polygon[(k + 1) % polygon.size()]);
+                joins_.push_back({corner, std::move(polygon)});
             }
-            polygon.push_back(b);
-            double area = 0.0;
-            for (size_t k = 0; k < polygon.size(); ++k) area += cross(polygon[k], polygon[(k + 1) % polygon.size()]);
-            if (!(std::abs(area) > 0.0)) continue;
-            if (area < 0.0) std::reverse(polygon.begin(), polygon.end());
-            for (size_t k = 0; k < polygon.size(); ++k) add_segment(polygon[k], polygon[(k + 1) % polygon.size()]);
-            joins_.push_back({corner, std::move(polygon)});
         }
     }
 }
@@ -229,7 +234,7 @@ void StrokeReference::add_offset(const Quad& q, double s) {
 }
 
 bool StrokeReference::in_glyph(Vec2 p) const {
-    return glyph_->winding(p.x, p.y) != 0;
+    return std::any_of(fills_.begin(), fills_.end(), [&](const auto& fill) { return fill->winding(p.x, p.y) != 0; });
 }
 
 bool StrokeReference::in_stroke(Vec2 p) const {

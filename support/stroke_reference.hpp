@@ -36,6 +36,12 @@ public:
     // `glyph`: closed contours (em, y up), G by the nonzero rule and the outline S(r) strokes.
     StrokeReference(const std::vector<Contour>& glyph, StrokeJoin join, double half_width, double miter_limit,
                     StrokeOp op);
+    // A colour glyph's silhouette: G the union of the fills (each by the nonzero rule, wound either
+    // way), S(r) the sweeps of every curve of every fill. A sweep of a curve inside G adds nothing
+    // outside G, so this is the silhouette's exact (S(r) op G) for the ops that keep S only
+    // outside G (a_not_b, a_or_b); for the others, S(r) of the silhouette's boundary is not this.
+    StrokeReference(const std::vector<std::vector<Contour>>& fills, StrokeJoin join, double half_width,
+                    double miter_limit, StrokeOp op);
     ~StrokeReference();
     StrokeReference(StrokeReference&&) = default;
 
@@ -84,8 +90,8 @@ private:
     double r_;
     double miter_limit_;
     StrokeOp op_;
-    std::vector<Quad> glyph_curves_;
-    std::unique_ptr<ExactCoverage> glyph_;  // G's winding
+    std::vector<std::vector<Quad>> fill_curves_;
+    std::vector<std::unique_ptr<ExactCoverage>> fills_;  // each fill's winding: G is where any is nonzero
     std::vector<Element> elements_;
     std::vector<Join> joins_;
     std::vector<Boundary> boundary_;

@@ -13,6 +13,7 @@
 #include "text/effect_code.hpp"
 #include "text/stroke.hpp"
 
+#include <crisp/bake.hpp>
 #include <crisp/effects.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
@@ -22,6 +23,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -526,6 +528,210 @@ TEST(Effects, BlurredPointSamplesAndTransformedGlyphsConvergeOnTheExactBlur) {
         EXPECT_EQ(w.layers, 2u);
         EXPECT_LE(w.max, kTarget) << c.name << " " << c.layout;
     }
+}
+
+// Colour glyphs of crisp's COLRv0 test font (tests/fonts/colour/README.md): four_layers (U+E002)
+// is the square, the circle, the ring and the bar, whose union is the square.
+constexpr uint32_t kSquare = 1, kRing = 3, kBar = 4, kFourLayers = 16;
+
+std::unique_ptr<Font> colour_font(bool ring_and_bar = false) {
+    BakeOptions options;
+    options.all_glyphs = false;
+    options.codepoints = {0xE002};
+    Result<BakeResult> baked = bake_font_file(test::source_path("tests/fonts/colour/colrv0.ttf"), options);
+    EXPECT_TRUE(baked) << (baked ? "" : baked.error().message);
+    if (!baked) return nullptr;
+    if (ring_and_bar) {
+        // Two layers that cross: the bar through the ring's hole, out past its sides.
+        FontAsset& asset = baked->asset;
+        ColourGlyph& four = asset.colour_glyphs.front();
+        EXPECT_EQ(four.glyph, kFourLayers);
+        asset.layers[four.first_layer] = asset.layers[four.first_layer + 2];
+        asset.layers[four.first_layer + 1] = asset.layers[four.first_layer + 3];
+        EXPECT_EQ(asset.layers[four.first_layer].glyph, kRing);
+        EXPECT_EQ(asset.layers[four.first_layer + 1].glyph, kBar);
+        four.layer_count = 2;
+        // The bar mirrored about its middle (x = 1/2 em): the same rectangle wound the other way,
+        // as a CFF layer among TrueType ones would be.
+        const GlyphRecord& bar = asset.glyphs[kBar];
+        for (uint32_t i = 0; i < 2 * bar.curve_count + 1; ++i) {
+            Point& point = asset.points[size_t{bar.point_offset} + i];
+            point.x = 1.0f - point.x;
+        }
+    }
+    Result<Font> font = Font::create(std::move(baked->asset), 1);
+    EXPECT_TRUE(font) << (font ? "" : font.error().message);
+    return font ? std::make_unique<Font>(std::move(*font)) : nullptr;
+}
+
+// converge_and_hold() of every layer around a colour glyph to the exact stroked area of its
+// silhouette, the union of `fills` (StrokeReference's union: exact for every op where the fills
+// are the silhouette's own boundary, for the outside ones otherwise), or blurred, to the exact
+// blurred coverage of the silhouette's derived glyph.
+Worst converge_and_compare_silhouette(const Font& font, std::span<const GlyphInstance> glyphs,
+                                      std::span<const TextEffects> effects, uint32_t samples,
+                                      const std::vector<std::vector<Contour>>& fills) {
+    return converge_and_hold(
+        font, glyphs, effects, samples, "gray", [&](const DrawnGlyph& d, const SubpixelLayout& sub) -> TexelReference {
+            const GlyphKey& key = d.instance.key;
+            if (!(key.glyph & kSilhouetteGlyph)) return {};
+            EXPECT_NE(key.effect, 0u);
+            EXPECT_EQ(d.instance.paint, kNoPaint);
+            const ColourGlyph* colour = font.asset().colour_glyph(key.glyph & ~kSilhouetteGlyph);
+            EXPECT_TRUE(colour);
+            if (!colour) return {};
+            const Result<DerivedGlyph> derived =
+                derive_silhouette_glyph(font.asset(), *colour, key.effect, effect_tolerance(effect_octave(key)));
+            EXPECT_TRUE(derived) << (derived ? "" : derived.error().message);
+            if (!derived) return {};
+            const EffectShape shape = decode_effect(key.effect);
+            if (key.blur != 0) {
+                auto reference = std::make_shared<BlurReference>(BlurReference::of_derived(*derived, shape.op));
+                const Projective map = em_to_texel(glyph_rect(derived->record, key), key);
+                const double w = blur_box_width(key.blur * kBlurUnit);
+                return [reference, map, &sub, w](uint32_t tx, uint32_t ty) {
+                    return reference->texel(map, sub, tx, ty, w);
+                };
+            }
+            auto reference =
+                std::make_shared<StrokeReference>(fills, shape.join, shape.half_width, shape.miter_limit, shape.op);
+            const TexelToEm map = texel_to_em(glyph_rect(derived->record, key), key);
+            return [reference, map, &sub](uint32_t tx, uint32_t ty) { return reference->texel(map, sub, tx, ty); };
+        });
+}
+
+TEST(Effects, ColourGlyphsAreOutlinedAroundTheirSilhouette) {
+    REQUIRE_GPU();
+    auto font = colour_font();
+    ASSERT_TRUE(font);
+    const FontAsset& asset = font->asset();
+    // The silhouette of four layers that touch, share edges and overlap is the square.
+    const std::vector<std::vector<Contour>> square = {glyph_contours(asset, asset.glyphs[kSquare])};
+    for (const float size : {16.0f, 48.0f}) {
+        const std::vector<GlyphInstance> glyphs = lay_out(*font, "\uE002", size, 3.3f, 4.0f + size);
+        ASSERT_EQ(glyphs.size(), 4u);
+        const float width = std::max(1.5f, size / 16.0f);
+        const TextEffects all[] = {outline(width, OutlinePlacement::outside, LineJoin::round),
+                                   outline(width, OutlinePlacement::inside, LineJoin::miter),
+                                   outline(width, OutlinePlacement::centred, LineJoin::bevel)};
+        const Worst w = converge_and_compare_silhouette(*font, glyphs, all, 128, square);
+        EXPECT_EQ(w.layers, 3u);  // one outline of each colour glyph, not one of each layer
+        for (const auto& [code, max] : w.by_effect) {
+            const EffectShape shape = decode_effect(code);
+            std::printf("[ effects ] four_layers %2.0f px, op %d, %s join: max %.4f\n", static_cast<double>(size),
+                        static_cast<int>(shape.op), line_join_name(static_cast<LineJoin>(shape.join)), max);
+            EXPECT_LE(max, kTarget) << size << " px, op " << static_cast<int>(shape.op);
+        }
+    }
+}
+
+TEST(Effects, ColourGlyphsThatCrossHaveTheirUnionOutlinedAndShadowed) {
+    REQUIRE_GPU();
+    auto font = colour_font(true);
+    ASSERT_TRUE(font);
+    const FontAsset& asset = font->asset();
+    const std::vector<std::vector<Contour>> ring_and_bar = {glyph_contours(asset, asset.glyphs[kRing]),
+                                                            glyph_contours(asset, asset.glyphs[kBar])};
+    // The bar is wound against the ring: a silhouette of the layers' curves added up would cancel
+    // where the bar crosses the ring.
+    const std::vector<GlyphInstance> glyphs = lay_out(*font, "\uE002", 24.0f, 3.3f, 30.0f);
+    ASSERT_EQ(glyphs.size(), 2u);
+    TextEffects outlined = outline(2.0f, OutlinePlacement::outside, LineJoin::miter);
+    TextEffects shadowed;
+    shadowed.shadow = TextShadow{1.5f, 2.0f, {0.0f, 0.0f, 0.0f, 0.5f}, 2.0f};
+    const TextEffects both[] = {outlined, shadowed};
+    const Worst w = converge_and_compare_silhouette(*font, glyphs, both, 128, ring_and_bar);
+    EXPECT_EQ(w.layers, 2u);
+    std::printf("[ effects ] ring and bar 24 px, outline and blurred shadow: max %.4f, mean %.5f\n", w.max, w.mean);
+    for (const auto& [code, max] : w.by_effect) std::printf("  code %x: %.4f\n", code, max);
+    EXPECT_LE(w.max, kTarget);
+}
+
+TEST(Effects, ColourGlyphLayersAreEachWeightedAndBitmapsAreLeftAsTheyAre) {
+    REQUIRE_GPU();
+    auto font = colour_font();
+    ASSERT_TRUE(font);
+    auto renderer = make_renderer("gray", 8);
+    ASSERT_TRUE(renderer);
+    ASSERT_TRUE(renderer->add_font(*font));
+    const std::vector<GlyphInstance> glyphs = lay_out(*font, "\uE002\uE002", 20.0f, 3.0f, 24.0f);
+    ASSERT_EQ(glyphs.size(), 8u);
+    DrawOptions options;
+    options.effects = outline(1.0f, OutlinePlacement::outside, LineJoin::round, 0.5f);
+    options.effects->shadow = TextShadow{1.0f, 1.0f, {0.0f, 0.0f, 0.0f, 1.0f}, 0.0f};
+    const std::vector<DrawnGlyph> drawn = one_frame(*renderer, [&] { renderer->draw(glyphs, options); });
+    EXPECT_EQ(renderer->stats().failed_effects, 0u);
+    // Each of the two glyphs: a shadow and an outline of its silhouette under its four layers,
+    // each layer emboldened and keeping its paint.
+    ASSERT_EQ(drawn.size(), 12u);
+    uint32_t silhouettes = 0, faces = 0;
+    for (const DrawnGlyph& d : drawn) {
+        if (d.instance.key.glyph & kSilhouetteGlyph) {
+            ++silhouettes;
+            EXPECT_EQ(d.instance.paint, kNoPaint);
+            EXPECT_LT(d.stack, kStackGlyph);
+            EXPECT_EQ(d.instance.key.glyph & ~kSilhouetteGlyph, kFourLayers);
+        } else {
+            ++faces;
+            EXPECT_NE(d.instance.paint, kNoPaint);
+            EXPECT_NE(d.instance.key.effect, 0u);  // weighted
+            EXPECT_EQ(d.stack, kStackGlyph);
+        }
+    }
+    EXPECT_EQ(silhouettes, 4u);
+    EXPECT_EQ(faces, 8u);
+
+    // A bitmap glyph has no outline: drawn as it is, counted once.
+    const std::string noto = "/usr/share/fonts/truetype/noto/NotoColorEmoji.ttf";
+    if (!std::filesystem::exists(noto)) GTEST_SKIP() << noto << " is missing (scripts/setup.sh installs it)";
+    BakeOptions bitmap;
+    bitmap.all_glyphs = false;
+    bitmap.codepoints = {0x1F600};
+    Result<BakeResult> baked = bake_font_file(noto, bitmap);
+    ASSERT_TRUE(baked) << baked.error().message;
+    Result<Font> emoji = Font::create(std::move(baked->asset), 2);
+    ASSERT_TRUE(emoji);
+    ASSERT_TRUE(renderer->add_font(*emoji));
+    const std::vector<GlyphInstance> smile = lay_out(*emoji, "\U0001F600", 20.0f, 3.0f, 24.0f);
+    ASSERT_EQ(smile.size(), 1u);
+    const std::vector<DrawnGlyph> as_is = one_frame(*renderer, [&] { renderer->draw(smile, options); });
+    EXPECT_EQ(as_is.size(), 1u);
+    EXPECT_EQ(renderer->stats().failed_effects, 1u);
+}
+
+TEST(Effects, ABlurredKeysCostCountsThePassesOfItsWiderRows) {
+    // 24 bars 1/100 em wide, 1/50 em apart, full height: 48 crossings on every row, the same
+    // curves in every band (their vertical sides; the flat tops and bottoms are in none).
+    std::vector<Contour> bars;
+    for (int i = 0; i < 24; ++i) {
+        const double x = 0.05 + 0.02 * i;
+        bars.push_back(test::polygon({{x, 0.0}, {x, 0.7}, {x + 0.01, 0.7}, {x + 0.01, 0.0}}));
+    }
+    uint32_t index = 0;
+    auto font = test::with_shape(bars, index);
+    ASSERT_TRUE(font);
+    const GlyphRecord& record = font->asset().glyphs[index];
+    GlyphKey key;
+    key.font = 1;
+    key.glyph = index;
+    key.size_x = key.size_y = 32 * kSizeOne;
+    const auto texels = [&](const GlyphKey& k) {
+        const GlyphRect rect = glyph_rect(record, k);
+        return uint64_t{rect.width} * rect.height;
+    };
+    const uint64_t plain = curve_tests_per_sample(font->asset(), record, key);
+    ASSERT_EQ(plain % texels(key), 0u);
+    const uint64_t per_texel = plain / texels(key);  // the curves of a band
+    EXPECT_GE(per_texel, 48u);
+    // A blur of 1/64 px reaches no further crossing: one pass a texel, over its wider rect.
+    key.blur = 1;
+    EXPECT_EQ(curve_tests_per_sample(font->asset(), record, key), per_texel * texels(key));
+    // 8 px: a texel's row reaches 8 texels either side, over 20 texels of bars' 32: up to 30
+    // crossings, four passes; more than two on average over the rect and its margins.
+    key.blur = 8 * 64;
+    const uint64_t blurred = curve_tests_per_sample(font->asset(), record, key);
+    EXPECT_GT(blurred, 2 * per_texel * texels(key));
+    EXPECT_LE(blurred, 6 * per_texel * texels(key));
 }
 
 TEST(Effects, EffectsPastTheGlyphsLimitsAreLeftOutAndCounted) {

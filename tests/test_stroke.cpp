@@ -372,6 +372,27 @@ TEST(Stroke, BoundaryOfOverlappingContoursIsTheFillsEdge) {
     }
 }
 
+TEST(Stroke, UnionOfFillsWoundEitherWay) {
+    // A ring and a bar across it, its hole and beyond its sides, the bar wound the other way (a
+    // CFF layer among TrueType ones): their windings added would cancel where they overlap.
+    const std::vector<Contour> ring = {test::circle(0.5, 0.4, 0.4, true), test::circle(0.5, 0.4, 0.2, false)};
+    const Contour bar_cw = test::polygon({{0.1, 0.3}, {0.1, 0.5}, {0.9, 0.5}, {0.9, 0.3}});
+    const Contour bar_ccw = test::polygon({{0.1, 0.3}, {0.9, 0.3}, {0.9, 0.5}, {0.1, 0.5}});
+    std::vector<Contour> same_way = ring;
+    same_way.push_back(bar_cw);
+    const std::vector<Contour> u = union_boundary({ring, {bar_ccw}});
+    EXPECT_LT(worst_fill_difference(same_way, u), 1e-9);
+    expect_fill_on_the_right(u);
+    // Fills that share edges and touch: a square, the bar on its sides, a disc touching them.
+    const Contour square = test::polygon({{0.1, 0.0}, {0.1, 0.8}, {0.9, 0.8}, {0.9, 0.0}});
+    const std::vector<Contour> s = union_boundary({{square}, {bar_ccw}, {test::circle(0.5, 0.4, 0.4, false)}});
+    ASSERT_EQ(s.size(), 1u);
+    EXPECT_LT(worst_fill_difference({square}, s), 1e-9);
+    expect_fill_on_the_right(s);
+    // One fill: boundary_contours().
+    EXPECT_EQ(union_boundary({ring}), boundary_contours(ring));
+}
+
 TEST(Stroke, BoundaryOfAVariableFontsOverlappingGlyphs) {
     // Inter's variable masters draw 'A', 'Q' and others with overlapping contours.
     auto inter = test::bake_subset(test::kInterVariable, "AQR8&");

@@ -57,10 +57,16 @@ struct GlyphKey {
     int32_t perspective[2] = {};
     // 0: the glyph's own outline. Otherwise an effect layer's outline derived from it (an outline,
     // a weight: include/crisp/effects.hpp, docs/effects.md), its shape coded by the renderer:
-    // keys of the same glyph, size and offset with equal codes share their atlas entry.
+    // keys of the same glyph, size and offset with equal codes share their atlas entry. With
+    // kSilhouetteGlyph in `glyph`, derived from a colour glyph's silhouette instead.
     uint32_t effect = 0;
     friend bool operator==(const GlyphKey&, const GlyphKey&) = default;
 };
+
+// GlyphKey::glyph of an effect layer of a colour glyph (an outline, shadow or glow around it; its
+// `effect` is never 0): this bit and the face glyph the colour glyph colours. The layer's outline
+// is derived from the union of that colour glyph's layers' outlines, its silhouette.
+inline constexpr uint32_t kSilhouetteGlyph = 1u << 31;
 
 // Whether `key` carries a transform (its linear part is not all zero).
 inline bool is_transformed(const GlyphKey& key) {
@@ -131,8 +137,10 @@ CRISP_API Projective inverse(const Projective& map);
 CRISP_API std::vector<uint32_t> flat_curve_words(const FontAsset& asset, const GlyphRecord& glyph);
 
 // What one sample of every texel of the glyph's rect costs the rasterizer, in curve tests: the
-// sum over the rect's rows of its width times the curves listed in the band of the row's centre.
-// The atlas budgets its samples in these units. 0 for a glyph without curves.
+// sum over the rect's rows of its width times the curves listed in the band of the row's centre;
+// for a blurred key, each texel's term times the passes its wider row takes (one per 8 crossings
+// of the row within the blur's reach of the texel, at least one). The atlas budgets its samples
+// in these units. 0 for a glyph without curves.
 CRISP_API uint64_t curve_tests_per_sample(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key);
 
 inline float size_to_float(uint32_t fixed) {

@@ -180,8 +180,9 @@ struct DrawOptions {
     // derived from the glyph's on the CPU and cached per glyph and shape in em until its font is
     // removed. Effects validate_text_effects() refuses draw nothing (skipped_glyphs); a glyph whose
     // effect reaches past kMaxEffectReachEm, or whose stroke passes limits::kMaxStrokeCurves, is
-    // drawn without that layer (failed_effects). Colour glyphs' layers take no effects (a bitmap
-    // glyph has no outline): they are drawn as they are, and count in failed_effects.
+    // drawn without that layer (failed_effects). A colour glyph's shadow, glow and outline are of
+    // its silhouette, the union of its layers (kSilhouetteGlyph), each of its layers weighted; a
+    // bitmap glyph has no outline: it is drawn as it is, and counts once in failed_effects.
     std::optional<TextEffects> effects;
 };
 
@@ -322,7 +323,8 @@ struct RendererStats {
     uint64_t upload_bytes = 0;    // bytes copied into GPU buffers while recording this frame
     // Effects (DrawOptions::effects): the effect layers drawn this frame (among drawn_glyphs) and
     // the atlas texels their rects take; layers not drawn (past kMaxEffectReachEm, a stroke past
-    // limits::kMaxStrokeCurves, a colour glyph's layer); and the derived outlines held for them,
+    // limits::kMaxStrokeCurves, a bitmap glyph, a silhouette past limits::kMaxSilhouetteCurves);
+    // and the derived outlines held for them,
     // those made this frame and their bytes on the GPU.
     uint32_t effect_layers = 0;
     uint64_t effect_texels = 0;

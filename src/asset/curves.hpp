@@ -24,6 +24,12 @@ inline Vec2 operator*(double s, Vec2 a) {
     return {s * a.x, s * a.y};
 }
 double length(Vec2 a);
+inline double dot(Vec2 a, Vec2 b) {
+    return a.x * b.x + a.y * b.y;
+}
+inline double cross(Vec2 a, Vec2 b) {
+    return a.x * b.y - a.y * b.x;
+}
 inline Vec2 lerp(Vec2 a, Vec2 b, double t) {
     return a + t * (b - a);
 }

@@ -24,6 +24,9 @@ inline constexpr uint64_t kImageFileBytes = uint64_t{16384} * 16384 * 3 * 4 + 40
 // Curves of one glyph's stroke pieces (src/text/stroke.hpp): a glyph of a few hundred curves
 // stroked at a quarter em makes a few thousand; each is tested by every sample of its bands.
 inline constexpr uint32_t kMaxStrokeCurves = 65536;
+// Curves of all layers of one colour glyph whose silhouette an effect outlines (the union of the
+// layers, src/text/boundary.cpp, tests every piece against every curve): emoji have a few hundred.
+inline constexpr uint32_t kMaxSilhouetteCurves = 8192;
 // A stroke's half-width in em: an outline 8 em wide is far past any effect's use, and its pieces
 // would reach far outside the glyph's rect.
 inline constexpr double kMaxStrokeHalfWidthEm = 4.0;

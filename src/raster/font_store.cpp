@@ -153,12 +153,18 @@ Status FontStore::derive(const GlyphKey& key) {
         return {};
     }
     const HeldFont* source = find(key.font);
-    if (key.effect == 0 || !source || !source->asset || key.glyph >= source->asset->glyphs.size()) {
-        return Error{ErrorCode::invalid_argument, "renderer: no glyph " + std::to_string(key.glyph) + " of font " +
+    const FontAsset* from = source ? source->asset : nullptr;
+    const uint32_t glyph = key.glyph & ~kSilhouetteGlyph;
+    const bool silhouette = (key.glyph & kSilhouetteGlyph) != 0;
+    const ColourGlyph* colour = silhouette && from ? from->colour_glyph(glyph) : nullptr;
+    if (key.effect == 0 || !from || glyph >= from->glyphs.size() || (silhouette && !colour)) {
+        return Error{ErrorCode::invalid_argument, std::string("renderer: no ") + (silhouette ? "colour " : "") +
+                                                      "glyph " + std::to_string(glyph) + " of font " +
                                                       std::to_string(key.font) + " to derive an effect from"};
     }
-    Result<DerivedGlyph> made =
-        derive_effect_glyph(*source->asset, source->asset->glyphs[key.glyph], key.effect, effect_tolerance(id.octave));
+    const double tolerance = effect_tolerance(id.octave);
+    Result<DerivedGlyph> made = colour ? derive_silhouette_glyph(*from, *colour, key.effect, tolerance)
+                                       : derive_effect_glyph(*from, from->glyphs[glyph], key.effect, tolerance);
     if (!made) return made.error();
     const uint64_t bytes = made->points.size() * sizeof(Point) + made->band_words.size() * sizeof(uint32_t);
     // Room: derived glyphs not drawn this frame go, least lately drawn first.

@@ -88,6 +88,14 @@ void MotionTracker::abandon_frame() {
 
 namespace {
 
+// Whether `glyph` is a further layer of the colour glyph `previous` is a layer of: the same colour
+// glyph at the same pen and cluster (two of one emoji side by side differ in both).
+bool same_colour_glyph(const GlyphInstance* previous, const GlyphInstance& glyph) {
+    return previous && previous->colour_glyph == glyph.colour_glyph && previous->key.font == glyph.key.font &&
+           previous->cluster == glyph.cluster && std::memcmp(&previous->pen_x, &glyph.pen_x, sizeof(float)) == 0 &&
+           std::memcmp(&previous->pen_y, &glyph.pen_y, sizeof(float)) == 0;
+}
+
 // A fingerprint of a draw's transform or plane: any change of a value changes it (0: none).
 uint64_t shape_of(const DrawOptions& options) {
     uint64_t h = 0;
@@ -189,7 +197,13 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
         effects = static_cast<uint32_t>(effects_.size());
         effects_.push_back(fx);
     }
+    // A colour glyph's layers follow each other: the first of them drawn carries the effect
+    // layers of its silhouette.
+    const GlyphInstance* previous = nullptr;
+    bool silhouette_due = false;
     for (const GlyphInstance& asked : glyphs) {
+        if (asked.colour_glyph != kNoColourGlyph && !same_colour_glyph(previous, asked)) silhouette_due = true;
+        previous = &asked;
         GlyphInstance glyph = asked;
         float depth = glyph.depth;
         const Placed placed = place(glyph, options, transform_steps, dx, dy, depth);
@@ -208,8 +222,11 @@ void FrameRequests::add(std::span<const GlyphInstance> glyphs, const DrawOptions
         if (options.palette) glyph.palette = *options.palette;
         const GlyphContrast contrast = resolve_contrast(options.contrast ? *options.contrast : contrast_,
                                                         static_cast<float>(glyph.key.size_x) / 256.0f);
-        requests_.push_back({glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps, contrast, effects});
-        request(glyph, visible, steps, contrast, effects);
+        const bool silhouette = silhouette_due && glyph.colour_glyph != kNoColourGlyph;
+        if (silhouette) silhouette_due = false;
+        requests_.push_back(
+            {glyph, visible != nullptr, visible ? *visible : VkRect2D{}, steps, contrast, effects, silhouette});
+        request(glyph, visible, steps, contrast, effects, silhouette);
     }
 }
 
@@ -252,14 +269,14 @@ FrameRequests::Placed FrameRequests::place(GlyphInstance& glyph, const DrawOptio
 // One draw()n instance: at the frame's subpixel steps, then culled, admitted whole, or kept
 // for admit_clipped() with its visible part.
 void FrameRequests::request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps,
-                            const GlyphContrast& contrast, uint32_t effects) {
+                            const GlyphContrast& contrast, uint32_t effects, bool silhouette) {
     const uint32_t frame_steps = std::min(coarsening_.steps(), steps);
     const GlyphInstance glyph = coarsened(fonts_.asset(asked.key.font), asked, frame_steps);
     if (glyph.key != asked.key) ++stats_.coarsened_glyphs;
     if (effects == kNoEffects) {
         submit(glyph, visible, contrast, kStackGlyph);
     } else {
-        request_effects(glyph, visible, frame_steps, contrast, effects_[effects]);
+        request_effects(glyph, visible, frame_steps, contrast, effects_[effects], silhouette);
     }
 }
 
@@ -289,17 +306,26 @@ static_assert(static_cast<int>(LineJoin::round) == static_cast<int>(StrokeJoin::
 }  // namespace
 
 // A glyph of a draw with effects: its shadow, its outline and its face (weighted), each a layer.
+// A colour glyph's layers are each weighted as a face; its shadow, glow and outline are of its
+// silhouette (kSilhouetteGlyph), made at its first drawn layer (`silhouette`).
 void FrameRequests::request_effects(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps,
-                                    const GlyphContrast& contrast, const DrawEffects& fx) {
+                                    const GlyphContrast& contrast, const DrawEffects& fx, bool silhouette) {
     const TextEffects& e = fx.effects;
     const HeldGlyph own = fonts_.glyph(glyph.key);
     if (!own.record || glyph.width == 0 || glyph.height == 0) {
         submit(glyph, visible, contrast, kStackGlyph);  // admit() counts it
         return;
     }
-    // A colour glyph's layers (and a bitmap glyph) are drawn as they are.
-    if (glyph.paint != kNoPaint || glyph.colour_glyph != kNoColourGlyph) {
-        ++stats_.failed_effects;
+    const FontAsset* asset = fonts_.asset(glyph.key.font);
+    const bool coloured = glyph.colour_glyph != kNoColourGlyph;
+    const ColourGlyph* colour = coloured && asset && glyph.colour_glyph < asset->colour_glyphs.size()
+                                    ? &asset->colour_glyphs[glyph.colour_glyph]
+                                    : nullptr;
+    const bool bitmap = glyph.paint != kNoPaint && asset && glyph.paint < asset->paints.size() &&
+                        asset->paints[glyph.paint].kind == PaintKind::image;
+    // A bitmap glyph (and a layer without its colour glyph) is drawn as it is, counted once.
+    if (bitmap || (coloured && !colour) || (glyph.paint != kNoPaint && !coloured)) {
+        if (silhouette || !coloured) ++stats_.failed_effects;
         submit(glyph, visible, contrast, kStackGlyph);
         return;
     }
@@ -310,76 +336,90 @@ void FrameRequests::request_effects(const GlyphInstance& glyph, const VkRect2D* 
                               ? effect_code(weight > 0.0 ? StrokeOp::a_or_b : StrokeOp::b_not_a, LineJoin::miter, 4.0f,
                                             std::abs(weight), size)
                               : 0;
-    if (face == 0 && weight != 0.0 && std::abs(weight) > reach_limit) ++stats_.failed_effects;
-    // The outline's layer, and the shadow's source: the face with its outline.
-    uint32_t outline = 0, shadow = face;
-    uint32_t outline_stack = kStackOutlineUnder;
-    if (const auto& o = e.outline) {
-        double r = 0.0;
-        StrokeOp op = StrokeOp::a;
-        switch (o->placement) {
-            case OutlinePlacement::outside:
-                r = static_cast<double>(o->width) + grown;
-                op = StrokeOp::a_not_b;
-                break;
-            case OutlinePlacement::inside:
-                r = static_cast<double>(o->width);
-                op = StrokeOp::a_and_b;
-                outline_stack = kStackOutlineOver;
-                break;
-            case OutlinePlacement::centred:
-                r = static_cast<double>(o->width) / 2.0;
-                op = StrokeOp::a;
-                outline_stack = kStackOutlineOver;
-                break;
-        }
-        if (r > reach_limit) {
-            ++stats_.failed_effects;
-        } else {
-            outline = effect_code(op, o->join, o->miter_limit, r, size);
-            if (o->placement != OutlinePlacement::inside && outline != 0) {
-                shadow = effect_code(StrokeOp::a_or_b, o->join, o->miter_limit, std::max(r, grown), size);
+    if (face == 0 && weight != 0.0 && std::abs(weight) > reach_limit && (silhouette || !coloured)) {
+        ++stats_.failed_effects;
+    }
+    if (!coloured || silhouette) {
+        // The layers around the glyph: of its own outline, or of the colour glyph's silhouette
+        // (whose face, unweighted, is the silhouette itself: S(0) or B).
+        const uint32_t source = coloured ? kSilhouetteGlyph | colour->glyph : glyph.key.glyph;
+        const uint32_t own_face = face != 0 || !coloured ? face : encode_effect({StrokeOp::a_or_b});
+        // The outline's layer, and the shadow's source: the face with its outline.
+        uint32_t outline = 0, shadow = own_face;
+        uint32_t outline_stack = kStackOutlineUnder;
+        if (const auto& o = e.outline) {
+            double r = 0.0;
+            StrokeOp op = StrokeOp::a;
+            switch (o->placement) {
+                case OutlinePlacement::outside:
+                    r = static_cast<double>(o->width) + grown;
+                    op = StrokeOp::a_not_b;
+                    break;
+                case OutlinePlacement::inside:
+                    r = static_cast<double>(o->width);
+                    op = StrokeOp::a_and_b;
+                    outline_stack = kStackOutlineOver;
+                    break;
+                case OutlinePlacement::centred:
+                    r = static_cast<double>(o->width) / 2.0;
+                    op = StrokeOp::a;
+                    outline_stack = kStackOutlineOver;
+                    break;
+            }
+            if (r > reach_limit) {
+                ++stats_.failed_effects;
+            } else {
+                outline = effect_code(op, o->join, o->miter_limit, r, size);
+                if (o->placement != OutlinePlacement::inside && outline != 0) {
+                    shadow = effect_code(StrokeOp::a_or_b, o->join, o->miter_limit, std::max(r, grown), size);
+                }
             }
         }
-    }
-    if (const auto& sh = e.shadow) {
-        // The offset on the glyph's subpixel grid, so that the shadow takes the glyph's steps.
-        const double dx = std::round(static_cast<double>(sh->offset_x) * steps) / steps;
-        const double dy = std::round(static_cast<double>(sh->offset_y) * steps) / steps;
-        submit_layer(glyph, shadow, fx.shadow_color, fx.first_order, kStackShadow, dx, dy, visible, contrast,
-                     blur_code(sh->blur));
-    }
-    // The glow: the shadow's source, unmoved and blurred.
-    if (const auto& g = e.glow) {
-        submit_layer(glyph, shadow, fx.glow_color, fx.first_order, kStackGlow, 0.0, 0.0, visible, contrast,
-                     blur_code(g->radius));
-    }
-    if (outline != 0) {
-        const uint32_t order = outline_stack == kStackOutlineUnder ? fx.first_order : fx.last_order;
-        submit_layer(glyph, outline, fx.outline_color, order, outline_stack, 0.0, 0.0, visible, contrast);
+        if (const auto& sh = e.shadow) {
+            // The offset on the glyph's subpixel grid, so that the shadow takes the glyph's steps.
+            const double dx = std::round(static_cast<double>(sh->offset_x) * steps) / steps;
+            const double dy = std::round(static_cast<double>(sh->offset_y) * steps) / steps;
+            submit_layer(glyph, {source, shadow, blur_code(sh->blur)}, fx.shadow_color, fx.first_order, kStackShadow,
+                         dx, dy, visible, contrast);
+        }
+        // The glow: the shadow's source, unmoved and blurred.
+        if (const auto& g = e.glow) {
+            submit_layer(glyph, {source, shadow, blur_code(g->radius)}, fx.glow_color, fx.first_order, kStackGlow, 0.0,
+                         0.0, visible, contrast);
+        }
+        if (outline != 0) {
+            const uint32_t order = outline_stack == kStackOutlineUnder ? fx.first_order : fx.last_order;
+            submit_layer(glyph, {source, outline}, fx.outline_color, order, outline_stack, 0.0, 0.0, visible, contrast);
+        }
     }
     if (face == 0) {
         submit(glyph, visible, contrast, kStackGlyph);
     } else {
-        const std::array<float, 4> colour{glyph.color[0], glyph.color[1], glyph.color[2], glyph.color[3]};
-        submit_layer(glyph, face, colour, glyph.paint_order, kStackGlyph, 0.0, 0.0, visible, contrast);
+        const std::array<float, 4> colour_of{glyph.color[0], glyph.color[1], glyph.color[2], glyph.color[3]};
+        submit_layer(glyph, {glyph.key.glyph, face}, colour_of, glyph.paint_order, kStackGlyph, 0.0, 0.0, visible,
+                     contrast);
     }
 }
 
-// A layer of `glyph`: its outline derived by `effect` (0: its own), in `colour`, at `order` and
-// `stack`, moved by (dx, dy) pixels and blurred by `blur` (GlyphKey::blur).
-void FrameRequests::submit_layer(const GlyphInstance& glyph, uint32_t effect, const std::array<float, 4>& colour,
-                                 uint32_t order, uint32_t stack, double dx, double dy, const VkRect2D* visible,
-                                 const GlyphContrast& contrast, uint16_t blur) {
+// A layer of `glyph` of the outline `shape` names, in `colour`, at `order` and `stack`, moved by
+// (dx, dy) pixels. Layers around the glyph are flat: filled with `colour`, not the glyph's paint.
+void FrameRequests::submit_layer(const GlyphInstance& glyph, const LayerShape& shape,
+                                 const std::array<float, 4>& colour, uint32_t order, uint32_t stack, double dx,
+                                 double dy, const VkRect2D* visible, const GlyphContrast& contrast) {
     const HeldGlyph own = fonts_.glyph(glyph.key);
     GlyphInstance layer = glyph;
-    layer.key.effect = effect;
-    layer.key.blur = blur;
-    if (effect != 0 && !fonts_.derive(layer.key)) {
+    layer.key.glyph = shape.glyph;
+    layer.key.effect = shape.effect;
+    layer.key.blur = shape.blur;
+    if (stack != kStackGlyph) {
+        layer.paint = kNoPaint;
+        layer.colour_glyph = kNoColourGlyph;
+    }
+    if (shape.effect != 0 && !fonts_.derive(layer.key)) {
         ++stats_.failed_effects;
         return;
     }
-    const HeldGlyph held = effect != 0 ? fonts_.glyph(layer.key) : own;
+    const HeldGlyph held = shape.effect != 0 ? fonts_.glyph(layer.key) : own;
     if (!held.record) {
         ++stats_.failed_effects;
         return;
@@ -534,7 +574,7 @@ void FrameRequests::settle(const AtlasLimits& limits) {
         stats_.skipped_glyphs = unplaceable_;
         atlas_full_ = 0;
         for (const Request& r : requests_) {
-            request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps, r.contrast, r.effects);
+            request(r.glyph, r.has_visible ? &r.visible : nullptr, r.steps, r.contrast, r.effects, r.silhouette);
         }
         admit_clipped();
     }

@@ -106,6 +106,13 @@ private:
         uint32_t steps = kSubpixelSteps;  // the finest subpixel steps it may take (moving text: fewer)
         GlyphContrast contrast;           // the draw's, resolved for the glyph's size
         uint32_t effects = kNoEffects;    // its draw's in effects_
+        bool silhouette = false;          // the first drawn layer of a colour glyph: its effects' layers
+    };
+    // An effect layer's outline: GlyphKey::glyph, ::effect (0: the glyph's own) and ::blur.
+    struct LayerShape {
+        uint32_t glyph = 0;
+        uint32_t effect = 0;
+        uint16_t blur = 0;
     };
     struct Pending {
         DrawnGlyph glyph;
@@ -122,12 +129,12 @@ private:
     Placed place(GlyphInstance& glyph, const DrawOptions& options, const TransformSteps& steps, double dx, double dy,
                  float& depth);
     void request(const GlyphInstance& asked, const VkRect2D* visible, uint32_t steps, const GlyphContrast& contrast,
-                 uint32_t effects);
+                 uint32_t effects, bool silhouette = false);
     void request_effects(const GlyphInstance& glyph, const VkRect2D* visible, uint32_t steps,
-                         const GlyphContrast& contrast, const DrawEffects& fx);
-    void submit_layer(const GlyphInstance& glyph, uint32_t effect, const std::array<float, 4>& colour, uint32_t order,
-                      uint32_t stack, double dx, double dy, const VkRect2D* visible, const GlyphContrast& contrast,
-                      uint16_t blur = 0);
+                         const GlyphContrast& contrast, const DrawEffects& fx, bool silhouette);
+    void submit_layer(const GlyphInstance& glyph, const LayerShape& shape, const std::array<float, 4>& colour,
+                      uint32_t order, uint32_t stack, double dx, double dy, const VkRect2D* visible,
+                      const GlyphContrast& contrast);
     void submit(const GlyphInstance& glyph, const VkRect2D* visible, const GlyphContrast& contrast, uint32_t stack);
     void admit(const GlyphInstance& glyph, const TexelRect& part, const GlyphContrast& contrast, uint32_t stack,
                const TexelRect* shown = nullptr);

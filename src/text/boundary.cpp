@@ -1,6 +1,7 @@
-// The boundary of a glyph's nonzero fill as closed contours (docs/effects.md, "Overlapping
-// contours"): every curve cut where another crosses it, the pieces that have the fill on one side
-// only kept, and chained back into contours.
+// The boundary of a glyph's nonzero fill, or of the union of several fills (a colour glyph's
+// layers), as closed contours (docs/effects.md, "Overlapping contours"): every curve cut where
+// another crosses it, the pieces that have the fill on one side only kept, and chained back into
+// contours.
 #include "text/stroke.hpp"
 
 #include <algorithm>
@@ -32,10 +33,11 @@ Quad sub_quad(const Quad& q, double t0, double t1) {
     return {a, a + (0.5 * (t1 - t0)) * d0, b};
 }
 
-// Nonzero winding of the curves about p: signed crossings of the ray to +x.
-int winding(const std::vector<Quad>& curves, Vec2 p) {
+// Nonzero winding of curves [first, last) about p: signed crossings of the ray to +x.
+int winding(const std::vector<Quad>& curves, size_t first, size_t last, Vec2 p) {
     int w = 0;
-    for (const Quad& q : curves) {
+    for (size_t at = first; at < last; ++at) {
+        const Quad& q = curves[at];
         const double a = q.p0.y - 2.0 * q.p1.y + q.p2.y, b = 2.0 * (q.p1.y - q.p0.y), c = q.p0.y - p.y;
         double roots[2];
         int n = 0;
@@ -62,8 +64,9 @@ int winding(const std::vector<Quad>& curves, Vec2 p) {
 }
 
 // Parameters where curves a and b cross, by subdividing both while their boxes meet. Coincident
-// stretches (more hits than two curves can cross) give none: the midpoint tests settle them.
-void crossings(const Quad& a, const Quad& b, std::vector<std::pair<double, double>>& hits) {
+// stretches (more hits than two curves can cross) give none and return true: the caller cuts each
+// curve where the other ends on it, and the midpoint tests settle the pieces.
+bool crossings(const Quad& a, const Quad& b, std::vector<std::pair<double, double>>& hits) {
     struct Span {
         double a0, a1, b0, b1;
         int depth;
@@ -77,7 +80,7 @@ void crossings(const Quad& a, const Quad& b, std::vector<std::pair<double, doubl
     constexpr int kMaxSpans = 1 << 14;
     int spans = 0;
     while (!stack.empty() && found.size() <= kMaxHits) {
-        if (++spans > kMaxSpans) return;
+        if (++spans > kMaxSpans) return true;
         const Span s = stack.back();
         stack.pop_back();
         const Quad qa = sub_quad(a, s.a0, s.a1), qb = sub_quad(b, s.b0, s.b1);
@@ -98,20 +101,82 @@ void crossings(const Quad& a, const Quad& b, std::vector<std::pair<double, doubl
         stack.push_back({am, s.a1, s.b0, bm, s.depth + 1});
         stack.push_back({am, s.a1, bm, s.b1, s.depth + 1});
     }
-    if (found.size() > 4) return;  // two quadratics cross at most four times
+    if (found.size() > 4) return true;  // two quadratics cross at most four times
     hits.insert(hits.end(), found.begin(), found.end());
+    return false;
+}
+
+// The parameter of q nearest p: the best of a few samples, refined by Newton's method on
+// (q(t) - p) . q'(t).
+double nearest_parameter(const Quad& q, Vec2 p) {
+    constexpr int kSamples = 32;
+    double best = 0.0, best_d = length(q.p0 - p);
+    for (int i = 1; i <= kSamples; ++i) {
+        const double t = static_cast<double>(i) / kSamples;
+        const double d = length(evaluate(q, t) - p);
+        if (d < best_d) {
+            best = t;
+            best_d = d;
+        }
+    }
+    const Vec2 a = q.p0 - 2.0 * q.p1 + q.p2, b = 2.0 * (q.p1 - q.p0);
+    double t = best;
+    for (int k = 0; k < 8; ++k) {
+        const Vec2 off = evaluate(q, t) - p, d1 = 2.0 * t * a + b, d2 = 2.0 * a;
+        const double f = dot(off, d1), df = dot(d1, d1) + dot(off, d2);
+        if (df <= 0.0) break;
+        t = std::clamp(t - f / df, 0.0, 1.0);
+    }
+    return length(evaluate(q, t) - p) < best_d ? t : best;
+}
+
+// Whether two kept pieces are one stretch of the boundary twice (coincident edges of two fills):
+// the same ends, and the same control point or both straight.
+bool same_piece(const Quad& a, const Quad& b, double snap) {
+    if (length(a.p0 - b.p0) > snap || length(a.p2 - b.p2) > snap) return false;
+    if (length(a.p1 - b.p1) <= snap) return true;
+    const auto straight = [snap](const Quad& q) {
+        const Vec2 chord = q.p2 - q.p0;
+        const double len = length(chord);
+        return len > 0.0 && std::abs(chord.x * (q.p1.y - q.p0.y) - chord.y * (q.p1.x - q.p0.x)) / len <= snap;
+    };
+    return straight(a) && straight(b);
 }
 
 double distance(Vec2 a, Vec2 b) {
     return length(a - b);
 }
 
+// Whether p is inside any fill: fill k is curves [ends[k - 1], ends[k]) (ends[-1] = 0).
+bool inside(const std::vector<Quad>& curves, const std::vector<size_t>& ends, Vec2 p) {
+    size_t first = 0;
+    for (const size_t last : ends) {
+        if (winding(curves, first, last, p) != 0) return true;
+        first = last;
+    }
+    return false;
+}
+
+std::vector<Contour> concatenated(const std::vector<std::vector<Contour>>& fills) {
+    std::vector<Contour> all;
+    for (const std::vector<Contour>& fill : fills) all.insert(all.end(), fill.begin(), fill.end());
+    return all;
+}
+
 }  // namespace
 
 std::vector<Contour> boundary_contours(const std::vector<Contour>& contours) {
+    return union_boundary({contours});
+}
+
+std::vector<Contour> union_boundary(const std::vector<std::vector<Contour>>& fills) {
     std::vector<Quad> curves;
-    for (const Contour& c : contours) curves.insert(curves.end(), c.begin(), c.end());
-    if (curves.empty()) return contours;
+    std::vector<size_t> ends;
+    for (const std::vector<Contour>& fill : fills) {
+        for (const Contour& c : fill) curves.insert(curves.end(), c.begin(), c.end());
+        ends.push_back(curves.size());
+    }
+    if (curves.empty()) return concatenated(fills);
     Box all = box_of(curves.front());
     for (const Quad& q : curves) {
         const Box b = box_of(q);
@@ -135,7 +200,20 @@ std::vector<Contour> boundary_contours(const std::vector<Contour>& contours) {
         for (size_t j = i + 1; j < curves.size(); ++j) {
             if (!overlap(boxes[i], boxes[j])) continue;
             hits.clear();
-            crossings(curves[i], curves[j], hits);
+            if (crossings(curves[i], curves[j], hits)) {
+                // Coincident: each curve cut where the other ends inside it.
+                const auto cut_at_ends = [&](size_t on, size_t of) {
+                    for (const Vec2 end : {curves[of].p0, curves[of].p2}) {
+                        const double t = nearest_parameter(curves[on], end);
+                        if (t > end_eps && t < 1.0 - end_eps && length(evaluate(curves[on], t) - end) <= snap) {
+                            cuts[on].push_back({t, end});
+                        }
+                    }
+                };
+                cut_at_ends(i, j);
+                cut_at_ends(j, i);
+                continue;
+            }
             for (const auto& [ti, tj] : hits) {
                 const bool inner_i = ti > end_eps && ti < 1.0 - end_eps;
                 const bool inner_j = tj > end_eps && tj < 1.0 - end_eps;
@@ -155,7 +233,7 @@ std::vector<Contour> boundary_contours(const std::vector<Contour>& contours) {
     // The pieces with the fill on exactly one side, each turned to have it on its right (clockwise
     // in y-up, TrueType's outer direction).
     std::vector<Quad> kept;
-    bool dropped = false;
+    bool dropped = false, turned = false;
     for (size_t i = 0; i < curves.size(); ++i) {
         std::vector<Cut>& c = cuts[i];
         std::sort(c.begin(), c.end(), [](const Cut& a, const Cut& b) { return a.t < b.t; });
@@ -179,29 +257,43 @@ std::vector<Contour> boundary_contours(const std::vector<Contour>& contours) {
             const double len = length(d);
             if (len == 0.0) continue;
             const Vec2 left{-d.y / len, d.x / len};
-            const bool in_left = winding(curves, m + side * left) != 0;
-            const bool in_right = winding(curves, m - side * left) != 0;
+            const bool in_left = inside(curves, ends, m + side * left);
+            const bool in_right = inside(curves, ends, m - side * left);
             if (in_left == in_right) {
                 dropped = true;
                 continue;
             }
-            if (in_left) piece = {piece.p2, piece.p1, piece.p0};
+            if (in_left) {
+                piece = {piece.p2, piece.p1, piece.p0};
+                turned = true;
+            }
+            if (std::any_of(kept.begin(), kept.end(),
+                            [&](const Quad& other) { return same_piece(other, piece, snap); })) {
+                dropped = true;
+                continue;
+            }
             kept.push_back(piece);
         }
     }
-    // Nothing overlapped and nothing was cut: the glyph's own contours are its boundary.
+    // Nothing overlapped and nothing was cut: the glyph's own contours are its boundary (several
+    // fills' contours only where none was turned, since their windings add).
     const bool cut = std::any_of(cuts.begin(), cuts.end(), [](const std::vector<Cut>& c) { return !c.empty(); });
-    if (!dropped && !cut) return contours;
+    if (!dropped && !cut && (fills.size() == 1 || !turned)) return concatenated(fills);
 
     // Chained back into closed contours: each piece followed by the unused piece that starts
-    // where it ends. A chain that does not close (a fault of the cuts) leaves the glyph's own
-    // contours, which overlap but never lose a curve of the boundary.
+    // where it ends. Where two curves touch (a layer's edge tangent to another's curve), the cuts
+    // about the touching point leave the stretch between them twice, once in a sliver that
+    // closes no contour: an open chain that short is dropped. Any other chain that does not close
+    // (a fault of the cuts) leaves the fills' own contours, which overlap but never lose a curve
+    // of the boundary.
+    const double sliver = 1e-3 * scale;
     std::vector<uint8_t> used(kept.size(), 0);
     std::vector<Contour> out;
     for (size_t first = 0; first < kept.size(); ++first) {
         if (used[first]) continue;
         Contour contour{kept[first]};
         used[first] = 1;
+        bool open = false;
         for (;;) {
             const Vec2 end = contour.back().p2;
             if (distance(end, contour.front().p0) <= snap && contour.size() > 1) break;
@@ -217,13 +309,18 @@ std::vector<Contour> boundary_contours(const std::vector<Contour>& contours) {
             }
             if (next == SIZE_MAX) {
                 if (distance(end, contour.front().p0) <= snap) break;  // a one-piece loop
-                return contours;
+                double length_of = 0.0;
+                for (const Quad& q : contour) length_of += distance(q.p0, q.p1) + distance(q.p1, q.p2);
+                if (length_of > sliver) return concatenated(fills);
+                open = true;
+                break;
             }
             used[next] = 1;
             Quad q = kept[next];
             q.p0 = end;
             contour.push_back(q);
         }
+        if (open) continue;
         contour.back().p2 = contour.front().p0;
         out.push_back(std::move(contour));
     }

@@ -31,6 +31,31 @@ Vec2 to_vec(const Point& p) {
     return {static_cast<double>(p.x), static_cast<double>(p.y)};
 }
 
+// Refuses contours of more than limits::kMaxStrokeCurves curves, naming them as `what`.
+Status check_curves(const std::vector<Contour>& contours, const char* what) {
+    uint64_t curves = 0;
+    for (const Contour& contour : contours) curves += contour.size();
+    if (curves > limits::kMaxStrokeCurves) {
+        return Error{ErrorCode::invalid_argument, "derived glyph: " + std::to_string(curves) + " " + what +
+                                                      ", more than " + std::to_string(limits::kMaxStrokeCurves) +
+                                                      " (limits::kMaxStrokeCurves)"};
+    }
+    return {};
+}
+
+// Bands over the packed slots, and the record: `base`'s advance and flags, the bearings of the
+// packed bbox.
+void finish(PackedGlyph& packed, const GlyphRecord& base, DerivedGlyph& derived) {
+    update_extent(packed);
+    FontAsset out;
+    derived.record = base;
+    append_glyph(packed, build_bands(packed, kTargetCurvesPerBand, kMaxBands, kBandOverlap), derived.record, out);
+    derived.record.bearing_x = packed.curve_count > 0 ? packed.min_x : 0.0f;
+    derived.record.bearing_y = packed.curve_count > 0 ? packed.max_y : 0.0f;
+    derived.points = std::move(out.points);
+    derived.band_words = std::move(out.band_words);
+}
+
 }  // namespace
 
 std::vector<Contour> glyph_contours(const FontAsset& asset, const GlyphRecord& glyph) {
@@ -52,13 +77,7 @@ std::vector<Contour> glyph_contours(const FontAsset& asset, const GlyphRecord& g
 
 Result<DerivedGlyph> pack_derived_glyph(const std::vector<Contour>& pieces, const FontAsset& asset,
                                         const GlyphRecord& glyph) {
-    uint64_t piece_curves = 0;
-    for (const Contour& contour : pieces) piece_curves += contour.size();
-    if (piece_curves > limits::kMaxStrokeCurves) {
-        return Error{ErrorCode::invalid_argument,
-                     "derived glyph: " + std::to_string(piece_curves) + " piece curves, more than " +
-                         std::to_string(limits::kMaxStrokeCurves) + " (limits::kMaxStrokeCurves)"};
-    }
+    if (Status s = check_curves(pieces, "piece curves"); !s) return s.error();
     PackedGlyph packed = pack_contours(pieces);
     DerivedGlyph derived;
     if (glyph.curve_count > 0) {
@@ -78,14 +97,24 @@ Result<DerivedGlyph> pack_derived_glyph(const std::vector<Contour>& pieces, cons
     } else {
         derived.set_b_first = static_cast<uint32_t>(packed.is_curve.size());
     }
-    update_extent(packed);
-    FontAsset out;
-    derived.record = glyph;
-    append_glyph(packed, build_bands(packed, kTargetCurvesPerBand, kMaxBands, kBandOverlap), derived.record, out);
-    derived.record.bearing_x = packed.curve_count > 0 ? packed.min_x : 0.0f;
-    derived.record.bearing_y = packed.curve_count > 0 ? packed.max_y : 0.0f;
-    derived.points = std::move(out.points);
-    derived.band_words = std::move(out.band_words);
+    finish(packed, glyph, derived);
+    return derived;
+}
+
+Result<DerivedGlyph> pack_derived_glyph(const std::vector<Contour>& pieces, const std::vector<Contour>& set_b,
+                                        const GlyphRecord& base) {
+    if (Status s = check_curves(pieces, "piece curves"); !s) return s.error();
+    if (Status s = check_curves(set_b, "curves of set B"); !s) return s.error();
+    // Set B's slots start on an even point after A's (pack_contours pads between contours).
+    std::vector<Contour> all = pieces;
+    all.insert(all.end(), set_b.begin(), set_b.end());
+    PackedGlyph packed = pack_contours(all);
+    DerivedGlyph derived;
+    if (!pieces.empty()) {
+        const uint32_t pad = set_b.empty() ? 0u : 1u;
+        derived.set_b_first = static_cast<uint32_t>(pack_contours(pieces).is_curve.size()) + pad;
+    }
+    finish(packed, base, derived);
     return derived;
 }
 

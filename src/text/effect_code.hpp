@@ -41,4 +41,13 @@ EffectShape decode_effect(uint32_t code);
 Result<DerivedGlyph> derive_effect_glyph(const FontAsset& asset, const GlyphRecord& glyph, uint32_t code,
                                          double tolerance);
 
+// The derived glyph of colour glyph `colour`'s silhouette (the union of its layers' outlines,
+// union_boundary) for effect `code` (its op and stroke as for a glyph; half-width 0 with op
+// a_or_b: the silhouette itself), with the advance and flags of the face glyph it colours.
+// Errors (ErrorCode::invalid_argument): a bitmap glyph (a layer painted with an image), layers of
+// more than limits::kMaxSilhouetteCurves curves, or stroke_pieces()' and pack_derived_glyph()'s.
+// Expects a valid asset (load_asset or validate_asset passed it).
+Result<DerivedGlyph> derive_silhouette_glyph(const FontAsset& asset, const ColourGlyph& colour, uint32_t code,
+                                             double tolerance);
+
 }  // namespace crisp

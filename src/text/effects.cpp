@@ -201,4 +201,34 @@ Result<DerivedGlyph> derive_effect_glyph(const FontAsset& asset, const GlyphReco
     return pack_derived_glyph(pieces, asset, glyph);
 }
 
+Result<DerivedGlyph> derive_silhouette_glyph(const FontAsset& asset, const ColourGlyph& colour, uint32_t code,
+                                             double tolerance) {
+    std::vector<std::vector<Contour>> fills;
+    uint64_t curves = 0;
+    for (uint32_t i = 0; i < colour.layer_count; ++i) {
+        const ColourLayer& layer = asset.layers[size_t{colour.first_layer} + i];
+        if (asset.paints[layer.paint].kind == PaintKind::image) {
+            return Error{ErrorCode::invalid_argument, "derived glyph: colour glyph " + std::to_string(colour.glyph) +
+                                                          " is a bitmap, without an outline to draw effects of"};
+        }
+        const GlyphRecord& outline = asset.glyphs[layer.glyph];
+        if (outline.curve_count == 0) continue;
+        curves += outline.curve_count;
+        if (curves > limits::kMaxSilhouetteCurves) {
+            return Error{ErrorCode::invalid_argument,
+                         "derived glyph: colour glyph " + std::to_string(colour.glyph) + "'s layers have more than " +
+                             std::to_string(limits::kMaxSilhouetteCurves) + " curves (limits::kMaxSilhouetteCurves)"};
+        }
+        fills.push_back(glyph_contours(asset, outline));
+    }
+    const std::vector<Contour> silhouette = union_boundary(fills);
+    const EffectShape shape = decode_effect(code);
+    std::vector<Contour> pieces;
+    if (shape.half_width > 0.0) {
+        const StrokeStyle style{shape.half_width, shape.join, shape.miter_limit, tolerance};
+        if (Status s = stroke_pieces(silhouette, style, pieces); !s) return s.error();
+    }
+    return pack_derived_glyph(pieces, silhouette, asset.glyphs[colour.glyph]);
+}
+
 }  // namespace crisp

@@ -1,9 +1,12 @@
 #include <crisp/glyph.hpp>
 
+#include "text/blur_kernel.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <tuple>
+#include <vector>
 
 namespace crisp {
 
@@ -179,6 +182,65 @@ uint64_t transformed_curve_tests(const FontAsset& asset, const GlyphRecord& glyp
     return static_cast<uint64_t>(std::ceil(per_texel * rect.width * rect.height));
 }
 
+// The texel x (of `map`'s rect) of each crossing of the curves `band` lists with the height
+// `y` em, sorted, into `xs`.
+void row_crossings(const FontAsset& asset, const GlyphRecord& glyph, uint32_t band, double y, const TexelToEm& map,
+                   std::vector<double>& xs) {
+    xs.clear();
+    const size_t first = size_t{glyph.band_offset} + size_t{band} * glyph.band_words;
+    for (uint32_t slot = 0; slot < glyph.curve_count; ++slot) {
+        if (!((asset.band_words[first + slot / 32] >> (slot % 32)) & 1u)) continue;
+        const Point* p = &asset.points[size_t{glyph.point_offset} + 2 * size_t{slot}];
+        const auto d = [](float v) { return static_cast<double>(v); };
+        const double a = d(p[0].y) - 2.0 * d(p[1].y) + d(p[2].y), b = 2.0 * (d(p[1].y) - d(p[0].y));
+        const double c = d(p[0].y) - y;
+        double roots[2];
+        int n = 0;
+        if (std::abs(a) < 1e-12) {
+            if (b != 0.0) roots[n++] = -c / b;
+        } else if (const double disc = b * b - 4.0 * a * c; disc >= 0.0) {
+            roots[n++] = (-b - std::sqrt(disc)) / (2.0 * a);
+            roots[n++] = (-b + std::sqrt(disc)) / (2.0 * a);
+        }
+        for (int i = 0; i < n; ++i) {
+            const double t = roots[i];
+            if (!(t >= 0.0 && t < 1.0)) continue;
+            const double x = (1.0 - t) * (1.0 - t) * d(p[0].x) + 2.0 * t * (1.0 - t) * d(p[1].x) + t * t * d(p[2].x);
+            xs.push_back((x - d(map.offset_x)) / d(map.scale_x));
+        }
+    }
+    std::sort(xs.begin(), xs.end());
+}
+
+// A blurred key's samples: each texel's row walks 3w/2 texels past the texel on either side (the
+// x filter's support), a pass over its band's curves for every kRasterRowCrossings (8) crossings
+// of that stretch, at least one (raster.comp).
+uint64_t blurred_curve_tests(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key) {
+    constexpr size_t kRowCrossings = 8;
+    const GlyphRect rect = glyph_rect(glyph, key);
+    const TexelToEm map = texel_to_em(rect, key);
+    const double reach = 1.5 * blur_box_width(static_cast<double>(key.blur) * kBlurUnit);
+    std::vector<double> xs;
+    uint64_t tests = 0;
+    for (uint32_t row = 0; row < rect.height; ++row) {
+        const float y = map.offset_y + map.scale_y * (static_cast<float>(row) + 0.5f);
+        const uint32_t band = FontAsset::band_of(glyph, y);
+        const size_t first = size_t{glyph.band_offset} + size_t{band} * glyph.band_words;
+        uint64_t curves = 0;
+        for (size_t w = 0; w < glyph.band_words; ++w) {
+            curves += static_cast<uint64_t>(std::popcount(asset.band_words[first + w]));
+        }
+        row_crossings(asset, glyph, band, static_cast<double>(y), map, xs);
+        size_t lo = 0, hi = 0;  // the crossings in [tx - reach, tx + 1 + reach)
+        for (uint32_t tx = 0; tx < rect.width; ++tx) {
+            while (lo < xs.size() && xs[lo] < static_cast<double>(tx) - reach) ++lo;
+            while (hi < xs.size() && xs[hi] < static_cast<double>(tx) + 1.0 + reach) ++hi;
+            tests += curves * std::max<uint64_t>(1, (hi - lo + kRowCrossings - 1) / kRowCrossings);
+        }
+    }
+    return tests;
+}
+
 }  // namespace
 
 std::vector<uint32_t> flat_curve_words(const FontAsset& asset, const GlyphRecord& glyph) {
@@ -195,6 +257,7 @@ std::vector<uint32_t> flat_curve_words(const FontAsset& asset, const GlyphRecord
 uint64_t curve_tests_per_sample(const FontAsset& asset, const GlyphRecord& glyph, const GlyphKey& key) {
     if (glyph.curve_count == 0 || glyph.band_count == 0) return 0;
     if (is_transformed(key)) return transformed_curve_tests(asset, glyph, key);
+    if (key.blur != 0) return blurred_curve_tests(asset, glyph, key);
     const GlyphRect rect = glyph_rect(glyph, key);
     const TexelToEm map = texel_to_em(rect, key);
     uint64_t tests = 0;

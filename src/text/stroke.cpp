@@ -25,12 +25,6 @@ constexpr double kMaxArc = 45.0 * std::numbers::pi / 180.0;
 // left between their sweeps is at most r * 1e-9 wide.
 constexpr double kStraightTurn = 1e-9;
 
-double dot(Vec2 a, Vec2 b) {
-    return a.x * b.x + a.y * b.y;
-}
-double cross(Vec2 a, Vec2 b) {
-    return a.x * b.y - a.y * b.x;
-}
 Vec2 left_normal(Vec2 d) {
     return {-d.y, d.x};
 }

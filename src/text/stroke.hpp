@@ -59,6 +59,11 @@ std::vector<Contour> glyph_contours(const FontAsset& asset, const GlyphRecord& g
 // chained. Contours that neither overlap nor cross come back as they are; where the pieces cannot be
 // chained (coincident stretches the cuts miss) the contours come back too.
 std::vector<Contour> boundary_contours(const std::vector<Contour>& contours);
+// The same for the union of several nonzero fills (a colour glyph's layers: its silhouette), the
+// contours of each fill wound either way: every piece turned to have the union on its right.
+// Where the pieces cannot be chained, all fills' contours come back as they are (whose windings
+// may cancel where fills of opposite directions overlap).
+std::vector<Contour> union_boundary(const std::vector<std::vector<Contour>>& fills);
 
 // Appends to `pieces` closed contours of quadratics, all wound clockwise in y-up (+1 by the
 // rasterizer's rule), whose nonzero union is S(style.half_width) of `contours` within
@@ -87,5 +92,9 @@ struct DerivedGlyph {
 // (ErrorCode::invalid_argument) when the slots would pass limits::kMaxStrokeCurves plus the glyph's.
 Result<DerivedGlyph> pack_derived_glyph(const std::vector<Contour>& pieces, const FontAsset& asset,
                                         const GlyphRecord& glyph);
+// The same with set B the closed contours `set_b` (a colour glyph's silhouette), the advance,
+// bearings and flags `base`'s. Errors as above, and when set B passes limits::kMaxStrokeCurves.
+Result<DerivedGlyph> pack_derived_glyph(const std::vector<Contour>& pieces, const std::vector<Contour>& set_b,
+                                        const GlyphRecord& base);
 
 }  // namespace crisp
