@@ -92,16 +92,8 @@ BlurReference BlurReference::of_derived(const DerivedGlyph& derived, StrokeOp op
 }
 
 void BlurReference::add_pieces(const Quad& q, bool in_b, std::vector<Piece>& out) const {
-    double cuts[3] = {0.0, 1.0, 1.0};
-    int n = 2;
-    const double a = q.p0.y - 2.0 * q.p1.y + q.p2.y;
-    if (a != 0.0) {
-        const double t = (q.p0.y - q.p1.y) / a;
-        if (t > 0.0 && t < 1.0) {
-            cuts[1] = t;
-            n = 3;
-        }
-    }
+    double cuts[3];
+    const int n = y_monotonic_cuts(q, cuts);
     for (int i = 0; i + 1 < n; ++i) {
         Piece p;
         p.curve = q;

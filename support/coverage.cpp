@@ -578,16 +578,8 @@ ExactCoverage::ExactCoverage(std::span<const Quad> curves) {
 }
 
 void ExactCoverage::add_curve(const Quad& curve) {
-    double cuts[3] = {0.0, 1.0, 1.0};
-    int cut_count = 2;
-    const double denominator = curve.p0.y - 2.0 * curve.p1.y + curve.p2.y;
-    if (denominator != 0.0) {
-        const double t = (curve.p0.y - curve.p1.y) / denominator;
-        if (t > 0.0 && t < 1.0) {
-            cuts[1] = t;
-            cut_count = 3;
-        }
-    }
+    double cuts[3];
+    const int cut_count = y_monotonic_cuts(curve, cuts);
     for (int i = 0; i + 1 < cut_count; ++i) {
         Piece piece;
         piece.curve = curve;

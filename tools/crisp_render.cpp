@@ -178,14 +178,28 @@ crisp::Status colour_after(std::string_view option, std::string_view text, const
     return {};
 }
 
+// Refuses `text` for `option` unless values [first, first + count) are there and lie in [lo, hi]
+// ((lo, hi] where `open_below`): "OPTION: WHAT, not 'TEXT'".
+crisp::Status check_values(std::string_view option, std::string_view text, const std::vector<float>& values,
+                           size_t first, size_t count, float lo, float hi, bool open_below, std::string_view what) {
+    bool good = values.size() >= first + count;
+    for (size_t i = first; good && i < first + count; ++i) {
+        good = (open_below ? values[i] > lo : values[i] >= lo) && values[i] <= hi;
+    }
+    if (good) return {};
+    return crisp::Error{crisp::ErrorCode::invalid_argument,
+                        std::string(option) + ": " + std::string(what) + ", not '" + crisp::cli::printable(text) + "'"};
+}
+
 // "WIDTH[,R,G,B[,A]]": an outline (its placement and join come from their own options).
 crisp::Result<crisp::TextOutline> parse_outline(std::string_view text) {
     const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>("--outline", text);
     if (!values) return values.error();
     crisp::TextOutline outline;
-    if (values->empty() || !((*values)[0] >= 0.0f && (*values)[0] <= crisp::kMaxEffectWidth)) {
-        return crisp::Error{crisp::ErrorCode::invalid_argument,
-                            "--outline: WIDTH is pixels in [0, 4096], not '" + crisp::cli::printable(text) + "'"};
+    if (crisp::Status s = check_values("--outline", text, *values, 0, 1, 0.0f, crisp::kMaxEffectWidth, false,
+                                       "WIDTH is pixels in [0, 4096]");
+        !s) {
+        return s.error();
     }
     outline.width = (*values)[0];
     if (crisp::Status s = colour_after("--outline", text, *values, 1, outline.color); !s) return s.error();
@@ -201,19 +215,17 @@ crisp::Result<crisp::TextShadow> parse_shadow(std::string_view text) {
                             "--shadow takes DX,DY,BLUR[,R,G,B[,A]], not '" + crisp::cli::printable(text) + "'"};
     }
     crisp::TextShadow shadow;
-    for (size_t i = 0; i < 2; ++i) {
-        if (!(std::abs((*values)[i]) <= crisp::kMaxShadowOffset)) {
-            return crisp::Error{
-                crisp::ErrorCode::invalid_argument,
-                "--shadow: DX and DY are pixels in [-4096, 4096], not '" + crisp::cli::printable(text) + "'"};
-        }
+    if (crisp::Status s = check_values("--shadow", text, *values, 0, 2, -crisp::kMaxShadowOffset,
+                                       crisp::kMaxShadowOffset, false, "DX and DY are pixels in [-4096, 4096]");
+        !s) {
+        return s.error();
     }
     shadow.offset_x = (*values)[0];
     shadow.offset_y = (*values)[1];
-    if (!((*values)[2] >= 0.0f && (*values)[2] <= crisp::kMaxEffectBlur)) {
-        return crisp::Error{
-            crisp::ErrorCode::invalid_argument,
-            "--shadow: BLUR is a radius in pixels in [0, 128], not '" + crisp::cli::printable(text) + "'"};
+    if (crisp::Status s = check_values("--shadow", text, *values, 2, 1, 0.0f, crisp::kMaxEffectBlur, false,
+                                       "BLUR is a radius in pixels in [0, 128]");
+        !s) {
+        return s.error();
     }
     shadow.blur = (*values)[2];
     if (crisp::Status s = colour_after("--shadow", text, *values, 3, shadow.color); !s) return s.error();
@@ -224,9 +236,10 @@ crisp::Result<crisp::TextShadow> parse_shadow(std::string_view text) {
 crisp::Result<crisp::TextGlow> parse_glow(std::string_view text) {
     const crisp::Result<std::vector<float>> values = crisp::cli::parse_number_list<float>("--glow", text);
     if (!values) return values.error();
-    if (values->empty() || !((*values)[0] > 0.0f && (*values)[0] <= crisp::kMaxEffectBlur)) {
-        return crisp::Error{crisp::ErrorCode::invalid_argument,
-                            "--glow: RADIUS is pixels in (0, 128], not '" + crisp::cli::printable(text) + "'"};
+    if (crisp::Status s = check_values("--glow", text, *values, 0, 1, 0.0f, crisp::kMaxEffectBlur, true,
+                                       "RADIUS is pixels in (0, 128]");
+        !s) {
+        return s.error();
     }
     crisp::TextGlow glow;
     glow.radius = (*values)[0];
@@ -416,10 +429,11 @@ void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
                store(args.weight, [](std::string_view text) -> crisp::Result<float> {
                    const crisp::Result<std::vector<float>> v = crisp::cli::parse_number_list<float>("--weight", text);
                    if (!v) return v.error();
-                   if (v->size() != 1 || !(std::abs((*v)[0]) <= crisp::kMaxEffectWidth)) {
-                       return crisp::Error{
-                           crisp::ErrorCode::invalid_argument,
-                           "--weight: PX is pixels in [-4096, 4096], not '" + crisp::cli::printable(text) + "'"};
+                   const std::vector<float> one = v->size() == 1 ? *v : std::vector<float>{};  // no more
+                   if (crisp::Status s = check_values("--weight", text, one, 0, 1, -crisp::kMaxEffectWidth,
+                                                      crisp::kMaxEffectWidth, false, "PX is pixels in [-4096, 4096]");
+                       !s) {
+                       return s.error();
                    }
                    return (*v)[0];
                }));

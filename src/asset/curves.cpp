@@ -81,24 +81,33 @@ double sampled_deviation(const Cubic& c, double t0, double t1, const Quad& q, in
     return worst;
 }
 
-int split_at_y_extremum(const Quad& q, Quad out[2]) {
+int y_monotonic_cuts(const Quad& q, double cuts[3]) {
+    cuts[0] = 0.0;
+    cuts[1] = cuts[2] = 1.0;
     // dy/dt = 2 ((1 - t)(p1 - p0) + t (p2 - p1)) vanishes at t = (p0 - p1) / (p0 - 2 p1 + p2).
     const double denominator = q.p0.y - 2.0 * q.p1.y + q.p2.y;
-    if (denominator != 0.0) {
-        const double t = (q.p0.y - q.p1.y) / denominator;
-        if (t > 0.0 && t < 1.0) {
-            const Vec2 a = lerp(q.p0, q.p1, t);
-            const Vec2 b = lerp(q.p1, q.p2, t);
-            Vec2 m = lerp(a, b, t);
-            m.y = evaluate(q, t).y;
-            // Both halves are flat at the extremum: their control points share its height.
-            out[0] = {q.p0, {a.x, m.y}, m};
-            out[1] = {m, {b.x, m.y}, q.p2};
-            return 2;
-        }
+    if (denominator == 0.0) return 2;
+    const double t = (q.p0.y - q.p1.y) / denominator;
+    if (!(t > 0.0 && t < 1.0)) return 2;
+    cuts[1] = t;
+    return 3;
+}
+
+int split_at_y_extremum(const Quad& q, Quad out[2]) {
+    double cuts[3];
+    if (y_monotonic_cuts(q, cuts) == 2) {
+        out[0] = q;
+        return 1;
     }
-    out[0] = q;
-    return 1;
+    const double t = cuts[1];
+    const Vec2 a = lerp(q.p0, q.p1, t);
+    const Vec2 b = lerp(q.p1, q.p2, t);
+    Vec2 m = lerp(a, b, t);
+    m.y = evaluate(q, t).y;
+    // Both halves are flat at the extremum: their control points share its height.
+    out[0] = {q.p0, {a.x, m.y}, m};
+    out[1] = {m, {b.x, m.y}, q.p2};
+    return 2;
 }
 
 bool is_zero_length(const Quad& q) {

@@ -79,6 +79,10 @@ void seed_split_cubic(const Cubic& c, Quad out[2]);
 // the cubic over [t0, t1] and s = (t - t0) / (t1 - t0). A measurement, not a bound.
 double sampled_deviation(const Cubic& c, double t0, double t1, const Quad& q, int samples);
 
+// The parameters that cut a quadratic into pieces monotonic in y: 0, its y-extremum's parameter
+// where that lies strictly inside (0, 1), and 1. Returns how many (2 or 3); cuts past them are 1.
+int y_monotonic_cuts(const Quad& q, double cuts[3]);
+
 // Splits a quadratic at the parameter of its y-extremum when that lies strictly inside (0, 1),
 // so every piece is monotonic in y. Returns the number of pieces written (1 or 2).
 int split_at_y_extremum(const Quad& q, Quad out[2]);
