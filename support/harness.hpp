@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 #include <vector>
 
 namespace crisp::harness {
@@ -26,12 +27,14 @@ inline Result<HeadlessContext> create_context(HeadlessContextOptions options, bo
 }
 
 // Frames of `draw` (which calls the renderer's draw() after begin_frame()), each recorded and
-// submitted on `context` and followed by `after()`, until the renderer converges or `max_frames`
-// were rendered. Returns the frames rendered, or the first failure of a record() or submission.
+// submitted on `context` and followed by `after()`, until the renderer converges, `max_frames`
+// were rendered, or `after()` (where it returns bool) returns false: a caller's own bound, such
+// as a time limit. Returns the frames rendered, or the first failure of a record() or submission.
 template <class Draw, class After>
 Result<uint32_t> render_until_converged(HeadlessContext& context, Renderer& renderer, uint32_t max_frames, Draw&& draw,
                                         After&& after) {
     uint32_t frames = 0;
+    bool go_on = true;
     do {
         renderer.begin_frame();
         draw();
@@ -39,9 +42,13 @@ Result<uint32_t> render_until_converged(HeadlessContext& context, Renderer& rend
         const Status submitted = context.submit_and_wait([&](VkCommandBuffer cb) { recorded = renderer.record(cb); });
         if (!recorded) return recorded.error();
         if (!submitted) return submitted.error();
-        after();
+        if constexpr (std::is_same_v<std::invoke_result_t<After>, bool>) {
+            go_on = after();
+        } else {
+            after();
+        }
         ++frames;
-    } while (!renderer.converged() && frames < max_frames);
+    } while (go_on && !renderer.converged() && frames < max_frames);
     return frames;
 }
 template <class Draw>

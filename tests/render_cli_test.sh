@@ -250,8 +250,8 @@ python3 - "$work" <<'PY' || fail "the render's outputs are wrong"
 import json, struct, sys
 work = sys.argv[1]
 report = json.load(open(work + "/hi.json"))
-assert report["frames"] > 1 and report["converged"], report
-assert report["samples"] == {"target": 16, "min": 16, "max": 16}, report["samples"]
+assert report["frames"] > 1 and report["converged"] and report["stopped"] is None, report
+assert report["samples"] == {"target": 16, "min": 16, "max": 16, "glyphs": 2, "converged_glyphs": 2}, report["samples"]
 assert report["glyphs"]["drawn"] == 2 and report["glyphs"]["failed"] == 0, report["glyphs"]
 assert report["canvas"] == {"width": 48, "height": 32}, report["canvas"]
 assert len(report["timings"]["frame_ms"]) == report["frames"], report["timings"]

@@ -148,22 +148,29 @@ private:
     std::filesystem::path path_;
 };
 
+// A pool of resettable command buffers on `context`'s queue family (destroying it frees them), and
+// `count` primary buffers from it; false when a call fails.
+inline bool create_command_buffers(const HeadlessContext& context, VkCommandPool& pool, VkCommandBuffer* buffers,
+                                   uint32_t count) {
+    VkCommandPoolCreateInfo pool_info{};
+    pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pool_info.queueFamilyIndex = context.queue_family();
+    if (vkCreateCommandPool(context.device(), &pool_info, nullptr, &pool) != VK_SUCCESS) return false;
+    VkCommandBufferAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    allocate.commandPool = pool;
+    allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    allocate.commandBufferCount = count;
+    return vkAllocateCommandBuffers(context.device(), &allocate, buffers) == VK_SUCCESS;
+}
+
 // A command buffer from a pool of its own, for frames a test records and never submits (dropped
 // frames). record() begins it, runs `commands`, ends it; drop() resets it for the next frame.
 class UnsubmittedCommandBuffer {
 public:
     explicit UnsubmittedCommandBuffer(const HeadlessContext& context) : device_(context.device()) {
-        VkCommandPoolCreateInfo pool_info{};
-        pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
-        pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-        pool_info.queueFamilyIndex = context.queue_family();
-        ok_ = vkCreateCommandPool(device_, &pool_info, nullptr, &pool_) == VK_SUCCESS;
-        VkCommandBufferAllocateInfo allocate{};
-        allocate.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-        allocate.commandPool = pool_;
-        allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-        allocate.commandBufferCount = 1;
-        ok_ = ok_ && vkAllocateCommandBuffers(device_, &allocate, &buffer_) == VK_SUCCESS;
+        ok_ = create_command_buffers(context, pool_, &buffer_, 1);
     }
     UnsubmittedCommandBuffer(const UnsubmittedCommandBuffer&) = delete;
     UnsubmittedCommandBuffer& operator=(const UnsubmittedCommandBuffer&) = delete;

@@ -951,5 +951,119 @@ TEST(Frames, DroppedFramesLeaveTheImageOfTheRunThatDroppedNone) {
     expect_no_validation_messages();
 }
 
+// Every earlier command's memory accesses before every later one's.
+void full_barrier(VkCommandBuffer cb) {
+    VkMemoryBarrier all{};
+    all.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    all.srcAccessMask = all.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &all, 0,
+                         nullptr, 0, nullptr);
+}
+
+// Frames in flight on the context's queue as an engine has them: frame i is recorded into command
+// buffer i % 2 once the fence of frame i - 2 has signalled, and submitted without a wait. Each
+// command buffer starts with a full barrier, so that the caller's own images (a target written by
+// consecutive frames) are ordered; the compositor's resources are the compositor's to keep apart.
+class FramesInFlight {
+public:
+    explicit FramesInFlight(const HeadlessContext& context) : device_(context.device()), queue_(context.queue()) {
+        ok_ = test::create_command_buffers(context, pool_, buffers_.data(), 2);
+        VkFenceCreateInfo fence_info{};
+        fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+        fence_info.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+        for (VkFence& fence : fences_) ok_ = ok_ && vkCreateFence(device_, &fence_info, nullptr, &fence) == VK_SUCCESS;
+    }
+    FramesInFlight(const FramesInFlight&) = delete;
+    FramesInFlight& operator=(const FramesInFlight&) = delete;
+    ~FramesInFlight() {
+        wait_idle();
+        for (VkFence fence : fences_) vkDestroyFence(device_, fence, nullptr);
+        if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
+    }
+    bool ok() const { return ok_; }
+
+    // True when every call succeeded.
+    template <typename Commands>
+    bool frame(Commands&& commands) {
+        const size_t i = next_++ % 2;
+        bool ok = vkWaitForFences(device_, 1, &fences_[i], VK_TRUE, UINT64_MAX) == VK_SUCCESS;
+        ok = ok && vkResetFences(device_, 1, &fences_[i]) == VK_SUCCESS;
+        ok = ok && vkResetCommandBuffer(buffers_[i], 0) == VK_SUCCESS;
+        VkCommandBufferBeginInfo begin{};
+        begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+        ok = ok && vkBeginCommandBuffer(buffers_[i], &begin) == VK_SUCCESS;
+        full_barrier(buffers_[i]);
+        commands(buffers_[i]);
+        ok = ok && vkEndCommandBuffer(buffers_[i]) == VK_SUCCESS;
+        VkSubmitInfo submit{};
+        submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+        submit.commandBufferCount = 1;
+        submit.pCommandBuffers = &buffers_[i];
+        return ok && vkQueueSubmit(queue_, 1, &submit, fences_[i]) == VK_SUCCESS;
+    }
+    void wait_idle() {
+        if (ok_) vkWaitForFences(device_, 2, fences_.data(), VK_TRUE, UINT64_MAX);
+    }
+
+private:
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    std::array<VkCommandBuffer, 2> buffers_{};
+    std::array<VkFence, 2> fences_{};
+    size_t next_ = 0;
+    bool ok_ = false;
+};
+
+// Issue 28, item 1: Compositor::record() twice in a frame, with two frames in flight, made the next
+// frame reuse a frame slot whose composite was still pending (12 validation errors). The rule of
+// compositor.hpp refuses the record calls of the frame after (and only those), so the validation
+// layer has nothing to report; compositing one frame again once it is done stays allowed.
+TEST(Frames, RecordTwiceInAFrameIsRefusedWhereItsSlotMayStillBePending) {
+    HeadlessContext& context = *fixture().context;
+    Scene scene = render_scene(overlapping_runs(0.7f));
+    ASSERT_TRUE(scene.renderer);
+    std::vector<GlyphInstance> glyphs;
+    for (const DrawnGlyph& drawn : scene.drawn) glyphs.push_back(drawn.instance);
+    auto compositor = Compositor::create(tile_info(2));
+    ASSERT_TRUE(compositor) << compositor.error().message;
+    Target t = make_target(VK_FORMAT_R32G32B32A32_SFLOAT, kWidth, kHeight, VK_IMAGE_USAGE_STORAGE_BIT);
+    CompositeTarget target;
+    target.view = t.image.view();
+    target.format = t.format;
+    target.extent = {t.width, t.height};
+    target.rect = {{0, 0}, {kWidth, kHeight}};
+    std::vector<std::pair<uint64_t, std::string>> refused;  // renderer frame, message
+    {
+        FramesInFlight frames(context);
+        ASSERT_TRUE(frames.ok());
+        for (int frame = 0; frame < 6; ++frame) {
+            ASSERT_TRUE(frames.frame([&](VkCommandBuffer cb) {
+                scene.renderer->begin_frame();
+                scene.renderer->draw(glyphs, VkRect2D{{0, 0}, {kWidth, kHeight}});
+                EXPECT_TRUE(scene.renderer->record(cb));
+                for (int twice = 0; twice < 2; ++twice) {
+                    const Status s = compositor->record(cb, scene.renderer->drawn_frame(), target);
+                    if (!s) refused.emplace_back(scene.renderer->frame(), s.error().message);
+                    full_barrier(cb);  // the caller orders its own target's writes
+                }
+            }));
+        }
+    }
+    // Frames 1, 3 and 5 of the six composite twice; frames 2, 4 and 6 would reuse a slot of the
+    // frame before, still in flight, and are refused both times.
+    EXPECT_EQ(refused.size(), 6u);
+    for (size_t i = 0; i < refused.size(); ++i) {
+        EXPECT_EQ(refused[i].first % 2, refused[0].first % 2) << refused[i].second;
+        EXPECT_NE(refused[i].second.find("may still be on the GPU"), std::string::npos) << refused[i].second;
+    }
+    // Once the GPU is done, a later renderer frame composites, and again as often as a caller asks.
+    scene.renderer->begin_frame();
+    scene.renderer->draw(glyphs, VkRect2D{{0, 0}, {kWidth, kHeight}});
+    ASSERT_TRUE(context.submit_and_wait([&](VkCommandBuffer cb) { EXPECT_TRUE(scene.renderer->record(cb)); }));
+    for (int again = 0; again < 3; ++again) composite_tiles(*compositor, scene, scene.renderer->drawn(), t);
+    expect_no_validation_messages();
+}
+
 }  // namespace
 }  // namespace crisp

@@ -63,6 +63,11 @@ constexpr uint32_t kMaxCanvas = 16384;
 // The default schedule reaches kMaxRendererSamples in about 1030 frames; far more means the
 // renderer stopped making progress.
 constexpr uint32_t kMaxFrames = 100000;
+// --max-seconds: a run's rendering stops at the first frame that ends past it (docs/crisp-render.md,
+// "Bounded work"), so that no small hostile input takes minutes: the compositing and writing that
+// follow leave a run on a 2-core lavapipe machine well under a minute.
+constexpr double kDefaultMaxSeconds = 30.0;
+constexpr double kMaxMaxSeconds = 86400.0;
 // Smallest atlas side the tool asks for; it grows to hold every glyph of the text at once.
 constexpr uint32_t kMinAtlasSide = 256;
 constexpr uint32_t kAtlasTexelBytes = 8;    // R16G16B16A16_UINT
@@ -81,7 +86,9 @@ or in linear light, the coverage as it is, with --contrast linear.
 
 constexpr const char* kExitCodes = R"(
 exit codes:
-  0 success   2 usage error   3 font asset cannot be loaded   4 output not writable
+  0 success, also a run stopped by --max-seconds or --max-frames before the text converged
+    (its outputs hold the text as it was then, and a warning on stderr says so)
+  2 usage error   3 font asset cannot be loaded   4 output not writable
   5 Vulkan unavailable or failed, or validation messages   6 bad --layout or scene layout
   7 bad --scene file (unreadable, invalid, or a run the layout refuses)   1 internal error
 
@@ -99,6 +106,8 @@ struct Arguments {
     std::optional<std::array<uint32_t, 2>> canvas;
     std::optional<std::string> layout;
     uint32_t samples = kDefaultSamples;
+    double max_seconds = kDefaultMaxSeconds;  // 0: no time limit
+    std::optional<uint32_t> max_frames;       // given: a stop there is not a failure
     std::optional<std::array<float, 4>> color;
     std::optional<std::array<float, 4>> background;
     std::optional<uint32_t> palette;                // TextStyle::palette of the command line's text
@@ -372,6 +381,15 @@ void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
              args.layout);
     cli.number<uint32_t>("--samples", "N", "samples per glyph texel and channel, 1..1023 (default 512)", args.samples,
                          {1, crisp::kMaxRendererSamples});
+    cli.number<double>("--max-seconds", "S",
+                       "stop rendering at the first frame that ends S seconds after the start\n"
+                       "(0..86400, default 30; 0: no limit) and write the text as it is then,\n"
+                       "partly converged, with a warning (exit 0)",
+                       args.max_seconds, {0.0, kMaxMaxSeconds});
+    cli.number<uint32_t>("--max-frames", "N",
+                         "stop rendering after N frames (1..100000) the same way, if the text\n"
+                         "has not converged by then",
+                         args.max_frames, {1, kMaxFrames});
     auto color = [](const char* option) {
         return [option](std::string_view text) { return parse_color(option, text); };
     };
@@ -604,6 +622,13 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+// --max-seconds, counted from the run's start.
+struct RunClock {
+    std::chrono::steady_clock::time_point start;
+    double max_seconds = 0.0;  // 0: no limit
+    bool past_limit() const { return max_seconds > 0.0 && milliseconds_since(start) >= max_seconds * 1000.0; }
+};
+
 // What is drawn: the scene (from --scene, or the one run the command line describes), its
 // resolved subpixel layout and fonts, and the glyphs its runs laid out.
 struct Job {
@@ -639,6 +664,9 @@ struct CompositeReport {
 struct RenderReport {
     uint64_t frames = 0;
     bool converged = false;
+    // Why rendering stopped short of convergence: "" (it converged), "max-seconds" or "max-frames".
+    std::string stopped;
+    double stopped_ms = 0.0;  // since the run's start, when it stopped
     std::vector<double> frame_ms;
     double render_ms = 0.0;
     double readback_ms = 0.0;
@@ -721,9 +749,10 @@ std::vector<float> backdrop_pixels(const std::string& kind, uint32_t width, uint
 
 // The tile or draw path: the backdrop is uploaded into an R32G32B32A32_SFLOAT canvas image and the
 // glyphs composited into it, twice from the same backdrop (the first frame's tile counts arrive
-// with the second), then read back into report.composite.target.
+// with the second; once when the first ends past --max-seconds), then read back into
+// report.composite.target.
 int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer& renderer, const Arguments& args,
-                         const Job& job, RenderReport& report) {
+                         const Job& job, const RunClock& clock, RenderReport& report) {
     CompositeReport& out = report.composite;
     const bool draw = args.composite == crisp::CompositeMode::draw;
     constexpr VkFormat kFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
@@ -766,6 +795,7 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
             return recorded;
         });
         if (code != kExitOk) return code;
+        if (clock.past_limit()) break;  // the first frame's image is the same, without measurements
     }
     out.stats = compositor.stats();
     crisp::Result<std::vector<std::byte>> bytes = context.read_image(*image, VK_IMAGE_LAYOUT_GENERAL);
@@ -780,12 +810,13 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
 
 // Composites the renderer's last frame twice, the same glyphs both times: the first frame
 // measures the overlap (what the report gives; measurements arrive one frame later), the second
-// is the image, read back into report.composite.target.
+// is the image, read back into report.composite.target. A first frame that ends past
+// --max-seconds is the image, and nothing is measured.
 int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, const Arguments& args, const Job& job,
-              RenderReport& report) {
+              const RunClock& clock, RenderReport& report) {
     CompositeReport& out = report.composite;
     if (args.composite == crisp::CompositeMode::tiled || args.composite == crisp::CompositeMode::draw) {
-        return composite_into_image(context, renderer, args, job, report);
+        return composite_into_image(context, renderer, args, job, clock, report);
     }
     crisp::CompositorCreateInfo info = crisp::compositor_create_info(context);
     info.width = job.scene.width;
@@ -819,11 +850,12 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
     for (int frame = 1; frame <= kCompositeFrames; ++frame) {
         const int code = run_composite_frame(context, frame, out, [&](VkCommandBuffer command_buffer) {
             crisp::Status recorded = compositor.record_reference(command_buffer, renderer.drawn_frame(), params);
-            if (recorded && frame == kCompositeFrames)
-                compositor.record_target_readback(command_buffer, buffer->handle());
+            // Every frame's image is read back: the first is the last where it ends past the limit.
+            if (recorded) compositor.record_target_readback(command_buffer, buffer->handle());
             return recorded;
         });
         if (code != kExitOk) return code;
+        if (clock.past_limit()) break;
     }
     out.stats = compositor.stats();
     out.target.resize(pixels * 4);
@@ -867,7 +899,8 @@ int read_atlas_rects(crisp::HeadlessContext& context, const crisp::Renderer& ren
     return kExitOk;
 }
 
-int render(crisp::HeadlessContext& context, const Arguments& args, const Job& job, RenderReport& report) {
+int render(crisp::HeadlessContext& context, const Arguments& args, const Job& job, const RunClock& clock,
+           RenderReport& report) {
     crisp::RendererCreateInfo info = crisp::renderer_create_info(context);
     info.layout = job.subpixel_layout;
     info.atlas.max_samples = args.samples;
@@ -914,7 +947,7 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
     const auto render_start = std::chrono::steady_clock::now();
     auto frame_start = render_start;
     const crisp::Result<uint32_t> frames = crisp::harness::render_until_converged(
-        context, renderer, kMaxFrames,
+        context, renderer, args.max_frames.value_or(kMaxFrames),
         [&] {
             frame_start = std::chrono::steady_clock::now();
             const VkRect2D canvas{{0, 0}, {job.scene.width, job.scene.height}};
@@ -938,6 +971,11 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
             report.total_curve_tests += renderer.stats().curve_tests;
             report.total_bitmap_uploads += renderer.stats().bitmap_uploads;
             report.max_bitmap_misses = std::max(report.max_bitmap_misses, renderer.stats().bitmap_misses);
+            if (!renderer.converged() && clock.past_limit()) {
+                report.stopped = "max-seconds";
+                return false;
+            }
+            return true;
         });
     if (!frames) {
         std::fprintf(stderr, "crisp-render: frame %llu: %s\n",
@@ -945,13 +983,17 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
         return exit_code_for_vulkan(frames.error());
     }
     report.frames = *frames;
-    if (!renderer.converged()) {
-        std::fprintf(stderr, "crisp-render: the renderer did not converge in %llu frames\n",
-                     static_cast<unsigned long long>(kMaxFrames));
-        return kExitInternal;
+    report.converged = renderer.converged();
+    if (!report.converged && report.stopped.empty()) {
+        if (!args.max_frames) {
+            std::fprintf(stderr, "crisp-render: the renderer did not converge in %llu frames\n",
+                         static_cast<unsigned long long>(kMaxFrames));
+            return kExitInternal;
+        }
+        report.stopped = "max-frames";
     }
     report.render_ms = milliseconds_since(render_start);
-    report.converged = true;
+    report.stopped_ms = milliseconds_since(clock.start);
     report.last_frame = renderer.stats();
     report.atlas = renderer.atlas().stats();
 
@@ -968,7 +1010,7 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
         }
     }
 
-    if (const int code = composite(context, renderer, args, job, report); code != kExitOk) return code;
+    if (const int code = composite(context, renderer, args, job, clock, report); code != kExitOk) return code;
     if (args.coverage_output.empty() || report.drawn.empty()) return kExitOk;
     return read_atlas_rects(context, renderer, report);
 }
@@ -1022,6 +1064,16 @@ std::vector<float> png_pixels(std::span<const float> target, bool opaque) {
 }
 
 // ---- Report
+
+// Distinct glyphs (atlas entries, effect layers included) the last frame drew that hold every sample.
+uint32_t converged_glyphs(const RenderReport& r) {
+    return r.atlas.pinned_glyphs - r.atlas.refining_glyphs;
+}
+// Glyph instances of the last frame left out of the image because they hold no sample yet.
+uint32_t glyphs_without_samples(const RenderReport& r) {
+    const crisp::RendererStats& f = r.last_frame;
+    return f.skipped_glyphs - std::min(f.skipped_glyphs, f.failed_glyphs + f.unknown_fonts);
+}
 
 struct Summary {
     const Arguments* args = nullptr;
@@ -1161,8 +1213,10 @@ void print_json(const Summary& s) {
     const RenderReport& r = *s.render;
     crisp::JsonWriter json;
     json.begin_object().field("frames", r.frames).field("converged", r.converged);
+    json.field("stopped", unless_empty(r.stopped)).field("max_seconds", args.max_seconds);
     json.key("samples").begin_object();
-    json.field("target", args.samples).field("min", r.min_samples).field("max", r.max_samples).end_object();
+    json.field("target", args.samples).field("min", r.min_samples).field("max", r.max_samples);
+    json.field("glyphs", r.atlas.pinned_glyphs).field("converged_glyphs", converged_glyphs(r)).end_object();
     write_glyphs_and_timings(json, s);
     json.key("atlas").begin_object();
     json.field("width", r.atlas_side)
@@ -1252,8 +1306,9 @@ void print_human(const Summary& s) {
                     r.last_frame.derived_glyphs, static_cast<unsigned long long>(r.last_frame.derived_bytes),
                     r.last_frame.failed_effects);
     }
-    std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)\n", static_cast<unsigned long long>(r.frames),
-                frame_total, r.frames ? frame_total / static_cast<double>(r.frames) : 0.0);
+    std::printf("  frames   %llu, %.1f ms (%.2f ms per frame)%s\n", static_cast<unsigned long long>(r.frames),
+                frame_total, r.frames ? frame_total / static_cast<double>(r.frames) : 0.0,
+                r.stopped.empty() ? "" : (", stopped by --" + r.stopped + ", not converged").c_str());
     std::printf("  blend    %s\n", human_composite(args, r.composite).c_str());
     std::printf("  contrast %s\n", human_contrast(job.contrast, job.scene).c_str());
     std::printf("  atlas    %ux%u, %.1f%% occupied, %u resident, %llu allocations, %llu evictions\n", r.atlas_side,
@@ -1415,6 +1470,15 @@ int write_outputs(const crisp::OutputFiles& outputs, const Arguments& args, cons
 // The compositor's notes and what the image lacks, on stderr; the exit code of glyphs not drawn
 // or of validation messages.
 int report_problems(const Arguments& args, const RenderReport& report, const crisp::ValidationMessages& validation) {
+    if (!args.quiet && !report.stopped.empty()) {
+        std::fprintf(stderr, "crisp-render: warning: stopped after %llu frame%s / %.1f s: %u of %u glyphs converged",
+                     static_cast<unsigned long long>(report.frames), report.frames == 1 ? "" : "s",
+                     report.stopped_ms / 1000.0, converged_glyphs(report), report.atlas.pinned_glyphs);
+        if (const uint32_t waiting = glyphs_without_samples(report); waiting > 0) {
+            std::fprintf(stderr, ", %u not drawn (no sample yet)", waiting);
+        }
+        std::fprintf(stderr, "; --%s to change\n", report.stopped.c_str());
+    }
     const CompositeReport& composite = report.composite;
     if (!args.quiet && !args.json) {
         for (const std::string& warning : composite.warnings) {
@@ -1461,7 +1525,8 @@ int run(const Arguments& args) {
         crisp::tools::create_context(options, report.composite.storage_without_format);
     if (!context) fail(exit_code_for_vulkan(context.error()), "Vulkan: " + context.error().message);
 
-    if (const int code = render(*context, args, job, report); code != kExitOk) return code;
+    if (const int code = render(*context, args, job, RunClock{start, args.max_seconds}, report); code != kExitOk)
+        return code;
     // The renderer and compositor are gone: every message the validation layer had for them has arrived.
     Summary summary;
     summary.validation = context->validation_messages();

@@ -22,7 +22,16 @@
 //
 // Like the Renderer, the compositor never submits, and the caller must not have more than
 // CompositorCreateInfo::frames_in_flight of its recorded command buffers pending at once; each
-// record*() call takes one frame slot.
+// record*() call takes one frame slot, in turn, the slot of the call frames_in_flight calls before.
+// The frame-slot rule, which the compositor checks: an engine that paces its frames by the
+// renderer's (waiting for frame F - frames_in_flight before recording frame F) may reuse a slot
+// only when the renderer frame it last held is at least frames_in_flight frames back. A record
+// call for DrawnFrame::frame F whose slot last held frame P with P < F < P + frames_in_flight
+// (more than frames_in_flight record calls within frames_in_flight renderer frames: two calls in
+// one frame, say) is refused with invalid_argument, recording nothing, since P's composite may
+// still be on the GPU. Compositing one renderer frame again (F equal to P: several modes, repeated
+// timing) is allowed, and the caller must have waited for the earlier calls then; frames of 0 (a
+// DrawnFrame made by hand) are not checked.
 #pragma once
 
 #include <crisp/export.hpp>

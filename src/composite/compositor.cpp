@@ -151,9 +151,37 @@ struct CRISP_HIDDEN Compositor::State {
     enum class Last { none, tiles, draw, reference };
     Last last = Last::none;   // the path of the last record call, until abandon_frame()
     uint64_t last_frame = 0;  // the DrawnFrame::frame it composited
+    // The frame-slot rule (compositor.hpp): the DrawnFrame::frame of each of the last
+    // frames_in_flight record calls, at records % frames_in_flight, and what the last call replaced
+    // there (for abandon_frame()).
+    std::vector<uint64_t> slot_frames;
+    uint64_t records = 0;
+    uint64_t replaced_frame = 0;
+
+    // invalid_argument when the next record call's slot may still be pending: see compositor.hpp.
+    Status check_slot(uint64_t frame) const;
+    void took_slot(uint64_t frame);
 
     void take(const composite::TileCounts& counts, uint64_t frame);
 };
+
+Status Compositor::State::check_slot(uint64_t frame) const {
+    const auto in_flight = static_cast<uint64_t>(slot_frames.size());
+    const uint64_t previous = slot_frames[records % in_flight];
+    if (frame == 0 || previous == 0 || frame <= previous || frame >= previous + in_flight) return {};
+    return Error{ErrorCode::invalid_argument,
+                 "compositor: frame " + std::to_string(frame) + " refused: its frame slot holds frame " +
+                     std::to_string(previous) + "'s composite, which may still be on the GPU (more than " +
+                     std::to_string(in_flight) + " record calls (frames_in_flight) within " +
+                     std::to_string(in_flight) + " renderer frames: one record call a renderer frame)"};
+}
+
+void Compositor::State::took_slot(uint64_t frame) {
+    uint64_t& slot = slot_frames[records % slot_frames.size()];
+    replaced_frame = slot;
+    slot = frame;
+    ++records;
+}
 
 void Compositor::State::take(const composite::TileCounts& counts, uint64_t frame) {
     stats.measured = true;
@@ -199,6 +227,7 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
         core.shaderStorageImageReadWithoutFormat && core.shaderStorageImageWriteWithoutFormat;
     auto state = std::make_unique<State>();
     state->context = std::move(*context);
+    state->slot_frames.assign(info.frames_in_flight, 0);
     const vk::DeviceRef& ref = state->context->ref;
     state->storage_without_format = storage_without_format;
     composite::TileConfig tiles;
@@ -234,6 +263,7 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
 Status Compositor::record(VkCommandBuffer command_buffer, const DrawnFrame& frame, const CompositeTarget& target) {
     State& s = *state_;
     if (Status checked = check_frame(frame); !checked) return checked;
+    if (Status checked = s.check_slot(frame.frame); !checked) return checked;
     if (!target.view) return Error{ErrorCode::invalid_argument, "compositor: the target has no image view"};
     const VkFormat view_format = target.view_format != VK_FORMAT_UNDEFINED ? target.view_format : target.format;
     if (!s.tiles.supports(target.format, view_format)) {
@@ -262,6 +292,7 @@ Status Compositor::record(VkCommandBuffer command_buffer, const DrawnFrame& fram
         return bytes.error();
     }
     if (measured_frame != 0) s.take(counts, measured_frame);
+    s.took_slot(frame.frame);
     s.last = State::Last::tiles;
     s.last_frame = frame.frame;
     s.stats.mode = CompositeMode::tiled;
@@ -298,12 +329,15 @@ Status Compositor::abandon_frame(uint64_t frame) {
     }
     s.paints.abandon_frame();
     s.last = State::Last::none;
+    --s.records;
+    s.slot_frames[s.records % s.slot_frames.size()] = s.replaced_frame;
     return {};
 }
 
 Status Compositor::record_draw(VkCommandBuffer command_buffer, const DrawnFrame& frame, const VkRect2D& rect) {
     State& s = *state_;
     if (Status checked = check_frame(frame); !checked) return checked;
+    if (Status checked = s.check_slot(frame.frame); !checked) return checked;
     if (!s.draw) {
         return Error{ErrorCode::invalid_argument, "compositor: no draw pipeline (CompositorCreateInfo::draw_format)"};
     }
@@ -319,6 +353,7 @@ Status Compositor::record_draw(VkCommandBuffer command_buffer, const DrawnFrame&
         s.paints.abandon_frame();
         return bytes.error();
     }
+    s.took_slot(frame.frame);
     s.last = State::Last::draw;
     s.last_frame = frame.frame;
     s.stats.mode = CompositeMode::draw;
@@ -333,9 +368,11 @@ Status Compositor::record_reference(VkCommandBuffer command_buffer, const DrawnF
     if (!state_->reference) return no_reference_modes();
     if (Status checked = check_frame(frame); !checked) return checked;
     State& s = *state_;
+    if (Status checked = s.check_slot(frame.frame); !checked) return checked;
     if (Status p = s.paints.upload(frame); !p) return p;
     Status status = s.reference->record(command_buffer, frame, s.paints, params, s.stats);
     if (status) {
+        s.took_slot(frame.frame);
         s.last = State::Last::reference;
         s.last_frame = frame.frame;
     } else {
