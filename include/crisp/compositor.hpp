@@ -195,7 +195,8 @@ struct CompositorStats {
     uint64_t exact_dropped = 0;     // exact: fragments past kMaxExactFragmentsPerPixel
     // tiled: the last completed tiled frame's tiles with quads, how many took the exact way (their
     // list fit) and the layered way, the (quad, tile) pairs binned; max_overlap and tail_pixels
-    // above count for it too.
+    // above count for it too. A batched frame's (tile_batches above 1) are summed over its
+    // batches, a tile counted once in each batch it is busy in; max_overlap is the most of one batch.
     uint32_t busy_tiles = 0;
     uint32_t exact_tiles = 0;
     uint32_t layered_tiles = 0;
