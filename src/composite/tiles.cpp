@@ -196,6 +196,57 @@ uint64_t TileCompositor::make_batches(std::span<const gpu::CompositeQuad> quads,
         most = std::max(most, batch.pairs);
     }
     batches_.push_back(batch);
+    if (batches_.size() == 1) return most;
+
+    // Batched anyway: cut also where a tile's list would pass the capacity, so that every batch's
+    // tiles take the exact way (sorted, walked front to back with its early exit) rather than the
+    // layered way, which walks every quad of its tile for each pixel, twice for those past K.
+    const int64_t side = gpu::kTileSide;
+    const uint32_t tiles_x = (width + gpu::kTileSide - 1) / gpu::kTileSide;
+    const uint32_t tiles = tiles_x * ((height + gpu::kTileSide - 1) / gpu::kTileSide);
+    tile_batch_.assign(tiles, UINT32_MAX);
+    tile_count_.assign(tiles, 0);
+    batches_.clear();
+    batch = {};
+    most = 0;
+    uint32_t number = 0;
+    for (size_t i = 0; i < quads.size(); ++i) {
+        const gpu::CompositeQuad& q = quads[i];
+        const uint64_t pairs = quad_tile_pairs(q, width, height);
+        uint32_t tx0 = 0, ty0 = 0, tx1 = 0, ty1 = 0;  // the tiles it reaches: [tx0, tx1) x [ty0, ty1)
+        if (pairs > 0) {
+            tx0 = static_cast<uint32_t>(std::max<int64_t>(q.x, 0) / side);
+            ty0 = static_cast<uint32_t>(std::max<int64_t>(q.y, 0) / side);
+            tx1 = static_cast<uint32_t>((std::min<int64_t>(int64_t{q.x} + q.width, width) - 1) / side + 1);
+            ty1 = static_cast<uint32_t>((std::min<int64_t>(int64_t{q.y} + q.height, height) - 1) / side + 1);
+        }
+        bool full = false;
+        for (uint32_t ty = ty0; ty < ty1 && !full; ++ty) {
+            for (uint32_t tx = tx0; tx < tx1 && !full; ++tx) {
+                const uint32_t t = ty * tiles_x + tx;
+                full = tile_batch_[t] == number && tile_count_[t] >= config_.capacity;
+            }
+        }
+        if (batch.count > 0 && (full || batch.pairs + pairs > budget)) {
+            batches_.push_back(batch);
+            batch = {static_cast<uint32_t>(i), 0, 0};
+            ++number;
+        }
+        for (uint32_t ty = ty0; ty < ty1; ++ty) {
+            for (uint32_t tx = tx0; tx < tx1; ++tx) {
+                const uint32_t t = ty * tiles_x + tx;
+                if (tile_batch_[t] != number) {
+                    tile_batch_[t] = number;
+                    tile_count_[t] = 0;
+                }
+                ++tile_count_[t];
+            }
+        }
+        ++batch.count;
+        batch.pairs += pairs;
+        most = std::max(most, batch.pairs);
+    }
+    batches_.push_back(batch);
     return most;
 }
 

@@ -123,7 +123,8 @@ private:
     Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
                 const char* what);
     Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
-    // Cuts `quads` into batches_ of at most `budget` pairs each; returns the most pairs of one.
+    // Cuts `quads` into batches_ of at most `budget` pairs each, and where that makes more than
+    // one, of at most the list capacity in any tile; returns the most pairs of one.
     uint64_t make_batches(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height, uint64_t budget);
     // The counts of the frame that last used `slot`, summed over its batches.
     TileCounts read_counts(const Slot& slot) const;
@@ -155,6 +156,8 @@ private:
     std::array<std::array<std::array<VkPipeline, 2>, 4>, kTileVariants.size()> tile_pipelines_{};
     std::vector<Slot> slots_;
     std::vector<Batch> batches_;  // the last record()'s, front to back (recorded from the last)
+    // A batched frame's tiles: the batch that last counted a quad there, and how many it counted.
+    std::vector<uint32_t> tile_batch_, tile_count_;
     uint64_t frame_ = 0;
     bool recorded_ = false;     // record() since the last abandon_frame()
     bool last_binned_ = false;  // the last record() binned anew
