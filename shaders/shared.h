@@ -282,6 +282,10 @@ CRISP_CONSTANT(uint, kTileScanPerInvocation, 4u);
 CRISP_CONSTANT(uint, kTileScanBlock, 1024u);
 // Invocations per workgroup of the binning passes (one quad each).
 CRISP_CONSTANT(uint, kTileBinInvocations, 64u);
+// (quad, tile) pairs a frame bins at once by default (32 bytes each: 128 MiB, the
+// maxStorageBufferRange every device has); a frame with more is binned and composited in batches of
+// consecutive quads, back to front (CompositorCreateInfo::tile_bin_pairs).
+CRISP_CONSTANT(uint, kTileDefaultBinPairs, 1u << 22);
 // Quad indices a tile's list holds in workgroup memory by default (8 bytes each: the list as
 // scattered and sorted); a longer list takes the layered way (the K nearest per pixel, the rest
 // estimated). Workgroup memory is kept small: it bounds how many tiles an SM composites at once.
@@ -358,8 +362,9 @@ struct TilePushConstants {
     uint height;
     uint tiles_x;  // tiles across and down the rect
     uint tiles_y;
-    uint quad_count;
+    uint quad_count;    // the batch's quads (binning): quads [quad_first, quad_first + quad_count)
     uint bin_capacity;  // entries the bins buffer holds
+    uint quad_first;    // the batch's first quad, in front-to-back order
 };
 
 #ifdef __cplusplus
@@ -373,7 +378,7 @@ static_assert(kTileScanBlock == kTileScanInvocations * kTileScanPerInvocation);
 static_assert(kTileScanBlock * kTileScanBlock <= 1u << kTileBusyIndexBits);
 static_assert(kTileMaxCapacity < kTileBusyCountMax && kTileBusyCountMax < 1u << (32 - kTileBusyIndexBits));
 static_assert(kTileScanBlock * kTileScanBlock * kTileSide * kTileSide >= 16384u * 16384u);
-static_assert(sizeof(TilePushConstants) == 32);
+static_assert(sizeof(TilePushConstants) == 36);
 static_assert(sizeof(CompositeQuad) == 80);
 static_assert(offsetof(CompositeQuad, color) == 48);
 static_assert(offsetof(CompositeQuad, paint) == 64);

@@ -9,6 +9,9 @@ with fontTools (Debian: python3-fonttools).
     make_hostile_fonts.py curve-composites GLYPHS OUT
         one glyph of 1024 squares (4096 curves, the most a glyph may have) and GLYPHS - 2
         composites of it: a 4096-curve glyph for every 6 bytes of the font.
+    make_hostile_fonts.py gsub-multiply OUT [COUNT]
+        'A' is substituted (GSUB multiple substitution, ccmp) by COUNT (default 1000) small squares,
+        'B' is one square: a character of 'A' makes COUNT glyphs.
 """
 import logging
 import sys
@@ -43,7 +46,7 @@ def squares(count):
     return pen.glyph()
 
 
-def build(glyphs, cmap, out):
+def build(glyphs, cmap, out, features=None, advance=700):
     names = list(glyphs)
     builder = FontBuilder(1000, isTTF=True)
     builder.setupGlyphOrder(names)
@@ -59,12 +62,14 @@ def build(glyphs, cmap, out):
     builder.font["glyf"] = glyf
     builder.font["loca"] = newTable("loca")
     builder.setupMaxp()
-    builder.setupHorizontalMetrics({name: (700, 0) for name in names})
+    builder.setupHorizontalMetrics({name: (advance, 0) for name in names})
     builder.setupHorizontalHeader(ascent=800, descent=-200)
     builder.setupNameTable({"familyName": "Hostile", "styleName": "Regular"})
     builder.setupOS2()
     builder.setupPost(keepGlyphNames=False)  # format 2 cannot name 65,535 glyphs
     builder.font.recalcBBoxes = False
+    if features is not None:
+        builder.addOpenTypeFeatures(features)
     builder.save(out)
 
 
@@ -89,6 +94,11 @@ def main():
         for i in range(count - 2):
             glyphs["c%d" % i] = composite("dense", 1)
         build(glyphs, {ord("A"): "dense", ord("B"): "c0"}, sys.argv[3])
+    elif len(sys.argv) in (3, 4) and sys.argv[1] == "gsub-multiply":
+        count = int(sys.argv[3]) if len(sys.argv) == 4 else 1000
+        glyphs = {".notdef": Glyph(), "A": squares(1), "square": squares(1)}
+        features = "feature ccmp { sub A by %s; } ccmp;" % " ".join(["square"] * count)
+        build(glyphs, {ord("A"): "A", ord("B"): "square"}, sys.argv[2], features, advance=20)
     else:
         sys.exit(__doc__)
 

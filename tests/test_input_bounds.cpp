@@ -134,5 +134,43 @@ TEST(InputBounds, RowsOfIgnorablesAreLaidOutInLinearTime) {
     EXPECT_EQ(short_row->ignorable_splits, 0u);
 }
 
+// A font whose GSUB makes 1000 glyphs of 'A' (make_hostile_fonts.py gsub-multiply): HarfBuzz's
+// buffer stops at 64 glyphs a character, so 1000 'A's failed as "HarfBuzz could not allocate
+// memory", and 1 MiB of them took 1.86 GB first. Now a run HarfBuzz cannot hold is shaped in
+// pieces, and the layout stops at kMaxLayoutGlyphs, naming it.
+TEST(InputBounds, SubstitutionsThatMultiplyGlyphsAreBoundedAndNamed) {
+    auto baked = bake_font_file(CRISP_HOSTILE_GSUB_FONT, BakeOptions{});
+    ASSERT_TRUE(baked) << baked.error().message;
+    auto font = Font::create(std::move(baked->asset), 1);
+    ASSERT_TRUE(font) << font.error().message;
+    const Font* fonts[] = {&*font};
+    auto thousand = layout_text(fonts, std::string(1000, 'A'), TextStyle{}, LayoutOptions{});
+    ASSERT_TRUE(thousand) << thousand.error().message;
+    EXPECT_EQ(thousand->shaped_glyphs, 1000u * 1000u);
+    EXPECT_EQ(thousand->glyphs.size(), 1000u * 1000u);
+    // The pieces are laid out in order: pens advance along the line.
+    EXPECT_LT(thousand->glyphs.front().pen_x, thousand->glyphs.back().pen_x);
+
+    const auto start = std::chrono::steady_clock::now();
+    auto refused = layout_text(fonts, std::string(size_t{1} << 20, 'A'), TextStyle{}, LayoutOptions{});
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::invalid_argument);
+    EXPECT_NE(
+        refused.error().message.find("more than " + std::to_string(kMaxLayoutGlyphs) + " glyphs (kMaxLayoutGlyphs)"),
+        std::string::npos)
+        << refused.error().message;
+    EXPECT_NE(refused.error().message.find("GSUB"), std::string::npos) << refused.error().message;
+    std::printf("1 MiB of a 1000-glyph substitution refused in %.3f s\n", seconds_since(start));  // not asserted
+
+    // Plain text of as many characters as the limit lays out; one character more (one glyph a
+    // character) is refused.
+    auto plain = layout_text(fonts, std::string(kMaxLayoutGlyphs, 'B'), TextStyle{}, LayoutOptions{});
+    ASSERT_TRUE(plain) << plain.error().message;
+    EXPECT_EQ(plain->shaped_glyphs, kMaxLayoutGlyphs);
+    auto past = layout_text(fonts, std::string(kMaxLayoutGlyphs + 1, 'B'), TextStyle{}, LayoutOptions{});
+    ASSERT_FALSE(past);
+    EXPECT_NE(past.error().message.find("kMaxLayoutGlyphs"), std::string::npos) << past.error().message;
+}
+
 }  // namespace
 }  // namespace crisp

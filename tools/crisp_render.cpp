@@ -775,7 +775,7 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
         std::fprintf(stderr, "crisp-render: cannot make the canvas image: %s\n", image.error().message.c_str());
         return exit_code_for_vulkan(image.error());
     }
-    const std::vector<float> backdrop = backdrop_pixels(args.backdrop, width, height, job.scene.background);
+    std::vector<float> backdrop = backdrop_pixels(args.backdrop, width, height, job.scene.background);
     const std::span<const std::byte> backdrop_bytes = std::as_bytes(std::span(backdrop));
     const VkRect2D rect{{0, 0}, {width, height}};
     constexpr int kCompositeFrames = 2;
@@ -798,11 +798,15 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
         if (clock.past_limit()) break;  // the first frame's image is the same, without measurements
     }
     out.stats = compositor.stats();
+    // A canvas is 16 bytes a pixel in each of these (4 GiB at 16384 x 16384): each goes once the
+    // next no longer needs it, so that at most two are held at once after the uploads.
+    std::vector<float>().swap(backdrop);
     crisp::Result<std::vector<std::byte>> bytes = context.read_image(*image, VK_IMAGE_LAYOUT_GENERAL);
     if (!bytes) {
         std::fprintf(stderr, "crisp-render: cannot read the canvas back: %s\n", bytes.error().message.c_str());
         return exit_code_for_vulkan(bytes.error());
     }
+    *image = crisp::Image{};
     out.target.resize(size_t{width} * height * 4);
     std::memcpy(out.target.data(), bytes->data(), out.target.size() * sizeof(float));
     return kExitOk;

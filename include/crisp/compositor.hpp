@@ -114,6 +114,14 @@ struct CompositorCreateInfo {
     // the upload and the binning passes and composite from the bins it has. Off only to measure
     // what binning costs.
     bool reuse_static_bins = true;
+    // The most (glyph, tile) pairs a frame bins at once, 32 bytes each (default 2^22: 128 MiB),
+    // at most what the device's maxStorageBufferRange reaches and at least the target's tiles. A
+    // frame with more (thousands of glyphs each covering much of the target) is binned and
+    // composited in batches of consecutive glyphs, back to front, each over the image the ones
+    // behind it left: the same image up to the target format's rounding between batches (and
+    // static text's bins are then not reused). So the bins' memory stays within this bound
+    // whatever the glyphs cover. 0 is refused.
+    uint32_t tile_bin_pairs = 1u << 22;
 
     // ---- The draw path (record_draw()): the colour attachment format of the caller's render
     // pass; VK_FORMAT_UNDEFINED makes no draw pipeline. The device must have been created with
@@ -183,6 +191,7 @@ struct CompositorStats {
     QuadPath path = QuadPath::raster;  // the path this frame's quad passes took
     uint32_t tiles = 0;                // compute path: 8 x 8 tiles dispatched
     bool bins_reused = false;          // tiled: the glyphs were unchanged, binning was skipped
+    uint32_t tile_batches = 0;         // tiled: batches binned (1 unless the pairs passed tile_bin_pairs)
     uint32_t quads = 0;                // glyph quads drawn
     uint64_t buffer_bytes = 0;         // buffers this frame used: tiled and draw: quads and bins;
                                        // reference modes: their per-pixel buffers over the whole target
@@ -195,7 +204,8 @@ struct CompositorStats {
     uint64_t exact_dropped = 0;     // exact: fragments past kMaxExactFragmentsPerPixel
     // tiled: the last completed tiled frame's tiles with quads, how many took the exact way (their
     // list fit) and the layered way, the (quad, tile) pairs binned; max_overlap and tail_pixels
-    // above count for it too.
+    // above count for it too. A batched frame's (tile_batches above 1) are summed over its
+    // batches, a tile counted once in each batch it is busy in; max_overlap is the most of one batch.
     uint32_t busy_tiles = 0;
     uint32_t exact_tiles = 0;
     uint32_t layered_tiles = 0;

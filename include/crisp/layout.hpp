@@ -63,6 +63,19 @@ inline constexpr uint32_t kMaxMarksPerCluster = 64;
 // HarfBuzz as context, and what is cut is invisible, so the text looks the same
 // (TextLayout::ignorable_splits counts the cuts).
 inline constexpr uint32_t kMaxIgnorablesPerRun = 64;
+// Glyphs one layout call shapes (HarfBuzz's output, before colour layers are expanded): past
+// this many the call fails (invalid_argument, naming this limit). A font's substitutions (GSUB)
+// can make a thousand glyphs of one character, so that 1 MiB of text would ask for 10^9; this
+// bounds the glyph arrays and shaping buffers to a few hundred MiB. Real text is about one glyph
+// a character: 4 Mi characters of it lay out.
+inline constexpr size_t kMaxLayoutGlyphs = size_t{1} << 22;
+// Characters HarfBuzz shapes in one call: a longer run of one font, script and direction is cut
+// (after a space where one lies within the last 256 characters, never before a mark), so that
+// HarfBuzz's buffer, which grows to 64 glyphs a character before it gives up, stays a few MiB.
+// Kerning or a ligature across a cut is lost: one place in 4096 characters of an unbroken line.
+// A run whose output HarfBuzz's buffer cannot hold (more than 64 glyphs a character) is shaped
+// again in halves, down to pieces of 16 characters, whose buffer holds 16,384 glyphs.
+inline constexpr uint32_t kMaxShapingRunCharacters = 4096;
 // Layer instances one layout expands colour glyphs into: past this many, further colour glyphs
 // are drawn as their plain outline (as with LayoutOptions::colour_glyphs off), so that a long text
 // in a font of many-layered glyphs (up to kMaxColourLayers each) stays within memory.

@@ -2,7 +2,8 @@
 // constant 0 picks the pass:
 //   0, count: add 1 to the count of every tile the quad reaches;
 //   1, scatter: write the quad's entry (TileBinEntry) into each such tile's list, at the tile's cursor.
-// The scatter order inside a list depends on arrival; the tile pass sorts each list.
+// The scatter order inside a list depends on arrival; the tile pass sorts each list. A frame whose
+// pairs pass the bins' budget is binned in batches: quads [pc.quad_first, + pc.quad_count).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -12,9 +13,10 @@ layout(local_size_x = kTileBinInvocations) in;
 layout(constant_id = 0) const uint kScatter = 0u;
 
 void main() {
-    const uint quad = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * kTileBinInvocations +
-                      gl_LocalInvocationIndex;
-    if (quad >= pc.quad_count) return;
+    const uint local = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * kTileBinInvocations +
+                       gl_LocalInvocationIndex;
+    if (local >= pc.quad_count) return;
+    const uint quad = pc.quad_first + local;  // its index in the frame: its key
     const CompositeQuad q = quads[quad];
     uvec2 first, last;
     if (!quad_tile_range(q, first, last)) return;

@@ -25,6 +25,7 @@ constexpr uint32_t kMaxTargetSide = 16384;
 constexpr uint32_t kMaxNodesPerPixel = 64;
 static_assert(kMaxTileCapacity == gpu::kTileMaxCapacity);
 static_assert(CompositorCreateInfo{}.tile_capacity == gpu::kTileDefaultCapacity);
+static_assert(CompositorCreateInfo{}.tile_bin_pairs == gpu::kTileDefaultBinPairs);
 
 std::string rect_string(const VkRect2D& rect) {
     return std::to_string(rect.extent.width) + "x" + std::to_string(rect.extent.height) + " at (" +
@@ -59,6 +60,7 @@ Status check_create_info(const CompositorCreateInfo& info) {
         return invalid("tile_capacity must be a power of two from 4 to " + std::to_string(kMaxTileCapacity));
     }
     if (info.tile_layers < 1 || info.tile_layers > kMaxCompositeLayers) return invalid("tile_layers must be 1 to 8");
+    if (info.tile_bin_pairs == 0) return invalid("tile_bin_pairs must be at least 1");
     if (!info.reference_modes) return {};
     if (info.width < 1 || info.width > kMaxTargetSide || info.height < 1 || info.height > kMaxTargetSide) {
         return invalid("the target size " + std::to_string(info.width) + "x" + std::to_string(info.height) +
@@ -237,6 +239,7 @@ Result<Compositor> Compositor::create(const CompositorCreateInfo& info) {
     tiles.capacity = info.tile_capacity;
     tiles.storage_without_format = storage_without_format;
     tiles.reuse_static_bins = info.reuse_static_bins;
+    tiles.bin_pairs = info.tile_bin_pairs;
     if (Status s = state->paints.create(ref, info.frames_in_flight); !s) return s.error();
     if (Status s = state->tiles.create(ref, tiles); !s) return s.error();
     if (!std::any_of(std::begin(kTileTargetFormats), std::end(kTileTargetFormats),
@@ -301,6 +304,7 @@ Status Compositor::record(VkCommandBuffer command_buffer, const DrawnFrame& fram
     s.stats.tiles = 0;
     s.stats.buffer_bytes = *bytes;
     s.stats.bins_reused = reused;
+    s.stats.tile_batches = s.tiles.batches();
     return {};
 }
 

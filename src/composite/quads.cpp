@@ -81,17 +81,13 @@ void sort_front_to_back(std::span<const DrawnGlyph> glyphs, size_t paint_count, 
     if (!std::is_sorted(out.begin(), out.end(), front_first)) std::sort(out.begin(), out.end(), front_first);
 }
 
-uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height) {
+uint64_t quad_tile_pairs(const gpu::CompositeQuad& q, uint32_t width, uint32_t height) {
     const int64_t side = gpu::kTileSide;
-    uint64_t pairs = 0;
-    for (const gpu::CompositeQuad& q : quads) {
-        const int64_t x0 = std::max<int64_t>(q.x, 0), y0 = std::max<int64_t>(q.y, 0);
-        const int64_t x1 = std::min<int64_t>(int64_t{q.x} + q.width, width);
-        const int64_t y1 = std::min<int64_t>(int64_t{q.y} + q.height, height);
-        if (x0 >= x1 || y0 >= y1) continue;
-        pairs += static_cast<uint64_t>(((x1 - 1) / side - x0 / side + 1) * ((y1 - 1) / side - y0 / side + 1));
-    }
-    return pairs;
+    const int64_t x0 = std::max<int64_t>(q.x, 0), y0 = std::max<int64_t>(q.y, 0);
+    const int64_t x1 = std::min<int64_t>(int64_t{q.x} + q.width, width);
+    const int64_t y1 = std::min<int64_t>(int64_t{q.y} + q.height, height);
+    if (x0 >= x1 || y0 >= y1) return 0;
+    return static_cast<uint64_t>(((x1 - 1) / side - x0 / side + 1) * ((y1 - 1) / side - y0 / side + 1));
 }
 
 void rank_quads(std::span<const DrawnGlyph> glyphs, size_t paint_count, std::vector<gpu::CompositeQuad>& out) {

@@ -31,9 +31,9 @@ gpu::CompositeQuad make_quad(const DrawnGlyph& glyph, size_t paint_count);
 void sort_front_to_back(std::span<const DrawnGlyph> glyphs, size_t paint_count, uint32_t width, uint32_t height,
                         std::vector<gpu::CompositeQuad>& out);
 
-// How many (quad, tile) pairs the tile compositor's binning makes for `quads` in a rect of
-// width x height pixels: the bins it needs.
-uint64_t count_tile_pairs(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height);
+// How many (quad, tile) pairs the tile compositor's binning makes for one quad in a rect of
+// width x height pixels: the tiles of the rect it reaches.
+uint64_t quad_tile_pairs(const gpu::CompositeQuad& quad, uint32_t width, uint32_t height);
 
 // The reference modes' quads, in submission order, with the exact mode's key: paint orders become
 // dense ranks of (paint order, stack) per depth plane.

@@ -180,6 +180,94 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
     return {};
 }
 
+uint64_t TileCompositor::make_batches(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height,
+                                      uint64_t budget) {
+    batches_.clear();
+    Batch batch;
+    uint64_t most = 0;
+    for (size_t i = 0; i < quads.size(); ++i) {
+        const uint64_t pairs = quad_tile_pairs(quads[i], width, height);
+        if (batch.count > 0 && batch.pairs + pairs > budget) {
+            batches_.push_back(batch);
+            batch = {static_cast<uint32_t>(i), 0, 0};
+        }
+        ++batch.count;
+        batch.pairs += pairs;
+        most = std::max(most, batch.pairs);
+    }
+    batches_.push_back(batch);
+    if (batches_.size() == 1) return most;
+
+    // Batched anyway: cut also where a tile's list would pass the capacity, so that every batch's
+    // tiles take the exact way (sorted, walked front to back with its early exit) rather than the
+    // layered way, which walks every quad of its tile for each pixel, twice for those past K.
+    const int64_t side = gpu::kTileSide;
+    const uint32_t tiles_x = (width + gpu::kTileSide - 1) / gpu::kTileSide;
+    const uint32_t tiles = tiles_x * ((height + gpu::kTileSide - 1) / gpu::kTileSide);
+    tile_batch_.assign(tiles, UINT32_MAX);
+    tile_count_.assign(tiles, 0);
+    batches_.clear();
+    batch = {};
+    most = 0;
+    uint32_t number = 0;
+    for (size_t i = 0; i < quads.size(); ++i) {
+        const gpu::CompositeQuad& q = quads[i];
+        const uint64_t pairs = quad_tile_pairs(q, width, height);
+        uint32_t tx0 = 0, ty0 = 0, tx1 = 0, ty1 = 0;  // the tiles it reaches: [tx0, tx1) x [ty0, ty1)
+        if (pairs > 0) {
+            tx0 = static_cast<uint32_t>(std::max<int64_t>(q.x, 0) / side);
+            ty0 = static_cast<uint32_t>(std::max<int64_t>(q.y, 0) / side);
+            tx1 = static_cast<uint32_t>((std::min<int64_t>(int64_t{q.x} + q.width, width) - 1) / side + 1);
+            ty1 = static_cast<uint32_t>((std::min<int64_t>(int64_t{q.y} + q.height, height) - 1) / side + 1);
+        }
+        bool full = false;
+        for (uint32_t ty = ty0; ty < ty1 && !full; ++ty) {
+            for (uint32_t tx = tx0; tx < tx1 && !full; ++tx) {
+                const uint32_t t = ty * tiles_x + tx;
+                full = tile_batch_[t] == number && tile_count_[t] >= config_.capacity;
+            }
+        }
+        if (batch.count > 0 && (full || batch.pairs + pairs > budget)) {
+            batches_.push_back(batch);
+            batch = {static_cast<uint32_t>(i), 0, 0};
+            ++number;
+        }
+        for (uint32_t ty = ty0; ty < ty1; ++ty) {
+            for (uint32_t tx = tx0; tx < tx1; ++tx) {
+                const uint32_t t = ty * tiles_x + tx;
+                if (tile_batch_[t] != number) {
+                    tile_batch_[t] = number;
+                    tile_count_[t] = 0;
+                }
+                ++tile_count_[t];
+            }
+        }
+        ++batch.count;
+        batch.pairs += pairs;
+        most = std::max(most, batch.pairs);
+    }
+    batches_.push_back(batch);
+    return most;
+}
+
+TileCounts TileCompositor::read_counts(const Slot& slot) const {
+    TileCounts counts;
+    for (uint32_t i = 0; i < slot.batches; ++i) {
+        gpu::TileHeader header{};
+        const void* from = slot.batches > 1 ? static_cast<const char*>(slot.batch_headers.mapped) + i * sizeof(header)
+                                            : slot.header.mapped;
+        std::memcpy(&header, from, sizeof(header));
+        counts.busy_tiles += header.busy_tiles;
+        counts.exact_tiles += header.busy_tiles - header.layered_tiles;
+        counts.layered_tiles += header.layered_tiles;
+        counts.max_overlap = std::max(counts.max_overlap, header.max_overlap);
+        counts.tail_pixels += header.tail_pixels;
+        counts.pairs += header.pairs;
+        counts.lost_pairs += header.lost_pairs;
+    }
+    return counts;
+}
+
 void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view, const PaintInputs& paints,
                                        VkImageView target_view) {
     vk::DescriptorWrites writes(kTable, slot.set);
@@ -263,18 +351,47 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const s
 
     ref_.fn->vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set,
                                      0, nullptr);
-    ref_.fn->vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-    if (!reuse_bins) record_binning(cb, push);
-    ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[0]);
-    ref_.fn->vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
-    // The tiles the exact pass handed on; usually none, and then an empty dispatch.
-    vk::memory_barrier(*ref_.fn, cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
-                       shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
-    ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[1]);
-    ref_.fn->vkCmdDispatchIndirect(cb, slot.header.buffer, gpu::kTileLayeredDispatchOffset);
+    // Batches back to front, each composited over what the ones behind it left in the image: the
+    // tile passes blend over the image, so the result is the one pass's (up to the target format's
+    // rounding between batches).
+    const bool batched = batches_.size() > 1;
+    for (size_t k = batches_.size(); k-- > 0;) {
+        const Batch& batch = batches_[k];
+        gpu::TilePushConstants batch_push = push;
+        batch_push.quad_first = batch.first;
+        batch_push.quad_count = batch.count;
+        batch_push.bin_capacity = static_cast<uint32_t>(batch.pairs);
+        if (k + 1 < batches_.size()) {
+            // The batch behind is done with the header and the tile words: they start again.
+            vk::memory_barrier(*ref_.fn, cb, compute | indirect | transfer,
+                               shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT, transfer,
+                               VK_ACCESS_TRANSFER_WRITE_BIT);
+            ref_.fn->vkCmdFillBuffer(cb, slot.header.buffer, 0, sizeof(gpu::TileHeader), 0);
+            ref_.fn->vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
+            vk::memory_barrier(*ref_.fn, cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, compute | indirect,
+                               shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+        }
+        ref_.fn->vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                                    sizeof(batch_push), &batch_push);
+        if (!reuse_bins) record_binning(cb, batch_push);
+        ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[0]);
+        ref_.fn->vkCmdDispatchIndirect(cb, slot.header.buffer, 0);
+        // The tiles the exact pass handed on; usually none, and then an empty dispatch.
+        vk::memory_barrier(*ref_.fn, cb, compute, shader, compute | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                           shader | VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+        ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, tile_passes[1]);
+        ref_.fn->vkCmdDispatchIndirect(cb, slot.header.buffer, gpu::kTileLayeredDispatchOffset);
+        if (batched) {
+            // The batch's counts, kept for the host before the next batch starts the header again.
+            vk::memory_barrier(*ref_.fn, cb, compute, VK_ACCESS_SHADER_WRITE_BIT, transfer,
+                               VK_ACCESS_TRANSFER_READ_BIT);
+            const VkBufferCopy copy{0, k * sizeof(gpu::TileHeader), sizeof(gpu::TileHeader)};
+            ref_.fn->vkCmdCopyBuffer(cb, slot.header.buffer, slot.batch_headers.buffer, 1, &copy);
+        }
+    }
     // The frame's counts for the host.
-    vk::memory_barrier(*ref_.fn, cb, compute, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-                       VK_ACCESS_HOST_READ_BIT);
+    vk::memory_barrier(*ref_.fn, cb, compute | transfer, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
 void TileCompositor::abandon_frame() {
@@ -291,12 +408,7 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
                                         TileCounts& measured, uint64_t& measured_frame, bool& reused) {
     Slot& slot = slots_[frame_ % slots_.size()];
     if (slot.pending) {
-        gpu::TileHeader header{};
-        std::memcpy(&header, slot.header.mapped, sizeof(header));
-        measured = {header.busy_tiles,    header.busy_tiles - header.layered_tiles,
-                    header.layered_tiles, header.max_overlap,
-                    header.tail_pixels,   header.pairs,
-                    header.lost_pairs};
+        measured = read_counts(slot);
         measured_frame = slot.frame;
         slot.pending = false;
     }
@@ -308,27 +420,40 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     push.tiles_x = (push.width + gpu::kTileSide - 1) / gpu::kTileSide;
     push.tiles_y = (push.height + gpu::kTileSide - 1) / gpu::kTileSide;
     push.quad_count = static_cast<uint32_t>(quads.size());
-    const uint64_t pairs = count_tile_pairs(quads, push.width, push.height);
-    if (pairs * sizeof(gpu::TileBinEntry) > max_buffer_range_ || quads.size_bytes() > max_buffer_range_) {
-        return Error{ErrorCode::invalid_argument, "compositor: " + std::to_string(quads.size()) + " glyphs in " +
-                                                      std::to_string(pairs) + " (glyph, tile) pairs need " +
-                                                      std::to_string(pairs * sizeof(gpu::TileBinEntry)) +
-                                                      " bytes of bins, more than the device's maxStorageBufferRange (" +
-                                                      std::to_string(max_buffer_range_) + ") lets a shader reach"};
-    }
-    push.bin_capacity = static_cast<uint32_t>(pairs);
     const uint32_t tiles = push.tiles_x * push.tiles_y;
+    if (quads.size_bytes() > max_buffer_range_) {
+        return Error{ErrorCode::invalid_argument,
+                     "compositor: " + std::to_string(quads.size()) + " glyphs need " +
+                         std::to_string(quads.size_bytes()) +
+                         " bytes of quads, more than the device's maxStorageBufferRange (" +
+                         std::to_string(max_buffer_range_) + ") lets a shader reach"};
+    }
+    // The bins hold one batch's pairs: at most the budget, and at least one quad's (the rect's tiles).
+    const uint64_t budget =
+        std::max<uint64_t>(std::min<uint64_t>(config_.bin_pairs, max_buffer_range_ / sizeof(gpu::TileBinEntry)), tiles);
+    const uint64_t pairs = make_batches(quads, push.width, push.height, budget);
+    const bool batched = batches_.size() > 1;
+    push.bin_capacity = static_cast<uint32_t>(pairs);
     // Static text: the slot's bins already hold these very quads for a rect of this size.
-    reused = config_.reuse_static_bins && slot.bins_valid && slot.binned_width == push.width &&
+    reused = config_.reuse_static_bins && slot.bins_valid && !batched && slot.binned_width == push.width &&
              slot.binned_height == push.height && slot.binned.size() == quads.size() &&
              (quads.empty() || std::memcmp(slot.binned.data(), quads.data(), quads.size_bytes()) == 0);
     if (!reused) {
         slot.bins_valid = false;
         if (Status s = prepare_slot(slot, quads, tiles, pairs); !s) return s.error();
-        slot.binned.assign(quads.begin(), quads.end());
-        slot.binned_width = push.width;
-        slot.binned_height = push.height;
-        slot.bins_valid = true;
+        if (batched) {
+            if (Status s = grow(slot.batch_headers, batches_.size() * sizeof(gpu::TileHeader),
+                                VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "tile batch headers");
+                !s) {
+                return s.error();
+            }
+        } else {
+            // The bins of a batched frame hold its front batch only: never reused.
+            slot.binned.assign(quads.begin(), quads.end());
+            slot.binned_width = push.width;
+            slot.binned_height = push.height;
+            slot.bins_valid = true;
+        }
     }
     // The contrast model's passes only for frames that correct some glyph, the fills' only for
     // frames with colour layers: plain linear text keeps the passes, registers and speed it had
@@ -348,10 +473,11 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     ++frame_;
     slot.pending = true;
     slot.frame = frame_;
+    slot.batches = static_cast<uint32_t>(batches_.size());
     recorded_ = true;
     last_binned_ = !reused;
     return quads.size_bytes() + tile_words(tiles) * kWord + pairs * sizeof(gpu::TileBinEntry) +
-           header_words(tiles) * kWord;
+           header_words(tiles) * kWord + (batched ? batches_.size() * sizeof(gpu::TileHeader) : 0);
 }
 
 }  // namespace crisp::composite

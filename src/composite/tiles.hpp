@@ -38,10 +38,11 @@ inline constexpr std::array<TileVariant, 5> kTileVariants = {{
 struct TileConfig {
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     uint32_t frames_in_flight = 2;
-    uint32_t layers = gpu::kCompositeMaxLayers;     // K of tiles whose list overflows
-    uint32_t capacity = gpu::kTileDefaultCapacity;  // quads a tile's list holds in workgroup memory
-    bool storage_without_format = false;            // B8G8R8A8 targets allowed
-    bool reuse_static_bins = true;                  // skip binning when the quads did not change
+    uint32_t layers = gpu::kCompositeMaxLayers;      // K of tiles whose list overflows
+    uint32_t capacity = gpu::kTileDefaultCapacity;   // quads a tile's list holds in workgroup memory
+    bool storage_without_format = false;             // B8G8R8A8 targets allowed
+    bool reuse_static_bins = true;                   // skip binning when the quads did not change
+    uint32_t bin_pairs = gpu::kTileDefaultBinPairs;  // (quad, tile) pairs binned at once: a batch's most
 };
 
 // Where the tile pass draws: glyph pixel (0, 0) is `origin` in the image; `size` pixels from there.
@@ -90,6 +91,9 @@ public:
     // if that record() binned, no longer count as holding its quads, its counts are not read,
     // and the frame does not count towards frames in flight.
     void abandon_frame();
+    // The batches the last record() binned and composited, back to front: 1 unless its (quad,
+    // tile) pairs passed the bins' budget (TileConfig::bin_pairs, at least the rect's tiles).
+    uint32_t batches() const { return static_cast<uint32_t>(batches_.size()); }
 
 private:
     struct Slot {
@@ -104,11 +108,26 @@ private:
         std::vector<gpu::CompositeQuad> binned;
         uint32_t binned_width = 0, binned_height = 0;
         bool bins_valid = false;
+        // A frame of several batches: each batch's TileHeader, copied there after its passes
+        // (host-visible), since the next batch starts the header again.
+        vk::DeviceBuffer batch_headers;
+        uint32_t batches = 1;  // of the frame that last used the slot
+    };
+    // Consecutive quads (front to back) binned and composited together.
+    struct Batch {
+        uint32_t first = 0;
+        uint32_t count = 0;
+        uint64_t pairs = 0;
     };
 
     Status grow(vk::DeviceBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, bool host_visible,
                 const char* what);
     Status prepare_slot(Slot& slot, std::span<const gpu::CompositeQuad> quads, uint32_t tiles, uint64_t pairs);
+    // Cuts `quads` into batches_ of at most `budget` pairs each, and where that makes more than
+    // one, of at most the list capacity in any tile; returns the most pairs of one.
+    uint64_t make_batches(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height, uint64_t budget);
+    // The counts of the frame that last used `slot`, summed over its batches.
+    TileCounts read_counts(const Slot& slot) const;
     void write_descriptors(const Slot& slot, VkImageView atlas_view, const PaintInputs& paints,
                            VkImageView target_view);
     void record_binning(VkCommandBuffer command_buffer, const gpu::TilePushConstants& push);
@@ -136,6 +155,9 @@ private:
     // create(), the others at the first frame that needs them.
     std::array<std::array<std::array<VkPipeline, 2>, 4>, kTileVariants.size()> tile_pipelines_{};
     std::vector<Slot> slots_;
+    std::vector<Batch> batches_;  // the last record()'s, front to back (recorded from the last)
+    // A batched frame's tiles: the batch that last counted a quad there, and how many it counted.
+    std::vector<uint32_t> tile_batch_, tile_count_;
     uint64_t frame_ = 0;
     bool recorded_ = false;     // record() since the last abandon_frame()
     bool last_binned_ = false;  // the last record() binned anew

@@ -134,6 +134,32 @@ float srgb_to_linear(float encoded) {
 
 bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level, hb_script_t script,
                             uint16_t font) {
+    // HarfBuzz (before 10.2, which lets the caller set it) stops a buffer at max(64 glyphs a
+    // character, 16,384): a run it cannot hold is shaped again in halves, cut before a character
+    // that starts a cluster, down to pieces of kPieceCharacters.
+    constexpr uint32_t kPieceCharacters = 16;
+    if (shape_once(p0, p1, begin, end, level, script, font)) {
+        if (glyphs_shaped <= kMaxLayoutGlyphs) return true;
+        failure = "layout: the text shapes into more than " + std::to_string(kMaxLayoutGlyphs) +
+                  " glyphs (kMaxLayoutGlyphs) by its character " + std::to_string(end) + " of " +
+                  std::to_string(codepoints.size()) +
+                  (glyphs_shaped > 4 * size_t{end} ? ": its font's substitutions (GSUB) make many glyphs of a character"
+                                                   : "");
+        return false;
+    }
+    uint32_t middle = begin + (end - begin) / 2;
+    while (middle > begin && (flags[middle] & (kCharAttached | kCharEmojiNext)) != 0) --middle;
+    if (end - begin > kPieceCharacters && middle > begin) {
+        return shape(p0, p1, begin, middle, level, script, font) && shape(p0, p1, middle, end, level, script, font);
+    }
+    failure = "layout: shaping characters " + std::to_string(begin) + " to " + std::to_string(end) +
+              " makes more glyphs than HarfBuzz's buffer holds (16384 for up to 256 characters, 64 a character "
+              "past that): the font's substitutions (GSUB) multiply them";
+    return false;
+}
+
+bool Layouter::State::shape_once(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level,
+                                 hb_script_t script, uint16_t font) {
     const bool rtl = (level & 1) != 0;
     hb_buffer_clear_contents(buffer);
     hb_buffer_set_direction(buffer, rtl ? HB_DIRECTION_RTL : HB_DIRECTION_LTR);
@@ -152,6 +178,8 @@ bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t e
 
     unsigned count = 0;
     const hb_glyph_info_t* infos = hb_buffer_get_glyph_infos(buffer, &count);
+    glyphs_shaped += count;
+    if (glyphs_shaped > kMaxLayoutGlyphs) return true;  // shape() says so
     const hb_glyph_position_t* positions = hb_buffer_get_glyph_positions(buffer, nullptr);
     const double per_unit = 1.0 / fonts[font]->units_per_em();
     const double scale_x = per_unit * size_x, scale_y = per_unit * size_y;
@@ -213,10 +241,15 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     for (uint32_t i = p0 + 1; i <= p1; ++i) {
         bool split = false, cut = false;
         if (i < p1) {
-            attached = (flags[i] & (kCharAttached | kCharEmojiNext)) != 0 ? attached + 1 : 0;
+            const bool continues = (flags[i] & (kCharAttached | kCharEmojiNext)) != 0;
+            attached = continues ? attached + 1 : 0;
             split = attached > kMaxMarksPerCluster;
             ignorables = is_default_ignorable(codepoints[i]) ? ignorables + 1 : 0;
             cut = ignorables > kMaxIgnorablesPerRun;
+            // A long run: cut after a space, or anywhere a cluster starts 256 characters later.
+            const uint32_t length = i - run_begin;
+            cut = cut || (!continues && length >= kMaxShapingRunCharacters &&
+                          (codepoints[i - 1] == ' ' || length >= kMaxShapingRunCharacters + 256));
         }
         if (i < p1 && !split && !cut && levels[i] == levels[i - 1] && scripts[i] == scripts[i - 1] &&
             font_of[i] == font_of[i - 1])
@@ -225,7 +258,7 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
             ++mark_splits;
             attached = 1;  // the mark at i starts the next run
         }
-        if (cut) ++ignorable_splits;
+        if (cut && ignorables > kMaxIgnorablesPerRun) ++ignorable_splits;
         Run run;
         run.begin = run_begin;
         run.end = i;
@@ -377,6 +410,8 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
     }
     options = &layout_options;
     failed = false;
+    failure.clear();
+    glyphs_shaped = 0;
     mark_splits = ignorable_splits = 0;
     size_x = static_cast<double>(key_size(static_cast<double>(style.size))) / kSizeOne;
     const float size_y_asked = style.size_y == 0.0f ? style.size : style.size_y;
@@ -417,7 +452,7 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
         paragraph(begin, end);
         if (failed) {
             reset(out, layout_options.first_paint_order);
-            return invalid("layout: HarfBuzz could not allocate memory for the text");
+            return invalid(failure);
         }
         if (end == n) break;
         begin = end + (codepoints[end] == '\r' && end + 1 < n && codepoints[end + 1] == '\n' ? 2 : 1);

@@ -92,7 +92,9 @@ struct CRISP_HIDDEN Layouter::State {
     double size_x = 0.0, size_y = 0.0;  // the key's quantized sizes, pixels per em
     double tab_width = 0.0;             // pixels; 0: tabs are spaces
     hb_language_t language = nullptr;
-    bool failed = false;            // HarfBuzz ran out of memory
+    bool failed = false;  // shaping failed: `failure` says why
+    std::string failure;
+    size_t glyphs_shaped = 0;       // by HarfBuzz in this call, re-shaped line pieces too: at most kMaxLayoutGlyphs
     uint32_t mark_splits = 0;       // clusters cut after kMaxMarksPerCluster attached characters
     uint32_t ignorable_splits = 0;  // runs cut after kMaxIgnorablesPerRun default ignorables in a row
 
@@ -127,6 +129,12 @@ struct CRISP_HIDDEN Layouter::State {
     Status layout(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
                   const LayoutOptions& options, TextLayout& out);
     void paragraph(uint32_t p0, uint32_t p1);
+    // Shapes [begin, end) of the paragraph [p0, p1) with one HarfBuzz call, appending to `shaped`;
+    // false when HarfBuzz's buffer could not hold the output.
+    bool shape_once(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level, hb_script_t script,
+                    uint16_t font);
+    // shape_once(), in pieces where HarfBuzz's buffer cannot hold a run's output; false (with
+    // `failure`) past kMaxLayoutGlyphs or where a piece of a few characters still does not fit.
     bool shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level, hb_script_t script,
                uint16_t font);
     void break_lines(uint32_t p0, uint32_t p1);
