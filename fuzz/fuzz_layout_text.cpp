@@ -4,6 +4,8 @@
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 
+#include "fuzz_fonts.hpp"
+
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
@@ -15,19 +17,11 @@ namespace {
 std::vector<std::unique_ptr<crisp::Font>> g_fonts;  // the fuzzer's fixture, made once
 std::vector<const crisp::Font*> g_chain;
 
-std::unique_ptr<crisp::Font> load(const char* relative, crisp::FontId id) {
-    auto baked = crisp::bake_font_file(std::string(CRISP_SOURCE_DIR) + "/" + relative, crisp::BakeOptions{});
-    if (!baked) std::abort();
-    auto font = crisp::Font::create(std::move(baked->asset), id);
-    if (!font) std::abort();
-    return std::make_unique<crisp::Font>(std::move(font).value());
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
-    g_fonts.push_back(load("fuzz/corpus/font/inter-cff-subset.otf", 1));  // a subset: most text falls back
-    g_fonts.push_back(load("fonts/DejaVuSans.ttf", 2));
+    g_fonts.push_back(load_fuzz_font("fuzz/corpus/font/inter-cff-subset.otf", 1));  // a subset: most text falls back
+    g_fonts.push_back(load_fuzz_font("fonts/DejaVuSans.ttf", 2));
     for (const auto& font : g_fonts) g_chain.push_back(font.get());
     return 0;
 }

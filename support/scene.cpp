@@ -20,8 +20,14 @@ namespace {
 using Type = json::Value::Type;
 
 constexpr std::string_view kSceneMembers[] = {"fonts", "canvas", "background", "layout", "contrast", "palette", "runs"};
-constexpr std::string_view kRunMembers[] = {"font",    "text",      "size",   "origin",  "color",  "depth", "contrast",
-                                            "palette", "transform", "weight", "outline", "shadow", "glow"};
+constexpr std::string_view kRunMembers[] = {
+    "font",           "text",           "size",         "origin",        "color",    "depth", "contrast",
+    "palette",        "transform",      "weight",       "outline",       "shadow",   "glow",  "features",
+    "letter_spacing", "baseline_shift", "underline",    "strikethrough", "skip_ink", "spans", "wrap_width",
+    "align",          "line_height",    "line_spacing", "max_lines",     "trimming", "scale", "tab_stops"};
+constexpr std::string_view kSpanMembers[] = {"begin",          "end",       "font",          "size",
+                                             "color",          "palette",   "features",      "letter_spacing",
+                                             "baseline_shift", "underline", "strikethrough", "skip_ink"};
 constexpr std::string_view kOutlineMembers[] = {"width", "placement", "join", "miter_limit", "color"};
 constexpr std::string_view kShadowMembers[] = {"offset", "color", "blur"};
 constexpr std::string_view kGlowMembers[] = {"radius", "color"};
@@ -265,22 +271,225 @@ std::optional<Error> read_effects(const json::Value& value, const std::string& p
     return std::nullopt;
 }
 
+// A number member `name` of `object` in [low, high] into `field`; absent: `field` is kept.
+std::optional<Error> read_number(const json::Value& object, const std::string& path, const char* name, double low,
+                                 double high, float& field) {
+    const json::Value* member = object.find(name);
+    if (!member) return std::nullopt;
+    std::string range;
+    json::append_number(range, low);
+    range += ", ";
+    json::append_number(range, high);
+    if (member->type != Type::number || !(member->number >= low && member->number <= high)) {
+        std::string got = member->type_name();
+        if (member->type == Type::number) {
+            got.clear();
+            json::append_number(got, member->number);
+        }
+        return fault(path + "." + name, "expected a number in [" + range + "], got " + got);
+    }
+    field = static_cast<float>(member->number);
+    return std::nullopt;
+}
+
+std::optional<Error> read_flag(const json::Value& object, const std::string& path, const char* name, bool& field) {
+    const json::Value* member = object.find(name);
+    if (!member) return std::nullopt;
+    if (member->type != Type::boolean) {
+        return fault(path + "." + name, "expected true or false, got " + std::string(member->type_name()));
+    }
+    field = member->boolean;
+    return std::nullopt;
+}
+
+// One of `names` (in enum order) into `field`.
+template <typename Enum, size_t N>
+std::optional<Error> read_choice(const json::Value& object, const std::string& path, const char* name,
+                                 const std::string_view (&names)[N], Enum& field) {
+    const json::Value* member = object.find(name);
+    if (!member) return std::nullopt;
+    for (size_t i = 0; i < N; ++i) {
+        if (member->type == Type::string && member->string == names[i]) {
+            field = static_cast<Enum>(i);
+            return std::nullopt;
+        }
+    }
+    std::string list;
+    for (const std::string_view choice : names) list += (list.empty() ? "\"" : ", \"") + std::string(choice) + "\"";
+    const std::string got =
+        member->type == Type::string ? "\"" + printable(member->string) + "\"" : member->type_name();
+    return fault(path + "." + name, "expected one of " + list + ", got " + got);
+}
+
+// "features": {"liga": 0, "kern": 1, ...}.
+std::optional<Error> read_features(const json::Value& object, const std::string& path,
+                                   std::vector<SceneFeature>& features) {
+    const json::Value* member = object.find("features");
+    if (!member) return std::nullopt;
+    const std::string where = path + ".features";
+    if (member->type != Type::object) {
+        return fault(where,
+                     "expected an object of OpenType feature tags and values, got " + std::string(member->type_name()));
+    }
+    features.clear();
+    for (const json::Member& feature : member->object) {
+        const std::string name = where + "." + printable(feature.name, 16);
+        if (feature.name.empty() || feature.name.size() > 4 ||
+            !std::all_of(feature.name.begin(), feature.name.end(), [](char c) { return c >= 0x21 && c <= 0x7E; })) {
+            return fault(name, "a feature tag is 1 to 4 printable ASCII characters (\"liga\", \"ss01\")");
+        }
+        const json::Value& value = feature.value;
+        if (value.type != Type::number || !(value.number >= 0.0 && value.number <= 65535.0) ||
+            value.number != std::floor(value.number)) {
+            return fault(name, "expected 0 (off), 1 (on) or an alternate's index, an integer up to 65535");
+        }
+        SceneFeature out;
+        std::copy(feature.name.begin(), feature.name.end(), out.tag.begin());
+        out.value = static_cast<uint32_t>(value.number);
+        features.push_back(out);
+    }
+    return std::nullopt;
+}
+
+// A run's or span's style members over `style`, their ranges at `size` pixels per em.
+std::optional<Error> read_text_style(const json::Value& object, const std::string& path, float size,
+                                     SceneTextStyle& style) {
+    if (auto error = read_features(object, path, style.features)) return error;
+    const double em = static_cast<double>(size);
+    if (auto error = read_number(object, path, "letter_spacing", -em, em, style.letter_spacing)) return error;
+    if (auto error = read_number(object, path, "baseline_shift", -4.0 * em, 4.0 * em, style.baseline_shift))
+        return error;
+    if (auto error = read_flag(object, path, "underline", style.underline)) return error;
+    if (auto error = read_flag(object, path, "strikethrough", style.strikethrough)) return error;
+    return read_flag(object, path, "skip_ink", style.skip_ink);
+}
+
+std::optional<Error> read_font_index(const json::Value& font, const std::string& path, const Scene& scene,
+                                     uint32_t& index) {
+    if (font.type != Type::number || font.number < 0.0 || font.number != std::floor(font.number)) {
+        return fault(path, "expected an index into fonts (an integer from 0)");
+    }
+    const size_t font_count = scene.fonts.size();
+    if (font.number >= static_cast<double>(font_count)) {
+        std::string written;
+        json::append_number(written, font.number);
+        return fault(path, "index " + written + " is out of range (the scene has " + std::to_string(font_count) +
+                               (font_count == 1 ? " font)" : " fonts)"));
+    }
+    index = static_cast<uint32_t>(font.number);
+    return std::nullopt;
+}
+
+// A run's "spans": byte ranges of its text, in order, not overlapping, on code point boundaries,
+// each with the run's style where it says nothing.
+std::optional<Error> read_spans(const json::Value& value, const std::string& path, const Scene& scene, SceneRun& run) {
+    if (value.type != Type::array) {
+        return fault(path, "expected an array of span objects, got " + std::string(value.type_name()));
+    }
+    if (value.array.size() > kMaxSceneSpans) {
+        return fault(path,
+                     "at most " + std::to_string(kMaxSceneSpans) + " spans, got " + std::to_string(value.array.size()));
+    }
+    uint32_t previous_end = 0;
+    for (size_t i = 0; i < value.array.size(); ++i) {
+        const json::Value& object = value.array[i];
+        const std::string where = element(path, i);
+        if (object.type != Type::object) {
+            return fault(where, "expected an object, got " + std::string(object.type_name()));
+        }
+        if (auto error = unknown_member(object, where, kSpanMembers)) return error;
+        SceneSpan span;
+        const auto offset = [&](const char* name, uint32_t& field) -> std::optional<Error> {
+            const json::Value* member = object.find(name);
+            if (!member) return fault(where, std::string("the \"") + name + "\" member is missing");
+            const double bytes = static_cast<double>(run.text.size());
+            if (member->type != Type::number || !(member->number >= 0.0 && member->number <= bytes) ||
+                member->number != std::floor(member->number)) {
+                return fault(where + "." + name, "expected a byte offset into the run's text, an integer from 0 to " +
+                                                     std::to_string(run.text.size()));
+            }
+            field = static_cast<uint32_t>(member->number);
+            if (field < run.text.size() && (static_cast<unsigned char>(run.text[field]) & 0xC0u) == 0x80u) {
+                return fault(where + "." + name,
+                             "byte " + std::to_string(field) + " is inside a UTF-8 sequence of the run's text");
+            }
+            return std::nullopt;
+        };
+        if (auto error = offset("begin", span.begin)) return error;
+        if (auto error = offset("end", span.end)) return error;
+        if (span.end < span.begin) return fault(where, "ends before it begins");
+        if (span.begin < previous_end) {
+            return fault(where, "begins at byte " + std::to_string(span.begin) +
+                                    ", inside the span before it (which "
+                                    "ends at byte " +
+                                    std::to_string(previous_end) +
+                                    "): spans must be in order and must "
+                                    "not overlap");
+        }
+        previous_end = span.end;
+        span.font = run.font;
+        if (const json::Value* font = object.find("font")) {
+            if (auto error = read_font_index(*font, where + ".font", scene, span.font)) return error;
+        }
+        span.size = run.size;
+        if (auto error = read_number(object, where, "size", 0.0, static_cast<double>(kMaxSceneTextSize), span.size))
+            return error;
+        if (!(span.size > 0.0f) ||
+            static_cast<double>(span.size) * static_cast<double>(run.scale) > static_cast<double>(kMaxSceneTextSize))
+            return fault(where + ".size", "must be in (0, 4096] pixels per em, times the run's scale");
+        std::copy(std::begin(run.color), std::end(run.color), span.color);
+        if (const json::Value* color = object.find("color")) {
+            if (auto error = read_color(*color, where + ".color", span.color)) return error;
+        }
+        span.palette = run.palette;
+        if (const json::Value* palette = object.find("palette")) {
+            if (auto error = read_palette(*palette, where + ".palette", span.palette)) return error;
+        }
+        span.style = run.style;
+        if (auto error = read_text_style(object, where, span.size, span.style)) return error;
+        run.spans.push_back(std::move(span));
+    }
+    return std::nullopt;
+}
+
+// A run's paragraph members (crisp::LayoutOptions).
+std::optional<Error> read_paragraph(const json::Value& value, const std::string& path, SceneRun& run) {
+    if (auto error = read_number(value, path, "scale", 1.0 / 64.0, 64.0, run.scale)) return error;
+    if (static_cast<double>(run.size) * static_cast<double>(run.scale) > static_cast<double>(kMaxSceneTextSize))
+        return fault(path + ".scale", "the size times the scale must be at most 4096 pixels per em");
+    if (auto error = read_number(value, path, "wrap_width", 0.0, 1e9, run.wrap_width)) return error;
+    constexpr std::string_view kAligns[] = {"left", "center", "right", "start", "end"};
+    if (auto error = read_choice(value, path, "align", kAligns, run.align)) return error;
+    if (auto error = read_number(value, path, "line_height", 0.0, 65536.0, run.line_height)) return error;
+    if (auto error = read_number(value, path, "line_spacing", 1.0 / 64.0, 16.0, run.line_spacing)) return error;
+    float max_lines = 0.0f;
+    if (auto error = read_number(value, path, "max_lines", 0.0, 1e6, max_lines)) return error;
+    if (max_lines != std::floor(max_lines)) return fault(path + ".max_lines", "expected a whole number of lines");
+    run.max_lines = static_cast<uint32_t>(max_lines);
+    constexpr std::string_view kTrimmings[] = {"none", "end", "start", "middle"};
+    if (auto error = read_choice(value, path, "trimming", kTrimmings, run.trimming)) return error;
+    if (const json::Value* stops = value.find("tab_stops")) {
+        if (stops->type != Type::array || stops->array.size() > 256) {
+            return fault(path + ".tab_stops", "expected an array of at most 256 increasing positive numbers (pixels)");
+        }
+        for (size_t i = 0; i < stops->array.size(); ++i) {
+            const json::Value& stop = stops->array[i];
+            const double previous = run.tab_stops.empty() ? 0.0 : static_cast<double>(run.tab_stops.back());
+            if (stop.type != Type::number || !(stop.number > previous && stop.number <= 1e9)) {
+                return fault(element(path + ".tab_stops", i), "expected a number of pixels past the stop before it");
+            }
+            run.tab_stops.push_back(static_cast<float>(stop.number));
+        }
+    }
+    return std::nullopt;
+}
+
 std::optional<Error> read_run(const json::Value& value, const std::string& path, const Scene& scene, SceneRun& run) {
     if (value.type != Type::object) return fault(path, "expected an object, got " + std::string(value.type_name()));
     if (auto error = unknown_member(value, path, kRunMembers)) return error;
 
     if (const json::Value* font = value.find("font")) {
-        if (font->type != Type::number || font->number < 0.0 || font->number != std::floor(font->number)) {
-            return fault(path + ".font", "expected an index into fonts (an integer from 0)");
-        }
-        const size_t font_count = scene.fonts.size();
-        if (font->number >= static_cast<double>(font_count)) {
-            std::string index;
-            json::append_number(index, font->number);
-            return fault(path + ".font", "index " + index + " is out of range (the scene has " +
-                                             std::to_string(font_count) + (font_count == 1 ? " font)" : " fonts)"));
-        }
-        run.font = static_cast<uint32_t>(font->number);
+        if (auto error = read_font_index(*font, path + ".font", scene, run.font)) return error;
     }
 
     const json::Value* text = value.find("text");
@@ -350,7 +559,11 @@ std::optional<Error> read_run(const json::Value& value, const std::string& path,
         }
         run.transform = m;
     }
-    return read_effects(value, path, run.size, run.effects);
+    if (auto error = read_effects(value, path, run.size, run.effects)) return error;
+    if (auto error = read_text_style(value, path, run.size, run.style)) return error;
+    if (auto error = read_paragraph(value, path, run)) return error;
+    if (const json::Value* spans = value.find("spans")) return read_spans(*spans, path + ".spans", scene, run);
+    return std::nullopt;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include <crisp/contrast.hpp>
 #include <crisp/effects.hpp>
+#include <crisp/layout.hpp>
 #include <crisp/result.hpp>
 
 #include <array>
@@ -28,6 +29,38 @@ inline constexpr uint32_t kMaxSceneCanvas = 16384;   // crisp-render's --canvas 
 inline constexpr float kMaxSceneTextSize = 4096.0f;  // pixels per em, crisp-render's --size limit
 // Runs one scene may hold (docs/limits.md): a screen of UI text is hundreds.
 inline constexpr uint32_t kMaxSceneRuns = 65536;
+
+// Spans one run may hold: a paragraph with a style change every few words is hundreds.
+inline constexpr uint32_t kMaxSceneSpans = 65536;
+
+// An OpenType feature of a run or span: "features": {"liga": 0, "smcp": 1}.
+struct SceneFeature {
+    std::array<char, 4> tag{' ', ' ', ' ', ' '};  // 1 to 4 printable ASCII characters, padded with spaces
+    uint32_t value = 1;                           // 0 off, 1 on, or an alternate's index, up to 65535
+    friend bool operator==(const SceneFeature&, const SceneFeature&) = default;
+};
+
+// What a run or span styles beyond its font, size, colour and palette (crisp::TextStyle).
+struct SceneTextStyle {
+    std::vector<SceneFeature> features;
+    float letter_spacing = 0.0f;  // pixels, within the size either way
+    float baseline_shift = 0.0f;  // pixels up, within four sizes either way
+    bool underline = false;
+    bool strikethrough = false;
+    bool skip_ink = true;
+    friend bool operator==(const SceneTextStyle&, const SceneTextStyle&) = default;
+};
+
+// A styled byte range of a run's text (crisp::TextSpan): the members it gives over the run's.
+struct SceneSpan {
+    uint32_t begin = 0, end = 0;  // bytes of the run's text, on code point boundaries, in order, not overlapping
+    uint32_t font = 0;            // index into Scene::fonts: that font first, the others as fallbacks
+    float size = 0.0f;
+    float color[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    uint32_t palette = 0;
+    SceneTextStyle style;
+    friend bool operator==(const SceneSpan&, const SceneSpan&) = default;
+};
 
 struct SceneRun {
     uint32_t font = 0;                          // index into Scene::fonts
@@ -48,6 +81,18 @@ struct SceneRun {
     // "join", "miter_limit", "color"}, "shadow" {"offset": [dx, dy], "color", "blur"} and "glow"
     // {"radius", "color"}; nullopt: none.
     std::optional<TextEffects> effects;
+    SceneTextStyle style;          // "features", "letter_spacing", "baseline_shift", "underline", ...
+    std::vector<SceneSpan> spans;  // "spans": at most kMaxSceneSpans
+    // The paragraph (crisp::LayoutOptions): "wrap_width", "align", "line_height", "line_spacing",
+    // "max_lines", "trimming", "scale", "tab_stops".
+    float wrap_width = 0.0f;
+    Align align = Align::left;
+    float line_height = 0.0f;
+    float line_spacing = 1.0f;
+    uint32_t max_lines = 0;
+    Trimming trimming = Trimming::none;
+    float scale = 1.0f;
+    std::vector<float> tab_stops;
     friend bool operator==(const SceneRun&, const SceneRun&) = default;
 };
 

@@ -28,20 +28,7 @@ constexpr FontId kInterId = 11;
 constexpr FontId kCjkId = 13;
 
 std::unique_ptr<Font> bake(const std::string& path, FontId id, std::vector<uint32_t> codepoints) {
-    BakeOptions options;
-    options.all_glyphs = codepoints.empty();
-    options.codepoints = std::move(codepoints);
-    Result<BakeResult> baked = bake_font_file(path, options);
-    if (!baked) {
-        ADD_FAILURE() << path << ": " << baked.error().message;
-        return nullptr;
-    }
-    Result<Font> font = Font::create(std::move(baked.value().asset), id);
-    if (!font) {
-        ADD_FAILURE() << path << ": " << font.error().message;
-        return nullptr;
-    }
-    return std::make_unique<Font>(std::move(font).value());
+    return test::bake_font_or_fail(path, id, std::move(codepoints));
 }
 
 std::vector<uint32_t> range(uint32_t first, uint32_t last) {

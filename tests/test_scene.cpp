@@ -207,6 +207,92 @@ TEST(Scene, ARunsEffectsAreItsWeightOutlineShadowAndGlow) {
     }
 }
 
+TEST(Scene, RunsTakeSpansAndParagraphs) {
+    auto scene = parse_scene(R"({"fonts": ["a", "b"], "canvas": [8, 8], "runs": [
+        {"text": "plain caf\u00e9 bold", "size": 20, "origin": [0, 0], "color": [0, 0, 1], "underline": true,
+         "features": {"liga": 0}, "wrap_width": 300, "align": "center", "line_height": 30, "line_spacing": 1.5,
+         "max_lines": 2, "trimming": "middle", "scale": 1.5, "tab_stops": [40, 90],
+         "spans": [{"begin": 6, "end": 11, "color": [1, 0, 0], "letter_spacing": 2, "skip_ink": false},
+                   {"begin": 12, "end": 16, "font": 1, "size": 24, "baseline_shift": -3, "strikethrough": true,
+                    "features": {"smcp": 1, "ss01": 2}}]}]})");
+    ASSERT_TRUE(scene) << scene.error().message;
+    const SceneRun& run = scene->runs[0];
+    EXPECT_TRUE(run.style.underline);
+    ASSERT_EQ(run.style.features.size(), 1u);
+    EXPECT_EQ(run.style.features[0].tag, (std::array<char, 4>{'l', 'i', 'g', 'a'}));
+    EXPECT_EQ(run.style.features[0].value, 0u);
+    EXPECT_EQ(run.wrap_width, 300.0f);
+    EXPECT_EQ(run.align, Align::center);
+    EXPECT_EQ(run.line_height, 30.0f);
+    EXPECT_EQ(run.line_spacing, 1.5f);
+    EXPECT_EQ(run.max_lines, 2u);
+    EXPECT_EQ(run.trimming, Trimming::middle);
+    EXPECT_EQ(run.scale, 1.5f);
+    EXPECT_EQ(run.tab_stops, (std::vector<float>{40.0f, 90.0f}));
+    ASSERT_EQ(run.spans.size(), 2u);
+    // A span takes the run's members where it gives none.
+    const SceneSpan& red = run.spans[0];
+    EXPECT_EQ(red.begin, 6u);
+    EXPECT_EQ(red.end, 11u);
+    EXPECT_EQ(red.font, 0u);
+    EXPECT_EQ(red.size, 20.0f);
+    EXPECT_EQ(red.color[0], 1.0f);
+    EXPECT_EQ(red.color[2], 0.0f);
+    EXPECT_TRUE(red.style.underline);
+    EXPECT_FALSE(red.style.skip_ink);
+    EXPECT_EQ(red.style.letter_spacing, 2.0f);
+    EXPECT_EQ(red.style.features, run.style.features);
+    const SceneSpan& bold = run.spans[1];
+    EXPECT_EQ(bold.font, 1u);
+    EXPECT_EQ(bold.size, 24.0f);
+    EXPECT_EQ(bold.color[2], 1.0f);
+    EXPECT_EQ(bold.style.baseline_shift, -3.0f);
+    EXPECT_TRUE(bold.style.strikethrough);
+    ASSERT_EQ(bold.style.features.size(), 2u);
+    EXPECT_EQ(bold.style.features[1].tag, (std::array<char, 4>{'s', 's', '0', '1'}));
+    EXPECT_EQ(bold.style.features[1].value, 2u);
+}
+
+TEST(Scene, BadSpansNameTheirFault) {
+    const auto fault = [](const std::string& members) {
+        auto scene =
+            parse_scene(with_run(R"({"text": "caf\u00e9 au lait", "size": 9, "origin": [0, 0], )" + members + "}"));
+        return scene ? std::string("accepted") : scene.error().message;
+    };
+    const struct {
+        const char* members;
+        const char* message;
+    } cases[] = {
+        {R"("spans": [{"begin": 0, "end": 4}])",
+         "scene: runs[0].spans[0].end: byte 4 is inside a UTF-8 sequence of the run's text"},
+        {R"("spans": [{"begin": 0, "end": 3}, {"begin": 2, "end": 6}])",
+         "scene: runs[0].spans[1]: begins at byte 2, inside the span before it (which ends at byte 3)"},
+        {R"("spans": [{"begin": 0, "end": 14}])",
+         "scene: runs[0].spans[0].end: expected a byte offset into the run's text, an integer from 0 to 13"},
+        {R"("spans": [{"begin": 5, "end": 2}])", "scene: runs[0].spans[0]: ends before it begins"},
+        {R"("spans": [{"end": 2}])", "scene: runs[0].spans[0]: the \"begin\" member is missing"},
+        {R"("spans": [{"begin": 0, "end": 2, "colour": [1, 0, 0]}])",
+         "scene: runs[0].spans[0]: unknown member \"colour\""},
+        {R"("spans": [{"begin": 0, "end": 2, "font": 3}])",
+         "scene: runs[0].spans[0].font: index 3 is out of range (the scene has 1 font)"},
+        {R"("spans": [{"begin": 0, "end": 2, "letter_spacing": 10}])",
+         "scene: runs[0].spans[0].letter_spacing: expected a number in [-9, 9], got 10"},
+        {R"("spans": {"begin": 0})", "scene: runs[0].spans: expected an array of span objects"},
+        {R"("features": {"toolong": 1})", "scene: runs[0].features.toolong: a feature tag is 1 to 4 printable"},
+        {R"("features": {"liga": -1})", "scene: runs[0].features.liga: expected 0 (off), 1 (on)"},
+        {R"("underline": 1)", "scene: runs[0].underline: expected true or false, got a number"},
+        {R"("trimming": "both")",
+         "scene: runs[0].trimming: expected one of \"none\", \"end\", \"start\", \"middle\", got \"both\""},
+        {R"("max_lines": 1.5)", "scene: runs[0].max_lines: expected a whole number of lines"},
+        {R"("tab_stops": [10, 5])", "scene: runs[0].tab_stops[1]: expected a number of pixels past the stop before it"},
+        {R"("scale": 1000)", "scene: runs[0].scale: expected a number in [0.015625, 64], got 1000"},
+    };
+    for (const auto& c : cases) {
+        const std::string message = fault(c.members);
+        EXPECT_NE(message.find(c.message), std::string::npos) << c.members << "\n  got: " << message;
+    }
+}
+
 TEST(Scene, MemberOrderDoesNotMatter) {
     auto a = parse_scene(R"({"fonts": ["a", "b"], "canvas": [9, 7], "layout": "bgr", "runs": [
         {"font": 1, "text": "t", "size": 3, "origin": [1, 2], "depth": 0.25}]})");
@@ -271,7 +357,9 @@ TEST(Scene, BadScenesNameTheirFault) {
         {with_run(
              R"({"text": "a", "size": 9, "origin": [0, 0]}, {"text": "a", "size": 9, "origin": [0, 0], "colour": [0, 0, 0]})"),
          "scene: runs[1]: unknown member \"colour\" (known: font, text, size, origin, color, depth, contrast, "
-         "palette, transform, weight, outline, shadow, glow)"},
+         "palette, transform, weight, outline, shadow, glow, features, letter_spacing, baseline_shift, underline, "
+         "strikethrough, skip_ink, spans, wrap_width, align, line_height, line_spacing, max_lines, trimming, scale, "
+         "tab_stops)"},
         // runs[].font
         {with_run(R"({"font": -1, "text": "a", "size": 9, "origin": [0, 0]})"),
          "scene: runs[0].font: expected an index into fonts (an integer from 0)"},

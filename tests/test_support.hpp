@@ -62,6 +62,25 @@ inline std::unique_ptr<Font> bake_test_font(std::string_view text, FontId id = 1
     return font ? std::make_unique<Font>(std::move(*font)) : nullptr;
 }
 
+// The font at `path` baked with the glyphs of `codepoints` (all of them when empty), as FontId `id`;
+// null, with a failure of the test naming the path, when baking or loading fails.
+inline std::unique_ptr<Font> bake_font_or_fail(const std::string& path, FontId id, std::vector<uint32_t> codepoints) {
+    BakeOptions options;
+    options.all_glyphs = codepoints.empty();
+    options.codepoints = std::move(codepoints);
+    Result<BakeResult> baked = bake_font_file(path, options);
+    if (!baked) {
+        ADD_FAILURE() << path << ": " << baked.error().message;
+        return nullptr;
+    }
+    Result<Font> font = Font::create(std::move(baked.value().asset), id);
+    if (!font) {
+        ADD_FAILURE() << path << ": " << font.error().message;
+        return nullptr;
+    }
+    return std::make_unique<Font>(std::move(font).value());
+}
+
 // `text` laid out with `fonts`; where that fails, a failure of the test (with the message) and an
 // empty layout.
 inline TextLayout layout_or_fail(const std::vector<const Font*>& fonts, std::string_view text,

@@ -648,6 +648,13 @@ struct Job {
         std::optional<crisp::TextEffects> effects;      // a run's
     };
     std::vector<Draw> draws;
+    // Underlines and strikethroughs, drawn into the backdrop beneath the text, with their run's
+    // transform (about its origin) where it has one.
+    struct Decoration {
+        crisp::TextDecoration rect;
+        std::optional<crisp::TextTransform> transform;
+    };
+    std::vector<Decoration> decorations;
     size_t laid_out = 0;  // instances the text layouts produced, culled ones included
     uint32_t missing = 0, blank = 0, out_of_range = 0;
     uint32_t colour_glyphs = 0, colour_layers = 0;  // TextLayout's, culled ones included
@@ -747,6 +754,78 @@ std::vector<float> backdrop_pixels(const std::string& kind, uint32_t width, uint
     return pixels;
 }
 
+// Paints the decorations over the backdrop (premultiplied linear RGBA), each pixel by the area of
+// it the rectangle covers: exactly for an untransformed run's, by 8 x 8 samples for a transformed
+// one's (its rectangle mapped about the run's origin).
+void paint_decorations(std::vector<float>& pixels, uint32_t width, uint32_t height,
+                       std::span<const Job::Decoration> decorations) {
+    for (const Job::Decoration& decoration : decorations) {
+        const crisp::TextDecoration& r = decoration.rect;
+        double x0 = static_cast<double>(r.x), y0 = static_cast<double>(r.y);
+        double x1 = x0 + static_cast<double>(r.width), y1 = y0 + static_cast<double>(r.height);
+        // The rectangle's corners on the canvas, and for a transform the inverse map back to it.
+        std::array<std::array<double, 2>, 4> corners = {{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}};
+        const auto& t = decoration.transform;
+        if (t) {
+            for (auto& [x, y] : corners) {
+                const double dx = x - static_cast<double>(t->pivot_x), dy = y - static_cast<double>(t->pivot_y);
+                x = static_cast<double>(t->pivot_x) + static_cast<double>(t->a) * dx + static_cast<double>(t->b) * dy;
+                y = static_cast<double>(t->pivot_y) + static_cast<double>(t->c) * dx + static_cast<double>(t->d) * dy;
+            }
+        }
+        double left = corners[0][0], right = left, top = corners[0][1], bottom = top;
+        for (const auto& [x, y] : corners) {
+            left = std::min(left, x);
+            right = std::max(right, x);
+            top = std::min(top, y);
+            bottom = std::max(bottom, y);
+        }
+        const auto clamp_x = [&](double v) { return static_cast<int64_t>(std::clamp(v, 0.0, double(width))); };
+        const auto clamp_y = [&](double v) { return static_cast<int64_t>(std::clamp(v, 0.0, double(height))); };
+        const int64_t px0 = clamp_x(std::floor(left)), px1 = clamp_x(std::ceil(right));
+        const int64_t py0 = clamp_y(std::floor(top)), py1 = clamp_y(std::ceil(bottom));
+        double inverse[4] = {1.0, 0.0, 0.0, 1.0};
+        if (t) {
+            const double a = static_cast<double>(t->a), b = static_cast<double>(t->b);
+            const double c = static_cast<double>(t->c), d = static_cast<double>(t->d);
+            const double det = a * d - b * c;
+            inverse[0] = d / det;
+            inverse[1] = -b / det;
+            inverse[2] = -c / det;
+            inverse[3] = a / det;
+        }
+        const double alpha = static_cast<double>(r.color[3]);
+        for (int64_t py = py0; py < py1; ++py) {
+            for (int64_t px = px0; px < px1; ++px) {
+                double cover = 0.0;
+                if (!t) {
+                    const double w = std::min(x1, double(px + 1)) - std::max(x0, double(px));
+                    const double h = std::min(y1, double(py + 1)) - std::max(y0, double(py));
+                    cover = std::max(0.0, w) * std::max(0.0, h);
+                } else {
+                    constexpr int kSamples = 8;
+                    for (int sy = 0; sy < kSamples; ++sy) {
+                        for (int sx = 0; sx < kSamples; ++sx) {
+                            const double dx = double(px) + (sx + 0.5) / kSamples - static_cast<double>(t->pivot_x);
+                            const double dy = double(py) + (sy + 0.5) / kSamples - static_cast<double>(t->pivot_y);
+                            const double x = static_cast<double>(t->pivot_x) + inverse[0] * dx + inverse[1] * dy;
+                            const double y = static_cast<double>(t->pivot_y) + inverse[2] * dx + inverse[3] * dy;
+                            if (x >= x0 && x < x1 && y >= y0 && y < y1) cover += 1.0 / (kSamples * kSamples);
+                        }
+                    }
+                }
+                if (cover <= 0.0) continue;
+                float* p = &pixels[(static_cast<size_t>(py) * width + static_cast<size_t>(px)) * 4];
+                const double a = alpha * cover;
+                for (int ch = 0; ch < 3; ++ch)
+                    p[ch] = static_cast<float>(static_cast<double>(r.color[ch]) * a +
+                                               static_cast<double>(p[ch]) * (1.0 - a));
+                p[3] = static_cast<float>(a + static_cast<double>(p[3]) * (1.0 - a));
+            }
+        }
+    }
+}
+
 // The tile or draw path: the backdrop is uploaded into an R32G32B32A32_SFLOAT canvas image and the
 // glyphs composited into it, twice from the same backdrop (the first frame's tile counts arrive
 // with the second; once when the first ends past --max-seconds), then read back into
@@ -776,6 +855,7 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
         return exit_code_for_vulkan(image.error());
     }
     std::vector<float> backdrop = backdrop_pixels(args.backdrop, width, height, job.scene.background);
+    paint_decorations(backdrop, width, height, job.decorations);
     const std::span<const std::byte> backdrop_bytes = std::as_bytes(std::span(backdrop));
     const VkRect2D rect{{0, 0}, {width, height}};
     constexpr int kCompositeFrames = 2;
@@ -822,6 +902,13 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
     if (args.composite == crisp::CompositeMode::tiled || args.composite == crisp::CompositeMode::draw) {
         return composite_into_image(context, renderer, args, job, clock, report);
     }
+    // The reference modes composite over a flat background, where there is no backdrop to draw
+    // decorations into.
+    if (!job.decorations.empty()) {
+        out.warnings.push_back(std::to_string(job.decorations.size()) +
+                               " underlines and strikethroughs are not drawn: the reference modes draw over a flat "
+                               "background (--composite tiled and draw draw them)");
+    }
     crisp::CompositorCreateInfo info = crisp::compositor_create_info(context);
     info.width = job.scene.width;
     info.height = job.scene.height;
@@ -834,7 +921,7 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
         return exit_code_for_vulkan(created.error());
     }
     crisp::Compositor& compositor = *created;
-    out.warnings = compositor.warnings();
+    for (const std::string& warning : compositor.warnings()) out.warnings.push_back(warning);
 
     crisp::CompositeParams params;
     params.mode = args.composite;
@@ -1351,23 +1438,63 @@ void lay_out(const Arguments& args, Job& job) {
     crisp::Layouter layouter;
     crisp::TextLayout text;
     uint32_t paint_order = 0;
+    // The chain of each font: it first, the scene's others in order as fallbacks.
+    std::vector<std::vector<const crisp::Font*>> chains(job.fonts.size());
+    for (size_t first = 0; first < job.fonts.size(); ++first) {
+        chains[first].push_back(&job.fonts[first]);
+        for (size_t f = 0; f < job.fonts.size(); ++f) {
+            if (f != first) chains[first].push_back(&job.fonts[f]);
+        }
+    }
+    std::vector<crisp::TextSpan> spans;
+    std::vector<std::vector<crisp::FontFeature>> features;  // the run's, then each span's
     for (size_t i = 0; i < job.scene.runs.size(); ++i) {
         const crisp::SceneRun& run = job.scene.runs[i];
-        std::vector<const crisp::Font*> font_chain = {&job.fonts[run.font]};
-        for (size_t f = 0; f < job.fonts.size(); ++f) {
-            if (f != run.font) font_chain.push_back(&job.fonts[f]);
+        features.assign(run.spans.size() + 1, {});
+        // A scene style as the layout's (sRGB colours: the layouter linearizes them).
+        const auto style_of = [&](uint32_t font, float size, const float(&color)[4], uint32_t palette,
+                                  const crisp::SceneTextStyle& scene_style, std::vector<crisp::FontFeature>& own) {
+            crisp::TextStyle style;
+            style.size = size;
+            std::copy(std::begin(color), std::end(color), style.color);
+            style.depth = run.depth;
+            style.palette = palette;
+            if (font != run.font) style.fonts = chains[font];
+            for (const crisp::SceneFeature& feature : scene_style.features) {
+                crisp::FontFeature out;
+                std::copy(feature.tag.begin(), feature.tag.end(), out.tag);
+                out.value = feature.value;
+                own.push_back(out);
+            }
+            style.features = own;
+            style.letter_spacing = scene_style.letter_spacing;
+            style.baseline_shift = scene_style.baseline_shift;
+            style.underline = scene_style.underline;
+            style.strikethrough = scene_style.strikethrough;
+            style.skip_ink = scene_style.skip_ink;
+            return style;
+        };
+        const crisp::TextStyle style = style_of(run.font, run.size, run.color, run.palette, run.style, features[0]);
+        spans.clear();
+        for (size_t k = 0; k < run.spans.size(); ++k) {
+            const crisp::SceneSpan& span = run.spans[k];
+            spans.push_back({span.begin, span.end,
+                             style_of(span.font, span.size, span.color, span.palette, span.style, features[k + 1])});
         }
-        crisp::TextStyle style;
-        style.size = run.size;
-        std::copy(std::begin(run.color), std::end(run.color), style.color);  // sRGB: the layouter linearizes it
-        style.depth = run.depth;
-        style.palette = run.palette;
         crisp::LayoutOptions options;
         options.colour_glyphs = !args.no_colour;
         options.origin_x = run.origin_x;
         options.origin_y = run.origin_y;
         options.first_paint_order = paint_order;
-        if (crisp::Status status = layouter.layout(font_chain, run.text, style, options, text); !status) {
+        options.wrap_width = run.wrap_width;
+        options.align = run.align;
+        options.line_height = run.line_height;
+        options.line_spacing = run.line_spacing;
+        options.max_lines = run.max_lines;
+        options.trimming = run.trimming;
+        options.scale = run.scale;
+        options.tab_stops = run.tab_stops;
+        if (crisp::Status status = layouter.layout(chains[run.font], run.text, style, spans, options, text); !status) {
             const bool input = status.error().code == crisp::ErrorCode::invalid_argument;
             if (args.scene.empty()) {
                 fail(input ? kExitUsage : kExitInternal, "cannot lay out the text: " + status.error().message);
@@ -1398,6 +1525,8 @@ void lay_out(const Arguments& args, Job& job) {
             run.effects != job.draws.back().effects) {
             job.draws.push_back({job.glyphs.size(), 0, run.contrast, transform, run.effects});
         }
+        for (const crisp::TextDecoration& decoration : text.decorations)
+            job.decorations.push_back({decoration, transform});
         const size_t before = job.glyphs.size();
         for (const crisp::GlyphInstance& glyph : text.glyphs) {
             if (transform ? glyph.width > 0 : touches_canvas(glyph, job.scene.width, job.scene.height))

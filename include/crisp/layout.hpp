@@ -98,13 +98,60 @@ enum class Direction : uint8_t {
     rtl,
 };
 
+// An OpenType feature set for a style: on (1), off (0), or an alternate's index (for 'salt',
+// 'cv01', ... and 'aalt'), over HarfBuzz's defaults for the script ('kern', 'liga', 'clig', 'calt',
+// the script's own). A tag shorter than four letters is padded with spaces.
+struct FontFeature {
+    char tag[4] = {' ', ' ', ' ', ' '};  // printable ASCII: "liga", "kern", "smcp", "ss01", "tnum", ...
+    uint32_t value = 1;
+};
+
 struct TextStyle {
-    float size = 16.0f;                         // pixels per em, horizontally; (0, kMaxTextSize]
-    float size_y = 0.0f;                        // pixels per em, vertically; 0: same as size
+    float size = 16.0f;   // pixels per em, horizontally, times LayoutOptions::scale; (0, kMaxTextSize]
+    float size_y = 0.0f;  // pixels per em, vertically; 0: same as size
     float color[4] = {0.0f, 0.0f, 0.0f, 1.0f};  // sRGB, straight (not premultiplied) alpha; clamped to [0, 1]
     float depth = 0.0f;                         // copied to every instance, for the compositor
     // CPAL palette of colour glyphs; past a font's palettes (or in a font without any), palette 0.
     uint32_t palette = 0;
+    // The fallback list of this style's text, as the `fonts` of Layouter::layout; empty: those
+    // fonts. A span in another weight or family names its own list (a bold face, then the same
+    // fallbacks). Read during the call only.
+    std::span<const Font* const> fonts = {};
+    // Features switched on or off for this style's text. Read during the call only.
+    std::span<const FontFeature> features = {};
+    // Added after every shaped cluster (tracking), in pixels times LayoutOptions::scale; may be
+    // negative; in [-size, size].
+    float letter_spacing = 0.0f;
+    // Moves the glyphs up (positive) or down from the line's baseline, in pixels times
+    // LayoutOptions::scale (superscripts, subscripts); in [-4 size, 4 size].
+    float baseline_shift = 0.0f;
+    // Lines drawn through the text at the positions and thicknesses the font gives (post's
+    // underline, OS/2's strikeout), in the text's colour, into TextLayout::decorations.
+    bool underline = false;
+    bool strikethrough = false;
+    // The underline is broken where glyphs cross it (descenders of g, j, p, q, y), with a gap of
+    // one underline thickness either side of the ink.
+    bool skip_ink = true;
+};
+
+// A style over a byte range of the text: the whole style of that range (copy the layout's style
+// and change what differs). Text outside every span takes the layout's style. Glyphs take the
+// style of their cluster's first character (a ligature of two spans' characters takes the first's).
+// Text is shaped as one across span boundaries where the font chosen, the size and the features
+// agree, so a change of colour, decoration, spacing or shift keeps kerning and ligatures.
+struct TextSpan {
+    uint32_t begin = 0;  // byte range [begin, end) of the text; both on code point boundaries
+    uint32_t end = 0;
+    TextStyle style;
+};
+
+// Where a line that does not fit loses text to an ellipsis (U+2026, or "..." where no font of the
+// style has it).
+enum class Trimming : uint8_t {
+    none,    // lines past max_lines are dropped; nothing is cut from the last
+    end,     // the last line shows what fits before the ellipsis ("A long tit…")
+    start,   // the rest of the last line's paragraph, with its start cut ("…ng title")
+    middle,  // the rest of the last line's paragraph, with its middle cut ("A lo…itle")
 };
 
 struct LayoutOptions {
@@ -134,6 +181,22 @@ struct LayoutOptions {
     // Colour glyphs (FontAsset::colour_glyphs) become their layers; false draws each as its plain
     // outline, one instance with kNoPaint. Fonts are chosen the same either way.
     bool colour_glyphs = true;
+    // Logical sizes times scale are pixels: styles' sizes, letter spacing and baseline shift, the
+    // wrap width, line height and tab stops are logical; origin_x and origin_y are canvas pixels,
+    // as is everything the layout returns. For a display's content scale (1.5 at 144 dpi); (0, 64].
+    float scale = 1.0f;
+    // Baseline to baseline: 0 gives each line the height of its tallest style (the layout's style
+    // at least, as CSS's strut) times line_spacing; above 0, every line this many logical pixels.
+    float line_height = 0.0f;
+    float line_spacing = 1.0f;  // (0, 16]
+    // Lines laid out at most (0: all); what does not fit is dropped, and `trimming` says where an
+    // ellipsis shows that it was (TextLayout::trimmed says whether it was).
+    uint32_t max_lines = 0;
+    Trimming trimming = Trimming::none;
+    // Tab stops in logical pixels from the line's left edge, increasing: a tab advances to the
+    // first stop past the pen, and past the last stop to the next multiple of `tab_spaces` space
+    // advances. Read during the call only.
+    std::span<const float> tab_stops = {};
 };
 
 struct GlyphInstance {
@@ -165,19 +228,44 @@ struct TextLine {
     float x = 0.0f;  // left edge of the line's content (its visual start), canvas pixels
     float baseline_y = 0.0f;
     float width = 0.0f;  // advance width of the content, spaces hanging at its end excluded
-    bool rtl = false;    // the paragraph's direction
+    // The line's box above and below the baseline, pixels: its tallest style's ascender and
+    // descender (the layout's style at least), baseline shifts included. A caret is this tall.
+    float ascent = 0.0f;
+    float descent = 0.0f;
+    bool rtl = false;  // the paragraph's direction
+};
+
+enum class DecorationKind : uint8_t { underline, strikethrough };
+
+// A line through text (TextStyle::underline, ::strikethrough): a rectangle for the caller to draw
+// in its colour at its depth, beneath the text's glyphs (crisp-render and the example engine draw
+// them so). Consecutive glyphs of one line, kind, colour, position and thickness share one
+// rectangle; an underline skipping ink is several.
+struct TextDecoration {
+    float x = 0.0f;  // canvas pixels, y down: the rectangle's top-left and size
+    float y = 0.0f;
+    float width = 0.0f;
+    float height = 0.0f;
+    float color[4] = {};  // LINEAR RGB and alpha, as GlyphInstance::color
+    float depth = 0.0f;
+    uint32_t line = 0;
+    uint32_t text_begin = 0;  // byte range of the text it decorates
+    uint32_t text_end = 0;
+    DecorationKind kind = DecorationKind::underline;
 };
 
 struct TextLayout {
-    std::vector<GlyphInstance> glyphs;  // in logical order
-    std::vector<TextLine> lines;        // one per line, hard or wrapped; empty for empty text
+    std::vector<GlyphInstance> glyphs;        // in logical order
+    std::vector<TextLine> lines;              // one per line, hard or wrapped; empty for empty text
+    std::vector<TextDecoration> decorations;  // underlines and strikethroughs, line by line
     // The box of the line boxes: from the leftmost line start to the rightmost line end, from
     // the first line's ascender down `lines.size()` line heights.
     float x = 0.0f;
     float y = 0.0f;
     float width = 0.0f;
     float height = 0.0f;
-    float line_height = 0.0f;          // pixels between baselines (whole when snapping)
+    float line_height = 0.0f;          // pixels between baselines of the layout's style (whole when snapping)
+    bool trimmed = false;              // max_lines dropped text (Trimming says where an ellipsis shows it)
     uint32_t shaped_glyphs = 0;        // glyphs HarfBuzz produced, blank and dropped ones included
     uint32_t missing_glyphs = 0;       // .notdef glyphs (characters no font has); they are emitted
     uint32_t blank_glyphs = 0;         // glyphs without an outline (dropped unless keep_blank_glyphs)
@@ -215,6 +303,17 @@ public:
     Status layout(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
                   const LayoutOptions& options, TextLayout& out);
 
+    // The same with styled spans over the text (TextSpan). Spans must be in order of their
+    // ranges, which must not overlap; an empty span is ignored. Also returns invalid_argument,
+    // naming the span, for a span that ends before it begins, ends past the text, begins or ends
+    // inside a UTF-8 sequence (a code point, or an ill-formed part the text decodes as one
+    // U+FFFD), overlaps the one before it, or whose style fails the checks of `style` or holds a
+    // null font, a feature tag that is not printable ASCII, or a letter spacing or baseline
+    // shift that is not finite or past its range. The fonts of all lists together count toward
+    // the 65535 fonts, and two different Fonts of any lists must not share a FontId.
+    Status layout(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
+                  std::span<const TextSpan> spans, const LayoutOptions& options, TextLayout& out);
+
 private:
     struct State;
     std::unique_ptr<State> state_;
@@ -223,6 +322,9 @@ private:
 // One-shot convenience: a temporary Layouter. Same behaviour and errors as Layouter::layout.
 CRISP_API Result<TextLayout> layout_text(std::span<const Font* const> fonts, std::string_view utf8,
                                          const TextStyle& style, const LayoutOptions& options);
+CRISP_API Result<TextLayout> layout_text(std::span<const Font* const> fonts, std::string_view utf8,
+                                         const TextStyle& style, std::span<const TextSpan> spans,
+                                         const LayoutOptions& options);
 
 // sRGB-encoded component (0..1) to linear light, with the exact piecewise sRGB transfer function.
 CRISP_API float srgb_to_linear(float encoded);

@@ -50,6 +50,49 @@ Status check_finite(const char* name, float value) {
     return {};
 }
 
+// The checks of a style, named `name` ("style", "spans[3].style") in messages.
+Status check_style(const std::string& name, const TextStyle& style, float scale) {
+    const std::string prefix = name + ".";
+    if (Status status = check_size((prefix + "size").c_str(), style.size); !status) return status;
+    if (style.size_y != 0.0f) {
+        if (Status status = check_size((prefix + "size_y").c_str(), style.size_y); !status) return status;
+    }
+    const float tallest = std::max(style.size, style.size_y);
+    if (static_cast<double>(tallest) * static_cast<double>(scale) > static_cast<double>(kMaxTextSize))
+        return invalid("layout: " + prefix + "size times options.scale is " +
+                       show(static_cast<float>(static_cast<double>(tallest) * static_cast<double>(scale))) +
+                       " pixels per em, more than 4096");
+    const std::pair<const char*, float> finite[] = {
+        {"color[0]", style.color[0]},
+        {"color[1]", style.color[1]},
+        {"color[2]", style.color[2]},
+        {"color[3]", style.color[3]},
+        {"depth", style.depth},
+        {"letter_spacing", style.letter_spacing},
+        {"baseline_shift", style.baseline_shift},
+    };
+    for (const auto& [member, value] : finite) {
+        if (Status status = check_finite((prefix + member).c_str(), value); !status) return status;
+    }
+    if (std::abs(style.letter_spacing) > style.size)
+        return invalid("layout: " + prefix + "letter_spacing is " + show(style.letter_spacing) +
+                       "; it must lie within one size (" + show(style.size) + ") either way");
+    if (std::abs(style.baseline_shift) > 4.0f * tallest)
+        return invalid("layout: " + prefix + "baseline_shift is " + show(style.baseline_shift) +
+                       "; it must lie within four sizes (" + show(4.0f * tallest) + ") either way");
+    for (size_t i = 0; i < style.fonts.size(); ++i) {
+        if (style.fonts[i] == nullptr) return invalid("layout: " + prefix + "fonts[" + std::to_string(i) + "] is null");
+    }
+    for (size_t i = 0; i < style.features.size(); ++i) {
+        for (const char letter : style.features[i].tag) {
+            if (letter < 0x20 || letter > 0x7E)
+                return invalid("layout: " + prefix + "features[" + std::to_string(i) +
+                               "] has a tag that is not four printable ASCII characters");
+        }
+    }
+    return {};
+}
+
 Status validate(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
                 const LayoutOptions& options) {
     if (fonts.empty()) return invalid("layout: the font list is empty; pass at least one font");
@@ -64,22 +107,33 @@ Status validate(std::span<const Font* const> fonts, std::string_view utf8, const
                                "; their glyph keys would collide");
         }
     }
-    if (Status status = check_size("style.size", style.size); !status) return status;
-    if (style.size_y != 0.0f) {
-        if (Status status = check_size("style.size_y", style.size_y); !status) return status;
-    }
     const std::pair<const char*, float> finite[] = {
-        {"style.color[0]", style.color[0]},     {"style.color[1]", style.color[1]},
-        {"style.color[2]", style.color[2]},     {"style.color[3]", style.color[3]},
-        {"style.depth", style.depth},           {"options.origin_x", options.origin_x},
-        {"options.origin_y", options.origin_y}, {"options.wrap_width", options.wrap_width},
+        {"options.origin_x", options.origin_x},       {"options.origin_y", options.origin_y},
+        {"options.wrap_width", options.wrap_width},   {"options.scale", options.scale},
+        {"options.line_height", options.line_height}, {"options.line_spacing", options.line_spacing},
     };
     for (const auto& [name, value] : finite) {
         if (Status status = check_finite(name, value); !status) return status;
     }
+    if (!(options.scale > 0.0f) || options.scale > 64.0f)
+        return invalid("layout: options.scale is " + show(options.scale) + "; it must lie in (0, 64]");
+    if (Status status = check_style("style", style, options.scale); !status) return status;
     if (options.wrap_width < 0.0f)
         return invalid("layout: options.wrap_width is " + show(options.wrap_width) +
                        "; it must be 0 (no wrapping) or positive");
+    if (options.line_height < 0.0f || options.line_height > 16.0f * kMaxTextSize)
+        return invalid("layout: options.line_height is " + show(options.line_height) +
+                       "; it must be 0 (from the fonts) or a positive number of pixels up to 65536");
+    if (!(options.line_spacing > 0.0f) || options.line_spacing > 16.0f)
+        return invalid("layout: options.line_spacing is " + show(options.line_spacing) + "; it must lie in (0, 16]");
+    float previous_stop = 0.0f;
+    for (size_t i = 0; i < options.tab_stops.size(); ++i) {
+        const float stop = options.tab_stops[i];
+        if (!std::isfinite(stop) || !(stop > previous_stop) || static_cast<double>(stop) > kMaxCoordinate)
+            return invalid("layout: options.tab_stops[" + std::to_string(i) + "] is " + show(stop) +
+                           "; tab stops must be finite, positive and increasing");
+        previous_stop = stop;
+    }
     const uint32_t steps = options.subpixel_steps;
     if (steps == 0 || steps > kSubpixelSteps || (steps & (steps - 1)) != 0)
         return invalid("layout: options.subpixel_steps is " + std::to_string(steps) +
@@ -107,7 +161,9 @@ void quantize(double pen, uint32_t steps, int32_t& whole, uint8_t& subpixel) {
 void reset(TextLayout& out, uint32_t first_paint_order) {
     out.glyphs.clear();
     out.lines.clear();
+    out.decorations.clear();
     out.x = out.y = out.width = out.height = out.line_height = 0.0f;
+    out.trimmed = false;
     out.shaped_glyphs = out.missing_glyphs = out.blank_glyphs = out.out_of_range_glyphs = out.mark_splits = 0;
     out.ignorable_splits = 0;
     out.colour_glyphs = out.colour_layers = 0;
@@ -132,13 +188,188 @@ float srgb_to_linear(float encoded) {
     return static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
 }
 
+bool Layouter::State::resolve_styles(std::span<const Font* const> font_list, const TextStyle& base,
+                                     std::span<const TextSpan> spans) {
+    const LayoutOptions& o = *options;
+    const double scale = static_cast<double>(o.scale);
+    all_fonts.assign(font_list.begin(), font_list.end());
+    font_map.clear();
+    styles.clear();
+    features.clear();
+    font_index.clear();
+    font_by_id.clear();
+    for (size_t i = 0; i < font_list.size(); ++i) {
+        font_index.emplace(font_list[i], static_cast<uint16_t>(i));
+        font_by_id.emplace(font_list[i]->id(), font_list[i]);
+    }
+    // Byte offsets to code points, walking the spans in order: a span's ends must be code point
+    // boundaries (offsets holds every one, and the text's size).
+    size_t cursor = 0;
+    auto code_point_at = [&](uint32_t byte, size_t& index) {
+        while (cursor < offsets.size() && offsets[cursor] < byte) ++cursor;
+        index = cursor;
+        return cursor < offsets.size() && offsets[cursor] == byte;
+    };
+    std::fill(style_of.begin(), style_of.end(), 0u);
+    auto add_style = [&](const TextStyle& style) -> bool {
+        StyleView view;
+        view.style = &style;
+        const bool own_list =
+            !style.fonts.empty() && !(style.fonts.data() == font_list.data() && style.fonts.size() == font_list.size());
+        if (!own_list) {
+            view.font_map = UINT32_MAX;
+            view.font_count = static_cast<uint16_t>(font_list.size());
+        } else if (!styles.empty() && styles.back().font_map != UINT32_MAX &&
+                   std::equal(style.fonts.begin(), style.fonts.end(), styles.back().style->fonts.begin(),
+                              styles.back().style->fonts.end())) {
+            view.font_map = styles.back().font_map;  // the span before had this list too
+            view.font_count = styles.back().font_count;
+        } else {
+            if (style.fonts.size() > 65535) {
+                failure = "layout: a span's font list has " + std::to_string(style.fonts.size()) +
+                          " fonts, at most 65535 are supported";
+                return false;
+            }
+            view.font_map = static_cast<uint32_t>(font_map.size());
+            view.font_count = static_cast<uint16_t>(style.fonts.size());
+            for (const Font* font : style.fonts) {
+                auto [found, added] = font_index.emplace(font, static_cast<uint16_t>(all_fonts.size()));
+                if (added) {
+                    if (all_fonts.size() >= 65535) {
+                        failure = "layout: the spans' font lists hold more than 65535 different fonts";
+                        return false;
+                    }
+                    auto [same_id, fresh] = font_by_id.emplace(font->id(), font);
+                    if (!fresh) {
+                        failure = "layout: two different fonts of the font lists have the same FontId " +
+                                  std::to_string(font->id()) + "; their glyph keys would collide";
+                        return false;
+                    }
+                    all_fonts.push_back(font);
+                }
+                font_map.push_back(found->second);
+            }
+        }
+        view.feature_begin = static_cast<uint32_t>(features.size());
+        view.feature_count = static_cast<uint32_t>(style.features.size());
+        for (const FontFeature& feature : style.features) {
+            const auto tag = static_cast<hb_tag_t>((uint32_t{static_cast<uint8_t>(feature.tag[0])} << 24) |
+                                                   (uint32_t{static_cast<uint8_t>(feature.tag[1])} << 16) |
+                                                   (uint32_t{static_cast<uint8_t>(feature.tag[2])} << 8) |
+                                                   uint32_t{static_cast<uint8_t>(feature.tag[3])});
+            features.push_back({tag, feature.value, HB_FEATURE_GLOBAL_START, HB_FEATURE_GLOBAL_END});
+        }
+        const auto px = [&](float logical) {
+            const double value = static_cast<double>(logical) * scale;
+            return static_cast<float>(o.snap_to_pixels ? std::round(value) : value);
+        };
+        view.size_x_fixed = key_size(static_cast<double>(style.size) * scale);
+        view.size_y_fixed = key_size(static_cast<double>(style.size_y == 0.0f ? style.size : style.size_y) * scale);
+        view.size_x = static_cast<double>(view.size_x_fixed) / kSizeOne;
+        view.size_y = static_cast<double>(view.size_y_fixed) / kSizeOne;
+        for (int c = 0; c < 3; ++c) view.color[c] = srgb_to_linear(std::clamp(style.color[c], 0.0f, 1.0f));
+        view.color[3] = std::clamp(style.color[3], 0.0f, 1.0f);
+        view.letter_spacing = px(style.letter_spacing);
+        view.baseline_shift = px(style.baseline_shift);
+        const Font& first = own_list ? *style.fonts[0] : *font_list[0];
+        const double shift = static_cast<double>(view.baseline_shift);
+        view.above = static_cast<double>(first.ascender()) * view.size_y + shift;
+        view.descent = -static_cast<double>(first.descender()) * view.size_y - shift;
+        view.gap = static_cast<double>(first.line_gap()) * view.size_y;
+        if (styles.empty()) {
+            strut_above = view.above - shift;
+            strut_descent = view.descent + shift;
+            strut_below = strut_descent + view.gap;
+            strut_height = static_cast<double>(first.line_height()) * view.size_y;
+        }
+        styles.push_back(view);
+        return true;
+    };
+    if (!add_style(base)) return false;
+    uint32_t previous_end = 0;
+    for (size_t k = 0; k < spans.size(); ++k) {
+        const TextSpan& span = spans[k];
+        const std::string name = "spans[" + std::to_string(k) + "]";
+        if (span.end < span.begin) {
+            failure = "layout: " + name + " ends (byte " + std::to_string(span.end) + ") before it begins (byte " +
+                      std::to_string(span.begin) + ")";
+            return false;
+        }
+        if (span.end > offsets.back()) {
+            failure = "layout: " + name + " ends at byte " + std::to_string(span.end) + ", past the text's " +
+                      std::to_string(offsets.back()) + " bytes";
+            return false;
+        }
+        if (span.begin < previous_end) {
+            failure = "layout: " + name + " begins at byte " + std::to_string(span.begin) +
+                      ", inside the span before it (which ends at byte " + std::to_string(previous_end) +
+                      "): spans must be in order and must not overlap";
+            return false;
+        }
+        if (Status status = check_style(name + ".style", span.style, o.scale); !status) {
+            failure = status.error().message;
+            return false;
+        }
+        size_t first = 0, last = 0;
+        if (!code_point_at(span.begin, first) || !code_point_at(span.end, last)) {
+            failure = "layout: " + name + " " + (offsets[first] == span.begin ? "ends" : "begins") + " at byte " +
+                      std::to_string(offsets[first] == span.begin ? span.end : span.begin) +
+                      ", inside a UTF-8 sequence: spans begin and end on code point boundaries";
+            return false;
+        }
+        previous_end = span.end;
+        if (span.begin == span.end) continue;
+        if (!add_style(span.style)) return false;
+        std::fill(style_of.begin() + static_cast<ptrdiff_t>(first), style_of.begin() + static_cast<ptrdiff_t>(last),
+                  static_cast<uint32_t>(styles.size() - 1));
+    }
+    fonts = all_fonts;
+    return true;
+}
+
+bool Layouter::State::same_shaping(uint32_t a, uint32_t b) const {
+    if (a == b) return true;
+    const StyleView& x = styles[a];
+    const StyleView& y = styles[b];
+    if (x.size_x_fixed != y.size_x_fixed || x.size_y_fixed != y.size_y_fixed || x.feature_count != y.feature_count)
+        return false;
+    for (uint32_t i = 0; i < x.feature_count; ++i) {
+        const hb_feature_t& f = features[x.feature_begin + i];
+        const hb_feature_t& g = features[y.feature_begin + i];
+        if (f.tag != g.tag || f.value != g.value) return false;
+    }
+    return true;
+}
+
+// The font of every character of the paragraph, in all_fonts: each stretch of one fallback list
+// chooses in that list.
+void Layouter::State::choose_paragraph_fonts(uint32_t p0, uint32_t p1) {
+    const std::span<const uint32_t> text(codepoints);
+    const std::span<const uint8_t> flag_span(flags);
+    for (uint32_t begin = p0; begin < p1;) {
+        const StyleView& view = styles[style_of[begin]];
+        uint32_t end = begin + 1;
+        while (end < p1 && styles[style_of[end]].font_map == view.font_map) ++end;
+        const std::span<uint16_t> chosen(font_of.data() + begin, end - begin);
+        if (view.font_map == UINT32_MAX) {
+            choose_fonts(fonts.first(base_font_count), text.subspan(begin, end - begin),
+                         flag_span.subspan(begin, end - begin), chosen);
+        } else {
+            choose_fonts(view.style->fonts, text.subspan(begin, end - begin), flag_span.subspan(begin, end - begin),
+                         chosen);
+            for (uint16_t& font : chosen) font = font_map[view.font_map + font];
+        }
+        begin = end;
+    }
+}
+
 bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level, hb_script_t script,
-                            uint16_t font) {
+                            uint16_t font, uint32_t style) {
     // HarfBuzz (before 10.2, which lets the caller set it) stops a buffer at max(64 glyphs a
     // character, 16,384): a run it cannot hold is shaped again in halves, cut before a character
     // that starts a cluster, down to pieces of kPieceCharacters.
     constexpr uint32_t kPieceCharacters = 16;
-    if (shape_once(p0, p1, begin, end, level, script, font)) {
+    if (shape_once(p0, p1, begin, end, level, script, font, style)) {
         if (glyphs_shaped <= kMaxLayoutGlyphs) return true;
         failure = "layout: the text shapes into more than " + std::to_string(kMaxLayoutGlyphs) +
                   " glyphs (kMaxLayoutGlyphs) by its character " + std::to_string(end) + " of " +
@@ -150,7 +381,8 @@ bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t e
     uint32_t middle = begin + (end - begin) / 2;
     while (middle > begin && (flags[middle] & (kCharAttached | kCharEmojiNext)) != 0) --middle;
     if (end - begin > kPieceCharacters && middle > begin) {
-        return shape(p0, p1, begin, middle, level, script, font) && shape(p0, p1, middle, end, level, script, font);
+        return shape(p0, p1, begin, middle, level, script, font, style) &&
+               shape(p0, p1, middle, end, level, script, font, style);
     }
     failure = "layout: shaping characters " + std::to_string(begin) + " to " + std::to_string(end) +
               " makes more glyphs than HarfBuzz's buffer holds (16384 for up to 256 characters, 64 a character "
@@ -159,7 +391,8 @@ bool Layouter::State::shape(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t e
 }
 
 bool Layouter::State::shape_once(uint32_t p0, uint32_t p1, uint32_t begin, uint32_t end, uint8_t level,
-                                 hb_script_t script, uint16_t font) {
+                                 hb_script_t script, uint16_t font, uint32_t style) {
+    const StyleView& view = styles[style];
     const bool rtl = (level & 1) != 0;
     hb_buffer_clear_contents(buffer);
     hb_buffer_set_direction(buffer, rtl ? HB_DIRECTION_RTL : HB_DIRECTION_LTR);
@@ -173,7 +406,7 @@ bool Layouter::State::shape_once(uint32_t p0, uint32_t p1, uint32_t begin, uint3
     hb_buffer_set_flags(buffer, static_cast<hb_buffer_flags_t>(buffer_flags));
     hb_buffer_add_codepoints(buffer, codepoints.data() + p0, static_cast<int>(p1 - p0), begin - p0,
                              static_cast<int>(end - begin));
-    hb_shape(fonts[font]->harfbuzz_font(), buffer, nullptr, 0);
+    hb_shape(fonts[font]->harfbuzz_font(), buffer, features.data() + view.feature_begin, view.feature_count);
     if (!hb_buffer_allocation_successful(buffer)) return false;
 
     unsigned count = 0;
@@ -182,7 +415,7 @@ bool Layouter::State::shape_once(uint32_t p0, uint32_t p1, uint32_t begin, uint3
     if (glyphs_shaped > kMaxLayoutGlyphs) return true;  // shape() says so
     const hb_glyph_position_t* positions = hb_buffer_get_glyph_positions(buffer, nullptr);
     const double per_unit = 1.0 / fonts[font]->units_per_em();
-    const double scale_x = per_unit * size_x, scale_y = per_unit * size_y;
+    const double scale_x = per_unit * view.size_x, scale_y = per_unit * view.size_y;
     const bool snap = options->snap_to_pixels;
     auto pixels = [snap](double value) { return static_cast<float>(snap ? std::round(value) : value); };
     // Grown geometrically: reserving exactly size + count here reallocated on every run (quadratic
@@ -201,6 +434,12 @@ bool Layouter::State::shape_once(uint32_t p0, uint32_t p1, uint32_t begin, uint3
         glyph.font = font;
         // What hb.h's hb_glyph_info_get_glyph_flags() macro reads, without its C casts.
         glyph.unsafe_to_break = (infos[i].mask & HB_GLYPH_FLAG_UNSAFE_TO_BREAK) != 0;
+        const StyleView& own = styles[style_of[glyph.cluster]];
+        glyph.y_offset += own.baseline_shift;
+        // Letter spacing after each cluster, on the glyph of it placed last (lines are placed in
+        // visual order): the last in logical order left to right, the first right to left.
+        const bool placed_last = (rtl ? k == 0 : k + 1 == count) || infos[i + 1].cluster != infos[i].cluster;
+        if (placed_last) glyph.advance += own.letter_spacing;
         shaped.push_back(glyph);
     }
     return true;
@@ -209,7 +448,11 @@ bool Layouter::State::shape_once(uint32_t p0, uint32_t p1, uint32_t begin, uint3
 void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     const LayoutOptions& o = *options;
     if (p0 == p1) {
-        lines.push_back({p0, p1, 0.0, o.direction == Direction::rtl});
+        lines.push_back({p0, p1, 0.0, strut_above, strut_descent, strut_below, false, o.direction == Direction::rtl});
+        if (o.max_lines != 0 && lines.size() >= o.max_lines) {
+            stopped = true;
+            for (size_t i = p1; i < codepoints.size() && !dropped; ++i) dropped = !is_hard_break(codepoints[i]);
+        }
         return;
     }
     const size_t n = p1 - p0;
@@ -226,7 +469,7 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     for (size_t i = 0; i < n; ++i)
         if ((paragraph_flags[i] & kCharTab) != 0) codepoints[p0 + i] = ' ';
     resolve_scripts(text, paragraph_flags, std::span(scripts.data() + p0, n));
-    choose_fonts(fonts, text, paragraph_flags, std::span(font_of.data() + p0, n));
+    choose_paragraph_fonts(p0, p1);
 
     runs.clear();
     shaped.clear();
@@ -252,7 +495,7 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
                           (codepoints[i - 1] == ' ' || length >= kMaxShapingRunCharacters + 256));
         }
         if (i < p1 && !split && !cut && levels[i] == levels[i - 1] && scripts[i] == scripts[i - 1] &&
-            font_of[i] == font_of[i - 1])
+            font_of[i] == font_of[i - 1] && same_shaping(style_of[i - 1], style_of[i]))
             continue;
         if (split) {
             ++mark_splits;
@@ -264,9 +507,10 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
         run.end = i;
         run.script = scripts[run_begin];
         run.font = font_of[run_begin];
+        run.style = style_of[run_begin];
         run.level = levels[run_begin];
         run.glyph_begin = shaped.size();
-        if (!shape(p0, p1, run.begin, run.end, run.level, run.script, run.font)) {
+        if (!shape(p0, p1, run.begin, run.end, run.level, run.script, run.font, run.style)) {
             failed = true;
             return;
         }
@@ -281,18 +525,33 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
     }
     for (const Run& run : runs) flags[run.begin] |= kCharClusterStart;  // run boundaries were shaped apart
 
-    if (o.wrap_width > 0.0f) {
+    if (wrap_width > 0.0) {
         std::fill(cluster_advance.begin() + p0, cluster_advance.begin() + p1, 0.0f);
         for (const ShapedGlyph& glyph : shaped) {
             // A tab is at most a full tab stop wide: measuring it so keeps wrapped lines inside.
-            const bool tab = (flags[glyph.cluster] & kCharTab) != 0 && tab_width > 0.0;
-            cluster_advance[glyph.cluster] += tab ? static_cast<float>(tab_width) : glyph.advance;
+            const bool tab = (flags[glyph.cluster] & kCharTab) != 0 && tab_measure > 0.0;
+            cluster_advance[glyph.cluster] += tab ? static_cast<float>(tab_measure) : glyph.advance;
         }
     }
     break_lines(p0, p1);
+    size_t kept = line_ranges.size();
+    bool trim = false;
+    if (o.max_lines != 0 && lines.size() + kept >= o.max_lines) {
+        // The last line max_lines allows: the layout stops after it, and trims it where text
+        // (more than line breaks) follows.
+        stopped = true;
+        kept = o.max_lines - lines.size();
+        dropped = kept < line_ranges.size();
+        for (size_t i = p1; i < codepoints.size() && !dropped; ++i) dropped = !is_hard_break(codepoints[i]);
+        trim = dropped && o.trimming != Trimming::none;
+    }
     size_t run_cursor = 0, glyph_cursor = 0;
-    for (const auto& [line_begin, line_end] : line_ranges) {
-        place_line(p0, p1, line_begin, line_end, base_level, run_cursor, glyph_cursor);
+    for (size_t i = 0; i < kept; ++i) {
+        const auto [line_begin, line_end] = line_ranges[i];
+        if (trim && i + 1 == kept)
+            place_trimmed_line(p0, p1, line_begin, line_end, base_level, run_cursor, glyph_cursor);
+        else
+            place_line(p0, p1, line_begin, line_end, base_level, run_cursor, glyph_cursor);
         if (failed) return;
     }
 }
@@ -300,12 +559,8 @@ void Layouter::State::paragraph(uint32_t p0, uint32_t p1) {
 // The placed glyphs as instances into `out`, line by line: .notdef for glyphs the asset lacks,
 // colour glyphs as their layers, blank glyphs kept only when asked, pens beyond kMaxCoordinate
 // counted and dropped.
-void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
+void Layouter::State::emit_glyphs(TextLayout& out) {
     const LayoutOptions& o = *options;
-    float color[4];
-    for (int c = 0; c < 3; ++c) color[c] = srgb_to_linear(std::clamp(style.color[c], 0.0f, 1.0f));
-    color[3] = std::clamp(style.color[3], 0.0f, 1.0f);
-    const uint32_t size_x_fixed = key_size(size_x), size_y_fixed = key_size(size_y);
 
     out.glyphs.reserve(placed.size());
     out.shaped_glyphs = static_cast<uint32_t>(std::min<size_t>(placed.size(), UINT32_MAX));
@@ -350,13 +605,14 @@ void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
             int32_t whole_x = 0, whole_y = 0;
             quantize(pen_x, o.subpixel_steps, whole_x, instance.key.subpixel_x);
             quantize(pen_y, o.subpixel_steps, whole_y, instance.key.subpixel_y);
+            const StyleView& view = styles[style_of[placed_glyph.cluster]];
             instance.key.font = font.id;
-            instance.key.size_x = size_x_fixed;
-            instance.key.size_y = size_y_fixed;
+            instance.key.size_x = view.size_x_fixed;
+            instance.key.size_y = view.size_y_fixed;
             instance.pen_x = static_cast<float>(pen_x);
             instance.pen_y = static_cast<float>(pen_y);
-            std::copy(std::begin(color), std::end(color), std::begin(instance.color));
-            instance.depth = style.depth;
+            std::copy(std::begin(view.color), std::end(view.color), std::begin(instance.color));
+            instance.depth = view.style->depth;
             instance.cluster = offsets[placed_glyph.cluster];
             instance.line = static_cast<uint32_t>(i);
             // The outline `outline` of glyph index `index` at the glyph's pen, next in paint order.
@@ -379,7 +635,7 @@ void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
             ++out.colour_glyphs;
             out.colour_layers += drawn_layers;
             instance.colour_glyph = colour_index;
-            instance.palette = font.palette;
+            instance.palette = view.style->palette < font.asset->palette_count() ? view.style->palette : 0;
             for (const ColourLayer& layer : layers) {
                 if (!font.is_drawn(layer)) continue;
                 instance.paint = layer.paint;
@@ -391,59 +647,74 @@ void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
     out.next_paint_order = o.first_paint_order + static_cast<uint32_t>(out.glyphs.size());
 }
 
-void Layouter::State::finish(const TextStyle& style, TextLayout& out) {
+void Layouter::State::finish(TextLayout& out) {
     align_lines(out);
-    emit_glyphs(style, out);
+    emit_glyphs(out);
+    decorate(out);
 }
 
 Status Layouter::State::layout(std::span<const Font* const> font_list, std::string_view utf8, const TextStyle& style,
-                               const LayoutOptions& layout_options, TextLayout& out) {
+                               std::span<const TextSpan> spans, const LayoutOptions& layout_options, TextLayout& out) {
     reset(out, layout_options.first_paint_order);
     if (Status status = validate(font_list, utf8, style, layout_options); !status) return status;
 
-    fonts = font_list;
-    font_views.clear();
-    for (const Font* font : fonts) {
-        const FontAsset& asset = font->asset();
-        const uint32_t palette = style.palette < asset.palette_count() ? style.palette : 0;
-        font_views.push_back({asset.glyphs.data(), asset.glyphs.size(), font->id(), &asset, palette});
-    }
     options = &layout_options;
-    failed = false;
+    failed = stopped = dropped = false;
     failure.clear();
     glyphs_shaped = 0;
     mark_splits = ignorable_splits = 0;
-    size_x = static_cast<double>(key_size(static_cast<double>(style.size))) / kSizeOne;
-    const float size_y_asked = style.size_y == 0.0f ? style.size : style.size_y;
-    size_y = static_cast<double>(key_size(static_cast<double>(size_y_asked))) / kSizeOne;
+    decode_utf8_with_offsets(utf8, codepoints, offsets);
+    const size_t n = codepoints.size();
+    style_of.resize(n);
+    base_font_count = font_list.size();
+    if (!resolve_styles(font_list, style, spans)) return invalid(failure);
+    font_views.clear();
+    for (const Font* font : fonts) {
+        const FontAsset& asset = font->asset();
+        font_views.push_back({asset.glyphs.data(), asset.glyphs.size(), font->id(), &asset});
+    }
+    const double scale = static_cast<double>(layout_options.scale);
+    wrap_width = static_cast<double>(layout_options.wrap_width) * scale;
     language = layout_options.language != nullptr && layout_options.language[0] != '\0'
                    ? hb_language_from_string(layout_options.language, -1)
                    : nullptr;
-    tab_width = 0.0;
-    if (layout_options.tab_spaces > 0 && utf8.find('\t') != std::string_view::npos) {
-        const Font& first = *fonts[0];
-        hb_position_t space = 0;
-        const uint32_t space_glyph = first.nominal_glyph(' ');
-        if (first.has_glyph_for(' ')) space = hb_font_get_glyph_h_advance(first.harfbuzz_font(), space_glyph);
-        double space_width = space / static_cast<double>(first.units_per_em()) * size_x;
-        if (!(space_width > 0.0)) space_width = 0.25 * size_x;  // no space glyph: a quarter em
-        if (layout_options.snap_to_pixels) space_width = std::max(1.0, std::round(space_width));
-        tab_width = space_width * layout_options.tab_spaces;
+    tab_width = tab_measure = 0.0;
+    tab_stops.clear();
+    if (utf8.find('\t') != std::string_view::npos) {
+        if (layout_options.tab_spaces > 0) {
+            const Font& first = *fonts[0];
+            const double size_x = styles[0].size_x;
+            hb_position_t space = 0;
+            const uint32_t space_glyph = first.nominal_glyph(' ');
+            if (first.has_glyph_for(' ')) space = hb_font_get_glyph_h_advance(first.harfbuzz_font(), space_glyph);
+            double space_width = space / static_cast<double>(first.units_per_em()) * size_x;
+            if (!(space_width > 0.0)) space_width = 0.25 * size_x;  // no space glyph: a quarter em
+            if (layout_options.snap_to_pixels) space_width = std::max(1.0, std::round(space_width));
+            tab_width = space_width * layout_options.tab_spaces;
+        }
+        tab_measure = tab_width;
+        double previous = 0.0;
+        for (const float logical : layout_options.tab_stops) {
+            double stop = static_cast<double>(logical) * scale;
+            if (layout_options.snap_to_pixels) stop = std::round(stop);
+            if (!tab_stops.empty() && stop <= tab_stops.back()) continue;  // rounded onto the one before
+            tab_stops.push_back(stop);
+            tab_measure = std::max(tab_measure, stop - previous);
+            previous = stop;
+        }
     }
     placed.clear();
     lines.clear();
-    if (utf8.empty()) {
-        finish(style, out);
+    if (n == 0) {
+        finish(out);
         return {};
     }
 
-    decode_utf8_with_offsets(utf8, codepoints, offsets);
-    const size_t n = codepoints.size();
     flags.resize(n);
     levels.resize(n);
     scripts.resize(n);
     font_of.resize(n);
-    if (layout_options.wrap_width > 0.0f) cluster_advance.resize(n);
+    if (wrap_width > 0.0) cluster_advance.resize(n);
 
     uint32_t begin = 0;
     for (;;) {
@@ -454,10 +725,11 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
             reset(out, layout_options.first_paint_order);
             return invalid(failure);
         }
-        if (end == n) break;
+        if (end == n || stopped) break;
         begin = end + (codepoints[end] == '\r' && end + 1 < n && codepoints[end + 1] == '\n' ? 2 : 1);
     }
-    finish(style, out);
+    out.trimmed = dropped;
+    finish(out);
     return {};
 }
 
@@ -468,9 +740,14 @@ Layouter::~Layouter() = default;
 
 Status Layouter::layout(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
                         const LayoutOptions& options, TextLayout& out) {
+    return layout(fonts, utf8, style, {}, options, out);
+}
+
+Status Layouter::layout(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
+                        std::span<const TextSpan> spans, const LayoutOptions& options, TextLayout& out) {
     assert(state_ && "a moved-from Layouter may only be destroyed or assigned to");
     try {
-        return state_->layout(fonts, utf8, style, options, out);
+        return state_->layout(fonts, utf8, style, spans, options, out);
     } catch (const std::exception& error) {
         // Only allocation can throw here (a text too large for memory): no exception crosses the API.
         reset(out, options.first_paint_order);
@@ -480,9 +757,14 @@ Status Layouter::layout(std::span<const Font* const> fonts, std::string_view utf
 
 Result<TextLayout> layout_text(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
                                const LayoutOptions& options) {
+    return layout_text(fonts, utf8, style, {}, options);
+}
+
+Result<TextLayout> layout_text(std::span<const Font* const> fonts, std::string_view utf8, const TextStyle& style,
+                               std::span<const TextSpan> spans, const LayoutOptions& options) {
     Layouter layouter;
     TextLayout layout;
-    if (Status status = layouter.layout(fonts, utf8, style, options, layout); !status) return status.error();
+    if (Status status = layouter.layout(fonts, utf8, style, spans, options, layout); !status) return status.error();
     return layout;
 }
 

@@ -222,6 +222,52 @@ public:
                  1000.0f);
     }
 
+    // A 10,000-glyph paragraph wrapped at 600 px, unstyled and with a style change every 20
+    // glyphs: colour only (shaping runs go on across them), colour and underline, the size, and
+    // the font (DejaVu Sans and Inter alternating: runs cut at each change).
+    void styled_text_cases() {
+        std::fprintf(out_,
+                     "\n| styled paragraph | spans | glyphs out | median ms | fastest ms | ns per glyph (median) |\n");
+        std::fprintf(out_, "|---|---:|---:|---:|---:|---:|\n");
+        const std::string words = "Lorem ipsum dolor sit amet, consectetur adipiscing elit, sed do eiusmod tempor. ";
+        std::string text;
+        while (text.size() < 11'800) text += words;  // about 10,000 glyphs (spaces are not emitted)
+        const std::vector<const crisp::Font*> inter = {all_fonts_[1], all_fonts_[0]};
+        // Spans over every other 20 characters: as many boundaries as a change every 20 glyphs.
+        auto spans_of = [&](auto&& style_of) {
+            std::vector<crisp::TextSpan> spans;
+            for (uint32_t begin = 20; begin + 20 <= text.size(); begin += 40)
+                spans.push_back({begin, begin + 20, style_of()});
+            return spans;
+        };
+        crisp::TextStyle base{.size = 14.0f};
+        const auto coloured = [&] {
+            crisp::TextStyle style = base;
+            style.color[0] = 0.8f;
+            return style;
+        };
+        styled_case("unstyled", text, {}, base);
+        styled_case("colour every 20 glyphs", text, spans_of(coloured), base);
+        styled_case("colour and underline every 20 glyphs", text, spans_of([&] {
+                        crisp::TextStyle style = coloured();
+                        style.underline = true;
+                        return style;
+                    }),
+                    base);
+        styled_case("size every 20 glyphs (14 and 18 px)", text, spans_of([&] {
+                        crisp::TextStyle style = base;
+                        style.size = 18.0f;
+                        return style;
+                    }),
+                    base);
+        styled_case("font every 20 glyphs (DejaVu Sans and Inter)", text, spans_of([&] {
+                        crisp::TextStyle style = base;
+                        style.fonts = inter;
+                        return style;
+                    }),
+                    base);
+    }
+
     // Every case measured, for the JSON.
     void write_json(crisp::JsonWriter& json) const {
         json.key("cases").begin_array();
@@ -315,6 +361,19 @@ private:
         std::snprintf(label, sizeof(label), "%s (%zu bytes, %zu lines, widest %.2g px)", name, text.size(),
                       layout_.lines.size(), static_cast<double>(layout_.width));
         print_row(label, 1, layout_.glyphs.size(), m);
+    }
+
+    void styled_case(const std::string& what, const std::string& text, const std::vector<crisp::TextSpan>& spans,
+                     const crisp::TextStyle& style) {
+        const std::string name = "10k-glyph paragraph, " + what;
+        if (!selected(name)) return;
+        crisp::LayoutOptions options;
+        options.wrap_width = 600.0f;
+        const Measurement m = measure(args_.warmup, args_.runs, [&] {
+            if (!layouter_.layout(one_, text, style, spans, options, layout_)) std::abort();
+        });
+        ::print_row(out_, name, spans.size(), layout_.glyphs.size(), m);
+        cases_.push_back({name, spans.size(), layout_.glyphs.size(), m});
     }
 
     void acquire_all(crisp::GlyphAtlas& atlas, const std::vector<crisp::GlyphInstance>& glyphs) const {
@@ -431,6 +490,8 @@ void crisp::bench::run_cpu(Session& session) {
     bench.atlas_cases();
     progress("cpu", "large text cases");
     bench.large_text_cases();
+    progress("cpu", "styled text cases");
+    bench.styled_text_cases();
     session.json.begin_object().field("runs", args.runs).field("warmup", args.warmup);
     bench.write_json(session.json);
     session.json.end_object();
