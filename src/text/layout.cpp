@@ -107,6 +107,7 @@ void quantize(double pen, uint32_t steps, int32_t& whole, uint8_t& subpixel) {
 void reset(TextLayout& out, uint32_t first_paint_order) {
     out.glyphs.clear();
     out.lines.clear();
+    out.clusters.clear();
     out.x = out.y = out.width = out.height = out.line_height = 0.0f;
     out.shaped_glyphs = out.missing_glyphs = out.blank_glyphs = out.out_of_range_glyphs = out.mark_splits = 0;
     out.ignorable_splits = 0;
@@ -393,6 +394,7 @@ void Layouter::State::emit_glyphs(const TextStyle& style, TextLayout& out) {
 
 void Layouter::State::finish(const TextStyle& style, TextLayout& out) {
     align_lines(out);
+    emit_clusters(out);
     emit_glyphs(style, out);
 }
 
@@ -431,6 +433,7 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
         tab_width = space_width * layout_options.tab_spaces;
     }
     placed.clear();
+    clusters.clear();
     lines.clear();
     if (utf8.empty()) {
         finish(style, out);

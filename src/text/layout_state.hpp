@@ -72,6 +72,16 @@ struct FontView {
     }
 };
 
+// A cluster placed on its line (TextCluster before alignment): code points, x from the line's left
+// edge.
+struct ClusterRecord {
+    uint32_t begin = 0, end = 0;
+    uint32_t line = 0;
+    double x = 0.0;
+    double advance = 0.0;
+    uint8_t level = 0;
+};
+
 struct LineRecord {
     uint32_t begin = 0, end = 0;  // code points, hanging spaces included, hard break excluded
     double width = 0.0;
@@ -115,9 +125,11 @@ struct CRISP_HIDDEN Layouter::State {
     std::vector<Piece> pieces;
     std::vector<uint32_t> order;
     std::vector<double> glyph_x;
+    std::vector<double> glyph_advance;  // the pen's advance past each glyph (a tab's to its stop)
 
     // Until the end of the call.
     std::vector<PlacedGlyph> placed;
+    std::vector<ClusterRecord> clusters;
     std::vector<LineRecord> lines;
     std::vector<double> line_x, line_baseline;
 
@@ -144,7 +156,9 @@ struct CRISP_HIDDEN Layouter::State {
     double place_pieces(size_t content_pieces, uint8_t base_level);
     void place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, uint32_t line_end, uint8_t base_level,
                     size_t& run_cursor, size_t& glyph_cursor);
+    void record_clusters(uint32_t line);
     void align_lines(TextLayout& out);
+    void emit_clusters(TextLayout& out) const;
     void emit_glyphs(const TextStyle& style, TextLayout& out);
     bool safe_to_break(uint32_t at) const {
         return (flags[at] & kCharClusterStart) != 0 && (flags[at] & kCharUnsafe) == 0;

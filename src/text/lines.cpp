@@ -135,6 +135,7 @@ void Layouter::State::order_pieces(size_t content_pieces) {
 // stop), then the hanging spaces past it in the paragraph's direction. Returns the content's width.
 double Layouter::State::place_pieces(size_t content_pieces, uint8_t base_level) {
     glyph_x.resize(shaped.size());
+    glyph_advance.resize(shaped.size());
     double x = 0.0;
     auto place = [&](const Piece& piece, bool tabs) {
         // Right-to-left pieces go through their glyphs backwards: HarfBuzz's offsets are relative
@@ -151,6 +152,7 @@ double Layouter::State::place_pieces(size_t content_pieces, uint8_t base_level) 
                 const double stop = (std::floor(x / tab_width + 1e-3) + 1.0) * tab_width;
                 advance = stop - x;
             }
+            glyph_advance[g] = advance;
             x += advance;
         }
     };
@@ -184,7 +186,44 @@ void Layouter::State::place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, 
             placed.push_back({glyph_x[g], glyph.y_offset, glyph.glyph, glyph.cluster, line, glyph.font});
         }
     }
+    record_clusters(line);
     lines.push_back({line_begin, line_end, width, (base_level & 1) != 0});
+}
+
+// The clusters of the placed pieces, in logical order: each run of glyphs of one HarfBuzz cluster
+// value, reaching to the next cluster's first character (the piece's ends at its ends), from its
+// leftmost pen over its glyphs' advances.
+void Layouter::State::record_clusters(uint32_t line) {
+    for (const Piece& piece : pieces) {
+        for (size_t g = piece.glyph_begin; g < piece.glyph_end;) {
+            ClusterRecord cluster{g == piece.glyph_begin ? piece.begin : shaped[g].cluster,
+                                  piece.end,
+                                  line,
+                                  std::numeric_limits<double>::infinity(),
+                                  0.0,
+                                  piece.level};
+            const uint32_t value = shaped[g].cluster;
+            for (; g < piece.glyph_end && shaped[g].cluster <= value; ++g) {
+                cluster.x = std::min(cluster.x, glyph_x[g] - static_cast<double>(shaped[g].x_offset));
+                cluster.advance += glyph_advance[g];
+            }
+            if (g < piece.glyph_end) cluster.end = shaped[g].cluster;
+            clusters.push_back(cluster);
+        }
+    }
+}
+
+void Layouter::State::emit_clusters(TextLayout& out) const {
+    out.clusters.resize(clusters.size());
+    for (size_t i = 0; i < clusters.size(); ++i) {
+        const ClusterRecord& cluster = clusters[i];
+        out.clusters[i] = {offsets[cluster.begin],
+                           offsets[cluster.end],
+                           cluster.line,
+                           static_cast<float>(line_x[cluster.line] + cluster.x),
+                           static_cast<float>(cluster.advance),
+                           cluster.level};
+    }
 }
 
 // Each line's x (aligned within the wrap width, or the widest line) and baseline into line_x and
@@ -207,6 +246,8 @@ void Layouter::State::align_lines(TextLayout& out) {
     line_baseline.resize(lines.size());
     out.lines.resize(lines.size());
     double left = std::numeric_limits<double>::infinity(), right = -left;
+    const auto ascent = static_cast<float>(static_cast<double>(fonts[0]->ascender()) * size_y);
+    const auto descent = static_cast<float>(-static_cast<double>(fonts[0]->descender()) * size_y);
     for (size_t i = 0; i < lines.size(); ++i) {
         const LineRecord& line = lines[i];
         Align align = o.align;
@@ -225,12 +266,16 @@ void Layouter::State::align_lines(TextLayout& out) {
         record.x = static_cast<float>(x);
         record.baseline_y = static_cast<float>(line_baseline[i]);
         record.width = static_cast<float>(line.width);
+        record.ascent = ascent;
+        record.descent = descent;
         record.rtl = line.rtl;
     }
+    // Empty text: the box where its first line's would start, of no size (where its caret goes).
+    out.x = static_cast<float>(origin_x);
+    out.y = static_cast<float>(origin_y - static_cast<double>(fonts[0]->ascender()) * size_y);
     if (!lines.empty()) {
         out.x = static_cast<float>(left);
         out.width = static_cast<float>(right - left);
-        out.y = static_cast<float>(origin_y - static_cast<double>(fonts[0]->ascender()) * size_y);
         out.height = static_cast<float>(line_height * static_cast<double>(lines.size()));
     }
 }
