@@ -47,8 +47,7 @@ bool is_rtl(const TextCluster& cluster) {
     return (cluster.level & 1) != 0;
 }
 
-// A grapheme's share of a cluster: its byte range, its place in the cluster in logical order,
-// and its left and right edges on the canvas.
+// A grapheme's share of a cluster: its byte range and its left and right edges on the canvas.
 struct Part {
     uint32_t begin = 0, end = 0;
     float left = 0.0f, right = 0.0f;
@@ -118,22 +117,21 @@ uint32_t line_of(const TextLayout& layout, TextPosition position) {
     return line;
 }
 
-// Where a position's caret is: the edge it is at, and the part of the character it belongs to,
-// on whose leading or trailing side.
+// Where a position's caret is: the edge it is at, and on which side of the character it belongs
+// to (its leading or trailing one, in that character's direction).
 struct Edge {
     float x = 0.0f;
     bool found = false;  // false: the line has no character for it; x is the line's
     bool leading = false;
     bool rtl = false;
-    Part part;
 };
 
 Edge leading_edge(const TextCluster& cluster, const Part& part) {
-    return {is_rtl(cluster) ? part.right : part.left, true, true, is_rtl(cluster), part};
+    return {is_rtl(cluster) ? part.right : part.left, true, true, is_rtl(cluster)};
 }
 
 Edge trailing_edge(const TextCluster& cluster, const Part& part) {
-    return {is_rtl(cluster) ? part.left : part.right, true, false, is_rtl(cluster), part};
+    return {is_rtl(cluster) ? part.left : part.right, true, false, is_rtl(cluster)};
 }
 
 // The caret rule (crisp/editing.hpp) for a position already snapped, on line `line`.
