@@ -8,6 +8,7 @@ packages=(
   libfreetype-dev                        # font outlines for the baker
   libharfbuzz-dev                        # shaping, GSUB closure for subset bakes, asset font checks
   libfribidi-dev                         # the Unicode bidirectional algorithm for mixed-direction text
+  libicu-dev                             # grapheme cluster and word boundaries for caret motion (UAX #29)
   libvulkan-dev                          # the Vulkan loader and headers
   mesa-vulkan-drivers                    # lavapipe, the CPU Vulkan driver the GPU tests run on
   vulkan-validationlayers                # the validation layer the tests turn on

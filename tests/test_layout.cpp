@@ -610,6 +610,86 @@ TEST_F(Layout, TabsAdvanceToStops) {
                 advance(*dejavu_, spaces.glyphs[0].key.glyph, 16) + space, 1e-3f);
 }
 
+// The clusters of a layout tile each line's text and its width: in logical order, without gaps,
+// side by side on screen.
+void expect_clusters_tile_lines(const TextLayout& layout) {
+    size_t c = 0;
+    for (uint32_t i = 0; i < layout.lines.size(); ++i) {
+        const TextLine& line = layout.lines[i];
+        uint32_t next = line.text_begin;
+        float left = std::numeric_limits<float>::infinity(), right = -left, content = 0.0f;
+        for (; c < layout.clusters.size() && layout.clusters[c].line == i; ++c) {
+            const TextCluster& cluster = layout.clusters[c];
+            EXPECT_EQ(cluster.text_begin, next) << "line " << i;
+            EXPECT_LT(cluster.text_begin, cluster.text_end);
+            next = cluster.text_end;
+            left = std::min(left, cluster.x);
+            right = std::max(right, cluster.x + cluster.advance);
+            content += cluster.advance;
+        }
+        EXPECT_EQ(next, line.text_end) << "line " << i;
+        if (line.text_begin != line.text_end) {
+            EXPECT_NEAR(right - left, content, 1e-3f) << "line " << i;
+        }
+    }
+    EXPECT_EQ(c, layout.clusters.size());
+}
+
+TEST_F(Layout, ClustersCoverTheTextInLogicalOrder) {
+    // Bytes: a0 b1 c2 ' '3 alef4 bet6 gimel8 ' '10 d11 e12 f13
+    const TextLayout mixed = lay("abc \u05D0\u05D1\u05D2 def", {.size = 20});
+    ASSERT_EQ(mixed.clusters.size(), 11u);
+    expect_clusters_tile_lines(mixed);
+    for (const TextCluster& cluster : mixed.clusters) {
+        // Spaces are clusters though their glyphs are dropped; Hebrew is odd, the rest even.
+        const bool hebrew = cluster.text_begin >= 4 && cluster.text_begin < 10;
+        EXPECT_EQ(cluster.level & 1, hebrew ? 1 : 0) << cluster.text_begin;
+        const GlyphInstance* glyph = at_cluster(mixed, cluster.text_begin);
+        if (glyph != nullptr) {
+            EXPECT_NEAR(glyph->pen_x, cluster.x, 1e-3f) << cluster.text_begin;
+        }
+    }
+    // The Hebrew reads right to left: alef is the rightmost of the three.
+    EXPECT_GT(mixed.clusters[4].x, mixed.clusters[5].x);
+    EXPECT_GT(mixed.clusters[5].x, mixed.clusters[6].x);
+    EXPECT_NEAR(mixed.clusters[6].x, mixed.clusters[3].x + mixed.clusters[3].advance, 1e-3f);
+
+    // A ligature and a mark with its base are one cluster each; a tab reaches to its stop.
+    const TextLayout ligature = lay("office e\u0301\tx", {.size = 20}, {.tab_spaces = 4});
+    expect_clusters_tile_lines(ligature);
+    EXPECT_LT(ligature.clusters.size(), 10u);
+    const auto mark = std::find_if(ligature.clusters.begin(), ligature.clusters.end(),
+                                   [](const TextCluster& cluster) { return cluster.text_begin == 7; });
+    ASSERT_NE(mark, ligature.clusters.end());
+    EXPECT_EQ(mark->text_end, 10u);
+    const TextCluster& tab = *(mark + 1);
+    const float space = advance(*dejavu_, dejavu_->nominal_glyph(' '), 20);
+    const float stops = (tab.x + tab.advance - ligature.lines[0].x) / (4 * space);
+    EXPECT_NEAR(stops, std::round(stops), 1e-4f);
+    EXPECT_GT(tab.advance, 0.0f);
+
+    // Wrapped lines, centred: the hanging space is the first line's last cluster, after alignment.
+    const TextLayout wrapped = lay("abc def", {.size = 20}, {.wrap_width = 50, .align = Align::center});
+    ASSERT_EQ(wrapped.lines.size(), 2u);
+    expect_clusters_tile_lines(wrapped);
+    ASSERT_EQ(wrapped.clusters.size(), 7u);
+    EXPECT_EQ(wrapped.clusters[3].line, 0u);
+    EXPECT_NEAR(wrapped.clusters[3].x, wrapped.lines[0].x + wrapped.lines[0].width, 1e-3f);
+    EXPECT_NEAR(wrapped.clusters[4].x, wrapped.lines[1].x, 1e-3f);
+    EXPECT_GT(wrapped.lines[0].x, 0.0f);
+
+    // The line box: the font's ascender above the baseline and descender below it.
+    EXPECT_NEAR(mixed.lines[0].ascent, dejavu_->ascender() * 20, 1e-4f);
+    EXPECT_NEAR(mixed.lines[0].descent, -dejavu_->descender() * 20, 1e-4f);
+    EXPECT_NEAR(mixed.y, mixed.lines[0].baseline_y - mixed.lines[0].ascent, 1e-4f);
+
+    // Empty text has no clusters, and its box starts where its first line's would.
+    const TextLayout empty = lay("", {.size = 20}, {.origin_x = 5, .origin_y = 30});
+    EXPECT_TRUE(empty.clusters.empty());
+    EXPECT_FLOAT_EQ(empty.x, 5.0f);
+    EXPECT_NEAR(empty.y, 30.0f - dejavu_->ascender() * 20, 1e-4f);
+}
+
 TEST_F(Layout, ReusedLayouterGivesTheSameResult) {
     Layouter layouter;
     const Font* fonts[] = {inter_, dejavu_, cjk_};

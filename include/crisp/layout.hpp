@@ -228,8 +228,9 @@ struct TextLine {
     float x = 0.0f;  // left edge of the line's content (its visual start), canvas pixels
     float baseline_y = 0.0f;
     float width = 0.0f;  // advance width of the content, spaces hanging at its end excluded
-    // The line's box above and below the baseline, pixels: its tallest style's ascender and
-    // descender (the layout's style at least), baseline shifts included. A caret is this tall.
+    // The line's box: pixels above and below its baseline (positive both), where carets and
+    // selections are drawn: its tallest style's ascender and descender (the layout's style at
+    // least), baseline shifts included.
     float ascent = 0.0f;
     float descent = 0.0f;
     bool rtl = false;  // the paragraph's direction
@@ -254,12 +255,30 @@ struct TextDecoration {
     DecorationKind kind = DecorationKind::underline;
 };
 
+// One shaped cluster: a base character with its marks, or all the characters of a ligature, as
+// HarfBuzz clusters them; what carets, hit tests and selections (crisp/editing.hpp) work on.
+struct TextCluster {
+    uint32_t text_begin = 0;  // byte range of its characters in the UTF-8 text
+    uint32_t text_end = 0;
+    uint32_t line = 0;     // index into TextLayout::lines
+    float x = 0.0f;        // left edge on the canvas, pixels, after alignment
+    float advance = 0.0f;  // width: the sum of its glyphs' advances (a tab's to its stop)
+    uint8_t level = 0;     // bidi embedding level: odd is right-to-left
+};
+
 struct TextLayout {
     std::vector<GlyphInstance> glyphs;        // in logical order
     std::vector<TextLine> lines;              // one per line, hard or wrapped; empty for empty text
     std::vector<TextDecoration> decorations;  // underlines and strikethroughs, line by line
+    // Every shaped cluster in logical order (so in increasing text_begin, and line by line),
+    // blank ones (spaces, tabs, hanging spaces) included whatever keep_blank_glyphs says.
+    // Characters HarfBuzz shapes into no glyph (default ignorables) join a neighbouring cluster of
+    // their run; a run of nothing else (a bidi control between runs) and hard line breaks are in
+    // none.
+    std::vector<TextCluster> clusters;
     // The box of the line boxes: from the leftmost line start to the rightmost line end, from
-    // the first line's ascender down `lines.size()` line heights.
+    // the first line's ascender down `lines.size()` line heights. Empty text: x and y are where
+    // its first line's box would start (its caret's place), width and height 0.
     float x = 0.0f;
     float y = 0.0f;
     float width = 0.0f;

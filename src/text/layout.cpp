@@ -162,6 +162,7 @@ void reset(TextLayout& out, uint32_t first_paint_order) {
     out.glyphs.clear();
     out.lines.clear();
     out.decorations.clear();
+    out.clusters.clear();
     out.x = out.y = out.width = out.height = out.line_height = 0.0f;
     out.trimmed = false;
     out.shaped_glyphs = out.missing_glyphs = out.blank_glyphs = out.out_of_range_glyphs = out.mark_splits = 0;
@@ -649,6 +650,7 @@ void Layouter::State::emit_glyphs(TextLayout& out) {
 
 void Layouter::State::finish(TextLayout& out) {
     align_lines(out);
+    emit_clusters(out);
     emit_glyphs(out);
     decorate(out);
 }
@@ -704,6 +706,7 @@ Status Layouter::State::layout(std::span<const Font* const> font_list, std::stri
         }
     }
     placed.clear();
+    clusters.clear();
     lines.clear();
     if (n == 0) {
         finish(out);

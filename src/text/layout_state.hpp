@@ -101,6 +101,16 @@ struct StyleView {
     double above = 0.0, descent = 0.0, gap = 0.0;
 };
 
+// A cluster placed on its line (TextCluster before alignment): code points, x from the line's left
+// edge.
+struct ClusterRecord {
+    uint32_t begin = 0, end = 0;
+    uint32_t line = 0;
+    double x = 0.0;
+    double advance = 0.0;
+    uint8_t level = 0;
+};
+
 struct LineRecord {
     uint32_t begin = 0, end = 0;  // code points, hanging spaces included, hard break excluded
     double width = 0.0;
@@ -162,10 +172,11 @@ struct CRISP_HIDDEN Layouter::State {
     std::vector<Piece> pieces;
     std::vector<uint32_t> order;
     std::vector<double> glyph_x;
-    std::vector<float> glyph_advance;
+    std::vector<double> glyph_advance;  // the pen's advance past each glyph (a tab's to its stop)
 
     // Until the end of the call.
     std::vector<PlacedGlyph> placed;
+    std::vector<ClusterRecord> clusters;
     std::vector<LineRecord> lines;
     std::vector<double> line_x, line_baseline;
     std::vector<DecorationStretch> decoration_stretches;
@@ -209,7 +220,9 @@ struct CRISP_HIDDEN Layouter::State {
     double place_pieces(size_t content_pieces, uint8_t base_level);
     void place_line(uint32_t p0, uint32_t p1, uint32_t line_begin, uint32_t line_end, uint8_t base_level,
                     size_t& run_cursor, size_t& glyph_cursor);
+    void record_clusters(uint32_t line);
     void align_lines(TextLayout& out);
+    void emit_clusters(TextLayout& out) const;
     void emit_glyphs(TextLayout& out);
     void decorate(TextLayout& out);
     void skip_ink(size_t first, TextLayout& out);

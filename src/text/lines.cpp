@@ -283,7 +283,7 @@ double Layouter::State::place_pieces(size_t content_pieces, uint8_t base_level) 
                 else if (tab_width > 0.0)
                     advance = (std::floor(x / tab_width + 1e-3) + 1.0) * tab_width - x;
             }
-            glyph_advance[g] = static_cast<float>(advance);
+            glyph_advance[g] = advance;
             x += advance;
         }
     };
@@ -322,7 +322,7 @@ void Layouter::State::finish_line(uint32_t line_begin, uint32_t line_end, size_t
         for (size_t g = piece.glyph_begin; g < piece.glyph_end; ++g) {
             const ShapedGlyph& glyph = shaped[g];
             placed.push_back({glyph_x[g], glyph.y_offset, glyph.glyph, glyph.cluster, line, glyph.font, glyph.x_offset,
-                              glyph_advance[g]});
+                              static_cast<float>(glyph_advance[g])});
             const StyleView& view = styles[style_of[glyph.cluster]];
             record.above = std::max(record.above, view.above);
             record.descent = std::max(record.descent, view.descent);
@@ -330,7 +330,46 @@ void Layouter::State::finish_line(uint32_t line_begin, uint32_t line_end, size_t
         }
     }
     record.tall = record.above > strut_above || record.below > strut_below;
+    record_clusters(line);
     lines.push_back(record);
+}
+
+// The clusters of the placed pieces, in logical order: each run of glyphs of one HarfBuzz cluster
+// value, reaching to the next cluster's first character (the piece's ends at its ends), from its
+// leftmost pen over its glyphs' advances.
+void Layouter::State::record_clusters(uint32_t line) {
+    for (const Piece& piece : pieces) {
+        // A trimmed line's ellipsis stands for hidden text: no caret goes into it.
+        if (piece.begin == piece.end) continue;
+        for (size_t g = piece.glyph_begin; g < piece.glyph_end;) {
+            ClusterRecord cluster{g == piece.glyph_begin ? piece.begin : shaped[g].cluster,
+                                  piece.end,
+                                  line,
+                                  std::numeric_limits<double>::infinity(),
+                                  0.0,
+                                  piece.level};
+            const uint32_t value = shaped[g].cluster;
+            for (; g < piece.glyph_end && shaped[g].cluster <= value; ++g) {
+                cluster.x = std::min(cluster.x, glyph_x[g] - static_cast<double>(shaped[g].x_offset));
+                cluster.advance += glyph_advance[g];
+            }
+            if (g < piece.glyph_end) cluster.end = shaped[g].cluster;
+            clusters.push_back(cluster);
+        }
+    }
+}
+
+void Layouter::State::emit_clusters(TextLayout& out) const {
+    out.clusters.resize(clusters.size());
+    for (size_t i = 0; i < clusters.size(); ++i) {
+        const ClusterRecord& cluster = clusters[i];
+        out.clusters[i] = {offsets[cluster.begin],
+                           offsets[cluster.end],
+                           cluster.line,
+                           static_cast<float>(line_x[cluster.line] + cluster.x),
+                           static_cast<float>(cluster.advance),
+                           cluster.level};
+    }
 }
 
 // Each line's x (aligned within the wrap width, or the widest line) and baseline into line_x and
@@ -386,6 +425,9 @@ void Layouter::State::align_lines(TextLayout& out) {
         record.descent = static_cast<float>(line.descent);
         record.rtl = line.rtl;
     }
+    // Empty text: the box where its first line's would start, of no size (where its caret goes).
+    out.x = static_cast<float>(origin_x);
+    out.y = static_cast<float>(origin_y - strut_above);
     if (!lines.empty()) {
         // From the first line's top down to where a line after the last would start.
         out.x = static_cast<float>(left);
