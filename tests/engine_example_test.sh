@@ -295,12 +295,14 @@ PY
 # ---- The command line.
 "$example" --help >help.txt || fail "--help exited $?"
 for option in --frames --screenshot --validation --drop-every --resize-at --minimize-at --font --emoji-font \
-  --report; do
+  --report --caret-blink --snapshots; do
   grep -q -- "$option" help.txt || fail "--help does not mention $option"
 done
 "$example" --frames 2>/dev/null; [ $? -eq 1 ] || fail "--frames without a value: want exit 1"
 "$example" --resize-at 5:100 2>/dev/null; [ $? -eq 1 ] || fail "--resize-at 5:100: want exit 1"
 "$example" --bogus 2>/dev/null; [ $? -eq 1 ] || fail "an unknown option: want exit 1"
+"$example" --caret-blink 60001 2>/dev/null; [ $? -eq 1 ] || fail "--caret-blink 60001: want exit 1"
+"$example" --snapshots 2>/dev/null; [ $? -eq 1 ] || fail "--snapshots without a value: want exit 1"
 "$example" --font does-not-exist.ttf --frames 1 2>font.err; code=$?
 [ "$code" -eq 2 ] && grep -q "does-not-exist.ttf" font.err || fail "a missing font: exit $code, $(cat font.err)"
 "$example" --emoji-font no-emoji.ttf --frames 1 2>emoji.err; code=$?

@@ -8,7 +8,8 @@
 # next step. Steps: the field as it starts (no focus, no caret); a click after the text's end; typing
 # Latin and Arabic; Backspace; Shift+Left twice; a mouse drag over the start; Shift+click farther
 # right; a click in the Arabic word; Ctrl+A and typing, which replaces all; Home, Delete, End,
-# Ctrl+Left, Shift+End; Escape, after which typed keys leave the text alone. Each snapshot's report
+# Ctrl+Left, Shift+End; End and typing past the field's width, which scrolls; Escape, after which
+# typed keys leave the text alone. Each snapshot's report
 # is checked (text, caret, selection), and its screenshot: text ink inside the field, the selection
 # colour filling each of the report's selection rects, the caret's colour in its rect when the
 # report says it is shown and not when not. Ctrl+Q ends it, exit code 0 (the
@@ -133,6 +134,8 @@ def main():
             failures.append(f"selection rect {rect}: {sum(1 for p in shown if selection_colour(p))} "
                             f"of {len(shown)} pixels in the highlight's colour")
     caret = field["caret_rect"]
+    if not (box["x"] <= caret["x"] and caret["x"] + caret["width"] <= box["x"] + box["width"]):
+        failures.append(f"caret rect {caret} leaves the field {box}")
     if field["caret_visible"]:
         on = sum(1 for p in region(caret) if caret_colour(p))
         if on < 0.5 * max(len(region(caret)), 1):
@@ -288,10 +291,17 @@ check "$(json text '"done"' caret 4 selection '[4, 4]')"
 xdotool key Home Delete End ctrl+Left shift+End
 snapshot
 check "$(json text '"one"' caret 3 selection '[0, 3]')"
+# Typing past the field's width scrolls the text: the caret stays inside the field.
+long=$(printf 'w%.0s' $(seq 1 40))
+xdotool key End
+type_text "$long"
+snapshot
+check "$(json text "\"one$long\"" caret 43 selection '[43, 43]' caret_visible true)"
+[ "$(field text_x)" -lt "$tx" ] || fail "the long text did not scroll: it starts at $(field text_x), the field's text at $tx"
 xdotool key Escape
 type_text xy
 snapshot
-check "$(json text '"one"' focused false caret_visible false)"
+check "$(json text "\"one$long\"" focused false caret_visible false)"
 end
 
 # ---- The blinking caret: shown and hidden in turn, the pixels as the report says.
