@@ -274,6 +274,24 @@ check "$(json selection_end_in "[4, 8]" caret_in "[4, 8]")"
 dragged=$(field caret)
 xdotool keydown shift mousemove --window "$window" $((tx + 84)) "$mid" click 1 keyup shift
 snapshot
+# TEXT_FIELD_PICTURE=PATH.png: this snapshot's field, twice its size, for docs/integration.md.
+if [ -n "${TEXT_FIELD_PICTURE:-}" ]; then
+  python3 - "$prefix-$taken" "$TEXT_FIELD_PICTURE" <<'PY' || fail "TEXT_FIELD_PICTURE"
+import json, struct, sys, zlib
+from check_field import read_png
+width, _, pixels = read_png(sys.argv[1] + ".png")
+box = json.load(open(sys.argv[1] + ".json"))["field"]["box"]
+x0, y0, x1, y1 = int(box["x"]) - 8, int(box["y"]) - 8, int(box["x"] + box["width"]) + 8, int(box["y"] + box["height"]) + 8
+rows = []
+for y in range(y0, y1):
+    row = b"".join(pixels[(y * width + x) * 3:(y * width + x) * 3 + 3] * 2 for x in range(x0, x1))
+    rows += [row, row]
+chunk = lambda kind, body: struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+header = struct.pack(">IIBBBBB", 2 * (x1 - x0), len(rows), 8, 2, 0, 0, 0)
+data = zlib.compress(b"".join(b"\0" + row for row in rows), 9)
+open(sys.argv[2], "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", data) + chunk(b"IEND", b""))
+PY
+fi
 [ "$(field selection.0)" = 0 ] || fail "Shift+click: the selection starts at $(field selection.0), want 0"
 [ "$(field caret)" -gt "$dragged" ] || fail "Shift+click: caret $(field caret), not past the drag's $dragged"
 check '{}'

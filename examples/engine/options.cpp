@@ -92,7 +92,8 @@ const std::vector<OptionSpec>& option_table() {
              return minimize.has_value();
          }},
         {"--caret-blink", "MS",
-         "the text field's caret is shown MS milliseconds, then hidden as long (default 530; 0: never hidden)",
+         "the text field's caret is shown MS milliseconds, then hidden as long (default 530, at most 60000; 0: never "
+         "hidden)",
          [](Options& o, std::string_view v) {
              const std::optional<uint32_t> ms = parse_unsigned<uint32_t>(v);
              if (ms) o.caret_blink_ms = *ms;
