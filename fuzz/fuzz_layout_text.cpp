@@ -1,9 +1,12 @@
 // Fuzzes text layout: UTF-8 decoding, bidi, itemization, fallback, shaping, line breaking and
-// placement. The first bytes pick the options, the rest is the text.
+// placement, and editing over the result (boundaries, carets, hit tests, selections, motion). The
+// first bytes pick the options, the rest is the text.
 #include <crisp/bake.hpp>
+#include <crisp/editing.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
@@ -50,6 +53,31 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!layout) __builtin_trap();  // every option above is valid: only bugs fail
     for (const crisp::GlyphInstance& glyph : layout->glyphs) {
         if (glyph.cluster > text.size()) __builtin_trap();
+    }
+
+    auto bounds = crisp::TextBoundaries::analyze(text);
+    if (!bounds) __builtin_trap();  // the text is within kMaxTextBytes: only bugs fail
+    auto on_boundary = [&](crisp::TextPosition position) {
+        return position.offset <= text.size() && bounds->is_grapheme_boundary(position.offset);
+    };
+    // A few hundred positions at most, so that a long input still runs fast: each looks at one line.
+    const auto graphemes = bounds->graphemes();
+    const size_t stride = graphemes.size() / 256 + 1;
+    std::vector<crisp::TextRect> rects;
+    for (size_t i = 0; i < graphemes.size(); i += stride) {
+        const crisp::TextPosition position{graphemes[i], (i & 1) != 0};
+        const crisp::TextRect caret = crisp::caret_rect(*layout, *bounds, position);
+        if (!std::isfinite(caret.x) || !std::isfinite(caret.y)) __builtin_trap();
+        const crisp::HitTest hit = crisp::hit_test(*layout, *bounds, caret.x + 0.5f, caret.y + caret.height * 0.5f);
+        if (!on_boundary(hit.position)) __builtin_trap();
+        for (uint8_t motion = 0; motion <= static_cast<uint8_t>(crisp::CaretMotion::down); ++motion) {
+            const crisp::Caret moved = crisp::move_caret(*layout, *bounds, {position}, crisp::CaretMotion{motion});
+            if (!on_boundary(moved.position)) __builtin_trap();
+        }
+    }
+    crisp::selection_rects(*layout, *bounds, 0, static_cast<uint32_t>(text.size()), rects);
+    for (const crisp::TextRect& rect : rects) {
+        if (!(rect.width >= 0.0f) || !std::isfinite(rect.x)) __builtin_trap();
     }
     return 0;
 }

@@ -47,8 +47,7 @@ bool is_rtl(const TextCluster& cluster) {
     return (cluster.level & 1) != 0;
 }
 
-// A grapheme's share of a cluster: its byte range, its place in the cluster in logical order,
-// and its left and right edges on the canvas.
+// A grapheme's share of a cluster: its byte range and its left and right edges on the canvas.
 struct Part {
     uint32_t begin = 0, end = 0;
     float left = 0.0f, right = 0.0f;
@@ -118,22 +117,21 @@ uint32_t line_of(const TextLayout& layout, TextPosition position) {
     return line;
 }
 
-// Where a position's caret is: the edge it is at, and the part of the character it belongs to,
-// on whose leading or trailing side.
+// Where a position's caret is: the edge it is at, and on which side of the character it belongs
+// to (its leading or trailing one, in that character's direction).
 struct Edge {
     float x = 0.0f;
     bool found = false;  // false: the line has no character for it; x is the line's
     bool leading = false;
     bool rtl = false;
-    Part part;
 };
 
 Edge leading_edge(const TextCluster& cluster, const Part& part) {
-    return {is_rtl(cluster) ? part.right : part.left, true, true, is_rtl(cluster), part};
+    return {is_rtl(cluster) ? part.right : part.left, true, true, is_rtl(cluster)};
 }
 
 Edge trailing_edge(const TextCluster& cluster, const Part& part) {
-    return {is_rtl(cluster) ? part.left : part.right, true, false, is_rtl(cluster), part};
+    return {is_rtl(cluster) ? part.left : part.right, true, false, is_rtl(cluster)};
 }
 
 // The caret rule (crisp/editing.hpp) for a position already snapped, on line `line`.
@@ -166,8 +164,31 @@ Edge caret_edge(const TextLayout& layout, const TextBoundaries& boundaries, uint
     return edge;
 }
 
+// The first of the sorted `offsets` after `offset`, or `end`.
+uint32_t next_after(std::span<const uint32_t> offsets, uint32_t offset, uint32_t end) {
+    const auto* next = std::upper_bound(offsets.data(), offsets.data() + offsets.size(), offset);
+    return next == offsets.data() + offsets.size() ? end : *next;
+}
+
+// The last of the sorted `offsets` before `offset`, or 0.
+uint32_t previous_before(std::span<const uint32_t> offsets, uint32_t offset) {
+    const auto* at = std::lower_bound(offsets.data(), offsets.data() + offsets.size(), offset);
+    return at == offsets.data() ? 0 : *(at - 1);
+}
+
 TextPosition snapped(const TextBoundaries& boundaries, TextPosition position) {
     return {boundaries.snap(position.offset), position.upstream};
+}
+
+// The positions of a grapheme part's leading and trailing edges. A part's ends are grapheme
+// boundaries unless HarfBuzz's clusters and ICU's graphemes disagree (a cluster cut after
+// kMaxMarksPerCluster marks, a line broken inside a grapheme): then the grapheme holding them.
+TextPosition leading_position(const TextBoundaries& boundaries, const Part& part) {
+    return {boundaries.snap(part.begin), false};
+}
+TextPosition trailing_position(const TextBoundaries& boundaries, const Part& part) {
+    const uint32_t end = boundaries.is_grapheme_boundary(part.end) ? part.end : boundaries.next_grapheme(part.end);
+    return {end, true};
 }
 
 // The line nearest y in its box.
@@ -189,7 +210,7 @@ HitTest hit_line(const TextLayout& layout, const TextBoundaries& boundaries, uin
     hit.line = line;
     const std::span<const TextCluster> clusters = line_clusters(layout, line);
     if (clusters.empty()) {
-        hit.position = {layout.lines[line].text_begin, false};
+        hit.position = {boundaries.snap(layout.lines[line].text_begin), false};
         return hit;
     }
     // In doubles, with x clamped, so that far points (infinite ones too) still tell clusters apart.
@@ -208,7 +229,7 @@ HitTest hit_line(const TextLayout& layout, const TextBoundaries& boundaries, uin
     const Part part = parts.part(parts.index_at(x));
     const float middle = 0.5f * (part.left + part.right);
     const bool leading = is_rtl(*nearest) ? x >= middle : x < middle;
-    hit.position = leading ? TextPosition{part.begin, false} : TextPosition{part.end, true};
+    hit.position = leading ? leading_position(boundaries, part) : trailing_position(boundaries, part);
     hit.inside = nearest_distance == 0.0;
     return hit;
 }
@@ -233,8 +254,8 @@ void for_each_stop(const TextLayout& layout, const TextBoundaries& boundaries, u
         const bool rtl = is_rtl(cluster);
         for (uint32_t i = 0; i < parts.count(); ++i) {
             const Part part = parts.part(i);
-            visit(Stop{rtl ? part.right : part.left, {part.begin, false}, rtl});
-            visit(Stop{rtl ? part.left : part.right, {part.end, true}, !rtl});
+            visit(Stop{rtl ? part.right : part.left, leading_position(boundaries, part), rtl});
+            visit(Stop{rtl ? part.left : part.right, trailing_position(boundaries, part), !rtl});
         }
     }
 }
@@ -331,23 +352,19 @@ uint32_t TextBoundaries::snap(uint32_t offset) const {
 }
 
 uint32_t TextBoundaries::next_grapheme(uint32_t offset) const {
-    const auto next = std::upper_bound(graphemes_.begin(), graphemes_.end(), offset);
-    return next == graphemes_.end() ? size_ : *next;
+    return next_after(graphemes_, offset, size_);
 }
 
 uint32_t TextBoundaries::previous_grapheme(uint32_t offset) const {
-    const auto at = std::lower_bound(graphemes_.begin(), graphemes_.end(), offset);
-    return at == graphemes_.begin() ? 0 : *(at - 1);
+    return previous_before(graphemes_, offset);
 }
 
 uint32_t TextBoundaries::next_word_start(uint32_t offset) const {
-    const auto next = std::upper_bound(word_starts_.begin(), word_starts_.end(), offset);
-    return next == word_starts_.end() ? size_ : *next;
+    return next_after(word_starts_, offset, size_);
 }
 
 uint32_t TextBoundaries::previous_word_start(uint32_t offset) const {
-    const auto at = std::lower_bound(word_starts_.begin(), word_starts_.end(), offset);
-    return at == word_starts_.begin() ? 0 : *(at - 1);
+    return previous_before(word_starts_, offset);
 }
 
 HitTest hit_test(const TextLayout& layout, const TextBoundaries& boundaries, float x, float y) {
@@ -415,9 +432,11 @@ void selection_rects(const TextLayout& layout, const TextBoundaries& boundaries,
     flush(line);
 }
 
-Caret move_caret(const TextLayout& layout, const TextBoundaries& boundaries, Caret caret, CaretMotion motion) {
+namespace {
+
+// move_caret() before its result is snapped.
+Caret move_unsnapped(const TextLayout& layout, const TextBoundaries& boundaries, Caret caret, CaretMotion motion) {
     constexpr float kNoGoal = std::numeric_limits<float>::quiet_NaN();
-    if (layout.lines.empty()) return {};
     const TextPosition position = snapped(boundaries, caret.position);
     const uint32_t offset = position.offset;
     switch (motion) {
@@ -454,6 +473,16 @@ Caret move_caret(const TextLayout& layout, const TextBoundaries& boundaries, Car
         }
     }
     return {position, kNoGoal};
+}
+
+}  // namespace
+
+Caret move_caret(const TextLayout& layout, const TextBoundaries& boundaries, Caret caret, CaretMotion motion) {
+    if (layout.lines.empty()) return {};
+    Caret moved = move_unsnapped(layout, boundaries, caret, motion);
+    // Line ends are where HarfBuzz's clusters allowed a break; ICU's graphemes have the last word.
+    moved.position = snapped(boundaries, moved.position);
+    return moved;
 }
 
 }  // namespace crisp
