@@ -7,7 +7,8 @@
 # report and the screenshot of the next frame, --snapshots), and the test waits for it before the
 # next step. Steps: the field as it starts (no focus, no caret); a click after the text's end; typing
 # Latin and Arabic; Backspace; Shift+Left twice; a mouse drag over the start; Shift+click farther
-# right; a click in the Arabic word; Ctrl+A and typing, which replaces all; Home, Delete, End,
+# right; a click in the Arabic word; Ctrl+A and typing, which replaces all; "e" and a combining
+# accent, which one Backspace removes; Home, Delete, End,
 # Ctrl+Left, Shift+End; End and typing past the field's width, which scrolls; Escape, after which
 # typed keys leave the text alone. Each snapshot's report
 # is checked (text, caret, selection), and its screenshot: text ink inside the field, the selection
@@ -306,6 +307,13 @@ xdotool key ctrl+a
 type_text done
 snapshot
 check "$(json text '"done"' caret 4 selection '[4, 4]')"
+# "e" and a combining acute accent are one grapheme: one Backspace takes both.
+type_text $'e\xcc\x81'
+snapshot
+check "$(json text "$(quote $'donee\xcc\x81')" caret 7)"
+xdotool key BackSpace
+snapshot
+check "$(json text '"done"' caret 4)"
 xdotool key Home Delete End ctrl+Left shift+End
 snapshot
 check "$(json text '"one"' caret 3 selection '[0, 3]')"

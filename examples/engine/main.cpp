@@ -40,13 +40,14 @@ std::optional<crisp::Font> load_font(const char* option, const std::string& path
     return std::move(*font);
 }
 
-// The text font (printable ASCII, Latin-1 and the Arabic block, for what the text field shows and
+// The text font (printable ASCII, Latin-1, combining marks and Arabic, for what the text field shows and
 // what may be typed into it), then the emoji font where there is one: the layouts' fallback chain,
 // in which emoji presentation picks the colour font.
 std::optional<std::vector<crisp::Font>> load_fonts(const Options& options) {
     std::vector<uint32_t> text;
     for (uint32_t c = 0x20; c < 0x7F; ++c) text.push_back(c);
     for (uint32_t c = 0xA0; c <= 0xFF; ++c) text.push_back(c);    // Latin-1, the multiplication sign among them
+    for (uint32_t c = 0x300; c <= 0x36F; ++c) text.push_back(c);  // combining marks, for "e" + U+0301 and the like
     for (uint32_t c = 0x600; c <= 0x6FF; ++c) text.push_back(c);  // Arabic; its joining forms come with the closure
     std::optional<crisp::Font> font = load_font("--font", options.font, std::move(text), 1);
     if (!font) return std::nullopt;

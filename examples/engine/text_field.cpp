@@ -130,6 +130,10 @@ uint32_t TextField::selection_end() const {
 void TextField::replace_selection(std::string_view utf8) {
     const uint32_t begin = selection_begin(), end = selection_end();
     if (text_.size() - (end - begin) + utf8.size() > kFieldMaxBytes) return;
+    if (begin == end && utf8.empty()) {  // Backspace at the start, Delete at the end: nothing changes
+        touched();
+        return;
+    }
     text_.replace(begin, end - begin, utf8);
     // Laying out text the field already holds fails only where crisp runs out of memory; the field
     // then shows what it had laid out before.
