@@ -27,6 +27,7 @@ if [ "${TEXT_FIELD_TEST_INNER:-}" != 1 ]; then
   TEXT_FIELD_TEST_INNER=1 exec xvfb-run -a -n 190 -s "-screen 0 1024x768x24" bash "$0" "$@"
 fi
 
+cp "$(dirname "$(realpath "$0")")/png_rgb.py" "$work/" || { echo "FAIL: no png_rgb.py beside $0" >&2; exit 1; }
 cd "$work"
 failures=0
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
@@ -38,48 +39,12 @@ check_field.py PREFIX-N EXPECT_JSON: PREFIX-N.json's field against EXPECT_JSON (
 selection, focused, each where given; caret_in [lo, hi]; selection_end_in [lo, hi]), then
 PREFIX-N.png: text ink inside the field's box, the selection colour over each selection rect, the
 caret's colour filling the caret rect when shown and not when hidden. Prints each failure;
-exit status 1 when there is one. Pure Python (zlib).
+exit status 1 when there is one.
 """
 import json
-import struct
 import sys
-import zlib
 
-
-def read_png(path):
-    """RGB8 pixels of a non-interlaced 8-bit RGB PNG (filters 0-4), as (width, height, bytes)."""
-    data = open(path, "rb").read()
-    pos, idat, header = 8, b"", None
-    while pos < len(data):
-        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        if kind == b"IHDR":
-            header = struct.unpack(">IIBBBBB", data[pos + 8:pos + 8 + length])
-        elif kind == b"IDAT":
-            idat += data[pos + 8:pos + 8 + length]
-        pos += 12 + length
-    width, height = header[0], header[1]
-    raw, stride = zlib.decompress(idat), width * 3
-    out, previous = bytearray(stride * height), bytearray(stride)
-    for y in range(height):
-        kind = raw[y * (stride + 1)]
-        row = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = row[i - 3] if i >= 3 else 0
-            b = previous[i]
-            c = previous[i - 3] if i >= 3 else 0
-            if kind == 1:
-                row[i] = (row[i] + a) & 255
-            elif kind == 2:
-                row[i] = (row[i] + b) & 255
-            elif kind == 3:
-                row[i] = (row[i] + ((a + b) >> 1)) & 255
-            elif kind == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                row[i] = (row[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        out[y * stride:(y + 1) * stride] = row
-        previous = row
-    return width, height, bytes(out)
+from png_rgb import read_png
 
 
 def selection_colour(p):  # linear (0.05, 0.20, 0.60) is sRGB about (63, 124, 203)
@@ -279,7 +244,7 @@ snapshot
 if [ -n "${TEXT_FIELD_PICTURE:-}" ]; then
   python3 - "$prefix-$taken" "$TEXT_FIELD_PICTURE" <<'PY' || fail "TEXT_FIELD_PICTURE"
 import json, struct, sys, zlib
-from check_field import read_png
+from png_rgb import read_png
 width, _, pixels = read_png(sys.argv[1] + ".png")
 box = json.load(open(sys.argv[1] + ".json"))["field"]["box"]
 x0, y0, x1, y1 = int(box["x"]) - 8, int(box["y"]) - 8, int(box["x"] + box["width"]) + 8, int(box["y"] + box["height"]) + 8
