@@ -134,10 +134,15 @@ void TextField::replace_selection(std::string_view utf8) {
         touched();
         return;
     }
+    std::string before = text_;
     text_.replace(begin, end - begin, utf8);
-    // Laying out text the field already holds fails only where crisp runs out of memory; the field
-    // then shows what it had laid out before.
-    (void)lay_out();
+    // Valid UTF-8 within kFieldMaxBytes fails to lay out only where memory runs out: the edit is
+    // then undone, so that the text, its layout and its boundaries stay one text.
+    if (!lay_out()) {
+        text_ = std::move(before);
+        (void)lay_out();
+        return;
+    }
     caret_ = {static_cast<uint32_t>(begin + utf8.size()), false};
     anchor_ = caret_.offset;
     touched();
