@@ -5,17 +5,17 @@
 #
 # One session with a steady caret (--caret-blink 0): after each step F9 takes a snapshot (the
 # report and the screenshot of the next frame, --snapshots), and the test waits for it before the
-# next step. Steps: the field as it starts (no focus, no caret); a click after the text's end; typing
-# Latin and Arabic; Backspace; Shift+Left twice; a mouse drag over the start; Shift+click farther
-# right; a click in the Arabic word; Ctrl+A and typing, which replaces all; "e" and a combining
-# accent, which one Backspace removes; Home, Delete, End,
-# Ctrl+Left, Shift+End; End and typing past the field's width, which scrolls; Escape, after which
-# typed keys leave the text alone. Each snapshot's report
-# is checked (text, caret, selection), and its screenshot: text ink inside the field, the selection
-# colour filling each of the report's selection rects, the caret's colour in its rect when the
-# report says it is shown and not when not. Ctrl+Q ends it, exit code 0 (the
-# validation layer said nothing). A second session (--caret-blink 150) samples the caret over a
-# second or two: it is seen both shown and hidden, and the pixels agree with the report each time.
+# next step. Steps: the field as it starts (no focus, no caret); a click after the text's end;
+# typing Latin and Arabic; Backspace; Shift+Left twice; a mouse drag over the start; Shift+click
+# farther right; a click in the Arabic word, then Right and Left, which move the caret that way on
+# screen; Ctrl+A and typing, which replaces all; "e" and a combining accent, which one Backspace
+# removes; Home, Delete, End, Ctrl+Left, Shift+End; End and typing past the field's width, which
+# scrolls; Escape, after which typed keys leave the text alone. Each snapshot's report is checked
+# (text, caret, selection), and its screenshot: text ink inside the field, the selection colour
+# filling each of the report's selection rects, the caret's colour in its rect when the report says
+# it is shown and not when not. Ctrl+Q ends it, exit code 0 (the validation layer said nothing). A
+# second session (--caret-blink 150) samples the caret over a second or two: it is seen both shown
+# and hidden, and the pixels agree with the report each time.
 set -uo pipefail
 example=$(realpath "$1") work=$(realpath -m "$2")
 if [ "${TEXT_FIELD_TEST_INNER:-}" != 1 ]; then
@@ -268,6 +268,18 @@ print(int(rects[0]["x"] + rects[0]["width"]) + 30)' "$prefix-$taken.json")
 xdotool mousemove --window "$window" "$ax" "$mid" click 1
 snapshot
 check "$(json caret_in "[$((arabic_begin + 2)), $((arabic_end - 2))]")"
+# Right and Left move the caret on screen: in the Arabic, Right goes back through the text.
+clicked=$(field caret) clicked_x=$(field caret_rect.x)
+xdotool key Right
+snapshot
+check '{}'
+[ "$(field caret_rect.x)" -gt "$clicked_x" ] && [ "$(field caret)" -lt "$clicked" ] ||
+  fail "Right in the Arabic: caret $(field caret) at x $(field caret_rect.x), from $clicked at x $clicked_x"
+xdotool key Left Left
+snapshot
+check '{}'
+[ "$(field caret_rect.x)" -lt "$clicked_x" ] && [ "$(field caret)" -gt "$clicked" ] ||
+  fail "Left twice in the Arabic: caret $(field caret) at x $(field caret_rect.x), from $clicked at x $clicked_x"
 xdotool key ctrl+a
 type_text done
 snapshot
