@@ -506,6 +506,56 @@ TEST_F(Editing, BadInputIsClampedOrSnapped) {
     EXPECT_NE(too_long.error().message.find("kMaxTextBytes"), std::string::npos);
 }
 
+TEST_F(Editing, HostileTextNeverCrashes) {
+    // Marks past kMaxMarksPerCluster, bidi controls, joiners, invalid bytes, breaks: whatever the
+    // clusters, every position that comes back is on a grapheme boundary and every rect is finite.
+    std::mt19937 random(2027);
+    const std::string pieces[] = {"a",        " ",
+                                  "\n",       "\r\n",
+                                  "\t",       "\u05D0",
+                                  "\u0627",   "\u0301",
+                                  "\u200D",   "\u202E",
+                                  "\u2067",   "\u2069",
+                                  "1",        "\xFF",
+                                  "\xE2\x82", "\u200B",
+                                  "f",        "i",
+                                  "-",        "\u1100",
+                                  "\u1161",   std::string(70, '\xCC') + "\x81"};
+    const std::string combining = [] {
+        std::string marks = "e";
+        for (int i = 0; i < 70; ++i) marks += "\u0301";
+        return marks;
+    }();
+    std::vector<TextRect> rects;
+    for (int round = 0; round < 100; ++round) {
+        std::string text = round % 10 == 0 ? combining : std::string();
+        const int length = static_cast<int>(random() % 48);
+        for (int i = 0; i < length; ++i) text += pieces[random() % std::size(pieces)];
+        LayoutOptions options;
+        options.wrap_width = static_cast<float>(random() % 4) * 25.0f;
+        options.align = static_cast<Align>(random() % 5);
+        options.direction = static_cast<Direction>(random() % 3);
+        options.break_long_words = random() % 2 == 0;
+        const TextLayout layout = lay(text, options);
+        const TextBoundaries bounds = boundaries(text);
+        auto on_boundary = [&](TextPosition position) {
+            return position.offset <= text.size() && bounds.is_grapheme_boundary(position.offset);
+        };
+        for (uint32_t offset = 0; offset <= text.size(); ++offset) {
+            const TextPosition position{offset, offset % 2 == 1};
+            const TextRect caret = caret_rect(layout, bounds, position);
+            ASSERT_TRUE(std::isfinite(caret.x) && std::isfinite(caret.y)) << round << " " << offset;
+            const HitTest hit = hit_test(layout, bounds, centre_x(caret), centre_y(caret));
+            ASSERT_TRUE(on_boundary(hit.position)) << round << " " << offset;
+            for (uint8_t motion = 0; motion <= static_cast<uint8_t>(CaretMotion::down); ++motion)
+                ASSERT_TRUE(on_boundary(move_caret(layout, bounds, {position}, CaretMotion{motion}).position))
+                    << round << " " << offset << " motion " << int{motion};
+        }
+        selection_rects(layout, bounds, 0, static_cast<uint32_t>(text.size()), rects);
+        for (const TextRect& rect : rects) ASSERT_TRUE(rect.width >= 0.0f && std::isfinite(rect.x)) << round;
+    }
+}
+
 TEST_F(Editing, EmptyTextHasACaret) {
     const TextLayout layout = lay("", {.origin_x = 12, .origin_y = 50});
     const TextBoundaries bounds = boundaries("");

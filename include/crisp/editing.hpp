@@ -20,7 +20,8 @@
 // XYZ" with XYZ Hebrew in a left-to-right paragraph (drawn "abc ZYX"), offset 4 downstream is at
 // the right end of the line (X's leading edge) and offset 4 upstream after the space (between the
 // space and Z). The caret's rectangle lies inside the character it belongs to, beside that edge,
-// so that hit testing its centre returns the position (hit_test).
+// so that hit testing its centre returns the position (hit_test; with the side the rule took, and
+// where the character is wider than the caret).
 //
 // Ligatures: a cluster of several graphemes (an "ffi" ligature) is divided into equal parts, one a
 // grapheme, in the cluster's direction; carets, hits and selections use those parts.
@@ -105,8 +106,10 @@ private:
 // nearest in x, and within it the grapheme and its half as HitTest says. A point left or right of a
 // line takes its nearest grapheme's edge; above the first line or below the last, that line.
 //
-// `boundaries` must be of the text `layout` was made of (it divides ligatures into graphemes);
-// with another text the result is still a position on a cluster edge of `layout`. Bad input: a NaN
+// The position is on a grapheme boundary of `boundaries`: where HarfBuzz's clusters cut a grapheme
+// (past kMaxMarksPerCluster marks; a line broken inside one), that grapheme's edge. `boundaries`
+// must be of the text `layout` was made of (it divides ligatures into graphemes); with another
+// text the result is still a position of `layout`'s lines, never a crash. Bad input: a NaN
 // coordinate is treated as 0; infinite ones are nearest the far side. A layout without lines (empty
 // text) gives offset 0, line 0, not inside.
 CRISP_API HitTest hit_test(const TextLayout& layout, const TextBoundaries& boundaries, float x, float y);
@@ -166,9 +169,10 @@ struct Caret {
 // time (at a direction boundary, two positions can share an edge: the one that belongs to the
 // character passed over is taken).
 //
-// Bad input: the caret's position is first snapped as caret_rect does; a NaN or infinite goal_x is
-// none. On a layout without lines every motion gives offset 0. At the ends of the text the motions
-// that would leave it stay.
+// The result is on a grapheme boundary (a line start inside a grapheme is moved to the grapheme's
+// start). Bad input: the caret's position is first snapped as caret_rect does; a NaN or infinite
+// goal_x is none. On a layout without lines every motion gives offset 0. At the ends of the text
+// the motions that would leave it stay.
 CRISP_API Caret move_caret(const TextLayout& layout, const TextBoundaries& boundaries, Caret caret, CaretMotion motion);
 
 }  // namespace crisp

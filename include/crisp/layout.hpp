@@ -188,8 +188,9 @@ struct TextLayout {
     std::vector<TextLine> lines;        // one per line, hard or wrapped; empty for empty text
     // Every shaped cluster in logical order (so in increasing text_begin, and line by line),
     // blank ones (spaces, tabs, hanging spaces) included whatever keep_blank_glyphs says.
-    // Characters HarfBuzz shapes into no glyph (default ignorables) join a neighbouring cluster;
-    // hard line breaks are in none.
+    // Characters HarfBuzz shapes into no glyph (default ignorables) join a neighbouring cluster of
+    // their run; a run of nothing else (a bidi control between runs) and hard line breaks are in
+    // none.
     std::vector<TextCluster> clusters;
     // The box of the line boxes: from the leftmost line start to the rightmost line end, from
     // the first line's ascender down `lines.size()` line heights. Empty text: x and y are where
