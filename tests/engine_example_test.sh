@@ -53,6 +53,7 @@ if [ "${ENGINE_EXAMPLE_TEST_INNER:-}" != 1 ]; then
   ENGINE_EXAMPLE_TEST_INNER=1 exec xvfb-run -a -n 130 -s "-screen 0 1024x768x24" bash "$0" run "$@"
 fi
 
+cp "$(dirname "$(realpath "$0")")/png_rgb.py" "$work/" || { echo "FAIL: no png_rgb.py beside $0" >&2; exit 1; }
 cd "$work"
 failures=0
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
@@ -70,53 +71,9 @@ printed. Pure Python (zlib), so it needs nothing beyond Debian's python3.
 """
 import json
 import math
-import struct
 import sys
-import zlib
 
-
-def read_png(path):
-    """RGB8 pixels of a non-interlaced 8-bit RGB PNG, as (width, height, bytes)."""
-    data = open(path, "rb").read()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path}: not a PNG"
-    pos, idat, header = 8, b"", None
-    while pos < len(data):
-        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + length]
-        if kind == b"IHDR":
-            header = struct.unpack(">IIBBBBB", body)
-        elif kind == b"IDAT":
-            idat += body
-        pos += 12 + length
-    width, height, depth, color, _, _, interlace = header
-    assert depth == 8 and color == 2 and interlace == 0, f"{path}: want 8-bit RGB, not interlaced"
-    raw = zlib.decompress(idat)
-    stride, bpp = width * 3, 3
-    out = bytearray(stride * height)
-    previous = bytearray(stride)
-    for y in range(height):
-        kind = raw[y * (stride + 1)]
-        row = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        if kind == 1:
-            for i in range(bpp, stride):
-                row[i] = (row[i] + row[i - bpp]) & 255
-        elif kind == 2:
-            row = bytearray((a + b) & 255 for a, b in zip(row, previous))
-        elif kind == 3:
-            for i in range(stride):
-                left = row[i - bpp] if i >= bpp else 0
-                row[i] = (row[i] + ((left + previous[i]) >> 1)) & 255
-        elif kind == 4:
-            for i in range(stride):
-                a = row[i - bpp] if i >= bpp else 0
-                b = previous[i]
-                c = previous[i - bpp] if i >= bpp else 0
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                row[i] = (row[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        out[y * stride:(y + 1) * stride] = row
-        previous = row
-    return width, height, bytes(out)
+from png_rgb import read_png
 
 
 class Image:
@@ -295,12 +252,14 @@ PY
 # ---- The command line.
 "$example" --help >help.txt || fail "--help exited $?"
 for option in --frames --screenshot --validation --drop-every --resize-at --minimize-at --font --emoji-font \
-  --report; do
+  --report --caret-blink --snapshots; do
   grep -q -- "$option" help.txt || fail "--help does not mention $option"
 done
 "$example" --frames 2>/dev/null; [ $? -eq 1 ] || fail "--frames without a value: want exit 1"
 "$example" --resize-at 5:100 2>/dev/null; [ $? -eq 1 ] || fail "--resize-at 5:100: want exit 1"
 "$example" --bogus 2>/dev/null; [ $? -eq 1 ] || fail "an unknown option: want exit 1"
+"$example" --caret-blink 60001 2>/dev/null; [ $? -eq 1 ] || fail "--caret-blink 60001: want exit 1"
+"$example" --snapshots 2>/dev/null; [ $? -eq 1 ] || fail "--snapshots without a value: want exit 1"
 "$example" --font does-not-exist.ttf --frames 1 2>font.err; code=$?
 [ "$code" -eq 2 ] && grep -q "does-not-exist.ttf" font.err || fail "a missing font: exit $code, $(cat font.err)"
 "$example" --emoji-font no-emoji.ttf --frames 1 2>emoji.err; code=$?

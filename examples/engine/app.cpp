@@ -23,13 +23,14 @@ bool operator==(VkExtent2D a, VkExtent2D b) {
 
 App::App(Device& device) : device_(device) {}
 
-crisp::Result<std::unique_ptr<App>> App::create(Device& device, std::vector<crisp::Font> fonts) {
+crisp::Result<std::unique_ptr<App>> App::create(Device& device, std::vector<crisp::Font> fonts,
+                                                uint32_t caret_blink_ms) {
     std::unique_ptr<App> app(new App(device));
     app->depth_format_ = choose_depth_format(device.physical_device());
     crisp::Result<Scene> scene = Scene::create(device, app->depth_format_);
     if (!scene) return scene.error();
     app->scene_.emplace(std::move(*scene));
-    crisp::Result<std::unique_ptr<TextOverlay>> text = TextOverlay::create(device, std::move(fonts));
+    crisp::Result<std::unique_ptr<TextOverlay>> text = TextOverlay::create(device, std::move(fonts), caret_blink_ms);
     if (!text) return text.error();
     app->text_ = std::move(*text);
     if (crisp::Status s = app->create_frame_slots(); !s) return s.error();
@@ -39,13 +40,69 @@ crisp::Result<std::unique_ptr<App>> App::create(Device& device, std::vector<cris
         if (crisp::Status s = app->recreate_swapchain(extent); !s) return s.error();
         app->report_.recreations = 0;  // the first swapchain is not a re-creation
     }
+    GLFWwindow* window = device.window();
+    glfwSetWindowUserPointer(window, app.get());
+    glfwSetKeyCallback(window, on_key);
+    glfwSetCharCallback(window, on_char);
+    glfwSetMouseButtonCallback(window, on_mouse_button);
+    glfwSetCursorPosCallback(window, on_cursor);
     return app;
 }
 
 App::~App() {
+    GLFWwindow* window = device_.window();
+    glfwSetKeyCallback(window, nullptr);
+    glfwSetCharCallback(window, nullptr);
+    glfwSetMouseButtonCallback(window, nullptr);
+    glfwSetCursorPosCallback(window, nullptr);
+    glfwSetWindowUserPointer(window, nullptr);
     // crisp's objects, like the engine's, may only go once the GPU is done with them. On a lost
     // device this returns an error, and destroying is still valid.
     vkDeviceWaitIdle(device_.device());
+}
+
+// The field takes the keys it knows while it has the focus; the example's own keys come after.
+void App::on_key(GLFWwindow* window, int key, int, int action, int mods) {
+    auto* app = static_cast<App*>(glfwGetWindowUserPointer(window));
+    if (!app || (action != GLFW_PRESS && action != GLFW_REPEAT)) return;
+    if (app->text_->field().key(key, mods)) return;
+    if (key == GLFW_KEY_Q && (mods & GLFW_MOD_CONTROL)) glfwSetWindowShouldClose(window, GLFW_TRUE);
+    if (key == GLFW_KEY_F9 && action == GLFW_PRESS && app->snapshots_enabled_) app->snapshot_requested_ = true;
+}
+
+void App::on_char(GLFWwindow* window, unsigned int codepoint) {
+    auto* app = static_cast<App*>(glfwGetWindowUserPointer(window));
+    if (app) app->text_->field().type(codepoint);
+}
+
+void App::on_mouse_button(GLFWwindow* window, int button, int action, int mods) {
+    auto* app = static_cast<App*>(glfwGetWindowUserPointer(window));
+    if (!app || button != GLFW_MOUSE_BUTTON_LEFT) return;
+    TextField& field = app->text_->field();
+    if (action == GLFW_RELEASE) {
+        field.release();
+        return;
+    }
+    const std::array<float, 2> at = app->to_pixels(app->cursor_x_, app->cursor_y_);
+    field.press(at[0], at[1], (mods & GLFW_MOD_SHIFT) != 0);
+}
+
+void App::on_cursor(GLFWwindow* window, double x, double y) {
+    auto* app = static_cast<App*>(glfwGetWindowUserPointer(window));
+    if (!app) return;
+    app->cursor_x_ = x;
+    app->cursor_y_ = y;
+    const std::array<float, 2> at = app->to_pixels(x, y);
+    app->text_->field().drag(at[0], at[1]);
+}
+
+std::array<float, 2> App::to_pixels(double x, double y) const {
+    int window_width = 0, window_height = 0;
+    glfwGetWindowSize(device_.window(), &window_width, &window_height);
+    const VkExtent2D pixels = framebuffer_extent(device_.window());
+    const double scale_x = window_width > 0 ? pixels.width / static_cast<double>(window_width) : 1.0;
+    const double scale_y = window_height > 0 ? pixels.height / static_cast<double>(window_height) : 1.0;
+    return {static_cast<float>(x * scale_x), static_cast<float>(y * scale_y)};
 }
 
 crisp::Status App::create_frame_slots() {
@@ -105,8 +162,9 @@ crisp::Status App::recreate_swapchain(VkExtent2D extent) {
     return {};
 }
 
-crisp::Status App::run(const Options& options) {
+crisp::Status App::run(const Options& options, const SnapshotWriter& snapshot) {
     GLFWwindow* window = device_.window();
+    snapshots_enabled_ = !options.snapshots.empty() && snapshot;
     while (!glfwWindowShouldClose(window) && (options.frames == 0 || frame_ < options.frames)) {
         glfwPollEvents();
         apply_scripted_events(options);
@@ -120,11 +178,15 @@ crisp::Status App::run(const Options& options) {
         }
         ++attempts_;
         const bool drop = options.drop_every != 0 && attempts_ % options.drop_every == 0;
-        const bool screenshot = !options.screenshot.empty() && frame_ + 1 == options.frames;
-        crisp::Result<Outcome> outcome = render_frame(drop, screenshot);
+        const bool last = !options.screenshot.empty() && frame_ + 1 == options.frames;
+        const bool snapshot_now = snapshot_requested_ && !drop;
+        crisp::Result<Outcome> outcome = render_frame(drop, last || snapshot_now);
         if (!outcome) return outcome.error();
         if (*outcome == Outcome::dropped) ++report_.dropped;
         if (*outcome == Outcome::out_of_date) ++report_.out_of_date;
+        if (*outcome == Outcome::presented && snapshot_now) {
+            if (crisp::Status s = take_snapshot(snapshot); !s) return s;
+        }
     }
     if (crisp::Status s = check("vkDeviceWaitIdle", vkDeviceWaitIdle(device_.device())); !s) return s;
     if (screenshot_recorded_) keep_screenshot();
@@ -314,6 +376,7 @@ crisp::Status App::submit_and_present(FrameSlot& slot, uint32_t image_index, boo
     // Submitted: crisp's frame counts, and so does the frame for the animation.
     text_->frame_submitted();
     report_.boxes = text_->frame().boxes;
+    report_.field = text_->field().report();
     report_.glyphs = text_->submitted_glyphs();
     report_.extent = swapchain_->extent();
     ++report_.presented;
@@ -332,6 +395,17 @@ crisp::Status App::submit_and_present(FrameSlot& slot, uint32_t image_index, boo
         return {};
     }
     return check("vkQueuePresentKHR", presented);
+}
+
+// The frame just presented, once the GPU is done with it, with its screenshot where the swapchain
+// allows one (the writer decides what a missing one means).
+crisp::Status App::take_snapshot(const SnapshotWriter& snapshot) {
+    if (crisp::Status s = check("vkDeviceWaitIdle", vkDeviceWaitIdle(device_.device())); !s) return s;
+    if (screenshot_recorded_) keep_screenshot();
+    snapshot_requested_ = false;
+    const crisp::Status written = snapshot(report_, ++snapshots_taken_);
+    report_.screenshot.clear();
+    return written;
 }
 
 // The last frame as presented, from the swapchain image's bytes (BGRA or RGBA) to RGB.

@@ -14,9 +14,12 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
+
+struct GLFWwindow;
 
 namespace engine {
 
@@ -31,20 +34,31 @@ struct RunReport {
     VkExtent2D extent{};           // of the last presented frame
     VkFormat swapchain_format = VK_FORMAT_UNDEFINED;
     std::vector<TextBox> boxes;       // text of the last presented frame
+    FieldReport field;                // the text field in the last presented frame
     GlyphCounts glyphs;               // of the last presented frame
     std::vector<uint8_t> screenshot;  // RGB8 of the last presented frame, when asked for
 };
 
+// Called with the report of a frame F9 asked for (its screenshot included) and the snapshot's
+// number, 1 and up (--snapshots). An error ends the run.
+using SnapshotWriter = std::function<crisp::Status(const RunReport& report, uint32_t number)>;
+
 class App {
 public:
-    static crisp::Result<std::unique_ptr<App>> create(Device& device, std::vector<crisp::Font> fonts);
+    // Takes the window's input callbacks (keys, characters, the mouse) for the text field and the
+    // example's keys; `caret_blink_ms` as Options::caret_blink_ms.
+    static crisp::Result<std::unique_ptr<App>> create(Device& device, std::vector<crisp::Font> fonts,
+                                                      uint32_t caret_blink_ms);
     App(const App&) = delete;
     App& operator=(const App&) = delete;
-    // Waits for the GPU, then destroys crisp's objects and the engine's (the device outlives them).
+    // Waits for the GPU, gives the window's callbacks back, then destroys crisp's objects and the
+    // engine's (the device outlives them).
     ~App();
 
-    // Presents frames until the window closes or options.frames were presented.
-    crisp::Status run(const Options& options);
+    // Presents frames until the window closes (Ctrl+Q, or the window system's close) or
+    // options.frames were presented. With options.snapshots, each F9 has `snapshot` called with
+    // the next presented frame.
+    crisp::Status run(const Options& options, const SnapshotWriter& snapshot = {});
     const RunReport& report() const { return report_; }
 
 private:
@@ -67,6 +81,14 @@ private:
     bool record_screenshot_copy(VkCommandBuffer command_buffer, VkImage image);
     crisp::Status submit_and_present(FrameSlot& slot, uint32_t image_index, bool& stale);
     void keep_screenshot();
+    crisp::Status take_snapshot(const SnapshotWriter& snapshot);
+    // GLFW's callbacks, which find the App through the window's user pointer.
+    static void on_key(GLFWwindow* window, int key, int scancode, int action, int mods);
+    static void on_char(GLFWwindow* window, unsigned int codepoint);
+    static void on_mouse_button(GLFWwindow* window, int button, int action, int mods);
+    static void on_cursor(GLFWwindow* window, double x, double y);
+    // A point in the window's coordinates to framebuffer pixels (they differ on high-DPI screens).
+    std::array<float, 2> to_pixels(double x, double y) const;
 
     Device& device_;
     VkFormat depth_format_ = VK_FORMAT_UNDEFINED;
@@ -83,6 +105,13 @@ private:
     size_t next_resize_ = 0, next_minimize_ = 0;
     uint32_t minimized_polls_left_ = 0;
     bool screenshot_recorded_ = false;
+    bool snapshots_enabled_ = false;
+    bool snapshot_requested_ = false;  // F9 was pressed: the next presented frame is a snapshot
+    uint32_t snapshots_taken_ = 0;
+    // The pointer as the last cursor event put it, in window coordinates: a button event is at
+    // that point (glfwGetCursorPos asks the window system for where the pointer is now, which
+    // may be later than the event's time when the loop is slow).
+    double cursor_x_ = 0.0, cursor_y_ = 0.0;
     RunReport report_;
 };
 

@@ -40,12 +40,15 @@ std::optional<crisp::Font> load_font(const char* option, const std::string& path
     return std::move(*font);
 }
 
-// The text font (printable ASCII and the multiplication sign), then the emoji font where there is
-// one: the layouts' fallback chain, in which emoji presentation picks the colour font.
+// The text font (printable ASCII, Latin-1, combining marks and Arabic, for what the text field shows and
+// what may be typed into it), then the emoji font where there is one: the layouts' fallback chain,
+// in which emoji presentation picks the colour font.
 std::optional<std::vector<crisp::Font>> load_fonts(const Options& options) {
     std::vector<uint32_t> text;
     for (uint32_t c = 0x20; c < 0x7F; ++c) text.push_back(c);
-    text.push_back(0x00D7);  // multiplication sign
+    for (uint32_t c = 0xA0; c <= 0xFF; ++c) text.push_back(c);    // Latin-1, the multiplication sign among them
+    for (uint32_t c = 0x300; c <= 0x36F; ++c) text.push_back(c);  // combining marks, for "e" + U+0301 and the like
+    for (uint32_t c = 0x600; c <= 0x6FF; ++c) text.push_back(c);  // Arabic; its joining forms come with the closure
     std::optional<crisp::Font> font = load_font("--font", options.font, std::move(text), 1);
     if (!font) return std::nullopt;
     std::vector<crisp::Font> fonts;
@@ -59,7 +62,8 @@ std::optional<std::vector<crisp::Font>> load_fonts(const Options& options) {
 
 // The window's life. Every Vulkan object is gone when it returns, so that the validation layer's
 // count includes the teardown.
-int run(const Options& options, std::vector<crisp::Font> fonts, std::atomic<uint32_t>& messages, RunReport& report) {
+int run(const Options& options, std::vector<crisp::Font> fonts, std::atomic<uint32_t>& messages, RunReport& report,
+        const SnapshotWriter& snapshot) {
     DeviceOptions device_options;
     device_options.width = options.width;
     device_options.height = options.height;
@@ -70,12 +74,12 @@ int run(const Options& options, std::vector<crisp::Font> fonts, std::atomic<uint
         std::fprintf(stderr, "crisp-engine-example: %s\n", device.error().message.c_str());
         return kExitVulkan;
     }
-    crisp::Result<std::unique_ptr<App>> app = App::create(**device, std::move(fonts));
+    crisp::Result<std::unique_ptr<App>> app = App::create(**device, std::move(fonts), options.caret_blink_ms);
     if (!app) {
         std::fprintf(stderr, "crisp-engine-example: %s\n", app.error().message.c_str());
         return kExitVulkan;
     }
-    const crisp::Status status = (*app)->run(options);
+    const crisp::Status status = (*app)->run(options, snapshot);
     report = (*app)->report();
     if (!status) {
         std::fprintf(stderr, "crisp-engine-example: %s\n", status.error().message.c_str());
@@ -84,26 +88,31 @@ int run(const Options& options, std::vector<crisp::Font> fonts, std::atomic<uint
     return kExitOk;
 }
 
-int write_outputs(const Options& options, const RunReport& report, uint32_t messages) {
-    if (!options.screenshot.empty()) {
+// The screenshot and the report, each where a path is given; the options named in the messages
+// are those that asked for them.
+struct Outputs {
+    const char* screenshot_option;
+    std::string screenshot;
+    const char* report_option;
+    std::string report;
+};
+
+crisp::Status write_outputs(const Outputs& outputs, const RunReport& report, uint32_t messages) {
+    const std::string& screenshot = outputs.screenshot;
+    const std::string& report_path = outputs.report;
+    if (!screenshot.empty()) {
         if (report.screenshot.empty()) {
-            std::fprintf(stderr, "crisp-engine-example: --screenshot: the swapchain's images cannot be copied from\n");
-            return kExitOutput;
+            return crisp::Error{crisp::ErrorCode::io, std::string(outputs.screenshot_option) +
+                                                          ": the swapchain's images cannot be copied from"};
         }
-        if (crisp::Status s =
-                write_png(options.screenshot, report.extent.width, report.extent.height, report.screenshot);
-            !s) {
-            std::fprintf(stderr, "crisp-engine-example: --screenshot %s\n", s.error().message.c_str());
-            return kExitOutput;
-        }
+        if (crisp::Status s = write_png(screenshot, report.extent.width, report.extent.height, report.screenshot); !s)
+            return crisp::Error{crisp::ErrorCode::io, std::string(outputs.screenshot_option) + " " + s.error().message};
     }
-    if (!options.report.empty()) {
-        if (crisp::Status s = write_report(options.report, report, messages); !s) {
-            std::fprintf(stderr, "crisp-engine-example: --report %s\n", s.error().message.c_str());
-            return kExitOutput;
-        }
+    if (!report_path.empty()) {
+        if (crisp::Status s = write_report(report_path, report, messages); !s)
+            return crisp::Error{crisp::ErrorCode::io, std::string(outputs.report_option) + " " + s.error().message};
     }
-    return kExitOk;
+    return {};
 }
 
 }  // namespace
@@ -122,10 +131,25 @@ int main(int argc, char** argv) {
     std::optional<std::vector<crisp::Font>> fonts = load_fonts(options);
     if (!fonts) return kExitFont;
     std::atomic<uint32_t> messages{0};
+    // A failed snapshot ends the run (App::run returns its error, which run() prints) with kExitOutput.
+    bool snapshot_failed = false;
+    const SnapshotWriter snapshot = [&](const RunReport& frame, uint32_t number) -> crisp::Status {
+        const std::string stem = options.snapshots + "-" + std::to_string(number);
+        crisp::Status s =
+            write_outputs({"--snapshots", stem + ".png", "--snapshots", stem + ".json"}, frame, messages.load());
+        snapshot_failed = !s;
+        return s;
+    };
     RunReport report;
-    const int code = run(options, std::move(*fonts), messages, report);
+    const int code = run(options, std::move(*fonts), messages, report, snapshot);
+    if (snapshot_failed) return kExitOutput;
     if (code != kExitOk) return code;
-    if (const int written = write_outputs(options, report, messages.load()); written != kExitOk) return written;
+    if (crisp::Status s =
+            write_outputs({"--screenshot", options.screenshot, "--report", options.report}, report, messages.load());
+        !s) {
+        std::fprintf(stderr, "crisp-engine-example: %s\n", s.error().message.c_str());
+        return kExitOutput;
+    }
     if (messages.load() > 0) {
         std::fprintf(stderr, "crisp-engine-example: the validation layer reported %u message(s)\n", messages.load());
         return kExitValidation;

@@ -91,6 +91,18 @@ const std::vector<OptionSpec>& option_table() {
              if (minimize) o.minimizes.push_back(*minimize);
              return minimize.has_value();
          }},
+        {"--caret-blink", "MS",
+         "the text field's caret is shown MS milliseconds, then hidden as long (default 530, at most 60000; 0: never "
+         "hidden)",
+         [](Options& o, std::string_view v) {
+             const std::optional<uint32_t> ms = parse_unsigned<uint32_t>(v);
+             if (ms) o.caret_blink_ms = *ms;
+             return ms.has_value() && *ms <= 60000;
+         }},
+        {"--snapshots", "PREFIX",
+         "F9 writes the next presented frame as PREFIX-N.png and its report as PREFIX-N.json, N = 1, 2, ... "
+         "(for scripted input: each snapshot follows every event before the key)",
+         [](Options& o, std::string_view v) { return !(o.snapshots = v).empty(); }},
         {"--help", nullptr, "this text", [](Options& o, std::string_view) { return o.help = true; }},
     };
     return table;
@@ -103,13 +115,20 @@ std::string usage() {
         "Usage: crisp-engine-example [options]\n\n"
         "A small engine that draws a lit 3D scene with its own Vulkan device and puts crisp's text in it:\n"
         "labels that follow the shapes, a HUD with a paragraph, a frame counter and a scrolling list, a\n"
-        "label below the HUD that turns every frame, and a sign in perspective on a face of the cube.\n\n"
+        "label below the HUD that turns every frame, a sign in perspective on a face of the cube, and a\n"
+        "text field of Latin and Arabic text under the HUD.\n\n"
         "Options:\n";
     for (const OptionSpec& option : option_table()) {
         std::string left = std::string("  ") + option.name + (option.value ? std::string(" ") + option.value : "");
         left.resize(std::max<size_t>(left.size() + 2, 24), ' ');
         text += left + option.help + "\n";
     }
+    text +=
+        "\nKeys: Ctrl+Q closes the window; F9 takes a snapshot (--snapshots). The text field: a click in it\n"
+        "gives it the focus and places the caret, a drag selects, Shift+click extends the selection, a click\n"
+        "outside or Escape takes the focus away. With the focus: typing replaces the selection, Backspace and\n"
+        "Delete remove a grapheme, Left and Right move on screen (Ctrl: by word), Home and End go to the\n"
+        "line's ends, Shift extends the selection with any motion, Ctrl+A selects all.\n";
     text +=
         "\nExit codes: 0 success; 1 bad command line; 2 the font could not be loaded; 3 no window, no suitable\n"
         "Vulkan device or a Vulkan failure; 4 the validation layer reported a message; 5 the screenshot or\n"

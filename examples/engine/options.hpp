@@ -40,6 +40,8 @@ struct Options {
     uint32_t drop_every = 0;  // every Nth frame is recorded, then abandoned
     std::vector<ResizeAt> resizes;
     std::vector<MinimizeAt> minimizes;
+    uint32_t caret_blink_ms = 530;  // the text field's caret: on this long, off this long; 0: steady
+    std::string snapshots;          // F9 writes PREFIX-N.json and PREFIX-N.png of the next frame
     bool help = false;
 };
 

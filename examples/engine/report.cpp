@@ -1,9 +1,11 @@
 #include "report.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 namespace engine {
 namespace {
@@ -39,6 +41,49 @@ void write_box(std::ostream& out, const TextBox& box) {
     out << "}";
 }
 
+// The field's text is UTF-8 the user typed: quotes, backslashes and control characters escaped.
+void write_string(std::ostream& out, std::string_view text) {
+    out << '"';
+    for (const char c : text) {
+        const auto byte = static_cast<unsigned char>(c);
+        if (c == '"' || c == '\\') {
+            out << '\\' << c;
+        } else if (byte < 0x20) {
+            char escaped[8];
+            std::snprintf(escaped, sizeof(escaped), "\\u%04x", byte);
+            out << escaped;
+        } else {
+            out << c;
+        }
+    }
+    out << '"';
+}
+
+void write_rect(std::ostream& out, const FieldRect& rect) {
+    out << "{\"x\": " << rect.x << ", \"y\": " << rect.y << ", \"width\": " << rect.width
+        << ", \"height\": " << rect.height << "}";
+}
+
+void write_field(std::ostream& out, const FieldReport& field) {
+    const uint32_t begin = std::min(field.anchor, field.caret), end = std::max(field.anchor, field.caret);
+    out << "  \"field\": {\n    \"text\": ";
+    write_string(out, field.text);
+    out << ",\n    \"bytes\": " << field.text.size() << ", \"focused\": " << (field.focused ? "true" : "false")
+        << ", \"caret\": " << field.caret << ", \"caret_upstream\": " << (field.caret_upstream ? "true" : "false")
+        << ", \"anchor\": " << field.anchor << ", \"selection\": [" << begin << ", " << end
+        << "],\n    \"caret_visible\": " << (field.caret_visible ? "true" : "false") << ", \"box\": ";
+    write_rect(out, field.box);
+    out << ", \"caret_rect\": ";
+    write_rect(out, field.caret_rect);
+    out << ",\n    \"text_x\": " << field.text_x << ", \"baseline_y\": " << field.baseline_y
+        << ", \"selection_rects\": [";
+    for (size_t i = 0; i < field.selection_rects.size(); ++i) {
+        out << (i ? ", " : "");
+        write_rect(out, field.selection_rects[i]);
+    }
+    out << "]\n  },\n";
+}
+
 }  // namespace
 
 crisp::Status write_report(const std::string& path, const RunReport& report, uint32_t validation_messages) {
@@ -51,7 +96,9 @@ crisp::Status write_report(const std::string& path, const RunReport& report, uin
         << "\",\n  \"validation_messages\": " << validation_messages
         << ",\n  \"glyphs\": {\"drawn\": " << report.glyphs.drawn << ", \"moving\": " << report.glyphs.moving
         << ", \"transformed\": " << report.glyphs.transformed << ", \"projective\": " << report.glyphs.projective
-        << "},\n  \"text\": [\n";
+        << "},\n";
+    write_field(out, report.field);
+    out << "  \"text\": [\n";
     for (size_t i = 0; i < report.boxes.size(); ++i) {
         write_box(out, report.boxes[i]);
         out << (i + 1 < report.boxes.size() ? ",\n" : "\n");

@@ -24,6 +24,8 @@ constexpr float kStem = 10.0f, kLabelMargin = 4.0f;
 // The spinner turns this many degrees clockwise a frame (a turn in 240 frames), below the HUD.
 constexpr double kSpinPerFrame = 1.5;
 constexpr float kSpinnerGap = 10.0f;
+// The text field: its height, widest width and the gap to the HUD and the window's edges.
+constexpr float kFieldHeight = 30.0f, kFieldMaxWidth = 400.0f, kFieldGap = 12.0f;
 // The sign's text spans this part of the cube face's width.
 constexpr float kSignFill = 0.8f;
 constexpr double kPi = 3.14159265358979323846;
@@ -33,6 +35,7 @@ constexpr uint64_t kLabelId = 1;
 constexpr uint64_t kRowId = 100;
 constexpr uint64_t kSpinnerId = 200;
 constexpr uint64_t kSignId = 300;
+constexpr uint64_t kFieldId = 400;
 // Paint orders: each text its own range (the HUD's texts do not overlap, so any order would do).
 constexpr uint32_t kCounterPaintOrder = 10000;
 constexpr uint32_t kRowPaintOrder = 20000, kRowPaintOrders = 256;  // per row
@@ -96,12 +99,14 @@ std::array<float, 3> to_array(Vec3 v) {
 
 }  // namespace
 
-TextOverlay::TextOverlay(std::vector<crisp::Font> fonts) : fonts_(std::move(fonts)) {
+TextOverlay::TextOverlay(std::vector<crisp::Font> fonts, uint32_t caret_blink_ms) : fonts_(std::move(fonts)) {
     for (const crisp::Font& font : fonts_) font_chain_.push_back(&font);
+    field_.emplace(font_chain_, layouter_, caret_blink_ms);
 }
 
-crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& device, std::vector<crisp::Font> fonts) {
-    std::unique_ptr<TextOverlay> self(new TextOverlay(std::move(fonts)));
+crisp::Result<std::unique_ptr<TextOverlay>> TextOverlay::create(const Device& device, std::vector<crisp::Font> fonts,
+                                                                uint32_t caret_blink_ms) {
+    std::unique_ptr<TextOverlay> self(new TextOverlay(std::move(fonts), caret_blink_ms));
     crisp::RendererCreateInfo renderer_info;
     renderer_info.instance = device.instance();
     renderer_info.instance_api_version = Device::kInstanceApiVersion;
@@ -176,6 +181,7 @@ crisp::Status TextOverlay::lay_out_static() {
     spinner_panel_ = {std::round(kHudX + (kHudWidth - side) / 2.0f), hud_.y + hud_.height + kSpinnerGap, side, side,
                       kLabelPanel};
     if (s) s = lay_out("CRISP", style(kSignSize, kSignColor), at(0, 0, kSignPaintOrder), sign_);
+    if (s) s = field_->set_text(kFieldText);
     return s;
 }
 
@@ -188,6 +194,7 @@ const OverlayFrame& TextOverlay::draw(uint64_t frame, VkExtent2D extent, const S
     draw_spinner(frame);
     draw_labels(extent, scene);
     draw_sign(extent, scene);
+    draw_field(extent);
     return frame_;
 }
 
@@ -365,6 +372,16 @@ void TextOverlay::draw_sign(VkExtent2D extent, const SceneState& scene) {
     }
     box.x = x0, box.y = y0, box.width = x1 - x0, box.height = y1 - y0;
     frame_.boxes.push_back(box);
+}
+
+// The field sits at the bottom of the scene's part of the window, right of the HUD, where it covers
+// only the ground; it narrows with the window (and scrolls its text), down to nothing.
+void TextOverlay::draw_field(VkExtent2D extent) {
+    const float x = hud_right() + kFieldGap;
+    const float width = std::clamp(static_cast<float>(extent.width) - x - kFieldGap, 0.0f, kFieldMaxWidth);
+    const float y = std::max(static_cast<float>(extent.height) - kFieldHeight - kFieldGap, 0.0f);
+    field_->place({x, y, width, kFieldHeight});
+    field_->draw(*renderer_, frame_.panels, kFieldId);
 }
 
 crisp::Status TextOverlay::record_rasterization(VkCommandBuffer command_buffer) {

@@ -13,6 +13,7 @@
 #include "device.hpp"
 #include "scene.hpp"
 #include "swapchain.hpp"
+#include "text_field.hpp"
 
 #include <crisp/compositor.hpp>
 #include <crisp/font.hpp>
@@ -63,8 +64,10 @@ public:
     // Creates the renderer and compositor on `device` (whose feature chain crisp checks) and lays
     // out the text that never changes. `fonts`: the text font, then optionally a colour font whose
     // kHudEmoji ends the HUD's title. Errors: crisp's, when the device lacks what it needs or the
-    // compositor cannot store to the scene target's format.
-    static crisp::Result<std::unique_ptr<TextOverlay>> create(const Device& device, std::vector<crisp::Font> fonts);
+    // compositor cannot store to the scene target's format. `caret_blink_ms`: the text field's
+    // (TextField).
+    static crisp::Result<std::unique_ptr<TextOverlay>> create(const Device& device, std::vector<crisp::Font> fonts,
+                                                              uint32_t caret_blink_ms);
     TextOverlay(const TextOverlay&) = delete;
     TextOverlay& operator=(const TextOverlay&) = delete;
 
@@ -75,8 +78,11 @@ public:
     // out again every frame), the list rows (moved and clipped to the list box), the spinner below
     // the HUD (turned about its centre by a transform), one label per shape (moved to its
     // projected anchor, at its depth, hover colour as a draw option) and the sign on the cube's
-    // face (on a plane seen through the camera).
+    // face (on a plane seen through the camera), and the text field at the bottom.
     const OverlayFrame& draw(uint64_t frame, VkExtent2D extent, const SceneState& scene);
+    // The text field, for the window's input callbacks.
+    TextField& field() { return *field_; }
+    const TextField& field() const { return *field_; }
     // renderer.record(): outside any render pass, before anything reads the atlas.
     crisp::Status record_rasterization(VkCommandBuffer command_buffer);
     // compositor.record() into `targets.color`, which must be in GENERAL with the scene pass's
@@ -91,7 +97,7 @@ public:
     const GlyphCounts& submitted_glyphs() const { return submitted_glyphs_; }
 
 private:
-    explicit TextOverlay(std::vector<crisp::Font> fonts);
+    TextOverlay(std::vector<crisp::Font> fonts, uint32_t caret_blink_ms);
     crisp::Status lay_out_static();
     crisp::Status lay_out(std::string_view text, const crisp::TextStyle& style, const crisp::LayoutOptions& options,
                           crisp::TextLayout& out);
@@ -100,6 +106,7 @@ private:
     void draw_spinner(uint64_t frame);
     void draw_labels(VkExtent2D extent, const SceneState& scene);
     void draw_sign(VkExtent2D extent, const SceneState& scene);
+    void draw_field(VkExtent2D extent);
     TextBox box_of(const char* name, const crisp::TextLayout& layout, float dx, float dy) const;
 
     // The text font first, the fallback chain of every layout; declared before the renderer, which
@@ -121,6 +128,8 @@ private:
     crisp::TextLayout spinner_;
     Panel spinner_panel_;  // a square the spinner turns in, whatever its angle
     crisp::TextLayout sign_;
+    // After the fonts and the layouter, which it uses.
+    std::optional<TextField> field_;
     crisp::RendererStats last_submitted_{};
     GlyphCounts submitted_glyphs_;
     bool have_stats_ = false;
