@@ -159,9 +159,21 @@ crisp::Status TextOverlay::lay_out_static() {
         fonts_.size() > 1 ? "crisp in a small engine \xF0\x9F\x98\x80" : "crisp in a small engine";
     crisp::Status s = lay_out(title, style(kTitleSize, kWhite), at(x, y + ascender * kTitleSize, 0), title_);
     y = title_.y + title_.height + 4.0f;
-    if (s)
-        s = lay_out(kParagraph, style(kBodySize, kBodyColor),
-                    at(x, y + ascender * kBodySize, title_.next_paint_order, wrap), paragraph_);
+    if (s) {
+        // Spans over the one paragraph: its words about hovering in the hover colour, "HDR target"
+        // underlined; shaped as one text, so kerning across the boundaries is kept.
+        const std::string_view paragraph = kParagraph;
+        crisp::TextStyle hover = style(kBodySize, kHoverColor);
+        crisp::TextStyle underlined = style(kBodySize, kBodyColor);
+        underlined.underline = true;
+        const auto span_of = [&](std::string_view words, const crisp::TextStyle& span_style) {
+            const auto begin = static_cast<uint32_t>(paragraph.find(words));
+            return crisp::TextSpan{begin, begin + static_cast<uint32_t>(words.size()), span_style};
+        };
+        const crisp::TextSpan spans[] = {span_of("hover colour", hover), span_of("HDR target", underlined)};
+        s = layouter_.layout(font_chain_, paragraph, style(kBodySize, kBodyColor), spans,
+                             at(x, y + ascender * kBodySize, title_.next_paint_order, wrap), paragraph_);
+    }
     y = paragraph_.y + paragraph_.height + 6.0f;
     counter_y_ = y + ascender * kCounterSize;
     y += 2.0f * fonts_.front().line_height() * kCounterSize + 6.0f;  // the counter's two lines
@@ -217,6 +229,14 @@ void TextOverlay::draw_hud(uint64_t frame, VkExtent2D extent) {
     title.effects->shadow = crisp::TextShadow{2.0f, 2.0f, {0.0f, 0.0f, 0.0f, 0.6f}};
     renderer_->draw(title_.glyphs, title);
     renderer_->draw(paragraph_.glyphs);
+    // Its underline: the layout's rectangles, drawn as panels beneath the text (whole pixels).
+    for (const crisp::TextDecoration& d : paragraph_.decorations) {
+        frame_.panels.push_back({std::round(d.x),
+                                 std::round(d.y),
+                                 std::round(d.width),
+                                 std::max(1.0f, std::round(d.height)),
+                                 {d.color[0], d.color[1], d.color[2], d.color[3]}});
+    }
     // Text that changes every frame is laid out every frame: the Layouter keeps its buffers.
     char text[160];
     if (have_stats_) {
