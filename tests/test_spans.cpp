@@ -3,6 +3,7 @@
 // strikethroughs; scale, line height, maximum lines with ellipsis trimming and tab stops; bad
 // spans refused by name.
 #include <crisp/bake.hpp>
+#include <crisp/editing.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
 
@@ -304,6 +305,49 @@ TEST_F(Spans, TabStops) {
     const float grid = 4.0f * space;  // past the last stop, tab_spaces' stops
     const float c_end = layout.glyphs[2].pen_x + dejavu_->glyph_record(layout.glyphs[2].key.glyph)->advance * 16.0f;
     EXPECT_NEAR(layout.glyphs[3].pen_x, std::ceil(c_end / grid) * grid, 1e-3f);
+}
+
+TEST_F(Spans, CaretsRoundTripThroughStyledLines) {
+    // Sizes, shifts and spacing change the line boxes and advances the caret works from; every
+    // grapheme boundary's caret, hit at its centre, gives the position back, and the caret is as
+    // tall as its line's box.
+    const std::string text =
+        "Mixed sizes: big \xD7\xA9\xD7\x9C\xD7\x95\xD7\x9D small x2 and spaced \xD8\xB3\xD9\x84\xD8\xA7\xD9\x85 end";
+    TextStyle big;
+    big.size = 30.0f;
+    TextStyle raised;
+    raised.size = 10.0f;
+    raised.baseline_shift = 6.0f;
+    TextStyle spaced;
+    spaced.letter_spacing = 3.0f;
+    const uint32_t two = static_cast<uint32_t>(text.find("x2")) + 1;
+    const uint32_t spaced_at = static_cast<uint32_t>(text.find("spaced"));
+    LayoutOptions options;
+    options.wrap_width = 160.0f;
+    const TextLayout layout =
+        lay(text, {}, {span(13, 16, big), span(two, two + 1, raised), span(spaced_at, spaced_at + 6, spaced)}, options);
+    ASSERT_GE(layout.lines.size(), 2u);
+    Result<TextBoundaries> boundaries = TextBoundaries::analyze(text);
+    ASSERT_TRUE(boundaries) << boundaries.error().message;
+    size_t checked = 0;
+    for (uint32_t offset = 0; offset <= text.size(); ++offset) {
+        if (!boundaries->is_grapheme_boundary(offset)) continue;
+        for (const bool upstream : {false, true}) {
+            const TextPosition position{offset, upstream};
+            const TextRect caret = caret_rect(layout, *boundaries, position);
+            const HitTest hit = hit_test(layout, *boundaries, caret.x + caret.width / 2, caret.y + caret.height / 2);
+            const TextRect back = caret_rect(layout, *boundaries, hit.position);
+            // The same caret (a position at a line's end and the next line's start are two carets).
+            EXPECT_NEAR(back.x, caret.x, 1e-3f) << offset << (upstream ? " upstream" : "");
+            EXPECT_NEAR(back.y, caret.y, 1e-3f) << offset << (upstream ? " upstream" : "");
+            const TextLine& line = layout.lines[hit.line];
+            EXPECT_NEAR(caret.height, line.ascent + line.descent, 1e-3f) << offset;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 100u);
+    // The first line holds the big word: its box is taller than the base style's.
+    EXPECT_GT(layout.lines[0].ascent, 1.5f * lay("x", {}, {}).lines[0].ascent);
 }
 
 TEST_F(Spans, BadSpansAreRefusedByName) {
