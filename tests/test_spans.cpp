@@ -201,6 +201,13 @@ TEST_F(Spans, UnderlinesSkipInkAndMergeAcrossSpans) {
     for (const TextDecoration& d : skipping.decorations) covered += d.width;
     EXPECT_LT(covered, solid.decorations[0].width);
 
+    // Tracking tighter than the glyphs' advances: one rectangle, running left to right.
+    TextStyle tight = underlined;
+    tight.letter_spacing = -12.0f;
+    const TextLayout overlapping = lay("iiii", tight, {});
+    ASSERT_EQ(overlapping.decorations.size(), 1u);
+    EXPECT_GT(overlapping.decorations[0].width, 0.0f);
+
     TextStyle struck;
     struck.strikethrough = true;
     const TextLayout strike = lay("xx", struck, {});

@@ -100,7 +100,10 @@ void Layouter::State::decorate(TextLayout& out) {
                     thickness = std::max(1.0, std::round(thickness));
                     top = std::round(top);
                 }
-                stretches.push_back({left, left + static_cast<double>(glyph.advance), top, top + thickness, style,
+                // A negative letter spacing can make an advance negative: the stretch still runs
+                // left to right.
+                const double right = left + static_cast<double>(glyph.advance);
+                stretches.push_back({std::min(left, right), std::max(left, right), top, top + thickness, style,
                                      static_cast<uint32_t>(p), kind});
             };
             if (view.style->underline)
@@ -127,8 +130,10 @@ void Layouter::State::decorate(TextLayout& out) {
                                   last.depth == view.style->depth && last.y == static_cast<float>(stretch.top) &&
                                   last.height == static_cast<float>(stretch.bottom - stretch.top);
                 const double last_right = static_cast<double>(last.x) + static_cast<double>(last.width);
-                if (same && std::abs(stretch.left - last_right) < 1e-3) {
-                    last.width = static_cast<float>(stretch.right - static_cast<double>(last.x));
+                // Touching or (with negative letter spacing) overlapping: one rectangle, so that
+                // no pixel is painted twice.
+                if (same && stretch.left <= last_right + 1e-3) {
+                    last.width = static_cast<float>(std::max(last_right, stretch.right) - static_cast<double>(last.x));
                     last.text_begin = std::min(last.text_begin, begin);
                     last.text_end = std::max(last.text_end, end);
                     continue;
