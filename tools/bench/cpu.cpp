@@ -166,8 +166,14 @@ void print_atlas_row(std::FILE* out, const std::string& name, size_t glyphs, Mea
 // The baked fonts and the scratch state the cases share; each group of cases prints its table.
 class Bench {
 public:
-    Bench(std::FILE* out, const Args& args, const crisp::Font& dejavu, const crisp::Font& inter, const crisp::Font& cjk)
-        : out_(out), args_(args), all_fonts_{&dejavu, &inter, &cjk}, one_{&dejavu}, chain_{&inter, &dejavu, &cjk} {}
+    Bench(std::FILE* out, const Args& args, const crisp::Font& dejavu, const crisp::Font& inter, const crisp::Font& cjk,
+          const crisp::Font& dejavu_again)
+        : out_(out),
+          args_(args),
+          all_fonts_{&dejavu, &inter, &cjk},
+          one_{&dejavu},
+          chain_{&inter, &dejavu, &cjk},
+          dejavu_again_(dejavu_again) {}
 
     // Layout: the UI frame with one font and with the fallback chain, against bare hb_shape.
     void layout_cases() {
@@ -260,6 +266,16 @@ public:
                         return style;
                     }),
                     base);
+        const std::vector<const crisp::Font*> again = {&dejavu_again_};
+        styled_case("font every 20 glyphs (DejaVu Sans and a second DejaVu Sans Font)", text, spans_of([&] {
+                        crisp::TextStyle style = base;
+                        style.fonts = again;
+                        return style;
+                    }),
+                    base);
+        crisp::TextStyle inter_base = base;
+        inter_base.fonts = inter;
+        styled_case("unstyled, Inter (the other font of the next case)", text, {}, inter_base);
         styled_case("font every 20 glyphs (DejaVu Sans and Inter)", text, spans_of([&] {
                         crisp::TextStyle style = base;
                         style.fonts = inter;
@@ -451,6 +467,7 @@ private:
     std::vector<const crisp::Font*> all_fonts_;  // by FontId - 1
     std::vector<const crisp::Font*> one_;        // DejaVu Sans alone
     std::vector<const crisp::Font*> chain_;      // Inter > DejaVu Sans > Noto Sans CJK
+    const crisp::Font& dejavu_again_;            // DejaVu Sans as another Font: runs cut where spans switch
     std::vector<Label> latin_;                   // the Latin UI frame
     crisp::Layouter layouter_;
     crisp::TextLayout layout_;
@@ -475,7 +492,8 @@ void crisp::bench::run_cpu(Session& session) {
     auto inter = load(args.inter, 2, {});
     // A subset: the CJK characters the frame uses, like an asset pipeline would bake.
     auto cjk = load(args.cjk, 3, {0x8A2D, 0x5B9A, 0x4FDD, 0x5B58, 0x6F22, 0x5B57});
-    if (!dejavu || !inter || !cjk) fail("cpu", "a font did not load (the message is above)");
+    auto dejavu_again = load(args.dejavu, 4, {});
+    if (!dejavu || !inter || !cjk || !dejavu_again) fail("cpu", "a font did not load (the message is above)");
     const double bake_ms = std::chrono::duration<double, std::milli>(Clock::now() - bake_start).count();
 
     std::fprintf(session.md,
@@ -483,7 +501,7 @@ void crisp::bench::run_cpu(Session& session) {
                  "case after %d untimed (the large-text cases a quarter as many).\n\n",
                  bench::cpu_model().c_str(), std::max(1u, static_cast<unsigned>(std::thread::hardware_concurrency())),
                  __VERSION__, bake_ms, args.runs, args.warmup);
-    Bench bench(session.md, args, *dejavu, *inter, *cjk);
+    Bench bench(session.md, args, *dejavu, *inter, *cjk, *dejavu_again);
     progress("cpu", "layout cases");
     bench.layout_cases();
     progress("cpu", "atlas cases");
