@@ -675,6 +675,35 @@ if [ -n "$(find /usr/share/vulkan /etc/vulkan -name 'VkLayer_khronos_validation.
   done
 fi
 
+# Issue 27: a scene run's spans. "nun" is underlined (without ink skipping, a solid line) and
+# "mum" struck through in red; the underline and the strikethrough are painted beneath the text,
+# the rows between and below the letters stay white elsewhere, and a reference mode says it leaves
+# them out.
+"$bake" "$source/fonts/DejaVuSans.ttf" --text "num " -o "$work/spans.crisp" -q || fail "crisp-bake num failed"
+printf '%s' '{"fonts": ["spans.crisp"], "canvas": [160, 40], "runs": [{"text": "nun mum", "size": 24,
+  "origin": [8, 24], "spans": [{"begin": 0, "end": 3, "underline": true, "skip_ink": false},
+  {"begin": 4, "end": 7, "strikethrough": true, "color": [1, 0, 0]}]}]}' >"$work/spans.json"
+expect_exit 0 "a scene with spans" -- "$render" --scene "$work/spans.json" -o "$work/spans.png" -q
+python3 - "$work" <<'PY' || fail "the scene's underline and strikethrough are not where they should be"
+import sys
+from read_png import read_png
+width, height, channels, data = read_png(sys.argv[1] + "/spans.png")
+pixel = lambda x, y: data[(y * width + x) * channels:(y * width + x) * channels + 3]
+# A line about a pixel thick lands on two rows, each about half covered: ink is anything not white.
+dark = lambda x, y: max(pixel(x, y)) < 220
+red = lambda x, y: pixel(x, y)[0] > 200 and pixel(x, y)[1] < 90
+# "nun" lies over x 10 to about 51; on and below its baseline (y 24) only the underline.
+under = [y for y in range(24, 32) if sum(dark(x, y) for x in range(10, 50)) >= 38]
+assert under, "no underline below the baseline of nun"
+assert not any(dark(x, y) for y in under for x in range(62, 160)), "the underline runs under mum"
+# "mum" (from about x 60): a red row through the middle of its letters, across their gaps too.
+struck = [y for y in range(8, 22) if sum(red(x, y) for x in range(62, 110)) > 40]
+assert struck, "no strikethrough through mum"
+PY
+expect_exit 0 "a scene with spans, --composite exact" -- "$render" --scene "$work/spans.json" --composite exact \
+  -o "$work/spans-exact.png"
+expect_stderr "underlines and strikethroughs are not drawn" "a reference mode with decorations"
+
 # Issue 28 item 16: a canvas is 16 bytes a pixel in each copy crisp-render holds (the backdrop,
 # the image, the upload and readback copies, the composited target); at 4096 x 4096 each is
 # 256 MiB, and the run peaked at 5.1 of them (1.33 GB of RSS on lavapipe, whose image memory is

@@ -410,6 +410,44 @@ TEST_F(Editing, VisualMotionThroughAnRtlRun) {
     EXPECT_EQ(visited, expected);
 }
 
+TEST_F(Editing, VisualWordMotionStopsAtWordStartsOnScreen) {
+    // "one two " then Hebrew "שלום אב" (a right-to-left run) then " end": Ctrl+Right from
+    // the start stops at each word start in turn; inside the Hebrew run, going right on screen
+    // walks it backwards, so its stops are its words' starts met from their left side.
+    const std::string text = "one two \u05E9\u05DC\u05D5\u05DD \u05D0\u05D1 end";
+    const TextLayout layout = lay(text);
+    const TextBoundaries bounds = boundaries(text);
+    Caret caret;
+    float x = caret_rect(layout, bounds, caret.position, 0).x;
+    std::vector<uint32_t> stops;
+    for (int i = 0; i < 12; ++i) {
+        const Caret next = move_caret(layout, bounds, caret, CaretMotion::word_right);
+        if (next.position == caret.position) break;
+        const float next_x = caret_rect(layout, bounds, next.position, 0).x;
+        EXPECT_GT(next_x, x) << "word_right moved the caret left, to " << next.position.offset;
+        x = next_x;
+        caret = next;
+        stops.push_back(caret.position.offset);
+    }
+    // Every stop is a word start or the text's end, and the LTR words' starts are among them.
+    for (const uint32_t stop : stops) {
+        const bool word_start = stop == text.size() || bounds.previous_word_start(bounds.next_grapheme(stop)) == stop;
+        EXPECT_TRUE(word_start) << stop;
+    }
+    EXPECT_NE(std::find(stops.begin(), stops.end(), 4u), stops.end());  // "two"
+    EXPECT_EQ(stops.back(), text.size());
+    // And back: word_left retraces to the start, moving left every time.
+    for (int i = 0; i < 12 && caret.position.offset != 0; ++i) {
+        const Caret next = move_caret(layout, bounds, caret, CaretMotion::word_left);
+        ASSERT_NE(next.position, caret.position);
+        const float next_x = caret_rect(layout, bounds, next.position, 0).x;
+        EXPECT_LT(next_x, x);
+        x = next_x;
+        caret = next;
+    }
+    EXPECT_EQ(caret.position.offset, 0u);
+}
+
 TEST_F(Editing, UpAndDownKeepTheGoalX) {
     // Three lines: long, short, long. Bytes: line 0 [0, 15), line 1 [16, 18), line 2 [19, 34).
     const std::string text = "a long line one\nab\na long line two";

@@ -225,13 +225,10 @@ bool TextField::key(int key, int mods) {
         case GLFW_KEY_LEFT:
         case GLFW_KEY_RIGHT: {
             const bool right = key == GLFW_KEY_RIGHT;
-            // crisp's word motion is logical: Ctrl+Right goes to the next word where the field
-            // reads left to right, the previous one where it reads right to left.
-            // WORKAROUND: crisp/editing.hpp has no visual word motion.
-            const bool rtl = !layout_.lines.empty() && layout_.lines.front().rtl;
+            // On screen, by grapheme or (Ctrl) by word, through either direction.
             const crisp::CaretMotion motion =
                 !control ? (right ? crisp::CaretMotion::right : crisp::CaretMotion::left)
-                         : (right != rtl ? crisp::CaretMotion::next_word : crisp::CaretMotion::previous_word);
+                         : (right ? crisp::CaretMotion::word_right : crisp::CaretMotion::word_left);
             move_caret(motion, shift);
             return true;
         }

@@ -148,12 +148,15 @@ enum class CaretMotion : uint8_t {
     text_start,         // to offset 0 (Ctrl+Home)
     text_end,           // to the end of the text, upstream (Ctrl+End)
     // Visual: on screen.
-    left,   // one grapheme edge to the left; past the line's left end to the line before (LTR
-            // paragraph) or after (RTL) it, at that line's right end
-    right,  // one grapheme edge to the right; past the right end to the line after (LTR) or
-            // before (RTL), at its left end
-    up,     // to the line above, nearest the goal x; on the first line, to the start of the text
-    down,   // to the line below, nearest the goal x; on the last line, to the end of the text
+    left,        // one grapheme edge to the left; past the line's left end to the line before (LTR
+                 // paragraph) or after (RTL) it, at that line's right end
+    right,       // one grapheme edge to the right; past the right end to the line after (LTR) or
+                 // before (RTL), at its left end
+    word_left,   // left grapheme edge by grapheme edge to the first word start (Ctrl+Left), or
+                 // as far as `left` goes: in right-to-left text that is the next word, logically
+    word_right,  // the same to the right (Ctrl+Right)
+    up,          // to the line above, nearest the goal x; on the first line, to the start of the text
+    down,        // to the line below, nearest the goal x; on the last line, to the end of the text
 };
 
 struct Caret {

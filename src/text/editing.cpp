@@ -460,6 +460,25 @@ Caret move_unsnapped(const TextLayout& layout, const TextBoundaries& boundaries,
             return {move_visually(layout, boundaries, position, -1), kNoGoal};
         case CaretMotion::right:
             return {move_visually(layout, boundaries, position, +1), kNoGoal};
+        case CaretMotion::word_left:
+        case CaretMotion::word_right: {
+            // On screen, one grapheme edge at a time, until the caret stands at a word's start
+            // (or at the text's ends, or where it can go no further).
+            const int step = motion == CaretMotion::word_left ? -1 : +1;
+            TextPosition at = position;
+            // Visual steps through text of many direction runs and lines may come back to where
+            // they were: at most as many steps as there are caret positions.
+            const size_t limit = 2 * size_t{boundaries.size()} + 2;
+            for (size_t steps = 0;; ++steps) {
+                const TextPosition next = move_visually(layout, boundaries, at, step);
+                if (next == at || steps == limit) return {at, kNoGoal};
+                at = next;
+                const bool word_start =
+                    at.offset == 0 || at.offset >= boundaries.size() ||
+                    boundaries.previous_word_start(boundaries.next_grapheme(at.offset)) == at.offset;
+                if (word_start) return {at, kNoGoal};
+            }
+        }
         case CaretMotion::up:
         case CaretMotion::down: {
             const uint32_t line = line_of(layout, position);
