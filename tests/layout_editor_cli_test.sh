@@ -3,8 +3,9 @@
 # at all ($DISPLAY and $WAYLAND_DISPLAY unset, so a window would fail with exit 3). --export
 # fontconfig prints well-formed fontconfig XML with the layout's rgba and lcdfilter, --export
 # freetype FT_Library_SetLcdGeometry's positions; what a form cannot express is a note on stderr
-# and the exit code stays 0; a bad --export value, a --layout that does not load and --export with
-# window options are usage errors (exit 1); stdout that cannot be written is exit 5.
+# and the exit code stays 0; a bad --export value, a --layout that does not load (a mistyped preset
+# named with the presets) and --export with window options are usage errors (exit 1); stdout that
+# cannot be written is exit 5.
 set -uo pipefail
 editor=$1 work=$2
 rm -rf "$work" && mkdir -p "$work"
@@ -59,6 +60,8 @@ expect_stderr "--export takes fontconfig or freetype, not 'xft'" "--export xft"
 [ ! -s "$work/out" ] || fail "--export xft printed: $(cat "$work/out")"
 expect_exit 1 "--export of a missing file" -- "$editor" --layout "$work/missing.json" --export fontconfig
 expect_stderr "missing.json" "--export of a missing file"
+expect_exit 1 "--export of a mistyped preset" -- "$editor" --layout qd-olde --export fontconfig
+expect_stderr "nor is it a preset (gray, rgb, bgr, vrgb, vbgr, qd-oled, woled, pentile)" "--layout qd-olde"
 printf '{"r": [0, 0, 1, 1]' >"$work/truncated.json"
 expect_exit 1 "--export of a truncated file" -- "$editor" --layout "$work/truncated.json" --export freetype
 expect_stderr "truncated.json" "--export of a truncated file"

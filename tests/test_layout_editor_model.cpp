@@ -169,6 +169,42 @@ TEST(LayoutEditorModel, TypedContrastIsValidatedByCrispAndResetDropsIt) {
     EXPECT_EQ(model.layout(), before);
 }
 
+TEST(LayoutEditorModel, TheLayoutArgumentIsAPresetOrAFileAndAMissingOneNamesThePresets) {
+    ASSERT_TRUE(crisp::editor::load_layout_argument("vbgr"));
+    EXPECT_EQ(*crisp::editor::load_layout_argument("vbgr"), preset("vbgr"));
+    const crisp::Result<SubpixelLayout> missing = crisp::editor::load_layout_argument("nosuchpreset");
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().code, crisp::ErrorCode::io);
+    for (const std::string_view name : crisp::subpixel_preset_names()) {
+        EXPECT_NE(missing.error().message.find(name), std::string::npos) << missing.error().message;
+    }
+    // A file that exists but does not load keeps crisp's message alone: it was meant as a file.
+    const crisp::Result<SubpixelLayout> directory = crisp::editor::load_layout_argument(CRISP_SOURCE_DIR);
+    ASSERT_FALSE(directory);
+    EXPECT_EQ(directory.error().message.find("qd-oled"), std::string::npos) << directory.error().message;
+}
+
+TEST(LayoutEditorModel, TypedNumbersAreDecimalsOrFractions) {
+    using crisp::editor::parse_typed_number;
+    EXPECT_EQ(parse_typed_number("0.25"), 0.25f);
+    EXPECT_EQ(parse_typed_number("1/3"), static_cast<float>(1.0 / 3.0));
+    EXPECT_EQ(parse_typed_number("-2/3"), static_cast<float>(-2.0 / 3.0));
+    EXPECT_EQ(parse_typed_number("2 / 96"), static_cast<float>(2.0 / 96.0));
+    EXPECT_EQ(parse_typed_number("0.5/2"), 0.25f);
+    std::string why;
+    EXPECT_FALSE(parse_typed_number("1/0", &why));
+    EXPECT_EQ(why, "divides by zero");
+    EXPECT_FALSE(parse_typed_number("1/x", &why));
+    EXPECT_NE(why.find("denominator 'x' is not a number"), std::string::npos) << why;
+    EXPECT_FALSE(parse_typed_number("/3", &why));
+    EXPECT_NE(why.find("numerator"), std::string::npos) << why;
+    EXPECT_FALSE(parse_typed_number("1/2/3", &why));
+    EXPECT_FALSE(parse_typed_number("1e300/1e-300", &why));
+    EXPECT_NE(why.find("out of range"), std::string::npos) << why;
+    EXPECT_FALSE(parse_typed_number("third", &why));
+    EXPECT_EQ(why, "is not a number");
+}
+
 using crisp::editor::export_form;
 using crisp::editor::export_layout;
 using crisp::editor::ExportForm;

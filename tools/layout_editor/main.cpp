@@ -298,8 +298,7 @@ int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, V
 // --export: the layout, a preset or a file, in that form on stdout and its notes on stderr. A
 // layout that does not load is a usage error: there is no window to report it in.
 int export_to_stdout(const Args& args) {
-    crisp::Result<crisp::SubpixelLayout> layout = crisp::subpixel_preset(args.layout);
-    if (!layout) layout = crisp::load_subpixel_layout_file(args.layout);
+    const crisp::Result<crisp::SubpixelLayout> layout = load_layout_argument(args.layout);
     if (!layout) {
         std::fprintf(stderr, "crisp-layout-editor: --layout: %s\n", layout.error().message.c_str());
         return kExitUsage;
@@ -336,17 +335,12 @@ int main(int argc, char** argv) {
     std::string path = args.save_to;
     std::optional<std::string> load_error;
     crisp::SubpixelLayout initial = *crisp::subpixel_preset("rgb");
-    if (crisp::Result<crisp::SubpixelLayout> preset = crisp::subpixel_preset(args.layout); preset) {
-        initial = *preset;
+    if (path.empty() && !crisp::subpixel_preset(args.layout)) path = args.layout;
+    if (crisp::Result<crisp::SubpixelLayout> loaded = load_layout_argument(args.layout); loaded) {
+        initial = *loaded;
     } else {
-        if (path.empty()) path = args.layout;
-        crisp::Result<crisp::SubpixelLayout> loaded = crisp::load_subpixel_layout_file(args.layout);
-        if (loaded) {
-            initial = *loaded;
-        } else {
-            load_error = loaded.error().message;
-            std::fprintf(stderr, "crisp-layout-editor: --layout: %s\n", loaded.error().message.c_str());
-        }
+        load_error = loaded.error().message;
+        std::fprintf(stderr, "crisp-layout-editor: --layout: %s\n", loaded.error().message.c_str());
     }
     LayoutModel model(initial);
     EditorView view(model, path);
