@@ -1,13 +1,17 @@
 // The layout editor's model (tools/layout_editor/editor_model.hpp): edits, bounds, undo and redo,
-// the monitor's contrast settings, without a window.
+// the monitor's contrast settings, and the --export forms (export.hpp), without a window.
 #include "editor_model.hpp"
+#include "export.hpp"
 
 #include <crisp/glyph.hpp>
 #include <crisp/subpixel.hpp>
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <string>
+#include <vector>
 
 namespace {
 
@@ -163,6 +167,150 @@ TEST(LayoutEditorModel, TypedContrastIsValidatedByCrispAndResetDropsIt) {
     EXPECT_EQ(model.contrast(), TextContrast{});
     ASSERT_TRUE(model.undo());
     EXPECT_EQ(model.layout(), before);
+}
+
+TEST(LayoutEditorModel, TheLayoutArgumentIsAPresetOrAFileAndAMissingOneNamesThePresets) {
+    ASSERT_TRUE(crisp::editor::load_layout_argument("vbgr"));
+    EXPECT_EQ(*crisp::editor::load_layout_argument("vbgr"), preset("vbgr"));
+    const crisp::Result<SubpixelLayout> missing = crisp::editor::load_layout_argument("nosuchpreset");
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().code, crisp::ErrorCode::io);
+    for (const std::string_view name : crisp::subpixel_preset_names()) {
+        EXPECT_NE(missing.error().message.find(name), std::string::npos) << missing.error().message;
+    }
+    // A file that exists but does not load keeps crisp's message alone: it was meant as a file.
+    const crisp::Result<SubpixelLayout> directory = crisp::editor::load_layout_argument(CRISP_SOURCE_DIR);
+    ASSERT_FALSE(directory);
+    EXPECT_EQ(directory.error().message.find("qd-oled"), std::string::npos) << directory.error().message;
+}
+
+TEST(LayoutEditorModel, TypedNumbersAreDecimalsOrFractions) {
+    using crisp::editor::parse_typed_number;
+    EXPECT_EQ(parse_typed_number("0.25"), 0.25f);
+    EXPECT_EQ(parse_typed_number("1/3"), static_cast<float>(1.0 / 3.0));
+    EXPECT_EQ(parse_typed_number("-2/3"), static_cast<float>(-2.0 / 3.0));
+    EXPECT_EQ(parse_typed_number("2 / 96"), static_cast<float>(2.0 / 96.0));
+    EXPECT_EQ(parse_typed_number("0.5/2"), 0.25f);
+    std::string why;
+    EXPECT_FALSE(parse_typed_number("1/0", &why));
+    EXPECT_EQ(why, "divides by zero");
+    EXPECT_FALSE(parse_typed_number("1/x", &why));
+    EXPECT_NE(why.find("denominator 'x' is not a number"), std::string::npos) << why;
+    EXPECT_FALSE(parse_typed_number("/3", &why));
+    EXPECT_NE(why.find("numerator"), std::string::npos) << why;
+    EXPECT_FALSE(parse_typed_number("1/2/3", &why));
+    EXPECT_FALSE(parse_typed_number("1e300/1e-300", &why));
+    EXPECT_NE(why.find("out of range"), std::string::npos) << why;
+    EXPECT_FALSE(parse_typed_number("third", &why));
+    EXPECT_EQ(why, "is not a number");
+}
+
+using crisp::editor::export_form;
+using crisp::editor::export_layout;
+using crisp::editor::ExportForm;
+using crisp::editor::fontconfig_rgba;
+using crisp::editor::freetype_lcd_geometry;
+
+size_t occurrences(const std::string& text, const std::string& needle) {
+    size_t count = 0;
+    for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + needle.size())) ++count;
+    return count;
+}
+
+std::string rgba_of(const SubpixelLayout& layout, std::vector<std::string>* notes = nullptr) {
+    std::vector<std::string> own;
+    return fontconfig_rgba(layout, notes ? *notes : own);
+}
+
+TEST(LayoutEditorExport, StripesMapToFontconfigsRgbaAndTwoDimensionalLayoutsToNoneWithANote) {
+    for (const char* name : {"rgb", "bgr", "vrgb", "vbgr"}) {
+        std::vector<std::string> notes;
+        EXPECT_EQ(rgba_of(preset(name), &notes), name);
+        EXPECT_TRUE(notes.empty()) << name << ": " << notes.front();
+    }
+    std::vector<std::string> notes;
+    EXPECT_EQ(rgba_of(preset("gray"), &notes), "none");
+    EXPECT_TRUE(notes.empty());
+    for (const char* name : {"qd-oled", "pentile"}) {
+        notes.clear();
+        EXPECT_EQ(rgba_of(preset(name), &notes), "none") << name;
+        ASSERT_EQ(notes.size(), 1u) << name;
+        EXPECT_NE(notes[0].find("neither side by side nor stacked"), std::string::npos) << notes[0];
+    }
+    // WOLED's stripes run red, blue, green: no fontconfig constant has that order.
+    notes.clear();
+    EXPECT_EQ(rgba_of(preset("woled"), &notes), "none");
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_NE(notes[0].find("red, blue, green left to right"), std::string::npos) << notes[0];
+}
+
+TEST(LayoutEditorExport, StripesOfOtherShapesKeepTheirOrderAndSayWhatIsLost) {
+    SubpixelLayout narrow = preset("rgb");
+    narrow.channels[0] = {0.0f, 0.0f, 0.25f, 1.0f};  // a narrower red stripe
+    std::vector<std::string> notes;
+    EXPECT_EQ(rgba_of(narrow, &notes), "rgb");
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_NE(notes[0].find("widths"), std::string::npos) << notes[0];
+
+    SubpixelLayout short_blue = preset("bgr");
+    short_blue.channels[2].y1 = 0.5f;  // blue's stripe half the height: per-channel heights
+    notes.clear();
+    EXPECT_EQ(rgba_of(short_blue, &notes), "bgr");
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_NE(notes[0].find("per-channel heights"), std::string::npos) << notes[0];
+
+    // Stripes that overlap a little (light bleeding) are still stripes; by half, they are not.
+    SubpixelLayout bleeding = preset("vrgb");
+    bleeding.channels[0].y1 += 0.05f;
+    bleeding.channels[1].y0 -= 0.05f;
+    EXPECT_EQ(rgba_of(bleeding), "vrgb");
+    bleeding.channels[1].y0 = 0.1f;
+    EXPECT_EQ(rgba_of(bleeding), "none");
+}
+
+TEST(LayoutEditorExport, FreetypePositionsAreTheCentresIn64thsFromThePixelCentreYUp) {
+    // FreeType's own examples: {{-21, 0}, {0, 0}, {21, 0}} is RGB, {{0, 21}, {0, 0}, {0, -21}} vertical RGB.
+    using Positions = std::array<std::array<long, 2>, 3>;
+    EXPECT_EQ(freetype_lcd_geometry(preset("rgb")), (Positions{{{-21, 0}, {0, 0}, {21, 0}}}));
+    EXPECT_EQ(freetype_lcd_geometry(preset("bgr")), (Positions{{{21, 0}, {0, 0}, {-21, 0}}}));
+    EXPECT_EQ(freetype_lcd_geometry(preset("vrgb")), (Positions{{{0, 21}, {0, 0}, {0, -21}}}));
+    // QD-OLED: green above the centre, red below left, blue below right.
+    EXPECT_EQ(freetype_lcd_geometry(preset("qd-oled")), (Positions{{{-16, -16}, {0, 16}, {16, -16}}}));
+    EXPECT_EQ(freetype_lcd_geometry(preset("gray")), Positions{});
+}
+
+TEST(LayoutEditorExport, TheFormsCarryTheirValuesAndNotesAndOnlyKnownNamesAreForms) {
+    EXPECT_EQ(export_form("fontconfig"), ExportForm::fontconfig);
+    EXPECT_EQ(export_form("freetype"), ExportForm::freetype);
+    EXPECT_FALSE(export_form("xft"));
+    EXPECT_FALSE(export_form(""));
+
+    const crisp::editor::Exported rgb = export_layout(preset("rgb"), ExportForm::fontconfig);
+    EXPECT_TRUE(rgb.notes.empty());
+    EXPECT_NE(rgb.text.find("<match target=\"font\">"), std::string::npos) << rgb.text;
+    EXPECT_NE(rgb.text.find("<edit name=\"rgba\" mode=\"assign\"><const>rgb</const></edit>"), std::string::npos);
+    EXPECT_NE(rgb.text.find("<edit name=\"lcdfilter\" mode=\"assign\"><const>lcddefault</const></edit>"),
+              std::string::npos);
+
+    SubpixelLayout monitor = preset("qd-oled");
+    monitor.name = "my--monitor */";  // neither may end the comment that names it
+    monitor.contrast = TextContrast{ContrastMode::corrected, 1.8f, 0.5f, 0.0f};
+    const crisp::editor::Exported fontconfig = export_layout(monitor, ExportForm::fontconfig);
+    ASSERT_EQ(fontconfig.notes.size(), 2u);  // the triangle, the contrast
+    EXPECT_NE(fontconfig.notes[1].find("gamma 1.8, contrast 0.5"), std::string::npos) << fontconfig.notes[1];
+    EXPECT_NE(fontconfig.text.find("<const>none</const>"), std::string::npos);
+    EXPECT_NE(fontconfig.text.find("<const>lcdnone</const>"), std::string::npos);
+    EXPECT_NE(fontconfig.text.find("<!-- Not expressed: " + fontconfig.notes[0] + " -->"), std::string::npos);
+    const crisp::editor::Exported freetype = export_layout(monitor, ExportForm::freetype);
+    ASSERT_EQ(freetype.notes.size(), 2u);  // the rectangles' sizes, the contrast
+    EXPECT_NE(freetype.text.find("FT_Vector sub[3] = {{-16, -16}, {0, 16}, {16, -16}};"), std::string::npos)
+        << freetype.text;
+    EXPECT_NE(fontconfig.text.find("\"my-_monitor __\""), std::string::npos) << fontconfig.text;
+    EXPECT_NE(freetype.text.find("\"my-_monitor __\""), std::string::npos) << freetype.text;
+    // As many comments closed as opened: the name closed none early.
+    EXPECT_EQ(occurrences(fontconfig.text, "-->"), occurrences(fontconfig.text, "<!--"));
+    EXPECT_EQ(occurrences(fontconfig.text, "--"), 2 * occurrences(fontconfig.text, "<!--"));
+    EXPECT_EQ(occurrences(freetype.text, "*/"), occurrences(freetype.text, "/*"));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # run.sh CMAKE BUILD_DIR WORK_DIR SOURCE_DIR: installs the build into WORK_DIR/prefix, then
+# checks that every tool built is installed (and that the installed layout editor runs), then
 # configures, builds and runs two projects against it with find_package(crisp CONFIG):
 #   engine/  links crisp::crisp alone, as an engine does: it loads an asset the installed
 #            crisp-bake made and lays out text. It is configured with FreeType and libpng hidden
@@ -22,6 +23,12 @@ test -x "$prefix/bin/crisp-bake"
 for tool in crisp-render crisp-bench crisp-layout-editor; do  # every tool this build made is installed
   [ ! -x "$build/tools/$tool" ] || [ -x "$prefix/bin/$tool" ] || fail "$tool is built but not installed"
 done
+# The installed editor runs from the prefix: its headless export needs no display, font or device.
+if [ -x "$prefix/bin/crisp-layout-editor" ]; then
+  env -u DISPLAY -u WAYLAND_DISPLAY "$prefix/bin/crisp-layout-editor" --layout bgr --export fontconfig \
+    >"$work/editor-export.xml" || fail "the installed crisp-layout-editor --export fontconfig failed"
+  grep -q "<const>bgr</const>" "$work/editor-export.xml" || fail "the installed editor's export: $(cat "$work/editor-export.xml")"
+fi
 test ! -e "$prefix/include/crisp/../bands.hpp"   # nothing private is installed
 test ! -e "$prefix/lib/libcrisp_support.a"       # nor the tools' support library
 

@@ -1,9 +1,14 @@
 #include "editor_model.hpp"
 
+#include "cli.hpp"
+
 #include <crisp/glyph.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <limits>
+#include <system_error>
 #include <utility>
 
 namespace crisp::editor {
@@ -47,7 +52,50 @@ void shift_span(float& lo, float& hi, float delta) {
     hi += delta;
 }
 
+std::string_view trim_spaces(std::string_view text) {
+    while (!text.empty() && text.front() == ' ') text.remove_prefix(1);
+    while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
+    return text;
+}
+
 }  // namespace
+
+Result<SubpixelLayout> load_layout_argument(std::string_view preset_or_file) {
+    if (Result<SubpixelLayout> preset = subpixel_preset(preset_or_file); preset) return preset;
+    const std::filesystem::path path(preset_or_file);
+    Result<SubpixelLayout> loaded = load_subpixel_layout_file(path);
+    std::error_code ignored;
+    if (loaded || std::filesystem::exists(path, ignored)) return loaded;
+    std::string presets;
+    for (const std::string_view name : subpixel_preset_names())
+        presets += (presets.empty() ? "" : ", ") + std::string(name);
+    return Error{loaded.error().code, loaded.error().message + "; nor is it a preset (" + presets + ")"};
+}
+
+std::optional<float> parse_typed_number(std::string_view text, std::string* why) {
+    const size_t slash = text.find('/');
+    if (slash == std::string_view::npos) return cli::parse_number<float>(text, why);
+    auto refuse = [&](std::string reason) -> std::optional<float> {
+        if (why) *why = std::move(reason);
+        return std::nullopt;
+    };
+    std::string part_why;
+    const std::string_view numerator_text = trim_spaces(text.substr(0, slash));
+    const std::optional<double> numerator = cli::parse_number<double>(numerator_text, &part_why);
+    if (!numerator)
+        return refuse("is not a fraction: its numerator '" + cli::printable(numerator_text) + "' " + part_why);
+    const std::string_view denominator_text = trim_spaces(text.substr(slash + 1));
+    const std::optional<double> denominator = cli::parse_number<double>(denominator_text, &part_why);
+    if (!denominator) {
+        return refuse("is not a fraction: its denominator '" + cli::printable(denominator_text) + "' " + part_why);
+    }
+    if (*denominator == 0.0) return refuse("divides by zero");
+    const double quotient = *numerator / *denominator;
+    if (!std::isfinite(quotient) || std::fabs(quotient) > static_cast<double>(std::numeric_limits<float>::max())) {
+        return refuse("is out of range for a 32-bit float (too large)");
+    }
+    return static_cast<float>(quotient);
+}
 
 float rect_coordinate(const SampleRect& rect, int coordinate) {
     SampleRect copy = rect;

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -33,6 +34,17 @@ std::pair<float, float> contrast_range(ContrastParameter parameter);
 
 // What a drag grabs: one edge of a channel's rectangle, or the whole rectangle.
 enum class Handle : uint8_t { left, top, right, bottom, body };
+
+// The --layout argument: a preset by name, else a layout file (load_subpixel_layout_file's
+// errors). Where no such file exists either, the error also lists the presets, since a mistyped
+// preset name ends up here.
+Result<SubpixelLayout> load_layout_argument(std::string_view preset_or_file);
+
+// A number typed into a field: a decimal as cli::parse_number<float> reads it ("0.25", "-1e-3"),
+// or a fraction of two such numbers ("1/3", "-2/3", spaces allowed around the slash), divided in
+// double and rounded once to float. Anything else, a zero denominator and a quotient past float's
+// range are nullopt, with the reason in `why` ("is not a number", "divides by zero").
+std::optional<float> parse_typed_number(std::string_view text, std::string* why = nullptr);
 
 // The four numbers of a SampleRect by index: 0 x0, 1 y0, 2 x1, 3 y1.
 float rect_coordinate(const SampleRect& rect, int coordinate);

@@ -230,7 +230,7 @@ void EditorView::commit_field_edit() {
         return;
     }
     std::string why;
-    const std::optional<float> value = cli::parse_number<float>(field_text_, &why);
+    const std::optional<float> value = parse_typed_number(field_text_, &why);
     const bool contrast = field.channel == kContrastChannel;
     const std::string what = contrast
                                  ? std::string(kContrastLabels[field.coordinate])

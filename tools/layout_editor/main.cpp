@@ -1,6 +1,7 @@
 // crisp-layout-editor: fit subpixel anti-aliasing to a monitor, live (docs/layout-editor.md).
 #include "editor_model.hpp"
 #include "editor_view.hpp"
+#include "export.hpp"
 #include "gpu_frame.hpp"
 #include "vulkan_window.hpp"
 
@@ -36,6 +37,7 @@ constexpr int kExitFont = 2;
 constexpr int kExitVulkan = 3;
 constexpr int kExitValidation = 4;
 constexpr int kExitScreenshot = 5;
+constexpr int kExitWrite = kExitScreenshot;  // the --export form could not be written
 
 constexpr const char* kSynopsis = R"(Usage: crisp-layout-editor [options]
 
@@ -48,7 +50,8 @@ constexpr const char* kExitCodes = R"(
 Exit codes: 0 success; 1 bad command line; 2 the font could not be loaded; 3 no window or no
 Vulkan device (or a Vulkan failure); 4 the validation layer reported a message; 5 the screenshot
 could not be written, or must not be (the --font or --layout file, a read-only file, a device:
-refused before the window opens; docs/limits.md).
+refused before the window opens; docs/limits.md), or the --export form could not be written.
+With --export, a --layout that does not load is exit code 1.
 )";
 
 struct Args {
@@ -59,6 +62,7 @@ struct Args {
     std::string screenshot;
     bool validation = false;
     bool print_geometry = false;
+    std::string export_form;  // print the layout in this form and quit, without a window
 };
 
 Args parse_args(int argc, char** argv) {
@@ -83,8 +87,18 @@ Args parse_args(int argc, char** argv) {
              args.validation);
     cli.flag("--print-geometry", "print the widgets' positions as JSON and quit (for scripted input)",
              args.print_geometry);
+    std::vector<std::string> forms(export_form_names().begin(), export_form_names().end());
+    cli.choice("--export", "FORM",
+               "print the --layout for other software and quit, without a window:\n"
+               "fontconfig (rgba and lcdfilter as XML) or freetype (the positions\n"
+               "FT_Library_SetLcdGeometry takes); what the form cannot express is a\n"
+               "note on stderr",
+               args.export_form, std::move(forms));
     cli.parse(argc, argv);
     if (!args.screenshot.empty() && args.frames == 0) cli.fail("--screenshot needs --frames N");
+    if (!args.export_form.empty() && (!args.screenshot.empty() || args.frames != 0)) {
+        cli.fail("--export prints and quits: it takes no --frames or --screenshot");
+    }
     return args;
 }
 
@@ -281,6 +295,25 @@ int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, V
     return kExitOk;
 }
 
+// --export: the layout, a preset or a file, in that form on stdout and its notes on stderr. A
+// layout that does not load is a usage error: there is no window to report it in.
+int export_to_stdout(const Args& args) {
+    const crisp::Result<crisp::SubpixelLayout> layout = load_layout_argument(args.layout);
+    if (!layout) {
+        std::fprintf(stderr, "crisp-layout-editor: --layout: %s\n", layout.error().message.c_str());
+        return kExitUsage;
+    }
+    const Exported exported = export_layout(*layout, *export_form(args.export_form));
+    for (const std::string& note : exported.notes) {
+        std::fprintf(stderr, "crisp-layout-editor: note: %s\n", note.c_str());
+    }
+    if (std::fputs(exported.text.c_str(), stdout) < 0 || std::fflush(stdout) != 0) {
+        std::fprintf(stderr, "crisp-layout-editor: --export: stdout could not be written\n");
+        return kExitWrite;
+    }
+    return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -289,6 +322,7 @@ int main(int argc, char** argv) {
         std::printf("%s\n", EditorView::geometry_json().c_str());
         return kExitOk;
     }
+    if (!args.export_form.empty()) return export_to_stdout(args);
 
     std::optional<crisp::OutputFiles> screenshot;
     if (!args.screenshot.empty()) {
@@ -301,17 +335,12 @@ int main(int argc, char** argv) {
     std::string path = args.save_to;
     std::optional<std::string> load_error;
     crisp::SubpixelLayout initial = *crisp::subpixel_preset("rgb");
-    if (crisp::Result<crisp::SubpixelLayout> preset = crisp::subpixel_preset(args.layout); preset) {
-        initial = *preset;
+    if (path.empty() && !crisp::subpixel_preset(args.layout)) path = args.layout;
+    if (crisp::Result<crisp::SubpixelLayout> loaded = load_layout_argument(args.layout); loaded) {
+        initial = *loaded;
     } else {
-        if (path.empty()) path = args.layout;
-        crisp::Result<crisp::SubpixelLayout> loaded = crisp::load_subpixel_layout_file(args.layout);
-        if (loaded) {
-            initial = *loaded;
-        } else {
-            load_error = loaded.error().message;
-            std::fprintf(stderr, "crisp-layout-editor: --layout: %s\n", loaded.error().message.c_str());
-        }
+        load_error = loaded.error().message;
+        std::fprintf(stderr, "crisp-layout-editor: --layout: %s\n", loaded.error().message.c_str());
     }
     LayoutModel model(initial);
     EditorView view(model, path);
