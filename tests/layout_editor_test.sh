@@ -2,14 +2,18 @@
 # layout_editor_test.sh EDITOR CRISP_RENDER CRISP_BAKE SOURCE_DIR WORK_DIR: runs crisp-layout-editor
 # under Xvfb on whatever Vulkan device there is (lavapipe in CI) with the validation layer on, and
 # drives it with xdotool: pick the bgr preset, drag the red rectangle's bottom edge up 24 screen
-# pixels, nudge it one step left, undo and redo the nudge, type 0.125 into its y0 field, raise the
-# contrast model's gamma one step (G), save (Ctrl+S), quit (Ctrl+Q). Checks that the saved JSON is
-# exactly bgr with those edits and the default contrast with gamma 2.3, that
+# pixels, nudge it one step left, undo and redo the nudge, type 0.125 into its y0 field, Tab to its
+# x1 field and type 0.95, Shift+Tab back to y0 and type 0.25, raise the contrast model's gamma one
+# step (G), save (Ctrl+S), quit (Ctrl+Q). Checks that the saved JSON is exactly bgr with those
+# edits, its numbers on the 1/96 grid exact and every number in its shortest form (0.65625, 0.95),
+# and the default contrast with gamma 2.3, that
 # crisp-render accepts it, that the editor exits 0 (so the validation layer stayed silent), and
 # that screenshots of the display before and after the edit show the preview, the magnified pixel
 # and the magnified rendered pixels, each not blank and each changed by the edit. Also: a bad
 # --layout file is reported (not fatal) and the --screenshot mode writes a PNG of the window, never
 # onto its own --layout or --font file; FIFOs as --font or --layout are refused without a hang.
+# The window: --window WxH screenshots are that size, filled (not mostly black), with the status
+# line drawn at the bottom; and the editor idles (next to no CPU) once the preview has converged.
 set -uo pipefail
 editor=$1 render=$2 bake=$3 source=$4 work=$5
 
@@ -105,6 +109,70 @@ python3 -c 'import sys; d=open("shot.png","rb").read(); sys.exit(not (d[:8]==b"\
 int.from_bytes(d[16:20],"big")==1280 and int.from_bytes(d[20:24],"big")==800))' ||
   fail "--screenshot did not write a 1280 x 800 PNG"
 
+# ---- --window WxH: the screenshot is that size, the widgets laid out for it (--print-geometry
+# --window says where), the status line drawn inside it and the picture not mostly black. A window
+# smaller than the interface needs is drawn smaller, and says so.
+cat >pngcheck.py <<'PY'
+import json, struct, sys, zlib
+def read_png(path):
+    data = open(path, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    pos, idat, width, height = 8, b"", 0, 0
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour = struct.unpack(">IIBB", body[:10])
+            assert depth == 8 and colour == 2, (depth, colour)
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    raw, rows, stride, prev = zlib.decompress(idat), [], width * 3, bytearray(width * 3)
+    for y in range(height):
+        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - 3] if i >= 3 else 0
+            b = prev[i]
+            c = prev[i - 3] if i >= 3 else 0
+            if f == 1: line[i] = (line[i] + a) & 255
+            elif f == 2: line[i] = (line[i] + b) & 255
+            elif f == 3: line[i] = (line[i] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(line)
+        prev = line
+    return width, height, lambda x, y: tuple(rows[y][3 * x:3 * x + 3])
+shot, geometry, want_w, want_h = sys.argv[1], json.load(open(sys.argv[2])), int(sys.argv[3]), int(sys.argv[4])
+w, h, at = read_png(shot)
+assert (w, h) == (want_w, want_h) == tuple(geometry["window"]), ((w, h), (want_w, want_h), geometry["window"])
+# Not mostly black: a 1280x800 picture in a larger black window was.
+samples = [at(x, y) for y in range(0, h, 4) for x in range(0, w, 4)]
+black = sum(1 for p in samples if max(p) < 8)
+assert black < len(samples) // 3, f"{black} of {len(samples)} samples black"
+# The status line: inside the picture, its bar's colour, with text (light pixels) on it.
+x, y, bw, bh = (int(round(v)) for v in geometry["status"])
+assert y + bh <= h and x + bw <= w, (geometry["status"], w, h)
+bar = [at(px, py) for py in range(y + 1, y + bh - 1) for px in range(x + 1, x + bw - 1, 2)]
+light = sum(1 for p in bar if min(p) > 150)
+assert light > 50, f"the status line has {light} light pixels: not drawn"
+print(f"{shot}: {w}x{h}, {black} of {len(samples)} samples black, status line {light} light pixels")
+PY
+for size in 1366x768 640x400 2560x1600; do
+  "$editor" --window "$size" --print-geometry >"geometry-$size.json" || fail "--print-geometry --window $size"
+  timeout 120 "$editor" --validation --window "$size" --frames 3 --screenshot "window-$size.png" 2>"window-$size.err"
+  code=$?
+  [ "$code" -eq 0 ] || fail "--window $size: exit $code: $(head -c 600 "window-$size.err")"
+  python3 pngcheck.py "window-$size.png" "geometry-$size.json" "${size%x*}" "${size#*x}" ||
+    fail "--window $size: the screenshot"
+done
+python3 -c 'import json,sys; g=json.load(open("geometry-640x400.json")); sys.exit(not abs(g["scale"] - 0.5) < 1e-6)' ||
+  fail "--window 640x400 is not drawn at half size"
+"$editor" --window 10x10 --print-geometry >/dev/null 2>window-small.err
+code=$?
+[ "$code" -eq 1 ] && grep -q -- "--window" window-small.err || fail "--window 10x10: exit $code, want 1: $(cat window-small.err)"
+
 # ---- --screenshot onto its own --layout or --font file, under another name: refused (exit 5) before
 # the window opens, the file kept (it used to be overwritten).
 printf '{"name": "own", "r": [0, 0, 0.25, 1], "g": [0.25, 0, 0.75, 1], "b": [0.75, 0, 1, 1]}' >own.json
@@ -165,12 +233,19 @@ xdotool key ctrl+z
 sleep 0.5
 xdotool key ctrl+y
 sleep 0.5
-# Type an exact number: red's top edge to 0.125.
+# Type exact numbers: red's top edge to 0.125, Tab on to its right edge (the keys go there) and
+# 0.95, Shift+Tab back to the top edge and 0.25.
 read -r fx fy < <(python3 -c 'import json; r=json.load(open("geometry.json"))["fields"]["r.y0"]
 print(int(r[0] + r[2] / 2), int(r[1] + r[3] / 2))')
 xdotool mousemove "$fx" "$fy" click 1
 sleep 0.5
 xdotool type --delay 50 0.125
+xdotool key Tab
+sleep 0.3
+xdotool type --delay 50 0.95
+xdotool key shift+Tab
+sleep 0.3
+xdotool type --delay 50 0.25
 xdotool key Return
 sleep 0.5
 xdotool key g
@@ -179,6 +254,20 @@ xdotool key ctrl+s
 for _ in $(seq 1 60); do [ -f saved.json ] && break; sleep 0.5; done
 [ -f saved.json ] || fail "Ctrl+S wrote no saved.json"
 shot_when_drawn after.xwd 6
+# Idle once converged: the CPU seconds of 5 s are far below a busy loop's (about 1.5 cores on
+# lavapipe, 2 cores: 7 to 8 s). Converging takes about 150 frames after the last edit.
+ticks=$(getconf CLK_TCK)
+cpu_ticks() { awk '{print $14 + $15}' "/proc/$pid/stat"; }
+idle=""
+for _ in $(seq 1 36); do
+  before=$(cpu_ticks)
+  sleep 5
+  after=$(cpu_ticks)
+  used=$(((after - before) * 100 / ticks))  # hundredths of a CPU second
+  if [ "$used" -lt 50 ]; then idle=$used; break; fi
+done
+[ -n "$idle" ] && echo "idle: $idle/100 CPU seconds in 5 s" ||
+  fail "the editor never idled: still $used/100 CPU seconds in 5 s after 3 minutes"
 xdotool key ctrl+q
 for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
 if kill -0 "$pid" 2>/dev/null; then
@@ -191,20 +280,23 @@ code=$?
 grep -q 'validation' editor.err && fail "validation messages: $(grep validation editor.err | head -5)"
 
 # ---- The saved layout: bgr, red's bottom edge 24 steps up, red one step left, red's
-# top edge typed to 0.125, nothing else.
+# top edge typed to 0.25 (0.125 first) and its right edge to 0.95, nothing else; exact where the
+# grid is (2/3 - 1/96 is 0.65625, 1 - 24/96 is 0.75) and in the shortest form.
 python3 - saved.json geometry.json <<'PY' || fail "saved layout"
 import json, sys
 saved = json.load(open(sys.argv[1]))
 step = json.load(open(sys.argv[2]))["edit_step"]
 third, two_thirds = 1 / 3, 2 / 3
 want = {"name": "bgr-edited",
-        "r": [two_thirds - step, 0.125, 1 - step, 1 - 24 * step],
+        "r": [two_thirds - step, 0.25, 0.95, 1 - 24 * step],
         "g": [third, 0, two_thirds, 1],
         "b": [0, 0, third, 1]}
 assert saved["name"] == want["name"], saved
 for channel in "rgb":
     got, expected = saved[channel], want[channel]
     assert len(got) == 4 and all(abs(a - b) < 1e-5 for a, b in zip(got, expected)), (channel, got, expected)
+text = open(sys.argv[1]).read()
+assert '"r": [0.65625, 0.25, 0.95, 0.75]' in text, text
 print("saved layout as expected:", json.dumps(saved))
 PY
 # ---- The contrast the saved layout carries: crisp's default with gamma one step up (G).

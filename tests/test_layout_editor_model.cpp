@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -220,6 +221,75 @@ size_t occurrences(const std::string& text, const std::string& needle) {
 std::string rgba_of(const SubpixelLayout& layout, std::vector<std::string>* notes = nullptr) {
     std::vector<std::string> own;
     return fontconfig_rgba(layout, notes ? *notes : own);
+}
+
+TEST(LayoutEditorModel, NudgesAndDragsStayOnTheGridAndSaveItsShortestForm) {
+    LayoutModel model(preset("rgb"));
+    ASSERT_TRUE(model.set_coordinate(0, 2, 0.5f).ok());
+    model.select(0);
+    for (int i = 0; i < 3; ++i) model.nudge(1, 0);
+    // 0.5 + 3/96, exactly (float steps added up would be 0.53125006).
+    EXPECT_EQ(model.layout().channels[0].x1, 0.53125f);
+    EXPECT_EQ(model.layout().channels[0].x0, 3.0f / 96.0f);
+    model.begin_drag(1, Handle::right);
+    model.drag_to(5.0f * kEditStep, 0.0f);
+    model.end_drag();
+    EXPECT_EQ(model.layout().channels[1].x1, static_cast<float>(69.0 / 96.0));  // 2/3 + 5/96
+    ASSERT_TRUE(model.set_coordinate(2, 1, 0.95f).ok());
+    const std::string text = crisp::editor::layout_file_text(model.layout());
+    EXPECT_NE(text.find("[0.03125, 0, 0.53125, 1]"), std::string::npos) << text;
+    EXPECT_NE(text.find("0.95"), std::string::npos) << text;
+    EXPECT_EQ(text.find("0.9499"), std::string::npos) << text;
+    EXPECT_EQ(text.find("0.53125006"), std::string::npos) << text;
+    // The file reads back as the same layout.
+    const std::filesystem::path path = std::filesystem::temp_directory_path() / "crisp_editor_grid_test.json";
+    ASSERT_TRUE(crisp::editor::save_layout_file(model.layout(), path).ok());
+    const crisp::Result<SubpixelLayout> loaded = crisp::load_subpixel_layout_file(path);
+    std::filesystem::remove(path);
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    EXPECT_EQ(*loaded, model.layout());
+    // A value off the grid is kept as it is.
+    EXPECT_EQ(crisp::editor::snap_to_grid_if_near(0.3f), 0.3f);
+    EXPECT_EQ(crisp::editor::snap_to_grid_if_near(0.5f + 3 * kEditStep), 0.53125f);
+    EXPECT_EQ(crisp::editor::format_number(0.95f), "0.95");
+    EXPECT_EQ(crisp::editor::format_number(-0.0001f), "-0.0001");
+    EXPECT_EQ(crisp::editor::format_number(0.0f), "0");
+}
+
+TEST(LayoutEditorModel, ChoosingAPresetIsNoModificationButAnEditAwayIs) {
+    LayoutModel model(preset("rgb"));
+    ASSERT_TRUE(model.apply_preset("bgr").ok());
+    EXPECT_FALSE(model.modified());
+    model.nudge(1, 0);
+    EXPECT_TRUE(model.modified());
+    ASSERT_TRUE(model.apply_preset("woled").ok());
+    EXPECT_FALSE(model.modified());
+}
+
+TEST(LayoutEditorModel, NumbersFitTheirFieldsAndMessagesWrapWithinTheirWidth) {
+    using crisp::editor::estimated_text_width;
+    const std::string shown = crisp::editor::fitted_number(-1.0f / 12.0f, 56.0f, 12.0f);
+    EXPECT_EQ(shown, "-0.08333");
+    EXPECT_EQ(crisp::editor::fitted_number(-1.0f / 12.0f, 50.0f, 12.0f), "-0.0833");
+    EXPECT_LE(estimated_text_width(shown, 12.0f), 56.0f);
+    EXPECT_EQ(crisp::editor::fitted_number(0.53125f, 60.0f, 12.0f), "0.53125");
+    EXPECT_EQ(crisp::editor::fitted_number(2.5f, 60.0f, 12.0f), "2.5");
+    const std::string message =
+        "x0 0.95 refused: channel r: the rectangle [0.95, 0, 0.333333, 1] is empty or inverted (x1 must "
+        "exceed x0, y1 must exceed y0)";
+    const std::vector<std::string> lines = crisp::editor::wrap_text(message, 330.0f, 11.0f);
+    ASSERT_GE(lines.size(), 3u);
+    std::string joined;
+    for (const std::string& line : lines) {
+        EXPECT_LE(estimated_text_width(line, 11.0f), 330.0f) << line;
+        joined += (joined.empty() ? "" : " ") + line;
+    }
+    EXPECT_EQ(joined, message);
+    // A word longer than the width is broken within it; nothing is lost.
+    const std::vector<std::string> broken = crisp::editor::wrap_text(std::string(80, 'W'), 100.0f, 10.0f);
+    ASSERT_EQ(broken.size(), 8u);
+    for (const std::string& line : broken) EXPECT_EQ(line.size(), 10u);
+    EXPECT_TRUE(crisp::editor::wrap_text("", 100.0f, 10.0f).empty());
 }
 
 TEST(LayoutEditorExport, StripesMapToFontconfigsRgbaAndTwoDimensionalLayoutsToNoneWithANote) {

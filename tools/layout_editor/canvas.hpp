@@ -1,5 +1,7 @@
 // crisp-layout-editor: the CPU-drawn part of each frame (panels, widgets, the magnified views),
 // 8-bit sRGB-encoded RGBA, top row first. crisp composites the text over it on the GPU.
+// Drawing is in interface pixels: `scale` window pixels each (the window's content scale, or
+// less in a window smaller than the interface needs).
 #pragma once
 
 #include <algorithm>
@@ -21,11 +23,15 @@ struct Rect {
 // Draws into memory it does not own (the mapped upload buffer).
 class Canvas {
 public:
-    Canvas(std::span<uint8_t> rgba, uint32_t width, uint32_t height) : rgba_(rgba), width_(width), height_(height) {}
+    Canvas(std::span<uint8_t> rgba, uint32_t width, uint32_t height, float scale = 1.0f)
+        : rgba_(rgba), width_(width), height_(height), scale_(scale) {}
+    // Window pixels.
     uint32_t width() const { return width_; }
     uint32_t height() const { return height_; }
 
-    void clear(Color color) { fill({0, 0, static_cast<float>(width_), static_cast<float>(height_)}, color); }
+    void clear(Color color) {
+        fill({0, 0, static_cast<float>(width_) / scale_, static_cast<float>(height_) / scale_}, color);
+    }
 
     // Pixels whose centre lies in `rect` take `color`.
     void fill(const Rect& rect, Color color) {
@@ -48,8 +54,9 @@ public:
         });
     }
 
-    // A frame `thickness` pixels wide just inside `rect`.
+    // A frame `thickness` pixels wide just inside `rect`, at least one window pixel.
     void outline(const Rect& rect, Color color, float thickness = 1.0f) {
+        thickness = std::max(thickness, 1.0f / scale_);
         fill({rect.x, rect.y, rect.width, thickness}, color);
         fill({rect.x, rect.y + rect.height - thickness, rect.width, thickness}, color);
         fill({rect.x, rect.y, thickness, rect.height}, color);
@@ -64,8 +71,9 @@ private:
         const auto first = [](float v, uint32_t limit) {
             return static_cast<uint32_t>(std::clamp(std::ceil(v - 0.5f), 0.0f, static_cast<float>(limit)));
         };
-        const uint32_t x0 = first(rect.x, width_), x1 = first(rect.x + rect.width, width_);
-        const uint32_t y0 = first(rect.y, height_), y1 = first(rect.y + rect.height, height_);
+        const float s = scale_;
+        const uint32_t x0 = first(rect.x * s, width_), x1 = first((rect.x + rect.width) * s, width_);
+        const uint32_t y0 = first(rect.y * s, height_), y1 = first((rect.y + rect.height) * s, height_);
         for (uint32_t y = y0; y < y1; ++y) {
             uint8_t* row = rgba_.data() + (size_t{y} * width_ + x0) * 4;
             for (uint32_t x = x0; x < x1; ++x, row += 4) f(row);
@@ -75,6 +83,7 @@ private:
     std::span<uint8_t> rgba_;
     uint32_t width_ = 0;
     uint32_t height_ = 0;
+    float scale_ = 1.0f;
 };
 
 }  // namespace crisp::editor

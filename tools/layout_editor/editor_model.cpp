@@ -1,11 +1,15 @@
 #include "editor_model.hpp"
 
 #include "cli.hpp"
+#include "core/file_io.hpp"
+#include "json_writer.hpp"
 
 #include <crisp/glyph.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <system_error>
@@ -17,8 +21,17 @@ namespace {
 constexpr float kLow = -static_cast<float>(kGlyphPadding);
 constexpr float kHigh = 1.0f + static_cast<float>(kGlyphPadding);
 
+// Steps per pixel, as kEditStep's inverse (96).
+constexpr double kStepsPerPixel = 96.0;
+static_assert(static_cast<float>(1.0 / kStepsPerPixel) == kEditStep);
+
+// The nearest grid value to `value`, as the float nearest k / 96.
 float snap(float value) {
-    return std::round(value / kEditStep) * kEditStep;
+    return static_cast<float>(std::round(static_cast<double>(value) * kStepsPerPixel) / kStepsPerPixel);
+}
+
+void snap_rect_to_grid(SampleRect& rect) {
+    for (float* value : {&rect.x0, &rect.y0, &rect.x1, &rect.y1}) *value = snap_to_grid_if_near(*value);
 }
 
 float& parameter_ref(TextContrast& contrast, ContrastParameter parameter) {
@@ -97,6 +110,111 @@ std::optional<float> parse_typed_number(std::string_view text, std::string* why)
     return static_cast<float>(quotient);
 }
 
+float snap_to_grid_if_near(float value) {
+    const double steps = static_cast<double>(value) * kStepsPerPixel;
+    const double nearest = std::round(steps);
+    return std::fabs(steps - nearest) < 1e-3 ? static_cast<float>(nearest / kStepsPerPixel) : value;
+}
+
+std::string format_number(float value) {
+    char buffer[32];
+    // Fixed notation keeps 0.0001 from becoming 1e-04; the editor's values stay near [-1, 2].
+    const std::to_chars_result written =
+        std::fabs(value) >= 1e-4f || value == 0.0f
+            ? std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed)
+            : std::to_chars(buffer, buffer + sizeof buffer, value);
+    return written.ec == std::errc{} ? std::string(buffer, written.ptr) : std::string("?");
+}
+
+float estimated_text_width(std::string_view text, float size) {
+    float em = 0.0f;
+    for (const char c : text) {
+        const auto byte = static_cast<unsigned char>(c);
+        if ((byte & 0xC0) == 0x80) continue;  // a UTF-8 continuation: counted at its first byte
+        if (c >= '0' && c <= '9') {
+            em += 0.64f;
+        } else if (c == '.' || c == ',' || c == ' ' || c == '-' || c == ':' || c == ';' || c == '/') {
+            em += 0.4f;
+        } else if (c == 'm' || c == 'w' || c == 'M' || c == 'W' || c == '%' || c == '@' || byte >= 0x80) {
+            em += 1.0f;
+        } else if (c >= 'a' && c <= 'z') {
+            em += 0.65f;
+        } else if (c >= 'A' && c <= 'Z') {
+            em += 0.8f;
+        } else {
+            em += 0.7f;
+        }
+    }
+    return em * size;
+}
+
+std::string fitted_number(float value, float width, float size) {
+    std::string text = format_number(value);
+    const size_t point = text.find('.');
+    if (estimated_text_width(text, size) <= width || point == std::string::npos) return text;
+    for (int decimals = static_cast<int>(text.size() - point) - 2; decimals >= 0; --decimals) {
+        char buffer[48];
+        std::snprintf(buffer, sizeof buffer, "%.*f", decimals, static_cast<double>(value));
+        text = buffer;
+        if (estimated_text_width(text, size) <= width) break;
+    }
+    return text;
+}
+
+std::vector<std::string> wrap_text(std::string_view text, float width, float size) {
+    std::vector<std::string> lines;
+    while (!text.empty()) {
+        // The longest prefix that fits, at least one character, ended at a space where there is one.
+        size_t fits = 0;
+        while (fits < text.size() && estimated_text_width(text.substr(0, fits + 1), size) <= width) ++fits;
+        if (fits == text.size()) {
+            lines.emplace_back(text);
+            break;
+        }
+        // A UTF-8 sequence stays whole.
+        while (fits > 0 && (static_cast<unsigned char>(text[fits]) & 0xC0) == 0x80) --fits;
+        if (fits == 0) {
+            fits = 1;
+            while (fits < text.size() && (static_cast<unsigned char>(text[fits]) & 0xC0) == 0x80) ++fits;
+        }
+        const size_t space = text.substr(0, fits + 1).rfind(' ');
+        if (space != std::string_view::npos && space > 0) {
+            lines.emplace_back(text.substr(0, space));
+            text.remove_prefix(space + 1);
+        } else {
+            lines.emplace_back(text.substr(0, fits));
+            text.remove_prefix(fits);
+        }
+    }
+    return lines;
+}
+
+std::string layout_file_text(const SubpixelLayout& layout) {
+    constexpr const char* kChannelKeys[] = {"r", "g", "b"};
+    crisp::JsonWriter json;
+    json.begin_object().field("name", layout.name);
+    for (size_t c = 0; c < 3; ++c) {
+        const SampleRect& r = layout.channels[c];
+        json.key(kChannelKeys[c]).begin_array();
+        for (const float value : {r.x0, r.y0, r.x1, r.y1}) json.value(value);
+        json.end_array();
+    }
+    if (const std::optional<TextContrast>& contrast = layout.contrast) {
+        json.key("contrast").begin_object();
+        json.field("mode", contrast->mode == ContrastMode::linear ? "linear" : "corrected");
+        json.field("gamma", contrast->gamma).field("contrast", contrast->contrast);
+        json.field("stem_darkening", contrast->stem_darkening).end_object();
+    }
+    json.end_object();
+    return json.line();
+}
+
+Status save_layout_file(const SubpixelLayout& layout, const std::filesystem::path& path) {
+    if (Status status = validate_subpixel_layout(layout); !status) return status;
+    const std::string text = layout_file_text(layout);
+    return write_file_atomically(path, std::as_bytes(std::span(text.data(), text.size())));
+}
+
 float rect_coordinate(const SampleRect& rect, int coordinate) {
     SampleRect copy = rect;
     return coordinate_ref(copy, coordinate);
@@ -150,6 +268,7 @@ void LayoutModel::nudge(int dx_steps, int dy_steps) {
     SampleRect rect = layout_.channels[static_cast<size_t>(selected_)];
     shift_span(rect.x0, rect.x1, static_cast<float>(dx_steps) * kEditStep);
     shift_span(rect.y0, rect.y1, static_cast<float>(dy_steps) * kEditStep);
+    snap_rect_to_grid(rect);
     if (rect == layout_.channels[static_cast<size_t>(selected_)]) return;
     push_undo();
     layout_.channels[static_cast<size_t>(selected_)] = rect;
@@ -189,6 +308,7 @@ void LayoutModel::drag_to(float dx, float dy) {
             shift_span(rect.y0, rect.y1, dy);
             break;
     }
+    snap_rect_to_grid(rect);
     SampleRect& current = layout_.channels[static_cast<size_t>(drag_channel_)];
     if (rect == current) return;
     current = rect;
@@ -241,7 +361,9 @@ void LayoutModel::toggle_contrast_mode() {
 Status LayoutModel::apply_preset(std::string_view name) {
     Result<SubpixelLayout> preset = subpixel_preset(name);
     if (!preset) return preset.error();
-    return replace(*preset);
+    if (Status status = replace(*preset); !status) return status;
+    saved_ = layout_;
+    return {};
 }
 
 Status LayoutModel::replace(const SubpixelLayout& layout) {

@@ -8,6 +8,7 @@
 #include <crisp/subpixel.hpp>
 
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -48,6 +49,36 @@ std::optional<float> parse_typed_number(std::string_view text, std::string* why 
 
 // The four numbers of a SampleRect by index: 0 x0, 1 y0, 2 x1, 3 y1.
 float rect_coordinate(const SampleRect& rect, int coordinate);
+
+// A value within 1/1000 of a step of the kEditStep grid becomes the float nearest that grid
+// value (k / 96 divided in double): sums of float steps drift off the grid (0.5 plus three steps
+// is 0.53125006), the grid value itself is exact wherever it can be (0.53125). Others are kept.
+float snap_to_grid_if_near(float value);
+
+// A number as a field shows it and a file stores it: the shortest text that reads back as the
+// same float ("0.95", "0.53125", "-0.083333336"), never an exponent for values the editor takes.
+std::string format_number(float value);
+
+// How wide `text` is at `size` pixels, at most, in DejaVu Sans (the default font): its advances
+// per character class, rounded up (digits 0.64 em, lowercase 0.65, capitals 0.8, m, w, M, W and
+// anything not ASCII 1). Fields and messages are fitted with it, so what they show stays inside their boxes.
+float estimated_text_width(std::string_view text, float size);
+
+// `value` as a field `width` pixels wide shows it at `size` pixels: format_number's form where it
+// fits, else rounded to as many decimals as fit ("-0.08333" for -0.083333336 in 56 pixels at 12).
+std::string fitted_number(float value, float width, float size);
+
+// `text` in lines no wider than `width` at `size` (estimated_text_width), broken at spaces, a word
+// too long for a line broken within it. Every character is kept: the lines joined with the spaces
+// they were broken at give `text` back. No lines for an empty text.
+std::vector<std::string> wrap_text(std::string_view text, float width, float size);
+
+// The layout as a layout file holds it (the format of docs/subpixel.md, which
+// load_subpixel_layout_file reads), every number in format_number's shortest form.
+std::string layout_file_text(const SubpixelLayout& layout);
+// Writes layout_file_text atomically. Refused (invalid_argument) when validate_subpixel_layout
+// refuses the layout; the file's errors are crisp's (ErrorCode::io, naming the path).
+Status save_layout_file(const SubpixelLayout& layout, const std::filesystem::path& path);
 
 class LayoutModel {
 public:
@@ -92,7 +123,8 @@ public:
     void toggle_contrast_mode();
 
     // Replaces the layout with a preset (subpixel_preset's error for an unknown name) or with a
-    // loaded layout (validated first). One undo step each.
+    // loaded layout (validated first). One undo step each. A chosen preset is what modified()
+    // compares with from then on: only an edit away from it is a modification.
     Status apply_preset(std::string_view name);
     Status replace(const SubpixelLayout& layout);
 
@@ -101,7 +133,8 @@ public:
     bool undo();
     bool redo();
 
-    // Whether the layout differs from the last one marked saved (at construction, or mark_saved()).
+    // Whether the layout differs from the last one marked saved (at construction, mark_saved(),
+    // or a preset chosen with apply_preset()).
     bool modified() const { return layout_ != saved_; }
     void mark_saved() { saved_ = layout_; }
 

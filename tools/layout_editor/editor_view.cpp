@@ -16,30 +16,36 @@
 namespace crisp::editor {
 namespace {
 
-// Positions of the widgets, window pixels.
+// Positions of the widgets that keep their place, interface pixels (EditorView::Geometry has the
+// others, laid out for the window's size from these at kMinimumWidth x kMinimumHeight).
 constexpr float kMargin = 16.0f;
 constexpr float kToolbarY = 10.0f, kButtonHeight = 28.0f;
 constexpr float kPresetX = kMargin, kPresetWidth = 82.0f, kPresetStride = 88.0f;
 constexpr float kCommandX = 736.0f, kCommandWidth = 64.0f, kCommandStride = 70.0f;
-constexpr Rect kPathField{1016.0f, kToolbarY, 248.0f, kButtonHeight};
-constexpr float kFieldsX = 72.0f, kFieldsY = 384.0f, kFieldWidth = 60.0f, kFieldStrideX = 66.0f, kFieldHeight = 26.0f,
+constexpr float kPathFieldX = 1016.0f;
+// The number fields: wide enough for "-0.08333" (fitted_number shortens what is longer).
+constexpr float kFieldsX = 52.0f, kFieldsY = 384.0f, kFieldWidth = 68.0f, kFieldStrideX = 72.0f, kFieldHeight = 26.0f,
                 kFieldStrideY = 30.0f;
-constexpr Rect kLightPanel{360.0f, 52.0f, 446.0f, 278.0f};
-constexpr Rect kDarkPanel{818.0f, 52.0f, 446.0f, 278.0f};
-constexpr Rect kLightStrip{360.0f, 336.0f, 446.0f, 92.0f};  // the moving line and the fringe test
-constexpr Rect kDarkStrip{818.0f, 336.0f, 446.0f, 92.0f};
-// The contrast controls: the preview's mode, gamma, contrast and stem darkening, and Reset.
-constexpr float kContrastY = 436.0f, kContrastHeight = kButtonHeight;
-constexpr Rect kModeButton{424.0f, kContrastY, 88.0f, kContrastHeight};
+constexpr float kFieldTextSize = 12.0f, kFieldPadding = 5.0f;
+// The preview: two panels of paragraphs and two strips below them (the moving line and the
+// fringe test), light left and dark right; what the window adds goes half to the panels' height.
+constexpr float kPreviewX = 360.0f, kPreviewY = 52.0f, kPreviewGap = 12.0f;
+constexpr float kPanelWidth = 446.0f, kPanelHeight = 278.0f, kStripHeight = 92.0f, kStripGap = 6.0f;
+// The contrast controls: the preview's mode, gamma, contrast and stem darkening, and Reset; a row
+// below the strips.
+constexpr float kContrastGap = 8.0f, kContrastHeight = kButtonHeight;
+constexpr float kModeButtonX = 424.0f, kModeButtonWidth = 88.0f;
 constexpr float kContrastFieldX[] = {572.0f, 696.0f, 862.0f};  // gamma, contrast, stem darkening
 constexpr float kContrastLabelWidth[] = {48.0f, 56.0f, 96.0f};
 constexpr float kContrastFieldWidth = 56.0f;
-constexpr Rect kResetButton{932.0f, kContrastY, 60.0f, kContrastHeight};
+constexpr float kResetButtonX = 932.0f, kResetButtonWidth = 60.0f;
 constexpr int kContrastChannel = 3;  // Field::channel of the contrast fields
-constexpr Rect kRenderedView{360.0f, 484.0f, 904.0f, 272.0f};
-constexpr Rect kStatusBar{0.0f, 766.0f, 1280.0f, 34.0f};
-constexpr int kCropWidth = static_cast<int>(904 / kRenderedScale);
-constexpr int kCropHeight = static_cast<int>(272 / kRenderedScale);
+// The magnified rendered pixels, below the contrast row down to the status line.
+constexpr float kRenderedViewGap = 20.0f, kRenderedViewHeight = 272.0f, kStatusHeight = 34.0f;
+// The left column's text: the layout's name, the messages below it, the help at the bottom.
+constexpr float kLayoutNameY = 490.0f, kMessagesY = 514.0f, kHelpY = 628.0f;
+constexpr float kMessageSize = 11.0f, kMessageLine = 14.0f, kMessageWidth = 330.0f;
+constexpr float kHelpSize = 11.0f, kHelpLine = 17.0f;
 // How near an edge (screen pixels) a press grabs it rather than the rectangle.
 constexpr float kEdgeGrab = 5.0f;
 
@@ -78,20 +84,10 @@ Rect channel_rect_on_screen(const SampleRect& rect, float cell_x, float cell_y) 
             (rect.x1 - rect.x0) * kMagnifiedPixelScale, (rect.y1 - rect.y0) * kMagnifiedPixelScale};
 }
 
-Rect contrast_field(int parameter) {
-    return {kContrastFieldX[parameter], kContrastY, kContrastFieldWidth, kContrastHeight};
-}
-
 Rect intersect(const Rect& a, const Rect& b) {
     const float x0 = std::max(a.x, b.x), y0 = std::max(a.y, b.y);
     const float x1 = std::min(a.x + a.width, b.x + b.width), y1 = std::min(a.y + a.height, b.y + b.height);
     return {x0, y0, std::max(0.0f, x1 - x0), std::max(0.0f, y1 - y0)};
-}
-
-std::string format_number(float value) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.5g", static_cast<double>(value));
-    return buffer;
 }
 
 void button(Canvas& canvas, std::vector<TextItem>& text, const Rect& rect, const std::string& label, bool highlighted,
@@ -103,18 +99,83 @@ void button(Canvas& canvas, std::vector<TextItem>& text, const Rect& rect, const
 
 }  // namespace
 
-EditorView::EditorView(LayoutModel& model, std::filesystem::path path)
-    : model_(model),
-      path_(path.string()),
-      crop_x_(static_cast<int>(kLightStrip.x) + 4),
-      crop_y_(static_cast<int>(kLightStrip.y) + 30) {}
+EditorView::EditorView(LayoutModel& model, std::filesystem::path path) : model_(model), path_(path.string()) {
+    resize(kWindowWidth, kWindowHeight, 1.0f);
+}
 
-std::string EditorView::field_value(const Field& field) const {
-    if (field.channel == kContrastChannel) {
-        return format_number(contrast_parameter(model_.contrast(), static_cast<ContrastParameter>(field.coordinate)));
+void EditorView::resize(uint32_t width, uint32_t height, float content_scale) {
+    if (width == 0 || height == 0 || !(content_scale > 0.0f)) return;
+    window_width_ = width;
+    window_height_ = height;
+    content_scale_ = content_scale;
+    const float window_width = static_cast<float>(width), window_height = static_cast<float>(height);
+    // The content scale, or as much less as the widgets need to fit.
+    scale_ = std::min({content_scale, window_width / kMinimumWidth, window_height / kMinimumHeight});
+    width_ = window_width / scale_;
+    height_ = window_height / scale_;
+    const float extra_width = std::max(0.0f, width_ - kMinimumWidth);
+    const float extra_height = std::max(0.0f, height_ - kMinimumHeight);
+    Geometry& g = geometry_;
+    g.path_field = {kPathFieldX, kToolbarY, width_ - kMargin - kPathFieldX, kButtonHeight};
+    const float panel_width = kPanelWidth + extra_width / 2.0f, panel_height = kPanelHeight + extra_height / 2.0f;
+    const float dark_x = kPreviewX + panel_width + kPreviewGap;
+    g.light_panel = {kPreviewX, kPreviewY, panel_width, panel_height};
+    g.dark_panel = {dark_x, kPreviewY, panel_width, panel_height};
+    const float strip_y = kPreviewY + panel_height + kStripGap;
+    g.light_strip = {kPreviewX, strip_y, panel_width, kStripHeight};
+    g.dark_strip = {dark_x, strip_y, panel_width, kStripHeight};
+    g.contrast_y = strip_y + kStripHeight + kContrastGap;
+    g.mode_button = {kModeButtonX, g.contrast_y, kModeButtonWidth, kContrastHeight};
+    g.reset_button = {kResetButtonX, g.contrast_y, kResetButtonWidth, kContrastHeight};
+    g.status_bar = {0.0f, height_ - kStatusHeight, width_, kStatusHeight};
+    const float rendered_y = g.contrast_y + kContrastHeight + kRenderedViewGap;
+    g.rendered_view = {kPreviewX, rendered_y, dark_x + panel_width - kPreviewX,
+                       std::max(kRenderedViewHeight, g.status_bar.y - 10.0f - rendered_y)};
+    // Until a click chooses otherwise, the magnified view looks at the fringe test's strokes.
+    if (!crop_chosen_) {
+        crop_x_ = g.light_strip.x + 4.0f;
+        crop_y_ = g.light_strip.y + 30.0f;
     }
-    return format_number(
-        rect_coordinate(model_.layout().channels[static_cast<size_t>(field.channel)], field.coordinate));
+    clamp_crop();
+}
+
+Rect EditorView::contrast_field(int parameter) const {
+    return {kContrastFieldX[parameter], geometry_.contrast_y, kContrastFieldWidth, kContrastHeight};
+}
+
+Rect EditorView::preview_area() const {
+    const Geometry& g = geometry_;
+    return {g.light_panel.x, g.light_panel.y, g.dark_panel.x + g.dark_panel.width - g.light_panel.x,
+            g.light_strip.y + g.light_strip.height - g.light_panel.y};
+}
+
+int EditorView::crop_columns() const {
+    return static_cast<int>(geometry_.rendered_view.width / static_cast<float>(kRenderedScale));
+}
+
+int EditorView::crop_rows() const {
+    const Rect area = preview_area();
+    // Never taller than the preview, whose pixels it shows.
+    return std::min(static_cast<int>(geometry_.rendered_view.height / static_cast<float>(kRenderedScale)),
+                    static_cast<int>(area.height * scale_));
+}
+
+// The magnified area stays within the preview, in whole window pixels.
+void EditorView::clamp_crop() {
+    const Rect area = preview_area();
+    const float columns = static_cast<float>(crop_columns()) / scale_;
+    const float rows = static_cast<float>(crop_rows()) / scale_;
+    crop_x_ = std::clamp(crop_x_, area.x, std::max(area.x, area.x + area.width - columns));
+    crop_y_ = std::clamp(crop_y_, area.y, std::max(area.y, area.y + area.height - rows));
+    crop_x_ = std::round(crop_x_ * scale_) / scale_;
+    crop_y_ = std::round(crop_y_ * scale_) / scale_;
+}
+
+float EditorView::field_number(const Field& field) const {
+    if (field.channel == kContrastChannel) {
+        return contrast_parameter(model_.contrast(), static_cast<ContrastParameter>(field.coordinate));
+    }
+    return rect_coordinate(model_.layout().channels[static_cast<size_t>(field.channel)], field.coordinate);
 }
 
 std::vector<EditorView::Field> EditorView::fields() const {
@@ -130,52 +191,57 @@ std::vector<EditorView::Field> EditorView::fields() const {
     for (int parameter = 0; parameter < 3; ++parameter) {
         out.push_back({contrast_field(parameter), kContrastChannel, parameter});
     }
-    out.push_back({kPathField, -1, 0});
+    out.push_back({geometry_.path_field, -1, 0});
     return out;
 }
 
-std::string EditorView::geometry_json() {
+std::string EditorView::geometry_json() const {
     crisp::JsonWriter json;
-    auto rect = [&json](std::string_view key, const Rect& r) {
-        json.key(key).begin_array().value(r.x).value(r.y).value(r.width).value(r.height).end_array();
+    // Window pixels, where scripted input clicks.
+    auto rect = [&json, this](std::string_view key, const Rect& r) {
+        json.key(key).begin_array().value(r.x * scale_).value(r.y * scale_).value(r.width * scale_);
+        json.value(r.height * scale_).end_array();
     };
+    const Geometry& g = geometry_;
     json.begin_object();
-    json.key("window").begin_array().value(kWindowWidth).value(kWindowHeight).end_array();
-    json.key("pixel_origin").begin_array().value(kPixelOriginX).value(kPixelOriginY).end_array();
-    json.field("pixel_scale", kMagnifiedPixelScale).field("edit_step", kEditStep);
+    json.key("window").begin_array().value(window_width_).value(window_height_).end_array();
+    json.field("scale", scale_);
+    json.key("pixel_origin").begin_array().value(kPixelOriginX * scale_).value(kPixelOriginY * scale_).end_array();
+    json.field("pixel_scale", kMagnifiedPixelScale * scale_).field("edit_step", kEditStep);
     json.key("presets").begin_object();
     const auto names = subpixel_preset_names();
     for (size_t i = 0; i < names.size(); ++i) rect(names[i], preset_button(i));
     json.end_object().key("commands").begin_object();
     for (size_t i = 0; i < 4; ++i) rect(kCommands[i], command_button(i));
     json.end_object().key("fields").begin_object();
-    for (int channel = 0; channel < 3; ++channel) {
-        for (int coordinate = 0; coordinate < 4; ++coordinate) {
-            rect(std::string(1, "rgb"[channel]) + "." + kCoordinateNames[coordinate],
-                 {kFieldsX + static_cast<float>(coordinate) * kFieldStrideX,
-                  kFieldsY + static_cast<float>(channel) * kFieldStrideY, kFieldWidth, kFieldHeight});
-        }
+    const std::vector<Field> all = fields();
+    for (const Field& field : all) {
+        if (field.channel < 0 || field.channel >= 3) continue;
+        rect(std::string(1, "rgb"[field.channel]) + "." + kCoordinateNames[field.coordinate], field.rect);
     }
     json.end_object().key("contrast").begin_object();
-    rect("mode", kModeButton);
+    rect("mode", g.mode_button);
     for (int parameter = 0; parameter < 3; ++parameter) rect(kContrastKeys[parameter], contrast_field(parameter));
-    rect("reset", kResetButton);
+    rect("reset", g.reset_button);
     json.end_object();
-    rect("path_field", kPathField);
+    rect("path_field", g.path_field);
     rect("magnified_pixel", {kPixelOriginX - kMagnifiedPixelScale, kPixelOriginY - kMagnifiedPixelScale,
                              3 * kMagnifiedPixelScale, 3 * kMagnifiedPixelScale});
-    rect("preview", {kLightPanel.x, kLightPanel.y, kDarkPanel.x + kDarkPanel.width - kLightPanel.x,
-                     kLightStrip.y + kLightStrip.height - kLightPanel.y});
+    rect("preview", preview_area());
     // The paragraphs only: no moving text, so they change only when the layout does.
-    rect("preview_paragraphs",
-         {kLightPanel.x, kLightPanel.y, kDarkPanel.x + kDarkPanel.width - kLightPanel.x, kLightPanel.height});
-    rect("rendered_pixels", kRenderedView);
-    rect("status", kStatusBar);
+    rect("preview_paragraphs", {g.light_panel.x, g.light_panel.y, g.dark_panel.x + g.dark_panel.width - g.light_panel.x,
+                                g.light_panel.height});
+    rect("rendered_pixels", g.rendered_view);
+    rect("status", g.status_bar);
+    rect("messages", {kMargin, kMessagesY - kMessageLine, kMessageWidth, kHelpY - kMessagesY});
+    rect("help", {kMargin, kHelpY - kHelpLine, kMessageWidth, 8 * kHelpLine});
     json.end_object();
     return json.text();
 }
 
 void EditorView::report(std::string text, bool error) {
+    // The window may show only the start of a long message: stderr has it whole.
+    std::fprintf(stderr, "crisp-layout-editor: %s\n", cli::printable(text, 4000).c_str());
     messages_.push_back({std::move(text), error});
     if (messages_.size() > 4) messages_.erase(messages_.begin());
 }
@@ -185,7 +251,7 @@ bool EditorView::save() {
         report("Save: no file; type a path in the file field first", true);
         return false;
     }
-    if (Status status = save_subpixel_layout_file(model_.layout(), path_); !status) {
+    if (Status status = save_layout_file(model_.layout(), path_); !status) {
         report("Save failed: " + status.error().message, true);
         return false;
     }
@@ -217,7 +283,7 @@ void EditorView::begin_field_edit(int index) {
     active_field_ = index;
     field_fresh_ = true;
     const Field field = fields()[static_cast<size_t>(index)];
-    field_text_ = field.channel < 0 ? path_ : field_value(field);
+    field_text_ = field.channel < 0 ? path_ : format_number(field_number(field));
     model_.select(field.channel);
 }
 
@@ -245,7 +311,11 @@ void EditorView::commit_field_edit() {
     if (!status) report(what + ": " + status.error().message, true);
 }
 
-void EditorView::handle(const InputEvent& event) {
+void EditorView::handle(const InputEvent& window_event) {
+    // Window pixels to interface pixels.
+    InputEvent event = window_event;
+    event.x /= static_cast<double>(scale_);
+    event.y /= static_cast<double>(scale_);
     switch (event.kind) {
         case InputEvent::Kind::mouse_move:
             if (model_.dragging()) {
@@ -277,7 +347,13 @@ void EditorView::handle_key(const InputEvent& event) {
     const bool control = (event.mods & GLFW_MOD_CONTROL) != 0;
     const bool shift = (event.mods & GLFW_MOD_SHIFT) != 0;
     if (active_field_ >= 0) {
-        if (event.key == GLFW_KEY_ENTER || event.key == GLFW_KEY_KP_ENTER || event.key == GLFW_KEY_TAB) {
+        if (event.key == GLFW_KEY_TAB) {
+            // Commits, and the next keys go to the next field (Shift: the previous one).
+            const int count = static_cast<int>(fields().size());
+            const int next = (active_field_ + (shift ? count - 1 : 1)) % count;
+            commit_field_edit();
+            begin_field_edit(next);
+        } else if (event.key == GLFW_KEY_ENTER || event.key == GLFW_KEY_KP_ENTER) {
             commit_field_edit();
         } else if (event.key == GLFW_KEY_ESCAPE) {
             active_field_ = -2;
@@ -344,11 +420,11 @@ void EditorView::handle_mouse_down(const InputEvent& event) {
         if (i == 3) save();
         return;
     }
-    if (kModeButton.contains(x, y)) {
+    if (geometry_.mode_button.contains(x, y)) {
         model_.toggle_contrast_mode();
         return;
     }
-    if (kResetButton.contains(x, y)) {
+    if (geometry_.reset_button.contains(x, y)) {
         (void)model_.set_contrast(std::nullopt);  // none is always accepted
         return;
     }
@@ -360,12 +436,13 @@ void EditorView::handle_mouse_down(const InputEvent& event) {
         }
     }
     if (start_drag(x, y)) return;
-    for (const Rect& panel : {kLightPanel, kDarkPanel, kLightStrip, kDarkStrip}) {
+    const Geometry& g = geometry_;
+    for (const Rect& panel : {g.light_panel, g.dark_panel, g.light_strip, g.dark_strip}) {
         if (panel.contains(x, y)) {
-            crop_x_ = std::clamp(static_cast<int>(x) - kCropWidth / 2, static_cast<int>(kLightPanel.x),
-                                 static_cast<int>(kDarkPanel.x + kDarkPanel.width) - kCropWidth);
-            crop_y_ = std::clamp(static_cast<int>(y) - kCropHeight / 2, static_cast<int>(kLightPanel.y),
-                                 static_cast<int>(kLightStrip.y + kLightStrip.height) - kCropHeight);
+            crop_x_ = x - static_cast<float>(crop_columns() / 2) / scale_;
+            crop_y_ = y - static_cast<float>(crop_rows() / 2) / scale_;
+            crop_chosen_ = true;
+            clamp_crop();
             return;
         }
     }
@@ -477,21 +554,30 @@ void EditorView::draw_fields(Canvas& canvas, std::vector<TextItem>& text) const 
         const bool active = static_cast<int>(i) == active_field_;
         canvas.fill(field.rect, active ? Color{20, 20, 22} : Color{28, 30, 34});
         canvas.outline(field.rect, active ? kActive : kButtonBorder);
+        const float room = field.rect.width - 2.0f * kFieldPadding;
         std::string value;
         if (active) {
             value = field_text_ + "_";
         } else if (field.channel < 0) {
             value = path_.empty() ? "(no file)" : path_;
         } else {
-            value = field_value(field);
+            value = fitted_number(field_number(field), room, kFieldTextSize);
         }
-        // Long paths show their end, where the file name is.
-        const size_t room = field.channel < 0 ? 34 : 9;
-        if (value.size() > room) value = "..." + value.substr(value.size() - room + 3);
-        text.push_back({cli::printable(value), field.rect.x + 5.0f, field.rect.y + 18.0f, 12.0f, kPanelText});
+        // Text longer than the field shows its end (where a path's file name is, and the caret).
+        value = cli::printable(value);
+        if (estimated_text_width(value, kFieldTextSize) > room) {
+            const std::string_view ellipsis = "...";
+            size_t start = 0;
+            while (start < value.size() &&
+                   estimated_text_width(std::string(ellipsis) + value.substr(start), kFieldTextSize) > room) {
+                ++start;
+            }
+            value = std::string(ellipsis) + value.substr(start);
+        }
+        text.push_back({value, field.rect.x + kFieldPadding, field.rect.y + 18.0f, kFieldTextSize, kPanelText});
         if (field.coordinate == 0 && field.channel >= 0 && field.channel < 3) {
             const bool selected = field.channel == model_.selected();
-            const Rect swatch{kMargin + 8.0f, field.rect.y + 3.0f, 20.0f, 20.0f};
+            const Rect swatch{kMargin + 6.0f, field.rect.y + 3.0f, 20.0f, 20.0f};
             canvas.fill(swatch, kChannelColors[static_cast<size_t>(field.channel)]);
             if (selected)
                 canvas.outline({swatch.x - 3, swatch.y - 3, swatch.width + 6, swatch.height + 6}, kActive, 2.0f);
@@ -500,68 +586,88 @@ void EditorView::draw_fields(Canvas& canvas, std::vector<TextItem>& text) const 
 }
 
 void EditorView::draw_contrast(Canvas& canvas, std::vector<TextItem>& text) const {
+    const Geometry& g = geometry_;
     const TextContrast contrast = model_.contrast();
     const bool linear = contrast.mode == ContrastMode::linear;
-    text.push_back({"Contrast", kRenderedView.x, kContrastY + 18.0f, 12.0f, kDimText});
-    button(canvas, text, kModeButton, linear ? "linear" : "corrected", false);
+    const float baseline = g.contrast_y + 18.0f;
+    text.push_back({"Contrast", g.rendered_view.x, baseline, 12.0f, kDimText});
+    button(canvas, text, g.mode_button, linear ? "linear" : "corrected", false);
     for (int parameter = 0; parameter < 3; ++parameter) {
         const Rect field = contrast_field(parameter);
         // The labels sit left of their fields; the parameters do nothing in linear mode.
-        text.push_back({kContrastLabels[parameter], field.x - kContrastLabelWidth[parameter], kContrastY + 18.0f, 12.0f,
+        text.push_back({kContrastLabels[parameter], field.x - kContrastLabelWidth[parameter], baseline, 12.0f,
                         linear ? Color{120, 120, 124} : kDimText});
     }
     const bool has = model_.layout().contrast.has_value();
-    button(canvas, text, kResetButton, "Reset", false, has);
+    button(canvas, text, g.reset_button, "Reset", false, has);
     text.push_back({has ? "the layout's own (saved with it)" : "crisp's default (the layout has none)",
-                    kResetButton.x + kResetButton.width + 12.0f, kContrastY + 18.0f, 12.0f, kDimText});
+                    g.reset_button.x + g.reset_button.width + 12.0f, baseline, 12.0f, kDimText});
 }
 
 void EditorView::draw_side_text(std::vector<TextItem>& text) const {
     const SubpixelLayout& layout = model_.layout();
     text.push_back({"Layout: " + cli::printable(layout.name.empty() ? "(unnamed)" : layout.name) +
                         (model_.modified() ? "  (modified)" : ""),
-                    kMargin, 490.0f, 13.0f, kPanelText});
-    float y = 514.0f;
-    for (const Message& message : messages_) {
-        // A message is crisp's sentence, wrapped below: escaped, but kept whole.
-        text.push_back(
-            {cli::printable(message.text, 1000), kMargin, y, 11.0f, message.error ? kErrorText : kDimText, 330.0f});
-        y += 28.0f;
+                    kMargin, kLayoutNameY, 13.0f, kPanelText});
+    // The messages, wrapped here into the lines that fit between the name and the help, newest
+    // last: older ones give way; a message with more lines than there is room for shows its
+    // first lines, the last ending in "..." (every message is also on stderr, whole).
+    const size_t room = static_cast<size_t>((kHelpY - kHelpLine - kMessagesY) / kMessageLine) + 1;
+    std::vector<std::pair<std::string, bool>> lines;
+    for (auto message = messages_.rbegin(); message != messages_.rend() && lines.size() < room; ++message) {
+        std::vector<std::string> wrapped = wrap_text(cli::printable(message->text, 1000), kMessageWidth, kMessageSize);
+        const size_t left = room - lines.size();
+        if (wrapped.size() > left) {
+            wrapped.resize(left);
+            std::string& last = wrapped.back();
+            while (!last.empty() && estimated_text_width(last + "...", kMessageSize) > kMessageWidth) last.pop_back();
+            last += "...";
+        }
+        std::vector<std::pair<std::string, bool>> block;
+        for (std::string& line : wrapped) block.emplace_back(std::move(line), message->error);
+        lines.insert(lines.begin(), block.begin(), block.end());
+    }
+    float y = kMessagesY;
+    for (const auto& [line, error] : lines) {
+        text.push_back({line, kMargin, y, kMessageSize, error ? kErrorText : kDimText});
+        y += kMessageLine;
     }
     const char* help[] = {
         "Drag an edge or a rectangle in the magnified pixel.",
         "Arrows nudge the selected one 1/96 px (Shift: 1/12).",
-        "Tab selects the next channel; click a number to type.",
-        "Ctrl+Z undo, Ctrl+Y redo, Ctrl+S save, Ctrl+O load,",
-        "Ctrl+Q quit.",
+        "Tab selects the next channel; click a number to type,",
+        "Tab or Shift+Tab to the next or previous field.",
+        "Ctrl+Z/Y undo/redo, Ctrl+S save, Ctrl+O load, Ctrl+Q quit.",
         "Click the preview to choose what is magnified.",
         "G, C, D raise gamma, contrast, stem darkening by 0.1,",
         "with Shift lower them; M: linear or corrected.",
     };
-    y = 628.0f;
+    y = kHelpY;
     for (const char* line : help) {
-        text.push_back({line, kMargin, y, 11.0f, kDimText});
-        y += 17.0f;
+        text.push_back({line, kMargin, y, kHelpSize, kDimText});
+        y += kHelpLine;
     }
 }
 
 void EditorView::draw_preview(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const {
-    text.push_back({"Preview at native pixels, drawn with this layout", kLightPanel.x, 46.0f, 12.0f, kDimText});
-    const std::pair<Rect, Color> panels[] = {{kLightPanel, kLightInk}, {kDarkPanel, kDarkInk}};
+    const Geometry& g = geometry_;
+    text.push_back({"Preview at native pixels, drawn with this layout", g.light_panel.x, 46.0f, 12.0f, kDimText});
+    const std::pair<Rect, Color> panels[] = {{g.light_panel, kLightInk}, {g.dark_panel, kDarkInk}};
     for (const auto& [panel, ink] : panels) {
-        const bool light = panel.x == kLightPanel.x;
+        const bool light = panel.x == g.light_panel.x;
         canvas.fill(panel, light ? kLightBackground : kDarkBackground);
         float y = panel.y + 16.0f;
         for (float size : kParagraphSizes) {
             text.push_back({kParagraph, panel.x + 10.0f, y, size, ink, panel.width - 20.0f, true});
             y += size * 2.0f * 1.17f + 10.0f;  // two lines of DejaVu Sans and a gap
         }
-        const Rect strip = light ? kLightStrip : kDarkStrip;
+        const Rect strip = light ? g.light_strip : g.dark_strip;
         canvas.fill(strip, light ? kLightBackground : kDarkBackground);
-        // A line moving 1/16 px a frame: a new subpixel offset, and new samples, every frame.
-        const float shift = static_cast<float>(stats.frame % 16) / 16.0f;
+        // A line moving 1/16 px a frame while the preview converges: a new subpixel offset, and
+        // new samples, every frame; then it stops, so that the editor can idle.
+        const float shift = stats.line_moving ? static_cast<float>(stats.frame % 16) / 16.0f : 0.0f;
         text.push_back({"Moving by 1/16 px a frame: Illegible 111 lll", strip.x + 10.0f + shift, strip.y + 20.0f, 13.0f,
-                        ink, 0.0f, true, true});
+                        ink, 0.0f, true, stats.line_moving});
         // The fringe test: thin vertical, horizontal and diagonal strokes.
         text.push_back({"||||||||  \u2014\u2014\u2014\u2014  ////////  \\\\\\\\\\\\\\\\  =====  xxxx", strip.x + 10.0f,
                         strip.y + 50.0f, 14.0f, ink, 0.0f, true});
@@ -569,25 +675,34 @@ void EditorView::draw_preview(Canvas& canvas, const FrameStats& stats, std::vect
                         strip.y + 78.0f, 11.0f, ink, 0.0f, true});
     }
     // Where the magnified view of rendered pixels looks, just outside the area it shows.
-    canvas.outline({static_cast<float>(crop_x_ - 1), static_cast<float>(crop_y_ - 1),
-                    static_cast<float>(kCropWidth + 2), static_cast<float>(kCropHeight + 2)},
-                   kActive);
+    const float one = 1.0f / scale_;
+    canvas.outline({crop_x_ - one, crop_y_ - one, static_cast<float>(crop_columns()) / scale_ + 2.0f * one,
+                    static_cast<float>(crop_rows()) / scale_ + 2.0f * one},
+                   kActive, one);
 }
 
 void EditorView::draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> previous,
                                       std::vector<TextItem>& text) const {
-    text.push_back({"The outlined preview pixels, x8, lighting this layout's subpixels", kRenderedView.x,
-                    kRenderedView.y - 6.0f, 12.0f, kDimText});
-    canvas.fill(kRenderedView, Color{0, 0, 0});
-    if (previous.size() < size_t{kWindowWidth} * kWindowHeight * 4) return;
+    const Rect view = geometry_.rendered_view;
+    text.push_back(
+        {"The outlined preview pixels, x8, lighting this layout's subpixels", view.x, view.y - 6.0f, 12.0f, kDimText});
+    canvas.fill(view, Color{0, 0, 0});
+    if (previous.size() != size_t{window_width_} * window_height_ * 4) return;
     const SubpixelLayout& layout = model_.layout();
     const float s = static_cast<float>(kRenderedScale);
-    for (int py = 0; py < kCropHeight; ++py) {
-        for (int px = 0; px < kCropWidth; ++px) {
-            const size_t source =
-                (static_cast<size_t>(crop_y_ + py) * kWindowWidth + static_cast<size_t>(crop_x_ + px)) * 4;
-            const float cell_x = kRenderedView.x + static_cast<float>(px) * s;
-            const float cell_y = kRenderedView.y + static_cast<float>(py) * s;
+    // The crop's top-left in window pixels (clamp_crop keeps it whole and inside the window).
+    const size_t left = static_cast<size_t>(std::lround(crop_x_ * scale_));
+    const size_t top = static_cast<size_t>(std::lround(crop_y_ * scale_));
+    const int columns = crop_columns(), rows = crop_rows();
+    for (int py = 0; py < rows; ++py) {
+        const size_t row = top + static_cast<size_t>(py);
+        if (row >= window_height_) break;
+        for (int px = 0; px < columns; ++px) {
+            const size_t column = left + static_cast<size_t>(px);
+            if (column >= window_width_) break;
+            const size_t source = (row * window_width_ + column) * 4;
+            const float cell_x = view.x + static_cast<float>(px) * s;
+            const float cell_y = view.y + static_cast<float>(py) * s;
             for (size_t c = 0; c < 3; ++c) {
                 const SampleRect& r = layout.channels[c];
                 // A channel's light stays inside its own pixel's cell, where the subpixel is.
@@ -602,18 +717,29 @@ void EditorView::draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> p
 }
 
 void EditorView::draw_status(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const {
-    canvas.fill(kStatusBar, Color{24, 25, 28});
-    char line[256];
+    const Rect bar = geometry_.status_bar;
+    canvas.fill(bar, Color{24, 25, 28});
+    char line[384];
     const char* state = stats.glyphs == 0                           ? "no glyphs yet"
                         : stats.min_samples >= stats.target_samples ? "converged"
                                                                     : "converging";
     char gpu[32] = "GPU -";
     if (stats.gpu_ms >= 0.0) std::snprintf(gpu, sizeof gpu, "GPU %.2f ms/frame", stats.gpu_ms);
-    std::snprintf(line, sizeof line,
-                  "frame %llu   samples per glyph %u to %u of %u (%s)   atlas %.1f%% occupied   %s   %u preview glyphs",
-                  static_cast<unsigned long long>(stats.frame), stats.min_samples, stats.max_samples,
-                  stats.target_samples, state, static_cast<double>(stats.atlas_occupancy) * 100.0, gpu, stats.glyphs);
-    text.push_back({line, kMargin, kStatusBar.y + 22.0f, 13.0f, kPanelText});
+    // A window too small for the interface at the monitor's scale is drawn smaller: say so.
+    char small[96] = "";
+    if (scale_ < content_scale_ * 0.999f) {
+        std::snprintf(small, sizeof small, "   window below %.0f x %.0f: drawn at %.0f%%",
+                      static_cast<double>(kMinimumWidth * content_scale_),
+                      static_cast<double>(kMinimumHeight * content_scale_), static_cast<double>(scale_) * 100.0);
+    }
+    std::snprintf(
+        line, sizeof line,
+        "frame %llu   samples per glyph %u to %u of %u (%s)   atlas %.1f%% occupied   %s   %u preview glyphs%s",
+        static_cast<unsigned long long>(stats.frame), stats.min_samples, stats.max_samples, stats.target_samples, state,
+        static_cast<double>(stats.atlas_occupancy) * 100.0, gpu, stats.glyphs, small);
+    TextItem item{line, kMargin, bar.y + 22.0f, 13.0f, kPanelText};
+    item.live = true;
+    text.push_back(std::move(item));
 }
 
 }  // namespace crisp::editor

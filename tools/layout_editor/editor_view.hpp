@@ -1,6 +1,11 @@
-// crisp-layout-editor: what the window shows and how input edits the layout. Every widget sits
-// at a fixed position in a 1280 x 800 window (geometry_json() lists them, for scripted input).
-// The view draws the panels and widgets on the CPU canvas and lists the text crisp draws on top.
+// crisp-layout-editor: what the window shows and how input edits the layout. The widgets are laid
+// out in interface pixels for the window's size (resize()): the left column keeps its place, the
+// preview, the magnified rendered pixels and the file field grow with the window, the status line
+// stays at the bottom. An interface pixel is the monitor's content scale in window pixels, less
+// in a window smaller than kMinimumWidth x kMinimumHeight interface pixels, where everything is
+// drawn smaller (and the status line says so) rather than cropped. geometry_json() lists the
+// widgets in window pixels, for scripted input. The view draws the panels and widgets on the CPU
+// canvas and lists the text crisp draws on top.
 #pragma once
 
 #include "canvas.hpp"
@@ -15,16 +20,20 @@
 
 namespace crisp::editor {
 
+// The starting window, in interface pixels, and the smallest that the widgets fit in.
 inline constexpr uint32_t kWindowWidth = 1280;
 inline constexpr uint32_t kWindowHeight = 800;
-// The magnified pixel: screen pixels per pixel, and where the centre pixel's top-left corner is.
+inline constexpr float kMinimumWidth = 1280.0f;
+inline constexpr float kMinimumHeight = 800.0f;
+// The magnified pixel: interface pixels per pixel, and where the centre pixel's top-left corner is.
 inline constexpr float kMagnifiedPixelScale = 96.0f;
 inline constexpr float kPixelOriginX = 136.0f;
 inline constexpr float kPixelOriginY = 160.0f;
-// The magnified view of rendered pixels: screen pixels per rendered pixel.
+// The magnified view of rendered pixels: interface pixels per rendered pixel.
 inline constexpr uint32_t kRenderedScale = 8;
 
-// A run of text for crisp to draw: a baseline origin in window pixels, sRGB colour.
+// A run of text for crisp to draw: a baseline origin, size and wrap width in interface pixels
+// (the frame loop scales them to window pixels), sRGB colour.
 struct TextItem {
     std::string text;
     float x = 0.0f, y = 0.0f;
@@ -32,7 +41,8 @@ struct TextItem {
     Color color{};
     float wrap_width = 0.0f;
     bool preview = false;  // drawn with the edited layout (else with the interface's gray one)
-    bool moving = false;   // moves every frame, so it never converges
+    bool moving = false;   // moves every frame while the preview converges
+    bool live = false;     // changes every frame (the status line): left out of settling
 };
 
 // What the status line reports, measured by the frame loop.
@@ -44,6 +54,7 @@ struct FrameStats {
     uint32_t target_samples = 0;
     float atlas_occupancy = 0.0f;  // the preview atlas, 0..1
     double gpu_ms = 0.0;           // last completed frame, timestamps; negative: not measured
+    bool line_moving = true;       // the preview's moving line still moves
 };
 
 struct Message {
@@ -53,14 +64,24 @@ struct Message {
 
 class EditorView {
 public:
+    // Laid out for a kWindowWidth x kWindowHeight window at scale 1 until resize().
     EditorView(LayoutModel& model, std::filesystem::path path);
 
-    // Applies one input event to the model and the view's own state (fields, file, crop).
+    // Lays the widgets out for a window of width x height window pixels on a monitor whose
+    // content scale is `content_scale` (window pixels per interface pixel; 1 where unknown). A
+    // zero size (a minimized window) or a scale that is not positive keeps the layout as it is.
+    void resize(uint32_t width, uint32_t height, float content_scale);
+    // Window pixels per interface pixel: the content scale, or less in a small window.
+    float scale() const { return scale_; }
+
+    // Applies one input event (positions in window pixels) to the model and the view's own state
+    // (fields, file, crop).
     void handle(const InputEvent& event);
 
-    // Draws the frame's CPU part into `canvas` and lists its text into `text`. `previous` is the
-    // last composited frame (kWindowWidth x kWindowHeight RGBA8, sRGB), for the magnified view of
-    // rendered pixels; empty before the first frame has completed.
+    // Draws the frame's CPU part into `canvas` (the window's size, at scale()) and lists its text
+    // into `text`. `previous` is the last composited frame (the window's size, RGBA8, sRGB), for
+    // the magnified view of rendered pixels; empty before the first frame has completed, or when
+    // it is not the size of the window.
     void draw(Canvas& canvas, std::span<const uint8_t> previous, const FrameStats& stats, std::vector<TextItem>& text);
 
     // Saves to / loads from the file field's path, reporting in the message list.
@@ -71,8 +92,12 @@ public:
     // Ctrl+Q was pressed.
     bool quit_requested() const { return quit_; }
 
-    // The widgets' positions, as JSON, for scripts that drive the window.
-    static std::string geometry_json();
+    // The widgets' positions in window pixels, as JSON, for scripts that drive the window.
+    std::string geometry_json() const;
+
+    // Interface pixels per window.
+    float width() const { return width_; }
+    float height() const { return height_; }
 
 private:
     struct Field {
@@ -81,7 +106,7 @@ private:
         int coordinate = 0;
     };
     std::vector<Field> fields() const;
-    std::string field_value(const Field& field) const;  // a number field's value, formatted
+    float field_number(const Field& field) const;  // a number field's value
     void begin_field_edit(int index);
     void commit_field_edit();
     void handle_key(const InputEvent& event);
@@ -97,15 +122,37 @@ private:
     void draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> previous, std::vector<TextItem>& text) const;
     void draw_status(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const;
 
+    // Where the widgets that move with the window's size are, interface pixels.
+    struct Geometry {
+        Rect path_field;
+        Rect light_panel, dark_panel, light_strip, dark_strip;
+        float contrast_y = 0.0f;
+        Rect mode_button, reset_button;
+        Rect rendered_view;
+        Rect status_bar;
+    };
+    Rect contrast_field(int parameter) const;
+    Rect preview_area() const;  // the panels and strips
+    // The rendered pixels the magnified view shows: columns and rows.
+    int crop_columns() const;
+    int crop_rows() const;
+    void clamp_crop();
+
     LayoutModel& model_;
+    Geometry geometry_;
+    uint32_t window_width_ = kWindowWidth, window_height_ = kWindowHeight;
+    float width_ = static_cast<float>(kWindowWidth), height_ = static_cast<float>(kWindowHeight);
+    float scale_ = 1.0f;
+    float content_scale_ = 1.0f;
     std::string path_;
     std::vector<Message> messages_;
     int active_field_ = -2;  // index into fields(); -2: none
     std::string field_text_;
     bool field_fresh_ = false;  // nothing typed since the field was clicked
     float drag_x_ = 0.0f, drag_y_ = 0.0f;
-    // Top-left of the preview area shown magnified, window pixels.
-    int crop_x_ = 0, crop_y_ = 0;
+    // Top-left of the preview area shown magnified, interface pixels.
+    float crop_x_ = 0.0f, crop_y_ = 0.0f;
+    bool crop_chosen_ = false;  // by a click; else it follows the strip as the window is resized
     bool quit_ = false;
 };
 

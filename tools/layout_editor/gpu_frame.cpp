@@ -51,25 +51,7 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
     }
     self->device_ =
         vk::make_device_ref(self->functions_, window.physical_device(), window.device(), nullptr, VK_NULL_HANDLE);
-    const uint32_t width = window.width(), height = window.height();
-    const VkDeviceSize bytes = VkDeviceSize{width} * height * 4;
-    if (Status s =
-            create_image(self->device_, VK_FORMAT_R8G8B8A8_UNORM, width, height,
-                         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                         "canvas", self->canvas_);
-        !s) {
-        return s.error();
-    }
-    if (Status s =
-            create_buffer(self->device_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "editor upload", self->upload_);
-        !s) {
-        return s.error();
-    }
-    if (Status s = create_buffer(self->device_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "editor readback",
-                                 self->readback_);
-        !s) {
-        return s.error();
-    }
+    if (Status s = self->create_images(window.width(), window.height()); !s) return s.error();
     VkCommandPoolCreateInfo pool_info{};
     pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
     pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -145,6 +127,34 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
     return self;
 }
 
+Status GpuFrame::create_images(uint32_t width, uint32_t height) {
+    readback_.reset();
+    upload_.reset();
+    canvas_.reset();
+    width_ = width;
+    height_ = height;
+    has_previous_ = false;
+    const VkDeviceSize bytes = VkDeviceSize{width} * height * 4;
+    if (Status s =
+            create_image(device_, VK_FORMAT_R8G8B8A8_UNORM, width, height,
+                         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                         "canvas", canvas_);
+        !s) {
+        return s;
+    }
+    if (Status s = create_buffer(device_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "editor upload", upload_);
+        !s) {
+        return s;
+    }
+    return create_buffer(device_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, "editor readback", readback_);
+}
+
+Status GpuFrame::match_window() {
+    if (window_.width() == width_ && window_.height() == height_) return {};
+    if (Status s = wait(); !s) return s;
+    return create_images(window_.width(), window_.height());
+}
+
 Status GpuFrame::wait() {
     if (!in_flight_) return {};
     if (VkResult r = vkWaitForFences(device_.device, 1, &fence_, VK_TRUE, UINT64_MAX); r != VK_SUCCESS) {
@@ -186,7 +196,7 @@ Status GpuFrame::set_preview_contrast(const TextContrast& contrast) {
 
 Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const GlyphInstance> interface_glyphs,
                         std::span<const GlyphInstance> preview_glyphs) {
-    const uint32_t width = window_.width(), height = window_.height();
+    const uint32_t width = width_, height = height_;
     const VkRect2D whole{{0, 0}, {width, height}};
     interface_renderer_->begin_frame();
     interface_renderer_->draw(interface_glyphs, whole);

@@ -25,7 +25,8 @@ inline constexpr uint32_t kPreviewMaxSamples = 256;
 
 class GpuFrame {
 public:
-    // The canvas is window.width() x window.height(). `font` must outlive the GpuFrame.
+    // The canvas is window.width() x window.height() (match_window() follows a resize). `font`
+    // must outlive the GpuFrame.
     static Result<std::unique_ptr<GpuFrame>> create(VulkanWindow& window, const Font& font,
                                                     const SubpixelLayout& preview_layout,
                                                     const TextContrast& preview_contrast);
@@ -37,6 +38,11 @@ public:
     // Waits for the frame in flight, if any; then the canvas may be written and previous_frame()
     // and gpu_milliseconds() describe it.
     Status wait();
+    // After wait(): makes the canvas and the copies of the frame the window's size where it has
+    // changed (previous_frame() is then empty until the next frame completes).
+    Status match_window();
+    uint32_t width() const { return width_; }
+    uint32_t height() const { return height_; }
     std::span<uint8_t> canvas();
     // The last completed frame as shown (RGBA8, sRGB, top row first); empty before the first.
     std::span<const uint8_t> previous_frame() const;
@@ -53,9 +59,12 @@ public:
                   std::span<const GlyphInstance> preview_glyphs);
 
     const Renderer& preview_renderer() const { return *preview_renderer_; }
+    const Renderer& interface_renderer() const { return *interface_renderer_; }
 
 private:
     explicit GpuFrame(VulkanWindow& window);
+    // The canvas image and the upload and readback buffers, width x height.
+    Status create_images(uint32_t width, uint32_t height);
 
     VulkanWindow& window_;
     vk::Functions functions_;  // for crisp's private helpers (the editor itself calls the loader)
@@ -67,6 +76,7 @@ private:
     VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
     VkFence fence_ = VK_NULL_HANDLE;
     VkQueryPool timestamps_ = VK_NULL_HANDLE;
+    uint32_t width_ = 0, height_ = 0;
     bool in_flight_ = false;
     bool has_previous_ = false;
     std::optional<double> gpu_ms_;

@@ -63,7 +63,32 @@ struct Args {
     bool validation = false;
     bool print_geometry = false;
     std::string export_form;  // print the layout in this form and quit, without a window
+    // The starting size, window pixels; none: kWindowWidth x kWindowHeight at the monitor's
+    // content scale, within its work area.
+    std::optional<std::pair<uint32_t, uint32_t>> window;
+    float ui_scale = 0.0f;  // window pixels per interface pixel; 0: the monitor's content scale
 };
+
+// The window sizes --window takes, each side.
+constexpr crisp::cli::Range<uint32_t> kWindowSides{64, 8192, false, " pixels"};
+
+// --window WxH: "1366x768".
+crisp::Status parse_window(std::string_view text, std::optional<std::pair<uint32_t, uint32_t>>& target) {
+    const std::vector<std::string_view> sides = crisp::cli::split(text, 'x');
+    if (sides.size() != 2) {
+        return crisp::Error{crisp::ErrorCode::invalid_argument,
+                            "--window: '" + crisp::cli::printable(text) + "' is not WIDTHxHEIGHT (such as 1366x768)"};
+    }
+    uint32_t size[2] = {};
+    for (size_t i = 0; i < 2; ++i) {
+        const crisp::Result<uint32_t> side =
+            crisp::cli::CommandLine::checked_number<uint32_t>("--window", sides[i], kWindowSides);
+        if (!side) return side.error();
+        size[i] = *side;
+    }
+    target = std::pair{size[0], size[1]};
+    return {};
+}
 
 Args parse_args(int argc, char** argv) {
     Args args;
@@ -85,7 +110,19 @@ Args parse_args(int argc, char** argv) {
              "turn on VK_LAYER_KHRONOS_validation; any warning or error it reports\n"
              "makes the exit code 4 (also: CRISP_VALIDATION=1 in the environment)",
              args.validation);
-    cli.flag("--print-geometry", "print the widgets' positions as JSON and quit (for scripted input)",
+    cli.option("--window", "WxH",
+               "the window's starting size in window pixels, each side 64..8192 (it can\n"
+               "be resized); default 1280x800 times the monitor's content scale, within\n"
+               "its work area. --screenshot writes a picture of this size",
+               [&args](std::string_view text) { return parse_window(text, args.window); });
+    cli.number("--ui-scale", "S",
+               "window pixels per interface pixel, 0.25..4; default the monitor's content\n"
+               "scale (1 where the window system does not say). A window smaller than\n"
+               "1280x800 interface pixels draws everything smaller",
+               args.ui_scale, crisp::cli::Range<float>{0.25f, 4.0f});
+    cli.flag("--print-geometry",
+             "print the widgets' positions (window pixels, for the --window size, default\n"
+             "1280x800, at --ui-scale, default 1) as JSON and quit (for scripted input)",
              args.print_geometry);
     std::vector<std::string> forms(export_form_names().begin(), export_form_names().end());
     cli.choice("--export", "FORM",
@@ -136,32 +173,42 @@ struct FrameText {
     std::vector<crisp::GlyphInstance> preview_glyphs;
     // Paint orders of moving preview text: it never converges, so the status line leaves it out.
     std::vector<std::pair<uint32_t, uint32_t>> moving;
+    // Paint orders of text that changes every frame (the status line): left out of settling.
+    std::vector<std::pair<uint32_t, uint32_t>> live;
 };
 
-void lay_out(crisp::Layouter& layouter, const crisp::Font& font, const std::vector<TextItem>& items, FrameText& out,
-             std::vector<std::string>& errors) {
+bool in_ranges(const std::vector<std::pair<uint32_t, uint32_t>>& ranges, uint32_t order) {
+    return std::any_of(ranges.begin(), ranges.end(),
+                       [order](const auto& range) { return order >= range.first && order < range.second; });
+}
+
+// The items' positions and sizes are interface pixels: `scale` window pixels each.
+void lay_out(crisp::Layouter& layouter, const crisp::Font& font, const std::vector<TextItem>& items, float scale,
+             FrameText& out, std::vector<std::string>& errors) {
     out.interface_glyphs.clear();
     out.preview_glyphs.clear();
     out.moving.clear();
+    out.live.clear();
     const crisp::Font* fonts[] = {&font};
     crisp::TextLayout laid;
     uint32_t paint_order = 0;
     for (const TextItem& item : items) {
         crisp::TextStyle style;
-        style.size = item.size;
+        style.size = item.size * scale;
         style.color[0] = static_cast<float>(item.color.r) / 255.0f;
         style.color[1] = static_cast<float>(item.color.g) / 255.0f;
         style.color[2] = static_cast<float>(item.color.b) / 255.0f;
         crisp::LayoutOptions options;
-        options.origin_x = item.x;
-        options.origin_y = item.y;
-        options.wrap_width = item.wrap_width;
+        options.origin_x = item.x * scale;
+        options.origin_y = item.y * scale;
+        options.wrap_width = item.wrap_width * scale;
         options.first_paint_order = paint_order;
         if (crisp::Status status = layouter.layout(fonts, item.text, style, options, laid); !status) {
             errors.push_back(status.error().message);
             continue;
         }
         if (item.moving) out.moving.emplace_back(paint_order, laid.next_paint_order);
+        if (item.live) out.live.emplace_back(paint_order, laid.next_paint_order);
         paint_order = laid.next_paint_order;
         auto& target = item.preview ? out.preview_glyphs : out.interface_glyphs;
         target.insert(target.end(), laid.glyphs.begin(), laid.glyphs.end());
@@ -176,11 +223,7 @@ FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
     stats.atlas_occupancy = gpu.preview_renderer().atlas().stats().occupancy;
     bool first = true;
     for (const crisp::DrawnGlyph& glyph : gpu.preview_renderer().drawn()) {
-        const uint32_t order = glyph.instance.paint_order;
-        const bool moving = std::any_of(text.moving.begin(), text.moving.end(), [&](const auto& range) {
-            return order >= range.first && order < range.second;
-        });
-        if (moving) continue;
+        if (in_ranges(text.moving, glyph.instance.paint_order)) continue;
         stats.min_samples = first ? glyph.samples : std::min(stats.min_samples, glyph.samples);
         stats.max_samples = first ? glyph.samples : std::max(stats.max_samples, glyph.samples);
         first = false;
@@ -188,6 +231,20 @@ FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
     }
     return stats;
 }
+
+// Whether the last frame drawn shows every glyph converged, but those of text that changes every
+// frame: the next frame would look the same, so the editor can wait for input.
+bool settled(const GpuFrame& gpu, const FrameText& text) {
+    for (const crisp::Renderer* renderer : {&gpu.preview_renderer(), &gpu.interface_renderer()}) {
+        for (const crisp::DrawnGlyph& glyph : renderer->drawn()) {
+            if (glyph.samples < kPreviewMaxSamples && !in_ranges(text.live, glyph.instance.paint_order)) return false;
+        }
+    }
+    return true;
+}
+
+// Frames the moving line goes on moving once the rest of the preview has converged.
+constexpr uint64_t kMovingAfterConverged = 32;
 
 // The --screenshot file, refused before the window opens when it cannot or must not be written:
 // the --font or --layout file under any name (a screenshot used to replace its own layout file).
@@ -204,6 +261,10 @@ std::optional<crisp::OutputFiles> declare_screenshot(const Args& args) {
 
 bool write_screenshot(const crisp::OutputFiles& output, std::span<const uint8_t> rgba, uint32_t width,
                       uint32_t height) {
+    if (rgba.size() != size_t{width} * height * 4) {
+        std::fprintf(stderr, "crisp-layout-editor: --screenshot: no frame of the window's size was completed\n");
+        return false;
+    }
     std::vector<float> pixels(size_t{width} * height * 3);
     for (size_t i = 0; i < size_t{width} * height; ++i) {
         for (size_t c = 0; c < 3; ++c)
@@ -240,16 +301,33 @@ int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, V
     std::array<crisp::SampleRect, 3> applied_channels = model.layout().channels;
     crisp::TextContrast applied_contrast = model.contrast();
     uint64_t frame = 0;
+    // With no --frames, once two frames in a row show every glyph converged and the moving line
+    // has stopped, the loop sleeps until the window system has something rather than drawing the
+    // same frame again; it also sleeps while the window is minimized.
+    uint32_t settled_frames = 0;
+    uint64_t converged_since = UINT64_MAX;  // the frame the preview's paragraphs converged in
     while (!window.should_close() && !view.quit_requested()) {
         if (crisp::Status status = gpu.wait(); !status) {
             std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
             return kExitVulkan;
         }
         if (args.frames != 0 && frame >= args.frames) break;
-        const FrameStats stats = measure(gpu, text, frame);
-        for (const InputEvent& event : window.poll_events()) view.handle(event);
+        FrameStats stats = measure(gpu, text, frame);
+        // Since the last edit: the moving line's glyphs share atlas entries with the paragraphs,
+        // and a paragraph glyph may dip below the target while the line moves.
+        const bool converged = stats.glyphs > 0 && stats.min_samples >= stats.target_samples;
+        if (converged && converged_since == UINT64_MAX) converged_since = frame;
+        stats.line_moving = converged_since == UINT64_MAX || frame < converged_since + kMovingAfterConverged;
+        settled_frames = !stats.line_moving && settled(gpu, text) ? settled_frames + 1 : 0;
+        const bool drawable = window.drawable();
+        const bool wait = args.frames == 0 && (settled_frames >= 2 || !drawable);
+        const std::vector<InputEvent> events = window.poll_events(wait);
+        if (!events.empty()) settled_frames = 0;
+        for (const InputEvent& event : events) view.handle(event);
+        if (!window.drawable()) continue;
         if (model.revision() != applied_revision) {
             applied_revision = model.revision();
+            converged_since = UINT64_MAX;  // the line moves again while the edit converges
             if (model.layout().channels != applied_channels) {
                 applied_channels = model.layout().channels;
                 if (crisp::Status status = gpu.set_preview_layout(model.layout()); !status) {
@@ -269,11 +347,17 @@ int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, V
             return kExitVulkan;
         }
         if (acquired->image == VK_NULL_HANDLE) continue;  // the swapchain was rebuilt
-        Canvas canvas(gpu.canvas(), window.width(), window.height());
+        // The window's size (it may have been resized) and the monitor's scale, for this frame.
+        if (crisp::Status status = gpu.match_window(); !status) {
+            std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
+            return kExitVulkan;
+        }
+        view.resize(window.width(), window.height(), args.ui_scale > 0.0f ? args.ui_scale : window.content_scale());
+        Canvas canvas(gpu.canvas(), window.width(), window.height(), view.scale());
         items.clear();
         view.draw(canvas, gpu.previous_frame(), stats, items);
         std::vector<std::string> errors;
-        lay_out(layouter, font, items, text, errors);
+        lay_out(layouter, font, items, view.scale(), text, errors);
         for (const std::string& error : errors) view.report("Text layout: " + error, true);
         if (crisp::Status status = gpu.render(*acquired, text.interface_glyphs, text.preview_glyphs); !status) {
             std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
@@ -289,7 +373,7 @@ int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, V
         std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
         return kExitVulkan;
     }
-    if (screenshot && !write_screenshot(*screenshot, gpu.previous_frame(), window.width(), window.height())) {
+    if (screenshot && !write_screenshot(*screenshot, gpu.previous_frame(), gpu.width(), gpu.height())) {
         return kExitScreenshot;
     }
     return kExitOk;
@@ -319,7 +403,12 @@ int export_to_stdout(const Args& args) {
 int main(int argc, char** argv) {
     const Args args = parse_args(argc, argv);
     if (args.print_geometry) {
-        std::printf("%s\n", EditorView::geometry_json().c_str());
+        crisp::SubpixelLayout rgb = *crisp::subpixel_preset("rgb");
+        LayoutModel model(rgb);
+        EditorView view(model, {});
+        const auto [width, height] = args.window.value_or(std::pair{kWindowWidth, kWindowHeight});
+        view.resize(width, height, args.ui_scale > 0.0f ? args.ui_scale : 1.0f);
+        std::printf("%s\n", view.geometry_json().c_str());
         return kExitOk;
     }
     if (!args.export_form.empty()) return export_to_stdout(args);
@@ -339,8 +428,7 @@ int main(int argc, char** argv) {
     if (crisp::Result<crisp::SubpixelLayout> loaded = load_layout_argument(args.layout); loaded) {
         initial = *loaded;
     } else {
-        load_error = loaded.error().message;
-        std::fprintf(stderr, "crisp-layout-editor: --layout: %s\n", loaded.error().message.c_str());
+        load_error = loaded.error().message;  // on stderr too, as every message the window shows
     }
     LayoutModel model(initial);
     EditorView view(model, path);
@@ -350,8 +438,9 @@ int main(int argc, char** argv) {
     if (!font) return kExitFont;
 
     WindowOptions window_options;
-    window_options.width = kWindowWidth;
-    window_options.height = kWindowHeight;
+    window_options.width = args.window ? args.window->first : kWindowWidth;
+    window_options.height = args.window ? args.window->second : kWindowHeight;
+    window_options.fit_to_monitor = !args.window;
     window_options.validation = args.validation;
     crisp::Result<std::unique_ptr<VulkanWindow>> window = VulkanWindow::create(window_options);
     if (!window) {

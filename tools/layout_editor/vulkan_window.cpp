@@ -7,6 +7,7 @@
 
 #include <crisp/device_features.hpp>
 
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -48,6 +49,7 @@ struct WindowCallbacks {
         event.mods = mods;
         self.events_.push_back(event);
     }
+    static void framebuffer_size(GLFWwindow* window, int, int) { owner(window).resized_ = true; }
     static void character(GLFWwindow* window, unsigned int codepoint) {
         VulkanWindow& self = owner(window);
         InputEvent event;
@@ -96,13 +98,23 @@ Status VulkanWindow::create_instance() {
     return {};
 }
 
-// The window (fixed size: the editor's widgets sit at fixed positions), its input callbacks and
+// The window (resizable: the editor lays its widgets out for the size), its input callbacks and
 // its surface.
 Status VulkanWindow::create_window() {
     glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
-    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
-    window_ = glfwCreateWindow(static_cast<int>(options_.width), static_cast<int>(options_.height),
-                               options_.title.c_str(), nullptr, nullptr);
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
+    int width = static_cast<int>(options_.width), height = static_cast<int>(options_.height);
+    if (GLFWmonitor* monitor = glfwGetPrimaryMonitor(); options_.fit_to_monitor && monitor) {
+        float scale_x = 1.0f, scale_y = 1.0f;
+        glfwGetMonitorContentScale(monitor, &scale_x, &scale_y);
+        int area_x = 0, area_y = 0, area_width = 0, area_height = 0;
+        glfwGetMonitorWorkarea(monitor, &area_x, &area_y, &area_width, &area_height);
+        width = static_cast<int>(static_cast<float>(width) * std::max(scale_x, 1.0f));
+        height = static_cast<int>(static_cast<float>(height) * std::max(scale_y, 1.0f));
+        if (area_width > 0) width = std::min(width, area_width);
+        if (area_height > 0) height = std::min(height, area_height);
+    }
+    window_ = glfwCreateWindow(width, height, options_.title.c_str(), nullptr, nullptr);
     if (!window_) return Error{ErrorCode::vulkan, "glfwCreateWindow failed"};
     glfwSetWindowPos(window_, 0, 0);
     glfwSetWindowUserPointer(window_, this);
@@ -110,6 +122,7 @@ Status VulkanWindow::create_window() {
     glfwSetMouseButtonCallback(window_, WindowCallbacks::button);
     glfwSetKeyCallback(window_, WindowCallbacks::key);
     glfwSetCharCallback(window_, WindowCallbacks::character);
+    glfwSetFramebufferSizeCallback(window_, WindowCallbacks::framebuffer_size);
     if (VkResult r = glfwCreateWindowSurface(instance(), window_, nullptr, &surface_); r != VK_SUCCESS) {
         return vk::vulkan_error("glfwCreateWindowSurface", r);
     }
@@ -151,6 +164,7 @@ Status VulkanWindow::create_device() {
 Status VulkanWindow::create_swapchain() {
     VkSurfaceCapabilitiesKHR capabilities{};
     vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_.handle, surface_, &capabilities);
+    resized_ = false;
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;  // the canvas is blitted in
     if ((capabilities.supportedUsageFlags & usage) != usage) {
         return Error{ErrorCode::vulkan, "the surface's images cannot be transfer destinations"};
@@ -177,7 +191,21 @@ Status VulkanWindow::create_swapchain() {
     }
     swapchain_format_ = chosen.format;
     VkExtent2D extent = capabilities.currentExtent;
-    if (extent.width == UINT32_MAX) extent = {options_.width, options_.height};
+    if (extent.width == UINT32_MAX) {
+        // The surface takes the swapchain's size: the framebuffer's, within the surface's limits.
+        int width = 0, height = 0;
+        glfwGetFramebufferSize(window_, &width, &height);
+        extent.width = std::clamp(static_cast<uint32_t>(std::max(width, 1)), capabilities.minImageExtent.width,
+                                  capabilities.maxImageExtent.width);
+        extent.height = std::clamp(static_cast<uint32_t>(std::max(height, 1)), capabilities.minImageExtent.height,
+                                   capabilities.maxImageExtent.height);
+    }
+    // A minimized window has no area: the swapchain stays as it is until it has one again.
+    if (extent.width == 0 || extent.height == 0) {
+        resized_ = true;
+        return {};
+    }
+    extent_ = extent;
     uint32_t image_count = capabilities.minImageCount + 1;
     if (capabilities.maxImageCount != 0 && image_count > capabilities.maxImageCount)
         image_count = capabilities.maxImageCount;
@@ -244,13 +272,29 @@ bool VulkanWindow::should_close() const {
     return glfwWindowShouldClose(window_) != 0;
 }
 
-std::vector<InputEvent> VulkanWindow::poll_events() {
-    glfwPollEvents();
+float VulkanWindow::content_scale() const {
+    float x = 1.0f, y = 1.0f;
+    glfwGetWindowContentScale(window_, &x, &y);
+    return x > 0.0f ? x : 1.0f;
+}
+
+bool VulkanWindow::drawable() const {
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(window_, &width, &height);
+    return width > 0 && height > 0 && glfwGetWindowAttrib(window_, GLFW_ICONIFIED) == GLFW_FALSE;
+}
+
+std::vector<InputEvent> VulkanWindow::poll_events(bool wait) {
+    wait ? glfwWaitEvents() : glfwPollEvents();
     return std::exchange(events_, {});
 }
 
 Result<VulkanWindow::Acquired> VulkanWindow::acquire() {
     Acquired acquired;
+    if (resized_ || swapchain_ == VK_NULL_HANDLE) {
+        if (Status status = create_swapchain(); !status) return status.error();
+        return acquired;
+    }
     const VkResult r =
         vkAcquireNextImageKHR(device(), swapchain_, UINT64_MAX, image_ready_, VK_NULL_HANDLE, &acquired.index);
     if (r == VK_ERROR_OUT_OF_DATE_KHR) {

@@ -31,8 +31,12 @@ struct InputEvent {
 };
 
 struct WindowOptions {
+    // The starting size, window pixels; the person may resize the window from there.
     uint32_t width = 1280;
     uint32_t height = 800;
+    // The size is in interface pixels instead: times the primary monitor's content scale, and
+    // no larger than its work area.
+    bool fit_to_monitor = false;
     std::string title = "crisp layout editor";
     // VK_LAYER_KHRONOS_validation with a messenger that counts its warnings and errors.
     bool validation = false;
@@ -64,16 +68,24 @@ public:
     // The feature chain the device was created with, for crisp's create infos.
     const VkPhysicalDeviceFeatures2* enabled_features() const { return device_.enabled_features(); }
     uint32_t timestamp_valid_bits() const { return physical_.queue_family_properties.timestampValidBits; }
-    uint32_t width() const { return options_.width; }
-    uint32_t height() const { return options_.height; }
+    // The swapchain's size, window pixels: what a frame fills.
+    uint32_t width() const { return extent_.width; }
+    uint32_t height() const { return extent_.height; }
+    // Window pixels per interface pixel the monitor asks for (glfwGetWindowContentScale; 1 where
+    // the window system does not say).
+    float content_scale() const;
+    // Whether a frame can be shown: the window is not minimized and has an area.
+    bool drawable() const;
 
     bool should_close() const;
-    // Polls the window system and returns the events since the last call, oldest first.
-    std::vector<InputEvent> poll_events();
+    // Polls the window system and returns the events since the last call, oldest first. With
+    // `wait`, sleeps until the window system has something (input, a resize, an exposure).
+    std::vector<InputEvent> poll_events(bool wait = false);
 
     // The swapchain image to draw into next, or nullopt-like (image == VK_NULL_HANDLE) when the
-    // swapchain had to be rebuilt and the frame should be skipped. `ready` is signalled when the
-    // image may be written.
+    // swapchain had to be rebuilt (out of date, or the window was resized: width() and height()
+    // are then the new size) and the frame should be skipped. `ready` is signalled when the image
+    // may be written.
     struct Acquired {
         VkImage image = VK_NULL_HANDLE;
         uint32_t index = 0;
@@ -116,6 +128,8 @@ private:
     std::vector<VkImage> swapchain_images_;
     std::vector<VkSemaphore> rendered_;  // one per swapchain image
     VkSemaphore image_ready_ = VK_NULL_HANDLE;
+    VkExtent2D extent_{};
+    bool resized_ = false;  // the framebuffer's size changed since the swapchain was made
     std::vector<InputEvent> events_;
     double cursor_x_ = 0.0, cursor_y_ = 0.0;
 };
