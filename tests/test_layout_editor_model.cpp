@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -254,6 +255,8 @@ TEST(LayoutEditorModel, NudgesAndDragsStayOnTheGridAndSaveItsShortestForm) {
     EXPECT_EQ(crisp::editor::format_number(0.95f), "0.95");
     EXPECT_EQ(crisp::editor::format_number(-0.0001f), "-0.0001");
     EXPECT_EQ(crisp::editor::format_number(0.0f), "0");
+    // Float's largest values in fixed notation (39 digits) still fit, and read back.
+    EXPECT_EQ(std::strtof(crisp::editor::format_number(-3e38f).c_str(), nullptr), -3e38f);
 }
 
 TEST(LayoutEditorModel, ChoosingAPresetIsNoModificationButAnEditAwayIs) {

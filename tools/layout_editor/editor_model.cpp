@@ -117,7 +117,7 @@ float snap_to_grid_if_near(float value) {
 }
 
 std::string format_number(float value) {
-    char buffer[32];
+    char buffer[64];  // fixed notation of float's largest value is 39 digits
     // Fixed notation keeps 0.0001 from becoming 1e-04; the editor's values stay near [-1, 2].
     const std::to_chars_result written =
         std::fabs(value) >= 1e-4f || value == 0.0f
