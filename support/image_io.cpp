@@ -10,6 +10,7 @@
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <string>
 #include <string_view>
@@ -66,15 +67,25 @@ void png_flush_bytes(png_structp) {}
 
 void png_on_warning(png_structp, png_const_charp) {}
 
-// libpng reports errors by longjmp to here. Only trivially destructible objects live in this frame
-// and in libpng's, so jumping over them skips no destructor.
-bool png_write_rows(png_structp png, png_infop info, uint32_t width, uint32_t height, int color_type, png_bytepp rows) {
+// libpng reports errors by longjmp to these. Only trivially destructible objects live in their
+// frames and in libpng's, so jumping over them skips no destructor.
+bool png_begin(png_structp png, png_infop info, uint32_t width, uint32_t height, int color_type) {
     if (setjmp(png_jmpbuf(png))) return false;
     png_set_IHDR(png, info, width, height, 8, color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
     png_write_info(png, info);
-    png_write_image(png, rows);
+    return true;
+}
+
+bool png_rows(png_structp png, png_bytepp rows, uint32_t count) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_write_rows(png, rows, count);
+    return true;
+}
+
+bool png_end(png_structp png, png_infop info) {
+    if (setjmp(png_jmpbuf(png))) return false;
     png_write_end(png, info);
     return true;
 }
@@ -149,39 +160,102 @@ uint8_t linear_to_srgb8(float linear) {
     return unit_to_byte(linear_to_srgb(static_cast<double>(linear)));
 }
 
+struct PngRowEncoder::State {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    uint32_t channels = 0;
+    uint32_t rows_done = 0;
+    bool failed = false;
+    std::vector<std::byte> bytes;
+    PngSink sink{&bytes};
+    PngErrorText error;
+    png_structp png = nullptr;
+    png_infop info = nullptr;
+    std::vector<png_byte> texels;  // the rows of one add_rows() call, encoded
+    std::vector<png_bytep> rows;
+
+    ~State() {
+        if (png != nullptr) png_destroy_write_struct(&png, info != nullptr ? &info : nullptr);
+    }
+    Error libpng_error() {
+        failed = true;
+        if (sink.out_of_memory) return Error{ErrorCode::io, "libpng: out of memory while encoding"};
+        return Error{ErrorCode::io, std::string("libpng: ") + error.text};
+    }
+};
+
+PngRowEncoder::PngRowEncoder(std::unique_ptr<State> state) : state_(std::move(state)) {}
+PngRowEncoder::PngRowEncoder(PngRowEncoder&&) noexcept = default;
+PngRowEncoder& PngRowEncoder::operator=(PngRowEncoder&&) noexcept = default;
+PngRowEncoder::~PngRowEncoder() = default;
+
+Result<PngRowEncoder> PngRowEncoder::create(uint32_t width, uint32_t height, uint32_t channels) {
+    if (channels != 3 && channels != 4) {
+        return Error{ErrorCode::invalid_argument, "a PNG needs 3 or 4 channels, not " + std::to_string(channels)};
+    }
+    if (Status status = check_image(width, height, channels, size_t{width} * height * channels); !status)
+        return status.error();
+    auto state = std::make_unique<State>();
+    state->width = width;
+    state->height = height;
+    state->channels = channels;
+    state->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &state->error, png_on_error, png_on_warning);
+    if (state->png == nullptr) return Error{ErrorCode::io, "libpng: cannot create a PNG writer"};
+    state->info = png_create_info_struct(state->png);
+    if (state->info == nullptr) return Error{ErrorCode::io, "libpng: cannot create a PNG writer"};
+    png_set_write_fn(state->png, &state->sink, png_write_bytes, png_flush_bytes);
+    if (!png_begin(state->png, state->info, width, height,
+                   channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB)) {
+        return state->libpng_error();
+    }
+    return PngRowEncoder(std::move(state));
+}
+
+Status PngRowEncoder::add_rows(std::span<const float> pixels) {
+    State& s = *state_;
+    if (s.failed) return Error{ErrorCode::invalid_argument, "the PNG encoder failed before"};
+    const size_t row_floats = size_t{s.width} * s.channels;
+    if (pixels.size() % row_floats != 0 || pixels.size() / row_floats > s.height - s.rows_done) {
+        return Error{ErrorCode::invalid_argument, std::to_string(pixels.size()) + " floats are not whole rows of " +
+                                                      std::to_string(row_floats) + " within the " +
+                                                      std::to_string(s.height - s.rows_done) + " rows left"};
+    }
+    const auto count = static_cast<uint32_t>(pixels.size() / row_floats);
+    if (count == 0) return {};
+    s.texels.resize(pixels.size());
+    for (size_t i = 0; i < pixels.size(); ++i) {
+        const bool alpha = s.channels == 4 && i % 4 == 3;
+        s.texels[i] = alpha ? unit_to_byte(static_cast<double>(pixels[i])) : linear_to_srgb8(pixels[i]);
+    }
+    s.rows.resize(count);
+    for (size_t y = 0; y < count; ++y) s.rows[y] = s.texels.data() + y * row_floats;
+    if (!png_rows(s.png, s.rows.data(), count) || s.sink.out_of_memory) return s.libpng_error();
+    s.rows_done += count;
+    return {};
+}
+
+Result<std::vector<std::byte>> PngRowEncoder::finish() {
+    State& s = *state_;
+    if (s.failed) return Error{ErrorCode::invalid_argument, "the PNG encoder failed before"};
+    if (s.rows_done != s.height) {
+        return Error{ErrorCode::invalid_argument,
+                     "the PNG has " + std::to_string(s.rows_done) + " of its " + std::to_string(s.height) + " rows"};
+    }
+    if (!png_end(s.png, s.info) || s.sink.out_of_memory) return s.libpng_error();
+    s.failed = true;  // finished: nothing more to add
+    return std::move(s.bytes);
+}
+
 Result<std::vector<std::byte>> encode_png_srgb8(uint32_t width, uint32_t height, uint32_t channels,
                                                 std::span<const float> pixels) {
     if (channels != 3 && channels != 4) {
         return Error{ErrorCode::invalid_argument, "a PNG needs 3 or 4 channels, not " + std::to_string(channels)};
     }
     if (Status status = check_image(width, height, channels, pixels.size()); !status) return status.error();
-
-    const size_t row_bytes = size_t{width} * channels;
-    std::vector<png_byte> texels(row_bytes * height);
-    for (size_t i = 0; i < texels.size(); ++i) {
-        const bool alpha = channels == 4 && i % 4 == 3;
-        texels[i] = alpha ? unit_to_byte(static_cast<double>(pixels[i])) : linear_to_srgb8(pixels[i]);
-    }
-    std::vector<png_bytep> rows(height);
-    for (size_t y = 0; y < height; ++y) rows[y] = texels.data() + y * row_bytes;
-
-    std::vector<std::byte> bytes;
-    PngSink sink{&bytes};
-    PngErrorText error;
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_on_error, png_on_warning);
-    if (png == nullptr) return Error{ErrorCode::io, "libpng: cannot create a PNG writer"};
-    png_infop info = png_create_info_struct(png);
-    if (info == nullptr) {
-        png_destroy_write_struct(&png, nullptr);
-        return Error{ErrorCode::io, "libpng: cannot create a PNG writer"};
-    }
-    png_set_write_fn(png, &sink, png_write_bytes, png_flush_bytes);
-    const bool written = png_write_rows(png, info, width, height,
-                                        channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, rows.data());
-    png_destroy_write_struct(&png, &info);
-    if (!written) return Error{ErrorCode::io, std::string("libpng: ") + error.text};
-    if (sink.out_of_memory) return Error{ErrorCode::io, "libpng: out of memory while encoding"};
-    return bytes;
+    Result<PngRowEncoder> encoder = PngRowEncoder::create(width, height, channels);
+    if (!encoder) return encoder.error();
+    if (Status status = encoder->add_rows(pixels); !status) return status.error();
+    return encoder->finish();
 }
 
 Status write_png_srgb8(const std::filesystem::path& path, uint32_t width, uint32_t height, uint32_t channels,
@@ -191,16 +265,24 @@ Status write_png_srgb8(const std::filesystem::path& path, uint32_t width, uint32
     return write_file_atomically(path, *bytes);
 }
 
+std::string pfm_header(uint32_t width, uint32_t height) {
+    return "PF\n" + std::to_string(width) + " " + std::to_string(height) + "\n-1.0\n";
+}
+
+void append_pfm_rows(std::vector<std::byte>& out, uint32_t width, std::span<const float> rgb) {
+    const size_t row_floats = size_t{width} * 3;
+    if (row_floats == 0) return;
+    out.reserve(out.size() + rgb.size() * 4);
+    for (size_t row = rgb.size() / row_floats; row-- > 0;) {
+        for (const float value : rgb.subspan(row * row_floats, row_floats)) append_float_le(out, value);
+    }
+}
+
 Result<std::vector<std::byte>> encode_pfm(uint32_t width, uint32_t height, std::span<const float> rgb) {
     if (Status status = check_image(width, height, 3, rgb.size()); !status) return status.error();
     std::vector<std::byte> bytes;
-    const std::string header = "PF\n" + std::to_string(width) + " " + std::to_string(height) + "\n-1.0\n";
-    bytes.reserve(header.size() + rgb.size() * 4);
-    append_text(bytes, header);
-    const size_t row_floats = size_t{width} * 3;
-    for (size_t row = height; row-- > 0;) {
-        for (const float value : rgb.subspan(row * row_floats, row_floats)) append_float_le(bytes, value);
-    }
+    append_text(bytes, pfm_header(width, height));
+    append_pfm_rows(bytes, width, rgb);
     return bytes;
 }
 

@@ -10,7 +10,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace crisp {
@@ -36,6 +38,34 @@ uint8_t linear_to_srgb8(float linear);
 Result<std::vector<std::byte>> encode_png_srgb8(uint32_t width, uint32_t height, uint32_t channels,
                                                 std::span<const float> pixels);
 
+// The same PNG as encode_png_srgb8(), encoded a few rows at a time, so that a large image is never
+// held whole: only its compressed bytes are (crisp-render composites its canvas in bands).
+class PngRowEncoder {
+public:
+    // Errors as encode_png_srgb8()'s for the size and channels.
+    static Result<PngRowEncoder> create(uint32_t width, uint32_t height, uint32_t channels);
+
+    PngRowEncoder(PngRowEncoder&&) noexcept;
+    PngRowEncoder& operator=(PngRowEncoder&&) noexcept;
+    ~PngRowEncoder();
+
+    // Encodes the next rows: whole rows of width * channels floats, top row first, as
+    // encode_png_srgb8() takes them. Errors: ErrorCode::invalid_argument for floats that are not
+    // whole rows or more rows than are left (nothing encoded); ErrorCode::io when libpng fails,
+    // after which every call fails.
+    Status add_rows(std::span<const float> pixels);
+
+    // The file's bytes, once all rows are added. Errors: ErrorCode::invalid_argument while rows are
+    // missing (the encoder stays usable) or after a failure or an earlier finish(); ErrorCode::io
+    // when libpng fails.
+    Result<std::vector<std::byte>> finish();
+
+private:
+    struct State;
+    explicit PngRowEncoder(std::unique_ptr<State> state);
+    std::unique_ptr<State> state_;
+};
+
 // encode_png_srgb8(), then write_file_atomically(path). Same errors; writing errors are
 // ErrorCode::io naming the path.
 Status write_png_srgb8(const std::filesystem::path& path, uint32_t width, uint32_t height, uint32_t channels,
@@ -54,6 +84,11 @@ struct PfmImage {
 // BOTTOM to the top, each pixel 3 little-endian IEEE-754 float32. Values are written as they are
 // (NaN and infinities included). Errors as encode_png_srgb8().
 Result<std::vector<std::byte>> encode_pfm(uint32_t width, uint32_t height, std::span<const float> rgb);
+// For a writer that streams a PFM too large to hold: the header encode_pfm() writes, and `rgb`'s
+// rows (whole rows of width * 3 floats, top row first) as the file stores them, bottom row first.
+// The rows of the whole image then follow the header from the bottom band up.
+std::string pfm_header(uint32_t width, uint32_t height);
+void append_pfm_rows(std::vector<std::byte>& out, uint32_t width, std::span<const float> rgb);
 Status write_pfm(const std::filesystem::path& path, uint32_t width, uint32_t height, std::span<const float> rgb);
 
 // Reads a PFM file: "PF" (colour) or "Pf" (grey, expanded to equal RGB), either byte order (the

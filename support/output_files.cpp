@@ -35,7 +35,14 @@ Status OutputFiles::add_input(std::filesystem::path path) {
 Status OutputFiles::write(std::span<const std::span<const std::byte>> contents) const {
     assert(contents.size() == paths_.size());
     std::vector<OutputFile> files;
-    for (size_t i = 0; i < paths_.size() && i < contents.size(); ++i) files.push_back({paths_[i], contents[i]});
+    for (size_t i = 0; i < paths_.size() && i < contents.size(); ++i) files.push_back({paths_[i], contents[i], {}});
+    return write_files_atomically(files);
+}
+
+Status OutputFiles::write_streamed(std::span<const OutputWriter> writers) const {
+    assert(writers.size() == paths_.size());
+    std::vector<OutputFile> files;
+    for (size_t i = 0; i < paths_.size() && i < writers.size(); ++i) files.push_back({paths_[i], {}, writers[i]});
     return write_files_atomically(files);
 }
 

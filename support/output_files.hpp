@@ -6,10 +6,15 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <vector>
 
 namespace crisp {
+
+// Writes an output in pieces, each through `put` (which appends it and returns the write's error,
+// to be passed on). The type src/core/file_io.hpp's writes take (that header is the library's own).
+using OutputWriter = std::function<Status(const std::function<Status(std::span<const std::byte> piece)>& put)>;
 
 class OutputFiles {
 public:
@@ -30,6 +35,10 @@ public:
     // into place (write_files_atomically()); on failure (ErrorCode::io, naming the path) every
     // existing output is kept. `contents` has one entry per output added.
     Status write(std::span<const std::span<const std::byte>> contents) const;
+
+    // As write(), each output's bytes written in pieces by `writers[i]` (an output too large to
+    // hold whole); a writer's error fails the write as a write error does, every output kept.
+    Status write_streamed(std::span<const OutputWriter> writers) const;
 
 private:
     std::vector<std::filesystem::path> inputs_;

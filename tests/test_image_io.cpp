@@ -180,6 +180,29 @@ TEST(ImageIo, PngRgbReadsBackAsSrgbWithItsChunks) {
     EXPECT_EQ(file.pixels.back(), 255);
 }
 
+// Rows added a few at a time make the file encode_png_srgb8() makes from all of them; whole rows
+// only, no more than the image has, and finish() only once all are in.
+TEST(ImageIo, PngRowsInPiecesMakeTheSameFile) {
+    constexpr uint32_t kWidth = 7, kHeight = 5;
+    const std::vector<float> pixels = gradient(kWidth, kHeight, 4);
+    Result<std::vector<std::byte>> whole = encode_png_srgb8(kWidth, kHeight, 4, pixels);
+    ASSERT_TRUE(whole.ok()) << whole.error().message;
+    Result<PngRowEncoder> encoder = PngRowEncoder::create(kWidth, kHeight, 4);
+    ASSERT_TRUE(encoder.ok()) << encoder.error().message;
+    const size_t row = size_t{kWidth} * 4;
+    EXPECT_FALSE(encoder->add_rows(std::span(pixels).first(row + 1))) << "not whole rows";
+    ASSERT_TRUE(encoder->add_rows(std::span(pixels).first(2 * row)));
+    EXPECT_FALSE(encoder->finish()) << "three rows missing";
+    EXPECT_FALSE(encoder->add_rows(pixels)) << "more rows than are left";
+    ASSERT_TRUE(encoder->add_rows(std::span(pixels).subspan(2 * row)));
+    Result<std::vector<std::byte>> pieces = encoder->finish();
+    ASSERT_TRUE(pieces.ok()) << pieces.error().message;
+    EXPECT_EQ(*pieces, *whole);
+    EXPECT_FALSE(encoder->finish()) << "finished once";
+    EXPECT_FALSE(PngRowEncoder::create(kWidth, kHeight, 2)) << "2 channels";
+    EXPECT_FALSE(PngRowEncoder::create(0, kHeight, 3)) << "no width";
+}
+
 TEST(ImageIo, PngRgbaStoresStraightAlphaLinearly) {
     // One pixel: linear 0.5 grey at alpha 0.5; then opaque black; then transparent.
     const std::vector<float> pixels = {0.5f, 0.5f, 0.5f, 0.5f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f, 1.0f, 0.0f};

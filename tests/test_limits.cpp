@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <future>
 #include <string>
 #include <utility>
@@ -192,6 +193,33 @@ TEST(Limits, LongClustersOfMarksAreShapedInRunsOfBoundedLength) {
     EXPECT_EQ(few->mark_splits, 0u);
 }
 
+// An output written in pieces (crisp-render's coverage PFM, band by band) lands whole, and a writer
+// that fails part way replaces nothing and leaves no temporary.
+TEST(Limits, OutputsWrittenInPiecesLandWholeOrNotAtAll) {
+    TemporaryDirectory directory;
+    const fs::path out = directory.path() / "out.pfm";
+    ASSERT_TRUE(write_file_atomically(out, bytes_of("old")));
+    auto pieces = [](int count, bool fail_after) -> OutputWriter {
+        return [=](const std::function<Status(std::span<const std::byte>)>& put) -> Status {
+            for (int i = 0; i < count; ++i) {
+                const std::vector<std::byte> piece = bytes_of("piece" + std::to_string(i) + ";");
+                if (Status s = put(piece); !s) return s;
+            }
+            if (fail_after) return Error{ErrorCode::io, "the writer failed"};
+            return {};
+        };
+    };
+    const OutputFile failing[] = {{out, {}, pieces(3, true)}};
+    const Status failed = write_files_atomically(failing);
+    ASSERT_FALSE(failed);
+    EXPECT_NE(failed.error().message.find("the writer failed"), std::string::npos) << failed.error().message;
+    EXPECT_EQ(test::read_file(out.string()), bytes_of("old"));
+    EXPECT_EQ(directory.entries(), std::vector<std::string>{"out.pfm"});
+    const OutputFile written[] = {{out, {}, pieces(3, false)}};
+    ASSERT_TRUE(write_files_atomically(written));
+    EXPECT_EQ(test::read_file(out.string()), bytes_of("piece0;piece1;piece2;"));
+}
+
 // A run's outputs are put in place together: when one cannot be written, none is replaced, and no
 // temporary is left; no file is ever removed for its name (a killed writer's temporaries stay).
 TEST(Limits, OutputsAreReplacedTogetherOrNotAtAll) {
@@ -200,11 +228,11 @@ TEST(Limits, OutputsAreReplacedTogetherOrNotAtAll) {
     const fs::path pfm = directory.path() / "out.pfm";
     ASSERT_TRUE(write_file_atomically(png, bytes_of("old png")));
     const std::vector<std::byte> new_png = bytes_of("new png"), new_pfm = bytes_of("new pfm");
-    const OutputFile refused[] = {{png, new_png}, {directory.path() / "missing" / "out.pfm", new_pfm}};
+    const OutputFile refused[] = {{png, new_png, {}}, {directory.path() / "missing" / "out.pfm", new_pfm, {}}};
     EXPECT_FALSE(write_files_atomically(refused));
     EXPECT_EQ(test::read_file(png.string()), bytes_of("old png"));
     EXPECT_EQ(directory.entries(), std::vector<std::string>{"out.png"});
-    const OutputFile both[] = {{png, new_png}, {pfm, new_pfm}};
+    const OutputFile both[] = {{png, new_png, {}}, {pfm, new_pfm, {}}};
     ASSERT_TRUE(write_files_atomically(both));
     EXPECT_EQ(test::read_file(png.string()), new_png);
     EXPECT_EQ(test::read_file(pfm.string()), new_pfm);

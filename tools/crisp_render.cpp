@@ -72,6 +72,10 @@ constexpr double kMaxMaxSeconds = 86400.0;
 constexpr uint32_t kMinAtlasSide = 256;
 constexpr uint32_t kAtlasTexelBytes = 8;    // R16G16B16A16_UINT
 constexpr uint32_t kTargetTexelBytes = 16;  // the compositor's R32G32B32A32_SFLOAT
+// The canvas is composited in bands of at most this many bytes of target, whole tiles' rows each
+// (see "Compositing in bands").
+constexpr uint64_t kBandBytes = uint64_t{32} << 20;
+constexpr uint32_t kBandRowStep = 16;
 
 constexpr const char* kSynopsis = R"(usage: crisp-render --font A.crisp [--font B.crisp ...] --text UTF8 --size PX
                     --origin X,Y --canvas W,H -o OUT.png [options]
@@ -130,6 +134,7 @@ struct Arguments {
     bool contrast_given = false;   // some contrast option was given: a layout file's settings yield
     std::string output;
     std::string coverage_output;
+    std::optional<uint32_t> band_rows;  // rows composited at once; not given: as many as kBandBytes hold
     bool json = false;
     bool quiet = false;
 #ifdef NDEBUG
@@ -386,6 +391,10 @@ void declare_render_options(crisp::cli::CommandLine& cli, Arguments& args) {
                        "(0..86400, default 30; 0: no limit) and write the text as it is then,\n"
                        "partly converged, with a warning (exit 0)",
                        args.max_seconds, {0.0, kMaxMaxSeconds});
+    cli.number<uint32_t>("--band-rows", "N",
+                         "composite the canvas N rows at a time, N a multiple of 16 (default:\n"
+                         "as many as 32 MiB of 16-byte pixels hold; the image is the same)",
+                         args.band_rows, {16, 16384});
     cli.number<uint32_t>("--max-frames", "N",
                          "stop rendering after N frames (1..100000) the same way, if the text\n"
                          "has not converged by then",
@@ -543,6 +552,9 @@ Arguments parse_arguments(int argc, char** argv) {
             "--path applies to --composite wboit and exact only (tiled always computes; draw and unsorted "
             "are always rasterized)");
     }
+    if (args.band_rows && *args.band_rows % kBandRowStep != 0) {
+        cli.fail("--band-rows is a multiple of 16 (the compositors' tiles), not " + std::to_string(*args.band_rows));
+    }
     if (args.backdrop != "flat" && args.composite != crisp::CompositeMode::tiled &&
         args.composite != crisp::CompositeMode::draw) {
         cli.fail(
@@ -664,8 +676,11 @@ struct CompositeReport {
     crisp::CompositorStats stats;  // the image's frame; its measurements are the first frame's
     std::vector<std::string> warnings;
     bool storage_without_format = false;  // the device's, as the context enabled it
-    std::vector<double> frame_ms;         // CPU wall time of each composite frame: record, submit and wait
-    std::vector<float> target;            // premultiplied linear RGBA, top row first
+    // CPU wall time of each composite frame (record, submit and wait), over all the canvas's bands.
+    std::vector<double> frame_ms;
+    uint32_t bands = 0;          // the canvas's bands, each composited apart (see kBandBytes)
+    uint32_t band_rows = 0;      // rows of each band but the last
+    std::vector<std::byte> png;  // the image, encoded band by band
 };
 
 struct RenderReport {
@@ -702,7 +717,8 @@ int run_composite_frame(crisp::HeadlessContext& context, int frame, CompositeRep
     crisp::Status recorded;
     const crisp::Status submitted =
         context.submit_and_wait([&](VkCommandBuffer command_buffer) { recorded = record(command_buffer); });
-    out.frame_ms.push_back(milliseconds_since(frame_start));
+    if (out.frame_ms.size() < static_cast<size_t>(frame)) out.frame_ms.resize(static_cast<size_t>(frame), 0.0);
+    out.frame_ms[static_cast<size_t>(frame) - 1] += milliseconds_since(frame_start);
     for (const crisp::Status& status : {std::cref(recorded), std::cref(submitted)}) {
         if (!status) {
             std::fprintf(stderr, "crisp-render: composite frame %d: %s\n", frame, status.error().message.c_str());
@@ -712,16 +728,16 @@ int run_composite_frame(crisp::HeadlessContext& context, int frame, CompositeRep
     return kExitOk;
 }
 
-// What the text is drawn over (--backdrop), premultiplied linear RGBA, top row first: the scene's
-// background colour, a ramp from it to its complement with soft diagonal stripes, or smooth colour
-// fields with fine detail, as a photograph has.
-std::vector<float> backdrop_pixels(const std::string& kind, uint32_t width, uint32_t height,
+// What the text is drawn over (--backdrop), premultiplied linear RGBA, top row first, for the
+// canvas's rows [y0, y0 + rows) of `height`: the scene's background colour, a ramp from it to its
+// complement with soft diagonal stripes, or smooth colour fields with fine detail, as a photograph has.
+std::vector<float> backdrop_pixels(const std::string& kind, uint32_t width, uint32_t height, uint32_t y0, uint32_t rows,
                                    const float (&background)[4]) {
     std::array<float, 3> base{};
     for (size_t c = 0; c < 3; ++c) base[c] = crisp::srgb_to_linear(background[c]);
     const float alpha = background[3];
-    std::vector<float> pixels(size_t{width} * height * 4);
-    for (uint32_t y = 0; y < height; ++y) {
+    std::vector<float> pixels(size_t{width} * rows * 4);
+    for (uint32_t y = y0; y < y0 + rows; ++y) {
         for (uint32_t x = 0; x < width; ++x) {
             const float u = width > 1 ? static_cast<float>(x) / static_cast<float>(width - 1) : 0.0f;
             const float v = height > 1 ? static_cast<float>(y) / static_cast<float>(height - 1) : 0.0f;
@@ -746,7 +762,7 @@ std::vector<float> backdrop_pixels(const std::string& kind, uint32_t width, uint
                     0.04f * std::sin(static_cast<float>(x) * 1.7f) * std::sin(static_cast<float>(y) * 2.3f);
                 for (float& c : colour) c = std::clamp(c + grain, 0.0f, 1.0f);
             }
-            float* p = &pixels[(size_t{y} * width + x) * 4];
+            float* p = &pixels[(size_t{y - y0} * width + x) * 4];
             for (size_t c = 0; c < 3; ++c) p[c] = colour[c] * alpha;
             p[3] = alpha;
         }
@@ -756,8 +772,8 @@ std::vector<float> backdrop_pixels(const std::string& kind, uint32_t width, uint
 
 // Paints the decorations over the backdrop (premultiplied linear RGBA), each pixel by the area of
 // it the rectangle covers: exactly for an untransformed run's, by 8 x 8 samples for a transformed
-// one's (its rectangle mapped about the run's origin).
-void paint_decorations(std::vector<float>& pixels, uint32_t width, uint32_t height,
+// one's (its rectangle mapped about the run's origin). `pixels` are the canvas's rows [y0, y0 + rows).
+void paint_decorations(std::vector<float>& pixels, uint32_t width, uint32_t first_row, uint32_t rows,
                        std::span<const Job::Decoration> decorations) {
     for (const Job::Decoration& decoration : decorations) {
         const crisp::TextDecoration& r = decoration.rect;
@@ -781,7 +797,9 @@ void paint_decorations(std::vector<float>& pixels, uint32_t width, uint32_t heig
             bottom = std::max(bottom, y);
         }
         const auto clamp_x = [&](double v) { return static_cast<int64_t>(std::clamp(v, 0.0, double(width))); };
-        const auto clamp_y = [&](double v) { return static_cast<int64_t>(std::clamp(v, 0.0, double(height))); };
+        const auto clamp_y = [&](double v) {
+            return static_cast<int64_t>(std::clamp(v, double(first_row), double(uint64_t{first_row} + rows)));
+        };
         const int64_t px0 = clamp_x(std::floor(left)), px1 = clamp_x(std::ceil(right));
         const int64_t py0 = clamp_y(std::floor(top)), py1 = clamp_y(std::ceil(bottom));
         double inverse[4] = {1.0, 0.0, 0.0, 1.0};
@@ -815,7 +833,7 @@ void paint_decorations(std::vector<float>& pixels, uint32_t width, uint32_t heig
                     }
                 }
                 if (cover <= 0.0) continue;
-                float* p = &pixels[(static_cast<size_t>(py) * width + static_cast<size_t>(px)) * 4];
+                float* p = &pixels[(static_cast<size_t>(py - first_row) * width + static_cast<size_t>(px)) * 4];
                 const double a = alpha * cover;
                 for (int ch = 0; ch < 3; ++ch)
                     p[ch] = static_cast<float>(static_cast<double>(r.color[ch]) * a +
@@ -826,16 +844,164 @@ void paint_decorations(std::vector<float>& pixels, uint32_t width, uint32_t heig
     }
 }
 
-// The tile or draw path: the backdrop is uploaded into an R32G32B32A32_SFLOAT canvas image and the
-// glyphs composited into it, twice from the same backdrop (the first frame's tile counts arrive
-// with the second; once when the first ends past --max-seconds), then read back into
-// report.composite.target.
+// ---- Compositing in bands
+
+// crisp-render composites the canvas in bands of whole rows, each band's R32G32B32A32 image at most
+// kBandBytes, one band after another through the same compositor, so that its memory follows the
+// text rather than the canvas: a band's image, its backdrop, the upload and the readback are
+// band-sized, and the PNG is encoded band by band (only its compressed bytes are held whole). A
+// band is a whole number of the compositors' tiles (16 rows: the tile path's, twice the reference
+// compute path's), so each pixel is composited from the same glyphs in the same tile as on a whole
+// canvas; and the glyphs reaching a band move up by whole pixels, keeping their subpixel phase.
+
+struct Band {
+    uint32_t y0 = 0;
+    uint32_t rows = 0;
+};
+
+std::vector<Band> canvas_bands(const Arguments& args, uint32_t width, uint32_t height) {
+    const uint64_t fit = kBandBytes / (uint64_t{width} * kTargetTexelBytes) / kBandRowStep * kBandRowStep;
+    const auto rows = static_cast<uint32_t>(std::min<uint64_t>(
+        args.band_rows.value_or(static_cast<uint32_t>(std::max<uint64_t>(fit, kBandRowStep))), height));
+    std::vector<Band> bands;
+    for (uint32_t y0 = 0; y0 < height; y0 += rows) bands.push_back({y0, std::min(rows, height - y0)});
+    return bands;
+}
+
+// For each band of `rows` rows (the last may be shorter), the glyphs whose rects reach it.
+std::vector<std::vector<uint32_t>> glyphs_by_band(std::span<const crisp::DrawnGlyph> glyphs, uint32_t rows,
+                                                  size_t bands) {
+    std::vector<std::vector<uint32_t>> members(bands);
+    for (size_t g = 0; g < glyphs.size(); ++g) {
+        const crisp::GlyphInstance& instance = glyphs[g].instance;
+        const int64_t bottom = int64_t{instance.y} + instance.height;  // exclusive
+        if (instance.width == 0 || instance.height == 0 || bottom <= 0) continue;
+        const int64_t top = std::max<int64_t>(instance.y, 0);
+        const auto last = std::min<int64_t>((bottom - 1) / rows, static_cast<int64_t>(bands) - 1);
+        for (int64_t b = top / rows; b <= last; ++b)
+            members[static_cast<size_t>(b)].push_back(static_cast<uint32_t>(g));
+    }
+    return members;
+}
+
+// The renderer's frame as one band sees it: the glyphs that reach its rows, moved up by its first
+// row, with the paints that follow them (their maps from target pixels and their clips moved too).
+// The whole canvas's frame where the band is the canvas.
+class BandFrames {
+public:
+    BandFrames(const crisp::DrawnFrame& frame, std::span<const Band> bands) : frame_(frame) {
+        if (bands.size() > 1) members_ = glyphs_by_band(frame.glyphs, bands[0].rows, bands.size());
+    }
+
+    crisp::DrawnFrame of(size_t band, const Band& rows) {
+        if (members_.empty()) return frame_;
+        const auto dy = static_cast<float>(rows.y0);
+        glyphs_.clear();
+        for (const uint32_t g : members_[band]) {
+            crisp::DrawnGlyph glyph = frame_.glyphs[g];
+            glyph.instance.y -= static_cast<int32_t>(rows.y0);
+            glyph.instance.pen_y -= dy;
+            glyphs_.push_back(glyph);
+        }
+        paints_.assign(frame_.paints.begin(), frame_.paints.end());
+        for (crisp::FramePaint& paint : paints_) {
+            // q = M (x, y + y0) + t: the translation takes M's y column times y0.
+            paint.to_paint[2] += paint.to_paint[1] * dy;
+            paint.to_paint[5] += paint.to_paint[4] * dy;
+            paint.clip[1] -= dy;
+            paint.clip[3] -= dy;
+        }
+        crisp::DrawnFrame frame = frame_.with_glyphs(glyphs_);
+        frame.paints = paints_;
+        return frame;
+    }
+
+private:
+    crisp::DrawnFrame frame_;
+    std::vector<std::vector<uint32_t>> members_;  // per band, the glyphs reaching it; empty: one band
+    std::vector<crisp::DrawnGlyph> glyphs_;
+    std::vector<crisp::FramePaint> paints_;
+};
+
+// A band's compositor statistics added to the canvas's: counts summed (a glyph reaching two bands
+// is two quads), the most overlap the most of any band, measured where every band was.
+void add_band_stats(crisp::CompositorStats& total, const crisp::CompositorStats& band, bool first) {
+    if (first) {
+        total = band;
+        return;
+    }
+    total.tiles += band.tiles;
+    total.bins_reused = total.bins_reused && band.bins_reused;
+    total.tile_batches += band.tile_batches;
+    total.quads += band.quads;
+    total.buffer_bytes = std::max(total.buffer_bytes, band.buffer_bytes);
+    total.measured = total.measured && band.measured;
+    total.max_overlap = std::max(total.max_overlap, band.max_overlap);
+    total.tail_pixels += band.tail_pixels;
+    total.exact_lost_nodes += band.exact_lost_nodes;
+    total.exact_dropped += band.exact_dropped;
+    total.busy_tiles += band.busy_tiles;
+    total.exact_tiles += band.exact_tiles;
+    total.layered_tiles += band.layered_tiles;
+    total.tile_pairs += band.tile_pairs;
+}
+
+// Encodes each band's premultiplied RGBA as the PNG's rows: RGB over an opaque background (alpha is
+// 1 everywhere, so the colour is as it is), else RGBA with the colour divided by alpha.
+crisp::Status add_png_rows(crisp::PngRowEncoder& png, std::span<const float> rgba, bool opaque) {
+    const size_t pixels = rgba.size() / 4;
+    const size_t channels = opaque ? 3 : 4;
+    std::vector<float> out(pixels * channels);
+    for (size_t p = 0; p < pixels; ++p) {
+        const float* source = &rgba[p * 4];
+        float* pixel = &out[p * channels];
+        if (opaque) {
+            std::copy(source, source + 3, pixel);
+            continue;
+        }
+        const float alpha = source[3];
+        for (size_t c = 0; c < 3; ++c) pixel[c] = alpha > 0.0f ? source[c] / alpha : 0.0f;
+        pixel[3] = alpha;
+    }
+    return png.add_rows(out);
+}
+
+// What every band's compositing shares: the bands, their frames, the PNG they go into.
+struct BandedImage {
+    std::vector<Band> bands;
+    BandFrames frames;
+    crisp::PngRowEncoder png;
+    bool opaque = true;
+};
+
+crisp::Result<BandedImage> banded_image(const Arguments& args, const Job& job, const crisp::Renderer& renderer,
+                                        CompositeReport& out) {
+    const uint32_t width = job.scene.width, height = job.scene.height;
+    const bool opaque = job.scene.background[3] >= 1.0f;
+    std::vector<Band> bands = canvas_bands(args, width, height);
+    crisp::Result<crisp::PngRowEncoder> png = crisp::PngRowEncoder::create(width, height, opaque ? 3 : 4);
+    if (!png) return png.error();
+    out.bands = static_cast<uint32_t>(bands.size());
+    out.band_rows = bands.front().rows;
+    BandFrames frames(renderer.drawn_frame(), bands);
+    return BandedImage{std::move(bands), std::move(frames), std::move(*png), opaque};
+}
+
+int png_failed(const crisp::Error& error) {
+    std::fprintf(stderr, "crisp-render: encoding the PNG: %s\n", error.message.c_str());
+    return error.code == crisp::ErrorCode::io ? kExitOutput : kExitInternal;
+}
+
+// The tile or draw path: each band's backdrop is uploaded into an R32G32B32A32_SFLOAT image of the
+// band and the band's glyphs composited into it, twice from the same backdrop (the first frame's
+// tile counts arrive with the second; once when the first ends past --max-seconds), then read back
+// into the PNG.
 int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer& renderer, const Arguments& args,
                          const Job& job, const RunClock& clock, RenderReport& report) {
     CompositeReport& out = report.composite;
     const bool draw = args.composite == crisp::CompositeMode::draw;
     constexpr VkFormat kFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
-    const uint32_t width = job.scene.width, height = job.scene.height;
+    const uint32_t width = job.scene.width;
     crisp::CompositorCreateInfo info = crisp::compositor_create_info(context);
     info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
     if (draw) info.draw_format = kFormat;
@@ -846,56 +1012,75 @@ int composite_into_image(crisp::HeadlessContext& context, const crisp::Renderer&
     }
     crisp::Compositor& compositor = *created;
     out.warnings = compositor.warnings();
+    crisp::Result<BandedImage> banded = banded_image(args, job, renderer, out);
+    if (!banded) return png_failed(banded.error());
     const VkImageUsageFlags usage = (draw ? VkImageUsageFlags{VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT}
                                           : VkImageUsageFlags{VK_IMAGE_USAGE_STORAGE_BIT}) |
                                     VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    crisp::Result<crisp::Image> image = context.create_image({kFormat, width, height, usage});
+    crisp::Result<crisp::Image> image = context.create_image({kFormat, width, banded->bands.front().rows, usage});
     if (!image) {
         std::fprintf(stderr, "crisp-render: cannot make the canvas image: %s\n", image.error().message.c_str());
         return exit_code_for_vulkan(image.error());
     }
-    std::vector<float> backdrop = backdrop_pixels(args.backdrop, width, height, job.scene.background);
-    paint_decorations(backdrop, width, height, job.decorations);
-    const std::span<const std::byte> backdrop_bytes = std::as_bytes(std::span(backdrop));
-    const VkRect2D rect{{0, 0}, {width, height}};
-    constexpr int kCompositeFrames = 2;
-    for (int frame = 1; frame <= kCompositeFrames; ++frame) {
-        if (crisp::Status s = context.upload(*image, backdrop_bytes, VK_IMAGE_LAYOUT_GENERAL); !s) {
-            std::fprintf(stderr, "crisp-render: cannot upload the backdrop: %s\n", s.error().message.c_str());
-            return exit_code_for_vulkan(s.error());
-        }
-        const int code = run_composite_frame(context, frame, out, [&](VkCommandBuffer command_buffer) {
-            if (!draw) {
-                const crisp::CompositeTarget target{image->view(), kFormat, VK_FORMAT_UNDEFINED, {width, height}, rect};
-                return compositor.record(command_buffer, renderer.drawn_frame(), target);
+    bool past_limit = false;
+    for (size_t b = 0; b < banded->bands.size(); ++b) {
+        const Band& band = banded->bands[b];
+        if (band.rows != banded->bands.front().rows) {  // the last band, shorter
+            image = context.create_image({kFormat, width, band.rows, usage});
+            if (!image) {
+                std::fprintf(stderr, "crisp-render: cannot make the canvas image: %s\n", image.error().message.c_str());
+                return exit_code_for_vulkan(image.error());
             }
-            crisp::tools::begin_rendering_over(command_buffer, image->view(), rect);
-            crisp::Status recorded = compositor.record_draw(command_buffer, renderer.drawn_frame(), rect);
-            vkCmdEndRendering(command_buffer);
-            return recorded;
-        });
-        if (code != kExitOk) return code;
-        if (clock.past_limit()) break;  // the first frame's image is the same, without measurements
+        }
+        std::vector<float> backdrop =
+            backdrop_pixels(args.backdrop, width, job.scene.height, band.y0, band.rows, job.scene.background);
+        paint_decorations(backdrop, width, band.y0, band.rows, job.decorations);
+        const crisp::DrawnFrame frame = banded->frames.of(b, band);
+        const VkRect2D rect{{0, 0}, {width, band.rows}};
+        constexpr int kCompositeFrames = 2;
+        for (int composite_frame = 1; composite_frame <= kCompositeFrames; ++composite_frame) {
+            if (crisp::Status s = context.upload(*image, std::as_bytes(std::span(backdrop)), VK_IMAGE_LAYOUT_GENERAL);
+                !s) {
+                std::fprintf(stderr, "crisp-render: cannot upload the backdrop: %s\n", s.error().message.c_str());
+                return exit_code_for_vulkan(s.error());
+            }
+            const int code = run_composite_frame(context, composite_frame, out, [&](VkCommandBuffer command_buffer) {
+                if (!draw) {
+                    const crisp::CompositeTarget target{
+                        image->view(), kFormat, VK_FORMAT_UNDEFINED, {width, band.rows}, rect};
+                    return compositor.record(command_buffer, frame, target);
+                }
+                crisp::tools::begin_rendering_over(command_buffer, image->view(), rect);
+                crisp::Status recorded = compositor.record_draw(command_buffer, frame, rect);
+                vkCmdEndRendering(command_buffer);
+                return recorded;
+            });
+            if (code != kExitOk) return code;
+            // The first frame's image is the same, without measurements; the bands after it too.
+            past_limit = past_limit || clock.past_limit();
+            if (past_limit) break;
+        }
+        add_band_stats(out.stats, compositor.stats(), b == 0);
+        std::vector<float>().swap(backdrop);
+        crisp::Result<std::vector<std::byte>> bytes = context.read_image(*image, VK_IMAGE_LAYOUT_GENERAL);
+        if (!bytes) {
+            std::fprintf(stderr, "crisp-render: cannot read the canvas back: %s\n", bytes.error().message.c_str());
+            return exit_code_for_vulkan(bytes.error());
+        }
+        std::vector<float> rgba(bytes->size() / sizeof(float));
+        std::memcpy(rgba.data(), bytes->data(), rgba.size() * sizeof(float));
+        if (crisp::Status s = add_png_rows(banded->png, rgba, banded->opaque); !s) return png_failed(s.error());
     }
-    out.stats = compositor.stats();
-    // A canvas is 16 bytes a pixel in each of these (4 GiB at 16384 x 16384): each goes once the
-    // next no longer needs it, so that at most two are held at once after the uploads.
-    std::vector<float>().swap(backdrop);
-    crisp::Result<std::vector<std::byte>> bytes = context.read_image(*image, VK_IMAGE_LAYOUT_GENERAL);
-    if (!bytes) {
-        std::fprintf(stderr, "crisp-render: cannot read the canvas back: %s\n", bytes.error().message.c_str());
-        return exit_code_for_vulkan(bytes.error());
-    }
-    *image = crisp::Image{};
-    out.target.resize(size_t{width} * height * 4);
-    std::memcpy(out.target.data(), bytes->data(), out.target.size() * sizeof(float));
+    crisp::Result<std::vector<std::byte>> png = banded->png.finish();
+    if (!png) return png_failed(png.error());
+    out.png = std::move(*png);
     return kExitOk;
 }
 
-// Composites the renderer's last frame twice, the same glyphs both times: the first frame
+// Composites the renderer's last frame twice a band, the same glyphs both times: the first frame
 // measures the overlap (what the report gives; measurements arrive one frame later), the second
-// is the image, read back into report.composite.target. A first frame that ends past
-// --max-seconds is the image, and nothing is measured.
+// is the image, read back into the PNG. A first frame that ends past --max-seconds is the image,
+// and nothing is measured (nor in the bands after it).
 int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, const Arguments& args, const Job& job,
               const RunClock& clock, RenderReport& report) {
     CompositeReport& out = report.composite;
@@ -909,48 +1094,71 @@ int composite(crisp::HeadlessContext& context, const crisp::Renderer& renderer, 
                                " underlines and strikethroughs are not drawn: the reference modes draw over a flat "
                                "background (--composite tiled and draw draw them)");
     }
-    crisp::CompositorCreateInfo info = crisp::compositor_create_info(context);
-    info.width = job.scene.width;
-    info.height = job.scene.height;
-    info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
-    info.reference_modes = true;
-    if (args.composite != crisp::CompositeMode::exact) info.exact_nodes_per_pixel = 0;  // no node pool
-    crisp::Result<crisp::Compositor> created = crisp::Compositor::create(info);
-    if (!created) {
-        std::fprintf(stderr, "crisp-render: cannot create the compositor: %s\n", created.error().message.c_str());
-        return exit_code_for_vulkan(created.error());
-    }
-    crisp::Compositor& compositor = *created;
-    for (const std::string& warning : compositor.warnings()) out.warnings.push_back(warning);
-
+    crisp::Result<BandedImage> banded = banded_image(args, job, renderer, out);
+    if (!banded) return png_failed(banded.error());
     crisp::CompositeParams params;
     params.mode = args.composite;
     params.path = args.path;
     for (size_t c = 0; c < 3; ++c) params.background[c] = crisp::srgb_to_linear(job.scene.background[c]);
     params.background[3] = job.scene.background[3];
 
-    const size_t pixels = size_t{job.scene.width} * job.scene.height;
-    crisp::Result<crisp::Buffer> buffer = context.create_buffer(
-        pixels * kTargetTexelBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
-    if (!buffer) {
-        std::fprintf(stderr, "crisp-render: cannot make the image's readback buffer: %s\n",
-                     buffer.error().message.c_str());
-        return exit_code_for_vulkan(buffer.error());
+    // The reference modes' target and per-pixel buffers are the compositor's, made for its size: one
+    // compositor for the bands of equal height, another for a shorter last band.
+    std::optional<crisp::Compositor> compositor;
+    uint32_t compositor_rows = 0;
+    bool past_limit = false;
+    for (size_t b = 0; b < banded->bands.size(); ++b) {
+        const Band& band = banded->bands[b];
+        if (band.rows != compositor_rows) {
+            compositor.reset();
+            crisp::CompositorCreateInfo info = crisp::compositor_create_info(context);
+            info.width = job.scene.width;
+            info.height = band.rows;
+            info.frames_in_flight = 1;  // every frame is waited for, so the next one has its measurements
+            info.reference_modes = true;
+            if (args.composite != crisp::CompositeMode::exact) info.exact_nodes_per_pixel = 0;  // no node pool
+            crisp::Result<crisp::Compositor> created = crisp::Compositor::create(info);
+            if (!created) {
+                std::fprintf(stderr, "crisp-render: cannot create the compositor: %s\n",
+                             created.error().message.c_str());
+                return exit_code_for_vulkan(created.error());
+            }
+            compositor.emplace(std::move(*created));
+            compositor_rows = band.rows;
+            for (const std::string& warning : compositor->warnings()) {
+                if (std::find(out.warnings.begin(), out.warnings.end(), warning) == out.warnings.end())
+                    out.warnings.push_back(warning);
+            }
+        }
+        const size_t pixels = size_t{job.scene.width} * band.rows;
+        crisp::Result<crisp::Buffer> buffer = context.create_buffer(
+            pixels * kTargetTexelBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, crisp::MemoryUsage::readback);
+        if (!buffer) {
+            std::fprintf(stderr, "crisp-render: cannot make the image's readback buffer: %s\n",
+                         buffer.error().message.c_str());
+            return exit_code_for_vulkan(buffer.error());
+        }
+        const crisp::DrawnFrame frame = banded->frames.of(b, band);
+        constexpr int kCompositeFrames = 2;
+        for (int composite_frame = 1; composite_frame <= kCompositeFrames; ++composite_frame) {
+            const int code = run_composite_frame(context, composite_frame, out, [&](VkCommandBuffer command_buffer) {
+                crisp::Status recorded = compositor->record_reference(command_buffer, frame, params);
+                // Every frame's image is read back: the first is the last where it ends past the limit.
+                if (recorded) compositor->record_target_readback(command_buffer, buffer->handle());
+                return recorded;
+            });
+            if (code != kExitOk) return code;
+            past_limit = past_limit || clock.past_limit();
+            if (past_limit) break;
+        }
+        add_band_stats(out.stats, compositor->stats(), b == 0);
+        std::vector<float> rgba(pixels * 4);
+        std::memcpy(rgba.data(), buffer->mapped().data(), pixels * kTargetTexelBytes);
+        if (crisp::Status s = add_png_rows(banded->png, rgba, banded->opaque); !s) return png_failed(s.error());
     }
-    constexpr int kCompositeFrames = 2;
-    for (int frame = 1; frame <= kCompositeFrames; ++frame) {
-        const int code = run_composite_frame(context, frame, out, [&](VkCommandBuffer command_buffer) {
-            crisp::Status recorded = compositor.record_reference(command_buffer, renderer.drawn_frame(), params);
-            // Every frame's image is read back: the first is the last where it ends past the limit.
-            if (recorded) compositor.record_target_readback(command_buffer, buffer->handle());
-            return recorded;
-        });
-        if (code != kExitOk) return code;
-        if (clock.past_limit()) break;
-    }
-    out.stats = compositor.stats();
-    out.target.resize(pixels * 4);
-    std::memcpy(out.target.data(), buffer->mapped().data(), pixels * kTargetTexelBytes);
+    crisp::Result<std::vector<std::byte>> png = banded->png.finish();
+    if (!png) return png_failed(png.error());
+    out.png = std::move(*png);
     return kExitOk;
 }
 
@@ -1108,23 +1316,26 @@ int render(crisp::HeadlessContext& context, const Arguments& args, const Job& jo
 
 // ---- Images
 
-// The text's linear coverage per channel, ignoring colours and alphas: where glyphs overlap,
+// The text's linear coverage per channel, ignoring colours and alphas, of the canvas's rows
+// [band.y0, band.y0 + band.rows), from the glyphs `members` names: where glyphs overlap,
 // 1 - (1 - c1)(1 - c2)...
-std::vector<float> coverage_image(uint32_t width, uint32_t height, const RenderReport& report) {
-    std::vector<float> uncovered(size_t{width} * height * 3, 1.0f);
-    for (size_t g = 0; g < report.drawn.size() && !report.texels.empty(); ++g) {
+std::vector<float> coverage_rows(uint32_t width, const Band& band, const RenderReport& report,
+                                 std::span<const uint32_t> members) {
+    std::vector<float> uncovered(size_t{width} * band.rows * 3, 1.0f);
+    const int64_t top = band.y0, bottom = int64_t{band.y0} + band.rows;
+    for (const uint32_t g : members) {
         const crisp::GlyphInstance& instance = report.drawn[g].instance;
         const uint16_t* texels = report.texels.data() + report.texel_offset[g];
         for (uint32_t j = 0; j < instance.height; ++j) {
             const int64_t y = int64_t{instance.y} + j;
-            if (y < 0 || y >= int64_t{height}) continue;
+            if (y < top || y >= bottom) continue;
             for (uint32_t i = 0; i < instance.width; ++i) {
                 const int64_t x = int64_t{instance.x} + i;
                 if (x < 0 || x >= int64_t{width}) continue;
                 const uint16_t* texel = texels + (size_t{j} * instance.width + i) * 4;
                 if (texel[3] == 0) continue;
                 const float full = static_cast<float>(crisp::kCoverageOne) * static_cast<float>(texel[3]);
-                const size_t p = (static_cast<size_t>(y) * width + static_cast<size_t>(x)) * 3;
+                const size_t p = (static_cast<size_t>(y - top) * width + static_cast<size_t>(x)) * 3;
                 for (size_t c = 0; c < 3; ++c)
                     uncovered[p + c] *= 1.0f - std::min(static_cast<float>(texel[c]) / full, 1.0f);
             }
@@ -1134,24 +1345,25 @@ std::vector<float> coverage_image(uint32_t width, uint32_t height, const RenderR
     return uncovered;
 }
 
-// The PNG's pixels from the compositor's premultiplied RGBA: RGB over an opaque background (alpha
-// is 1 everywhere, so the colour is as it is), else RGBA with the colour divided by alpha.
-std::vector<float> png_pixels(std::span<const float> target, bool opaque) {
-    const size_t pixels = target.size() / 4;
-    const size_t channels = opaque ? 3 : 4;
-    std::vector<float> out(pixels * channels);
-    for (size_t p = 0; p < pixels; ++p) {
-        const float* rgba = &target[p * 4];
-        float* pixel = &out[p * channels];
-        if (opaque) {
-            std::copy(rgba, rgba + 3, pixel);
-            continue;
+// Writes the coverage PFM band by band, from the bottom band up as the file stores its rows, so
+// that it is never held whole (16384 x 16384 is 3 GiB).
+crisp::OutputWriter coverage_writer(const Arguments& args, const Job& job, const RenderReport& report) {
+    return [&args, &job, &report](const std::function<crisp::Status(std::span<const std::byte>)>& put) {
+        const uint32_t width = job.scene.width, height = job.scene.height;
+        const std::vector<Band> bands = canvas_bands(args, width, height);
+        const std::vector<std::vector<uint32_t>> members =
+            glyphs_by_band(report.texels.empty() ? std::span<const crisp::DrawnGlyph>{} : report.drawn,
+                           bands.front().rows, bands.size());
+        const std::string header = crisp::pfm_header(width, height);
+        if (crisp::Status s = put(std::as_bytes(std::span(header))); !s) return s;
+        std::vector<std::byte> bytes;
+        for (size_t b = bands.size(); b-- > 0;) {
+            bytes.clear();
+            crisp::append_pfm_rows(bytes, width, coverage_rows(width, bands[b], report, members[b]));
+            if (crisp::Status s = put(bytes); !s) return s;
         }
-        const float alpha = rgba[3];
-        for (size_t c = 0; c < 3; ++c) pixel[c] = alpha > 0.0f ? rgba[c] / alpha : 0.0f;
-        pixel[3] = alpha;
-    }
-    return out;
+        return crisp::Status{};
+    };
 }
 
 // ---- Report
@@ -1217,6 +1429,8 @@ void write_composite(crisp::JsonWriter& json, const Arguments& args, const Compo
     json.field("backdrop", args.backdrop)
         .field("exact_lost_nodes", when(exact, s.exact_lost_nodes))
         .field("exact_dropped", when(exact, s.exact_dropped))
+        .field("bands", c.bands)
+        .field("band_rows", c.band_rows)
         .field("frame_ms", c.frame_ms)
         .field("ms", c.frame_ms.empty() ? 0.0 : c.frame_ms.back())
         .field("warnings", c.warnings)
@@ -1365,6 +1579,7 @@ std::string human_composite(const Arguments& args, const CompositeReport& c) {
                std::to_string(s.layered_tiles) + " layered)";
     }
     if (args.backdrop != "flat") out += ", over a " + args.backdrop + " backdrop";
+    if (c.bands > 1) out += ", in " + std::to_string(c.bands) + " bands of " + std::to_string(c.band_rows) + " rows";
     char ms[32];
     std::snprintf(ms, sizeof ms, ", %.1f ms", c.frame_ms.empty() ? 0.0 : c.frame_ms.back());
     return out + ms;
@@ -1583,20 +1798,11 @@ int write_outputs(const crisp::OutputFiles& outputs, const Arguments& args, cons
         std::fprintf(stderr, "crisp-render: %s\n", error.message.c_str());
         return error.code == crisp::ErrorCode::io ? kExitOutput : kExitInternal;
     };
-    const uint32_t width = job.scene.width, height = job.scene.height;
-    const bool opaque = job.scene.background[3] >= 1.0f;
-    crisp::Result<std::vector<std::byte>> png =
-        crisp::encode_png_srgb8(width, height, opaque ? 3 : 4, png_pixels(report.composite.target, opaque));
-    report.composite.target = {};
-    if (!png) return write_failed(png.error());
-    std::vector<std::span<const std::byte>> contents = {*png};
-    crisp::Result<std::vector<std::byte>> pfm = std::vector<std::byte>{};
-    if (!args.coverage_output.empty()) {
-        pfm = crisp::encode_pfm(width, height, coverage_image(width, height, report));
-        if (!pfm) return write_failed(pfm.error());
-        contents.push_back(*pfm);
-    }
-    if (crisp::Status status = outputs.write(contents); !status) return write_failed(status.error());
+    const std::vector<std::byte> png = std::move(report.composite.png);
+    std::vector<crisp::OutputWriter> writers = {
+        [&png](const std::function<crisp::Status(std::span<const std::byte>)>& put) { return put(png); }};
+    if (!args.coverage_output.empty()) writers.push_back(coverage_writer(args, job, report));
+    if (crisp::Status status = outputs.write_streamed(writers); !status) return write_failed(status.error());
     return kExitOk;
 }
 

@@ -266,7 +266,8 @@ void discard(Staged& staged) {
     staged.temporary.clear();
 }
 
-Status stage(const std::filesystem::path& path, std::span<const std::byte> bytes, Staged& staged) {
+Status stage(const std::filesystem::path& path, std::span<const std::byte> bytes, const OutputWriter& writer,
+             Staged& staged) {
     Result<Target> target = checked_target(path, {});
     if (!target) return target.error();
     staged.path = path;
@@ -296,7 +297,10 @@ Status stage(const std::filesystem::path& path, std::span<const std::byte> bytes
             return fail("keeping its owner", errno);
         if (::fchmod(staged.fd, old.st_mode & 0777) != 0) return fail("keeping its mode", errno);
     }
-    if (Status status = write_all(staged.fd, bytes); !status) {
+    const int fd = staged.fd;
+    const Status written =
+        writer ? writer([fd](std::span<const std::byte> piece) { return write_all(fd, piece); }) : write_all(fd, bytes);
+    if (Status status = written; !status) {
         discard(staged);
         return Error{ErrorCode::io, "cannot write " + path.string() + ": " + status.error().message};
     }
@@ -351,7 +355,8 @@ Status write_files_atomically(std::span<const OutputFile> files) {
         return status;
     };
     for (size_t i = 0; i < files.size(); ++i) {
-        if (Status status = stage(files[i].path, files[i].bytes, staged[i]); !status) return failed(status);
+        if (Status status = stage(files[i].path, files[i].bytes, files[i].writer, staged[i]); !status)
+            return failed(status);
     }
     for (Staged& file : staged) {
         if (Status status = name(file); !status) return failed(status);
@@ -374,7 +379,7 @@ Status write_files_atomically(std::span<const OutputFile> files) {
 }
 
 Status write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes) {
-    const OutputFile file{path, bytes};
+    const OutputFile file{path, bytes, {}};
     return write_files_atomically(std::span(&file, 1));
 }
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <span>
 #include <filesystem>
+#include <functional>
 #include <vector>
 
 namespace crisp {
@@ -24,10 +25,16 @@ Result<std::vector<std::byte>> read_file(const std::filesystem::path& path, uint
 // is a symbolic link, the regular file it leads to is replaced and the link kept.
 Status write_file_atomically(const std::filesystem::path& path, std::span<const std::byte> bytes);
 
-// One output of a run: where, and its bytes.
+// Writes an output too large to hold in pieces: calls `put` with each piece in turn (put appends it
+// to the file and returns the write's error, which the writer passes on). Its error fails the write
+// as a write error does.
+using OutputWriter = std::function<Status(const std::function<Status(std::span<const std::byte> piece)>& put)>;
+
+// One output of a run: where, and its bytes (or, where `writer` is set, what writes them).
 struct OutputFile {
     std::filesystem::path path;
     std::span<const std::byte> bytes;
+    OutputWriter writer;
 };
 
 // Writes every file as write_file_atomically() writes one, and puts them in place together: all
