@@ -298,18 +298,33 @@ CRISP_CONSTANT(uint, kTileNoQuad, 0xFFFFFFFFu);
 // Below this in every channel the transmittance left hides whatever lies behind (less than a
 // 16-bit code): a pixel's walk stops there.
 CRISP_CONSTANT(float, kTileOpaque, 1.0f / 65536.0f);
+// Deep stacks (tiles_classify.comp): in a frame whose (quad, tile) pairs average more than
+// kTileCullDepth a tile of the rect (or that is batched), each atlas entry its quads show is cut
+// into blocks of kTileBlockSide^2 texels from its corner, a block marked where some texel holds
+// coverage, and a pair whose blocks under its tile are all unmarked is not binned: it would draw
+// nothing, yet every pixel of its tile that no glyph makes opaque would read its texel. Hundreds of
+// copies of a large glyph otherwise cost every pixel of their gaps a read per copy. A block whose
+// texels all hold full coverage is marked full too: an opaque quad (alpha 1, no fill of its own)
+// full over a whole tile hides what lies behind it there, and those pairs are not binned either.
+CRISP_CONSTANT(uint, kTileCullDepth, 64u);
+CRISP_CONSTANT(uint, kTileBlockCovered, 1u);  // TileBlock::marked: some texel holds coverage
+CRISP_CONSTANT(uint, kTileBlockFull, 2u);     // ... every texel holds full coverage in every channel
+CRISP_CONSTANT(uint, kTileBlockSide, 16u);
+CRISP_CONSTANT(uint, kTileNoBlocks, 0xFFFFFFFFu);  // a quad whose entry was not classified
 
 // Bindings of the tile compositor's descriptor set (tiles_common.glsl declares the same).
-CRISP_CONSTANT(uint, kTileBindAtlas, 0u);   // the atlas, storage image
-CRISP_CONSTANT(uint, kTileBindQuads, 1u);   // CompositeQuad[], front to back
-CRISP_CONSTANT(uint, kTileBindTiles, 2u);   // per tile: count, start, cursor (plane-major); block sums
-CRISP_CONSTANT(uint, kTileBindBins, 3u);    // TileBinEntry[], each tile's at its start
-CRISP_CONSTANT(uint, kTileBindHeader, 4u);  // TileHeader, then the non-empty tiles' indices
-CRISP_CONSTANT(uint, kTileBindTarget, 5u);  // the caller's image, storage image
-CRISP_CONSTANT(uint, kTileBindPaints, 6u);  // QuadPaint[]
-CRISP_CONSTANT(uint, kTileBindStops, 7u);   // PaintStop[]
-CRISP_CONSTANT(uint, kTileBindImages, 8u);  // bitmap images, sampled 2D array
-CRISP_CONSTANT(uint, kTileBindingCount, 9u);
+CRISP_CONSTANT(uint, kTileBindAtlas, 0u);        // the atlas, storage image
+CRISP_CONSTANT(uint, kTileBindQuads, 1u);        // CompositeQuad[], front to back
+CRISP_CONSTANT(uint, kTileBindTiles, 2u);        // per tile: count, start, cursor (plane-major); block sums
+CRISP_CONSTANT(uint, kTileBindBins, 3u);         // TileBinEntry[], each tile's at its start
+CRISP_CONSTANT(uint, kTileBindHeader, 4u);       // TileHeader, then the non-empty tiles' indices
+CRISP_CONSTANT(uint, kTileBindTarget, 5u);       // the caller's image, storage image
+CRISP_CONSTANT(uint, kTileBindPaints, 6u);       // QuadPaint[]
+CRISP_CONSTANT(uint, kTileBindStops, 7u);        // PaintStop[]
+CRISP_CONSTANT(uint, kTileBindImages, 8u);       // bitmap images, sampled 2D array
+CRISP_CONSTANT(uint, kTileBindBlocks, 9u);       // TileBlock[]: the frame's atlas blocks, classified
+CRISP_CONSTANT(uint, kTileBindQuadBlocks, 10u);  // TileQuadBlocks[], per quad
+CRISP_CONSTANT(uint, kTileBindingCount, 11u);
 
 // Target encodings of the tile pass (specialization constant 1).
 CRISP_CONSTANT(uint, kTileEncodeLinear, 0u);  // float formats: the image holds linear colour
@@ -321,17 +336,17 @@ struct TileHeader {
     uint dispatch_x;  // VkDispatchIndirectCommand of the exact pass
     uint dispatch_y;
     uint dispatch_z;
-    uint busy_tiles;     // tiles with at least one quad
-    uint pairs;          // (quad, tile) pairs binned
-    uint lost_pairs;     // pairs past the bins' capacity (never, when the CPU sized them)
-    uint layered_tiles;  // tiles that took the layered way (the exact ones: busy - layered)
-    uint max_overlap;    // most fragments one pixel had
-    uint tail_pixels;    // layered tiles: pixels with fragments past K
-    uint padding0;
+    uint busy_tiles;          // tiles with at least one quad
+    uint pairs;               // (quad, tile) pairs binned
+    uint lost_pairs;          // pairs past the bins' capacity (never, when the CPU sized them)
+    uint layered_tiles;       // tiles that took the layered way (the exact ones: busy - layered)
+    uint max_overlap;         // most fragments one pixel had
+    uint tail_pixels;         // layered tiles: pixels with fragments past K
+    uint empty_pairs;         // pairs not binned: the quad's texels under the tile hold no coverage
     uint layered_dispatch_x;  // VkDispatchIndirectCommand of the layered pass (at byte 40)
     uint layered_dispatch_y;
     uint layered_dispatch_z;
-    uint padding1;
+    uint hidden_pairs;  // pairs not binned: an opaque quad in front covers the whole tile
     uint padding2;
     uint padding3;
 };
@@ -365,6 +380,22 @@ struct TilePushConstants {
     uint quad_count;    // the batch's quads (binning): quads [quad_first, quad_first + quad_count)
     uint bin_capacity;  // entries the bins buffer holds
     uint quad_first;    // the batch's first quad, in front-to-back order
+    uint block_count;   // atlas blocks classified this frame; 0: no pair is culled
+};
+
+// An atlas block to classify (tiles_classify.comp): its first texel, its size (up to
+// kTileBlockSide each way), and the marks the pass writes (kTileBlockCovered, kTileBlockFull).
+struct TileBlock {
+    uint x;
+    uint y;
+    uint size;  // width | height << 16
+    uint marked;
+};
+
+// Per quad of a classified frame: its entry's first block and blocks per row (kTileNoBlocks: none).
+struct TileQuadBlocks {
+    uint first;
+    uint across;
 };
 
 #ifdef __cplusplus
@@ -378,7 +409,9 @@ static_assert(kTileScanBlock == kTileScanInvocations * kTileScanPerInvocation);
 static_assert(kTileScanBlock * kTileScanBlock <= 1u << kTileBusyIndexBits);
 static_assert(kTileMaxCapacity < kTileBusyCountMax && kTileBusyCountMax < 1u << (32 - kTileBusyIndexBits));
 static_assert(kTileScanBlock * kTileScanBlock * kTileSide * kTileSide >= 16384u * 16384u);
-static_assert(sizeof(TilePushConstants) == 36);
+static_assert(sizeof(TilePushConstants) == 40);
+static_assert(sizeof(TileBlock) == 16);
+static_assert(sizeof(TileQuadBlocks) == 8);
 static_assert(sizeof(CompositeQuad) == 80);
 static_assert(offsetof(CompositeQuad, color) == 48);
 static_assert(offsetof(CompositeQuad, paint) == 64);

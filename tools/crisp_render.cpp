@@ -944,6 +944,8 @@ void add_band_stats(crisp::CompositorStats& total, const crisp::CompositorStats&
     total.exact_tiles += band.exact_tiles;
     total.layered_tiles += band.layered_tiles;
     total.tile_pairs += band.tile_pairs;
+    total.tile_empty_pairs += band.tile_empty_pairs;
+    total.tile_hidden_pairs += band.tile_hidden_pairs;
 }
 
 // Encodes each band's premultiplied RGBA as the PNG's rows: RGB over an opaque background (alpha is
@@ -1422,6 +1424,8 @@ void write_composite(crisp::JsonWriter& json, const Arguments& args, const Compo
             .field("exact", s.exact_tiles)
             .field("layered", s.layered_tiles)
             .field("pairs", s.tile_pairs)
+            .field("empty_pairs", s.tile_empty_pairs)
+            .field("hidden_pairs", s.tile_hidden_pairs)
             .end_object();
     } else {
         json.null();

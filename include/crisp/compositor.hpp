@@ -210,6 +210,14 @@ struct CompositorStats {
     uint32_t exact_tiles = 0;
     uint32_t layered_tiles = 0;
     uint32_t tile_pairs = 0;
+    // tiled: pairs left out of the bins because the glyph's atlas texels under the tile hold no
+    // coverage (empty), or because an opaque glyph in front (alpha 1, no fill of its own) covers the
+    // whole tile with full coverage (hidden). Only deep frames are classified so (more pairs than 64
+    // a tile of the rect, or batched): hundreds of copies of a large glyph would otherwise cost every
+    // pixel of their gaps, and of the batches behind, a read per copy. The image is the same; such a
+    // frame's bins are never reused; max_overlap no longer counts the hidden fragments.
+    uint32_t tile_empty_pairs = 0;
+    uint32_t tile_hidden_pairs = 0;
 };
 
 // The depth of a world-space label for CompositeParams/TextStyle::depth: the clip-space z / w of

@@ -1,9 +1,13 @@
 // The tile compositor's binning, one invocation per quad (docs/compositing.md). Specialization
 // constant 0 picks the pass:
 //   0, count: add 1 to the count of every tile the quad reaches;
-//   1, scatter: write the quad's entry (TileBinEntry) into each such tile's list, at the tile's cursor.
+//   1, scatter: write the quad's entry (TileBinEntry) into each such tile's list, at the tile's cursor;
+//   2, occluders (classified frames, before the others, over all the frame's quads): per tile the
+//      nearest quad that hides what lies behind it there.
 // The scatter order inside a list depends on arrival; the tile pass sorts each list. A frame whose
-// pairs pass the bins' budget is binned in batches: quads [pc.quad_first, + pc.quad_count).
+// pairs pass the bins' budget is binned in batches: quads [pc.quad_first, + pc.quad_count). In a
+// classified frame count and scatter leave out the pairs whose texels under the tile are empty and
+// those behind the tile's occluder.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -24,6 +28,19 @@ void main() {
     for (uint y = first.y; y <= last.y; ++y) {
         for (uint x = first.x; x <= last.x; ++x) {
             const uint tile = y * pc.tiles_x + x;
+            const ivec2 corner = ivec2(x, y) * int(kTileSide);
+            if (kScatter == 2u) {
+                if (quad_hides_tile(quad, q, corner)) atomicMin(tile_words[occluder_word(tile)], quad);
+                continue;
+            }
+            if (!quad_covers_tile(quad, q, corner)) {
+                if (kScatter == 0u) atomicAdd(header[kHeaderEmptyPairs], 1u);
+                continue;
+            }
+            if (pc.block_count != 0u && quad > tile_words[occluder_word(tile)]) {
+                if (kScatter == 0u) atomicAdd(header[kHeaderHiddenPairs], 1u);
+                continue;
+            }
             if (kScatter == 0u) {
                 atomicAdd(tile_words[tile], 1u);
             } else {

@@ -192,6 +192,8 @@ void Compositor::State::take(const composite::TileCounts& counts, uint64_t frame
     stats.exact_tiles = counts.exact_tiles;
     stats.layered_tiles = counts.layered_tiles;
     stats.tile_pairs = counts.pairs;
+    stats.tile_empty_pairs = counts.empty_pairs;
+    stats.tile_hidden_pairs = counts.hidden_pairs;
     stats.max_overlap = counts.max_overlap;
     stats.tail_pixels = counts.tail_pixels;
 }

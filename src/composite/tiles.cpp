@@ -10,12 +10,16 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <tuple>
 
 namespace crisp::composite {
 
 namespace {
 
 constexpr VkDeviceSize kWord = 4;
+// The most atlas blocks a frame classifies (16 MiB of TileBlock, the texels of a 4096 x 4096
+// atlas): past it the frame is binned whole, as it was before classification.
+constexpr size_t kMaxClassifiedBlocks = size_t{1} << 20;
 
 // The descriptor set of every pass of the tile compositor (tiles_common.glsl declares it).
 constexpr vk::Binding kBindings[] = {
@@ -28,6 +32,8 @@ constexpr vk::Binding kBindings[] = {
     {gpu::kTileBindPaints, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
     {gpu::kTileBindStops, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
     {gpu::kTileBindImages, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
+    {gpu::kTileBindBlocks, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+    {gpu::kTileBindQuadBlocks, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
 };
 static_assert(std::size(kBindings) == gpu::kTileBindingCount);
 constexpr vk::BindingTable kTable{kBindings, VK_SHADER_STAGE_COMPUTE_BIT};
@@ -48,9 +54,13 @@ VkDeviceSize header_words(uint32_t tiles) {
     return gpu::kTileHeaderWords + (gpu::kTileBusyEntryWords + 1) * VkDeviceSize{tiles};
 }
 
-// Words of the tiles buffer: count, start and cursor per tile, and two words per scan block.
-VkDeviceSize tile_words(uint32_t tiles) {
+// Words of the tiles buffer: count, start and cursor per tile, two words per scan block, and a
+// classified frame's occluder per tile (tiles_common.glsl, occluder_word).
+VkDeviceSize occluder_words_start(uint32_t tiles) {
     return VkDeviceSize{tiles} * 3 + 2 * VkDeviceSize{(tiles + gpu::kTileScanBlock - 1) / gpu::kTileScanBlock};
+}
+VkDeviceSize tile_words(uint32_t tiles) {
+    return occluder_words_start(tiles) + tiles;
 }
 
 // Workgroups for `count` invocations in groups of `size`, as a 2D grid of rows of
@@ -88,6 +98,12 @@ Status TileCompositor::create(const vk::DeviceRef& device, const TileConfig& con
     const VkSpecializationInfo scatter_info{1, &scatter_entry, 4, &scatter};
     if (Status s = make_pipeline("tiles_bin.comp", nullptr, "tiles_bin.comp (count)", count_); !s) return s;
     if (Status s = make_pipeline("tiles_bin.comp", &scatter_info, "tiles_bin.comp (scatter)", scatter_); !s) return s;
+    const uint32_t occluders = 2;
+    const VkSpecializationInfo occluders_info{1, &scatter_entry, 4, &occluders};
+    if (Status s = make_pipeline("tiles_bin.comp", &occluders_info, "tiles_bin.comp (occluders)", occluders_); !s) {
+        return s;
+    }
+    if (Status s = make_pipeline("tiles_classify.comp", nullptr, "tiles_classify.comp", classify_); !s) return s;
     for (uint32_t phase = 0; phase < scan_.size(); ++phase) {
         const VkSpecializationMapEntry phase_entry{0, 0, 4};
         const VkSpecializationInfo phase_info{1, &phase_entry, 4, &phase};
@@ -176,8 +192,51 @@ Status TileCompositor::prepare_slot(Slot& slot, std::span<const gpu::CompositeQu
         !s) {
         return s;
     }
+    // Host-visible: classify() writes them here, and the classification pass its marks.
+    const std::span<const std::byte> blocks = std::as_bytes(std::span(blocks_));
+    const std::span<const std::byte> quad_blocks = std::as_bytes(std::span(quad_blocks_));
+    if (Status s = grow(slot.blocks, blocks.size(), storage, true, "tile blocks"); !s) return s;
+    if (Status s = grow(slot.quad_blocks, quad_blocks.size(), storage, true, "tile quad blocks"); !s) return s;
     if (quad_bytes > 0) std::memcpy(slot.quads.mapped, quads.data(), quad_bytes);
+    if (!blocks.empty()) std::memcpy(slot.blocks.mapped, blocks.data(), blocks.size());
+    if (!quad_blocks.empty()) std::memcpy(slot.quad_blocks.mapped, quad_blocks.data(), quad_blocks.size());
     return {};
+}
+
+bool TileCompositor::classify(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height) {
+    blocks_.clear();
+    quad_blocks_.assign(quads.size(), {gpu::kTileNoBlocks, 0});
+    // The quads that reach the rect, grouped by the atlas rect they show: one entry's blocks serve
+    // every copy of it.
+    by_entry_.clear();
+    for (uint32_t i = 0; i < quads.size(); ++i) {
+        if (quad_tile_pairs(quads[i], width, height) > 0) by_entry_.push_back(i);
+    }
+    const auto entry = [&](uint32_t i) {
+        const gpu::CompositeQuad& q = quads[i];
+        return std::tuple(q.atlas_x, q.atlas_y, q.width, q.height);
+    };
+    std::sort(by_entry_.begin(), by_entry_.end(), [&](uint32_t a, uint32_t b) { return entry(a) < entry(b); });
+    constexpr uint32_t side = gpu::kTileBlockSide;
+    for (size_t i = 0; i < by_entry_.size();) {
+        const gpu::CompositeQuad& q = quads[by_entry_[i]];
+        const uint32_t across = (q.width + side - 1) / side, down = (q.height + side - 1) / side;
+        if (blocks_.size() + size_t{across} * down > kMaxClassifiedBlocks) {
+            blocks_.clear();
+            quad_blocks_.clear();
+            return false;
+        }
+        const gpu::TileQuadBlocks blocks{static_cast<uint32_t>(blocks_.size()), across};
+        for (uint32_t by = 0; by < down; ++by) {
+            for (uint32_t bx = 0; bx < across; ++bx) {
+                const uint32_t w = std::min(side, q.width - bx * side), h = std::min(side, q.height - by * side);
+                blocks_.push_back({q.atlas_x + bx * side, q.atlas_y + by * side, w | h << 16, 0});
+            }
+        }
+        const auto key = entry(by_entry_[i]);
+        for (; i < by_entry_.size() && entry(by_entry_[i]) == key; ++i) quad_blocks_[by_entry_[i]] = blocks;
+    }
+    return true;
 }
 
 uint64_t TileCompositor::make_batches(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height,
@@ -264,6 +323,8 @@ TileCounts TileCompositor::read_counts(const Slot& slot) const {
         counts.tail_pixels += header.tail_pixels;
         counts.pairs += header.pairs;
         counts.lost_pairs += header.lost_pairs;
+        counts.empty_pairs += header.empty_pairs;
+        counts.hidden_pairs += header.hidden_pairs;
     }
     return counts;
 }
@@ -278,6 +339,8 @@ void TileCompositor::write_descriptors(const Slot& slot, VkImageView atlas_view,
         .storage_buffer(gpu::kTileBindBins, slot.bins.buffer)
         .storage_buffer(gpu::kTileBindHeader, slot.header.buffer)
         .storage_image(gpu::kTileBindTarget, target_view)
+        .storage_buffer(gpu::kTileBindBlocks, slot.blocks.buffer)
+        .storage_buffer(gpu::kTileBindQuadBlocks, slot.quad_blocks.buffer)
         .update(ref_);
 }
 
@@ -346,11 +409,31 @@ void TileCompositor::record_passes(VkCommandBuffer cb, const Slot& slot, const s
     reset_header(slot, reuse_bins);
     if (!reuse_bins) {
         ref_.fn->vkCmdFillBuffer(cb, slot.tiles.buffer, 0, VkDeviceSize{tiles} * kWord, 0);
+        if (push.block_count > 0) {
+            ref_.fn->vkCmdFillBuffer(cb, slot.tiles.buffer, occluder_words_start(tiles) * kWord,
+                                     VkDeviceSize{tiles} * kWord, gpu::kTileNoQuad);
+        }
         vk::memory_barrier(*ref_.fn, cb, transfer, VK_ACCESS_TRANSFER_WRITE_BIT, compute, shader);
     }
 
     ref_.fn->vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, descriptors_.pipeline_layout, 0, 1, &slot.set,
                                      0, nullptr);
+    if (push.block_count > 0) {
+        // The atlas blocks first, then each tile's occluder over all the frame's quads: every
+        // batch's binning reads both.
+        ref_.fn->vkCmdPushConstants(cb, descriptors_.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push),
+                                    &push);
+        const VkExtent2D groups = grid(push.block_count, 1);
+        ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, classify_);
+        ref_.fn->vkCmdDispatch(cb, groups.width, groups.height, 1);
+        vk::memory_barrier(*ref_.fn, cb, compute, shader, compute, shader);
+        const VkExtent2D quad_groups = grid(push.quad_count, gpu::kTileBinInvocations);
+        if (quad_groups.width > 0) {
+            ref_.fn->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, occluders_);
+            ref_.fn->vkCmdDispatch(cb, quad_groups.width, quad_groups.height, 1);
+            vk::memory_barrier(*ref_.fn, cb, compute, shader, compute, shader);
+        }
+    }
     // Batches back to front, each composited over what the ones behind it left in the image: the
     // tile passes blend over the image, so the result is the one pass's (up to the target format's
     // rounding between batches).
@@ -434,9 +517,21 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
     const uint64_t pairs = make_batches(quads, push.width, push.height, budget);
     const bool batched = batches_.size() > 1;
     push.bin_capacity = static_cast<uint32_t>(pairs);
+    // A deep frame's empty pairs are left out (shared.h, kTileCullDepth). Its bins are never
+    // reused: more samples may give an empty texel coverage by the next frame.
+    uint64_t all_pairs = 0;
+    for (const Batch& batch : batches_) all_pairs += batch.pairs;
+    const bool classified =
+        (batched || all_pairs > uint64_t{gpu::kTileCullDepth} * tiles) && classify(quads, push.width, push.height);
+    if (!classified) {
+        blocks_.clear();
+        quad_blocks_.clear();
+    }
+    push.block_count = static_cast<uint32_t>(blocks_.size());
     // Static text: the slot's bins already hold these very quads for a rect of this size.
-    reused = config_.reuse_static_bins && slot.bins_valid && !batched && slot.binned_width == push.width &&
-             slot.binned_height == push.height && slot.binned.size() == quads.size() &&
+    reused = config_.reuse_static_bins && slot.bins_valid && !batched && !classified &&
+             slot.binned_width == push.width && slot.binned_height == push.height &&
+             slot.binned.size() == quads.size() &&
              (quads.empty() || std::memcmp(slot.binned.data(), quads.data(), quads.size_bytes()) == 0);
     if (!reused) {
         slot.bins_valid = false;
@@ -447,8 +542,9 @@ Result<uint64_t> TileCompositor::record(VkCommandBuffer command_buffer, std::spa
                 !s) {
                 return s.error();
             }
-        } else {
-            // The bins of a batched frame hold its front batch only: never reused.
+        } else if (!classified) {
+            // The bins of a batched frame hold its front batch only, a classified frame's the
+            // coverage of its frame: neither is reused.
             slot.binned.assign(quads.begin(), quads.end());
             slot.binned_width = push.width;
             slot.binned_height = push.height;

@@ -63,6 +63,8 @@ struct TileCounts {
     uint32_t tail_pixels = 0;
     uint32_t pairs = 0;
     uint32_t lost_pairs = 0;
+    uint32_t empty_pairs = 0;   // left out: the quad's texels under the tile hold no coverage
+    uint32_t hidden_pairs = 0;  // left out: behind an opaque quad full over the tile
 };
 
 class TileCompositor {
@@ -112,6 +114,10 @@ private:
         // (host-visible), since the next batch starts the header again.
         vk::DeviceBuffer batch_headers;
         uint32_t batches = 1;  // of the frame that last used the slot
+        // A classified frame's atlas blocks and each quad's (host-visible; a stand-in of 256 bytes
+        // otherwise, so that the descriptor set is whole).
+        vk::DeviceBuffer blocks;       // TileBlock[]
+        vk::DeviceBuffer quad_blocks;  // TileQuadBlocks[]
     };
     // Consecutive quads (front to back) binned and composited together.
     struct Batch {
@@ -126,6 +132,10 @@ private:
     // Cuts `quads` into batches_ of at most `budget` pairs each, and where that makes more than
     // one, of at most the list capacity in any tile; returns the most pairs of one.
     uint64_t make_batches(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height, uint64_t budget);
+    // Fills blocks_ and quad_blocks_ for a deep frame (shared.h, kTileCullDepth): the distinct atlas
+    // entries its quads reaching the width x height rect show, cut into blocks. False, leaving them empty, where the
+    // blocks would pass kMaxClassifiedBlocks: the frame is then binned whole, as any other.
+    bool classify(std::span<const gpu::CompositeQuad> quads, uint32_t width, uint32_t height);
     // The counts of the frame that last used `slot`, summed over its batches.
     TileCounts read_counts(const Slot& slot) const;
     void write_descriptors(const Slot& slot, VkImageView atlas_view, const PaintInputs& paints,
@@ -149,7 +159,8 @@ private:
     VkDeviceSize max_buffer_range_ = 0;  // maxStorageBufferRange: the largest buffer a descriptor reaches
     vk::DescriptorSets descriptors_;
     vk::DeviceObjects objects_;  // shader modules and pipelines
-    VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE;
+    VkPipeline count_ = VK_NULL_HANDLE, scatter_ = VK_NULL_HANDLE, classify_ = VK_NULL_HANDLE,
+               occluders_ = VK_NULL_HANDLE;
     std::array<VkPipeline, 3> scan_{};  // reduce, blocks, down
     // Per variant and features, the exact and layered passes: those without features made by
     // create(), the others at the first frame that needs them.
@@ -158,6 +169,10 @@ private:
     std::vector<Batch> batches_;  // the last record()'s, front to back (recorded from the last)
     // A batched frame's tiles: the batch that last counted a quad there, and how many it counted.
     std::vector<uint32_t> tile_batch_, tile_count_;
+    // A classified frame's blocks and per-quad entries, and the quads sorted by entry to find them.
+    std::vector<gpu::TileBlock> blocks_;
+    std::vector<gpu::TileQuadBlocks> quad_blocks_;
+    std::vector<uint32_t> by_entry_;
     uint64_t frame_ = 0;
     bool recorded_ = false;     // record() since the last abandon_frame()
     bool last_binned_ = false;  // the last record() binned anew
