@@ -75,6 +75,9 @@ PY
 expect_exit 0 "json check" -- "$bake" --check "$work/inter.crisp" --json
 python3 -c "import json,sys; r=json.load(open(sys.argv[1])); assert r['valid'] and r['cubic'], r" "$work/out" ||
   fail "--check --json output is wrong"
+expect_exit 0 "json check of a max size bake" -- "$bake" --check "$work/inter64.crisp" --json
+python3 -c "import json,sys; r=json.load(open(sys.argv[1])); assert r['tolerance_size_px'] == 64, r" "$work/out" ||
+  fail "--check --json does not give the size the asset was baked for"
 
 # A collection face and a variable instance.
 expect_exit 0 "ttc face" -- "$bake" /usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc --face 2 --text "骨" -o "$work/cjk.crisp" --json

@@ -141,6 +141,12 @@ Arguments parse_arguments(int argc, char** argv) {
     return args;
 }
 
+// The size at which the asset's tolerance is crisp::kPixelTolerance: what --max-size it was baked
+// for (or would have been, for a tolerance given in em).
+double tolerance_size_px(const crisp::FontInfo& info) {
+    return static_cast<double>(crisp::kPixelTolerance) / static_cast<double>(info.tolerance_em);
+}
+
 double peak_rss_bytes() {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
@@ -241,6 +247,7 @@ int run_check(const Arguments& args) {
             .field("band_words", asset->band_words.size())
             .field("font_bytes", asset->font_bytes.size())
             .field("tolerance_em", info.tolerance_em)
+            .field("tolerance_size_px", tolerance_size_px(info))
             .field("max_deviation_em", info.max_deviation_em)
             .end_object();
         std::fputs(json.line().c_str(), stdout);
@@ -259,8 +266,9 @@ int run_check(const Arguments& args) {
         std::printf("  curves      %llu slots, %zu points; %llu bands, %zu bitset words\n",
                     static_cast<unsigned long long>(slots), asset->points.size(),
                     static_cast<unsigned long long>(bands), asset->band_words.size());
-        std::printf("  lowering    tolerance %.3g em, largest deviation %.3g em\n",
-                    static_cast<double>(info.tolerance_em), static_cast<double>(info.max_deviation_em));
+        std::printf("  lowering    tolerance %.3g em (1/1024 px at %.4g px), largest deviation %.3g em\n",
+                    static_cast<double>(info.tolerance_em), tolerance_size_px(info),
+                    static_cast<double>(info.max_deviation_em));
         std::printf("  font bytes  %s\n", human_bytes(static_cast<double>(asset->font_bytes.size())).c_str());
     }
     return kExitOk;
