@@ -15,7 +15,7 @@ expect_exit 0 "--help" -- "$bench" --help
 for suite in "${suites[@]}"; do
   grep -q "^  $suite " "$work/out" || fail "--help does not list the suite $suite"
 done
-for option in --quick --suite --out --canvas --samples --sample-kind --clock-load --modes --variants --steps --pictures --glyphs; do
+for option in --quick --suite --out --canvas --samples --sample-kind --clock-load --modes --variants --steps --pictures --glyphs --glyph --tolerance; do
   grep -qF -- "$option" "$work/out" || fail "--help does not list $option"
 done
 expect_exit 2 "unknown suite" -- "$bench" --suite nonesuch
@@ -28,6 +28,9 @@ expect_exit 2 "unknown compositing mode" -- "$bench" --modes tiled,bogus
 expect_stderr "unknown mode 'bogus'" "unknown compositing mode"
 expect_exit 2 "unknown sample kind" -- "$bench" --sample-kind lines
 expect_exit 2 "--steps not a power of two" -- "$bench" --steps 3
+expect_exit 2 "--glyph without a size" -- "$bench" --glyph fonts/DejaVuSans.ttf:g
+expect_stderr "PATH:PX:TEXT" "--glyph without a size"
+expect_exit 2 "--glyph size out of range" -- "$bench" --glyph fonts/DejaVuSans.ttf:0:g
 expect_exit 2 "compositing warm-up below its frames in flight" -- "$bench" --suite compositing --warmup 1
 
 # ---- From another directory: the default fonts come from the source tree it was built from.
@@ -70,6 +73,15 @@ for r in runs:
     for p in r["points"]:
         assert unit(p["mean"]) and unit(p["worst"]) and p["mean"] <= p["worst"], p
         assert len(p["glyph_mean"]) == len(suites["coverage"]["glyphs"])
+    # The split of the last count's error: its three signed parts add up to the worst texel's.
+    split = r["split"]
+    assert split["samples"] == 16 and len(split["glyphs"]) == len(suites["coverage"]["glyphs"]), split
+    for g, p in zip(split["glyphs"], r["points"][-1]["glyph_worst"]):
+        parts = g["worst_texel_sampling"] + g["worst_texel_lowering"] + g["worst_texel_reference"]
+        assert abs(abs(parts) - g["total_worst"]) < 1e-5 and abs(g["total_worst"] - p) < 1e-9, (g, p)
+        assert all(unit(g[k + "_worst"]) for k in ("sampling", "lowering", "reference")), g
+for b in suites["coverage"]["bakes"]:
+    assert b["tolerance_em"] > 0 and b["size_px"] >= 1 and 0 <= b["max_deviation_px"] <= 1 / 1024 * (1 + 1e-6), b
 assert {p["mode"] for p in suites["coverage"]["freetype"]} == {"gray", "lcd", "lcd-unfiltered"}
 for p in suites["coverage"]["freetype"]:
     assert unit(p["mean"]) and unit(p["worst"]) and p["us_per_glyph"] > 0, p

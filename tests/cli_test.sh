@@ -16,6 +16,10 @@ expect_exit 2 "bad number" -- "$bake" "$font" --face x
 expect_exit 2 "bad variation" -- "$bake" "$font" --var wght
 expect_exit 2 "bad ranges" -- "$bake" "$font" --codepoints 10-5
 expect_exit 2 "text and codepoints" -- "$bake" "$font" --text a --codepoints 65
+expect_exit 2 "max size and tolerance" -- "$bake" "$font" --max-size 32 --tolerance 0.001
+grep -q "exclude each other" "$work/err" || fail "--max-size with --tolerance: $(cat "$work/err")"
+expect_exit 2 "max size out of range" -- "$bake" "$font" --max-size 2000
+expect_exit 2 "max size below a pixel" -- "$bake" "$font" --max-size 0.5
 expect_exit 3 "missing font" -- "$bake" "$work/missing.ttf"
 head -c 5000 /dev/urandom > "$work/noise.ttf"
 expect_exit 3 "not a font" -- "$bake" "$work/noise.ttf" -o "$work/noise.crisp"
@@ -55,12 +59,25 @@ assert r["cubics"] > 0 and r["cubic_pieces"] >= r["cubics"], r
 lowering = r["cubic_lowering"]
 assert 0 < lowering["max_deviation_em"] <= lowering["tolerance_em"], lowering
 assert lowering["seed_split_max_deviation_em"] > lowering["max_deviation_em"], lowering
+assert lowering["max_size_px"] == 16 and 0 < lowering["max_deviation_px"] <= 1 / 1024, lowering
 assert r["bands"]["total"] > 0 and r["curves_per_glyph"]["max"] > 0, r
 assert r["asset_bytes"] > 0 and r["seconds"] >= 0 and r["peak_rss_bytes"] > 0, r
+PY
+# --max-size sets the tolerance to 1/1024 px at that size, and the report gives the deviation there.
+expect_exit 0 "max size bake" -- "$bake" "$source/fonts/Inter-Regular.otf" --text "Quick" --max-size 64 --json -o "$work/inter64.crisp"
+python3 - "$work/out" <<'PY' || fail "--max-size 64: the report is not as expected"
+import json, sys
+lowering = json.load(open(sys.argv[1]))["cubic_lowering"]
+assert abs(lowering["tolerance_em"] - 1 / 65536) < 1e-12, lowering
+assert lowering["max_size_px"] == 64 and 0 < lowering["max_deviation_px"] <= 1 / 1024, lowering
+assert abs(lowering["thirds_coverage_per_edge"] - 3 * lowering["max_deviation_px"]) < 1e-12, lowering
 PY
 expect_exit 0 "json check" -- "$bake" --check "$work/inter.crisp" --json
 python3 -c "import json,sys; r=json.load(open(sys.argv[1])); assert r['valid'] and r['cubic'], r" "$work/out" ||
   fail "--check --json output is wrong"
+expect_exit 0 "json check of a max size bake" -- "$bake" --check "$work/inter64.crisp" --json
+python3 -c "import json,sys; r=json.load(open(sys.argv[1])); assert r['tolerance_size_px'] == 64, r" "$work/out" ||
+  fail "--check --json does not give the size the asset was baked for"
 
 # A collection face and a variable instance.
 expect_exit 0 "ttc face" -- "$bake" /usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc --face 2 --text "骨" -o "$work/cjk.crisp" --json

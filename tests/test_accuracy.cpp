@@ -53,8 +53,11 @@ using test::Texel;
 
 // Renders the glyph instances with `samples` samples per glyph and measures the error.
 // Rows: every texel channel is also held to the CPU reference in float, sample for sample.
+// `truth_asset`, when given, holds the same glyphs baked otherwise (finer): the exact coverage is then
+// that of its curves, over the texels of the rects `font` was drawn at.
 Accuracy render_and_measure(const Font& font, std::span<const GlyphInstance> glyphs, const SubpixelLayout& layout,
-                            uint32_t samples, uint32_t atlas_size = 512, SampleKind kind = SampleKind::rows) {
+                            uint32_t samples, uint32_t atlas_size = 512, SampleKind kind = SampleKind::rows,
+                            const FontAsset* truth_asset = nullptr) {
     HeadlessContext& ctx = *context();
     RendererCreateInfo info = renderer_create_info(ctx);
     info.sample_kind = kind;
@@ -78,7 +81,8 @@ Accuracy render_and_measure(const Font& font, std::span<const GlyphInstance> gly
     EXPECT_EQ(renderer->drawn().size(), glyphs.size());
     for (const DrawnGlyph& d : renderer->drawn()) {
         const GlyphRecord& glyph = font.asset().glyphs[d.instance.key.glyph];
-        const ExactCoverage exact(font.asset(), glyph);
+        const ExactCoverage exact = truth_asset ? ExactCoverage(*truth_asset, truth_asset->glyphs[d.instance.key.glyph])
+                                                : ExactCoverage(font.asset(), glyph);
         const TexelToEm map = texel_to_em(glyph_rect(glyph, d.instance.key), d.instance.key);
         for (uint32_t ty = 0; ty < d.instance.height; ++ty) {
             for (uint32_t tx = 0; tx < d.instance.width; ++tx) {
@@ -184,6 +188,46 @@ TEST(Accuracy, SizesFromSixToTwoHundredPixelsAndFractionalOffsets) {
         EXPECT_TRUE(a.in_range);
         EXPECT_LT(a.mean, 0.02);
         EXPECT_LT(a.max, 0.2);
+    }
+}
+
+// Issue 31: converged CFF text within one 8-bit code of the font's own outline at subpixel
+// thirds, where a channel a third of a pixel wide weighs the lowering's deviation three times.
+// The truth is the same glyph baked at 1e-6 em (its lowering error 5e-5 px at 48 px); the old
+// default of 1/4096 em put Inter's 'R' at 16 px 0.006 off and at 48 px further.
+TEST(Accuracy, ConvergedCffWithinOneCodeAtThirds) {
+    REQUIRE_GPU();
+    BakeOptions fine;
+    fine.all_glyphs = false;
+    fine.codepoints = decode_utf8("R");
+    fine.tolerance_em = 1e-6f;
+    auto truth = bake_font_file(test::kInterCff, fine);
+    ASSERT_TRUE(truth) << truth.error().message;
+    struct Case {
+        float size;
+        float max_size_px;  // the bake's; 0: the default
+    };
+    for (const Case c : {Case{16.0f, 0.0f}, Case{48.0f, 48.0f}}) {
+        BakeOptions options = fine;
+        options.tolerance_em = kDefaultToleranceEm;
+        options.max_size_px = c.max_size_px;
+        auto baked = bake_font_file(test::kInterCff, options);
+        ASSERT_TRUE(baked) << baked.error().message;
+        // Within the float rounding of kPixelTolerance / 48.
+        EXPECT_LE(baked->report.max_deviation_px, static_cast<double>(kPixelTolerance) * (1.0 + 1e-6));
+        auto font = Font::create(std::move(baked->asset), 1);
+        ASSERT_TRUE(font) << font.error().message;
+        const auto glyphs = lay_out(*font, "R", c.size, 1.37f, 0.61f + c.size);
+        ASSERT_EQ(glyphs.size(), 1u);
+        const Accuracy a =
+            render_and_measure(*font, glyphs, *subpixel_preset("rgb"), 512, 512, SampleKind::rows, &truth->asset);
+        report(
+            ("Inter 'R' rgb " + std::to_string(static_cast<int>(c.size)) + " px, 512 samples, against 1e-6 em").c_str(),
+            a);
+        EXPECT_TRUE(a.in_range);
+        EXPECT_EQ(a.texels_unlike_reference, 0u);
+        EXPECT_LE(a.max, 1.0 / 255.0) << c.size << " px";
+        EXPECT_LT(a.mean, 0.0005) << c.size << " px";
     }
 }
 

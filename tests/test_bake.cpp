@@ -12,6 +12,7 @@
 #include <hb.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace crisp {
@@ -253,6 +254,38 @@ TEST(Bake, BadFontsAreErrorsNotCrashes) {
     auto d = bake_font_file(test::kDejaVuSans, bad_tolerance);
     ASSERT_FALSE(d);
     EXPECT_EQ(d.error().code, ErrorCode::invalid_argument);
+}
+
+// Issue 31: the tolerance follows the largest size the asset is drawn at, and the report gives
+// the deviation in pixels at that size.
+TEST(Bake, MaxSizeSetsTheToleranceInPixels) {
+    BakeOptions options = subset("Sag");
+    auto at16 = bake_font_file(test::kInterCff, options);
+    ASSERT_TRUE(at16) << at16.error().message;
+    EXPECT_EQ(at16->report.tolerance_em, static_cast<double>(kPixelTolerance / kDefaultMaxSizePx));
+    EXPECT_EQ(at16->report.report_size_px, static_cast<double>(kDefaultMaxSizePx));
+    EXPECT_GT(at16->report.max_deviation_px, 0.0);
+    EXPECT_LE(at16->report.max_deviation_px, static_cast<double>(kPixelTolerance));
+
+    options.max_size_px = 64.0f;
+    options.tolerance_em = 0.01f;  // not read once a size is given
+    auto at64 = bake_font_file(test::kInterCff, options);
+    ASSERT_TRUE(at64) << at64.error().message;
+    EXPECT_EQ(at64->report.tolerance_em, static_cast<double>(kPixelTolerance / 64.0f));
+    EXPECT_FLOAT_EQ(at64->asset.info.tolerance_em, kPixelTolerance / 64.0f);
+    EXPECT_EQ(at64->report.report_size_px, 64.0);
+    EXPECT_LE(at64->report.max_deviation_px, static_cast<double>(kPixelTolerance));
+    EXPECT_NEAR(at64->report.max_deviation_px, at64->report.max_deviation_em * 64.0, 1e-12);
+    // A quarter of the tolerance costs more pieces (about 4^(1/3) as many).
+    EXPECT_GT(at64->report.cubic_pieces, at16->report.cubic_pieces * 5 / 4);
+
+    for (const float bad : {0.5f, -1.0f, kMaxBakeSizePx * 2.0f, std::numeric_limits<float>::quiet_NaN()}) {
+        options.max_size_px = bad;
+        auto refused = bake_font_file(test::kInterCff, options);
+        ASSERT_FALSE(refused) << bad;
+        EXPECT_EQ(refused.error().code, ErrorCode::invalid_argument) << bad;
+        EXPECT_NE(refused.error().message.find("largest size"), std::string::npos) << refused.error().message;
+    }
 }
 
 TEST(Bake, SplittingAtYExtremaAddsCurvesAndKeepsTheAssetValid) {

@@ -90,8 +90,12 @@ void declare_options(crisp::cli::CommandLine& cli, Arguments& args, std::vector<
                    text_codepoints);
     cli.option("--codepoints", "RANGES", "the same for code points: U+0020-007E,0x4E00-0x4E10,65",
                [&bake](std::string_view text) { return append_codepoints(bake, crisp::parse_codepoint_ranges(text)); });
-    cli.number<float>("--tolerance", "EM", "largest cubic-to-quadratic deviation in em (default 1/4096)",
+    cli.number<float>("--tolerance", "EM", "largest cubic-to-quadratic deviation in em (default 1/16384)",
                       bake.tolerance_em, {0.0f, 0.1f, true, " em"});
+    cli.number<float>("--max-size", "PX",
+                      "the largest size the asset is drawn at, 1..1024 px per em: cubics are\n"
+                      "lowered within 1/1024 px at that size (default 16, --tolerance 1/16384)",
+                      bake.max_size_px, {1.0f, crisp::kMaxBakeSizePx, false, " px"});
     cli.flag("--split-y-extrema", "split curves at their y-extrema (measured not to pay; see docs)",
              bake.split_y_extrema);
     cli.number<uint32_t>("--max-curves", "N", "a glyph with more than N curves fails, 1..4096 (default 4096)",
@@ -119,6 +123,9 @@ Arguments parse_arguments(int argc, char** argv) {
     declare_options(cli, args, text_codepoints);
     cli.parse(argc, argv);
     if (cli.given("--text") && cli.given("--codepoints")) cli.fail("--text and --codepoints exclude each other");
+    if (cli.given("--tolerance") && cli.given("--max-size")) {
+        cli.fail("--tolerance and --max-size exclude each other (--max-size sets the tolerance)");
+    }
     if (cli.given("--text") || cli.given("--codepoints")) args.bake.all_glyphs = false;
     args.bake.codepoints.insert(args.bake.codepoints.end(), text_codepoints.begin(), text_codepoints.end());
     if (!args.check.empty()) {
@@ -132,6 +139,12 @@ Arguments parse_arguments(int argc, char** argv) {
         args.output = stem + ".crisp";
     }
     return args;
+}
+
+// The size at which the asset's tolerance is crisp::kPixelTolerance: what --max-size it was baked
+// for (or would have been, for a tolerance given in em).
+double tolerance_size_px(const crisp::FontInfo& info) {
+    return static_cast<double>(crisp::kPixelTolerance) / static_cast<double>(info.tolerance_em);
 }
 
 double peak_rss_bytes() {
@@ -234,6 +247,7 @@ int run_check(const Arguments& args) {
             .field("band_words", asset->band_words.size())
             .field("font_bytes", asset->font_bytes.size())
             .field("tolerance_em", info.tolerance_em)
+            .field("tolerance_size_px", tolerance_size_px(info))
             .field("max_deviation_em", info.max_deviation_em)
             .end_object();
         std::fputs(json.line().c_str(), stdout);
@@ -252,8 +266,9 @@ int run_check(const Arguments& args) {
         std::printf("  curves      %llu slots, %zu points; %llu bands, %zu bitset words\n",
                     static_cast<unsigned long long>(slots), asset->points.size(),
                     static_cast<unsigned long long>(bands), asset->band_words.size());
-        std::printf("  lowering    tolerance %.3g em, largest deviation %.3g em\n",
-                    static_cast<double>(info.tolerance_em), static_cast<double>(info.max_deviation_em));
+        std::printf("  lowering    tolerance %.3g em (1/1024 px at %.4g px), largest deviation %.3g em\n",
+                    static_cast<double>(info.tolerance_em), tolerance_size_px(info),
+                    static_cast<double>(info.max_deviation_em));
         std::printf("  font bytes  %s\n", human_bytes(static_cast<double>(asset->font_bytes.size())).c_str());
     }
     return kExitOk;
@@ -300,6 +315,9 @@ crisp::JsonWriter report_json(const Arguments& args, const crisp::FontInfo& info
     json.key("cubic_lowering").begin_object();
     json.field("tolerance_em", info.tolerance_em)
         .field("max_deviation_em", r.max_deviation_em)
+        .field("max_size_px", r.report_size_px)
+        .field("max_deviation_px", r.max_deviation_px)
+        .field("thirds_coverage_per_edge", 3.0 * r.max_deviation_px)
         .field("max_deviation_px_at_16px", r.max_deviation_em * px16)
         .field("seed_split_max_deviation_em", r.seed_max_deviation_em)
         .field("seed_split_max_deviation_px_at_16px", r.seed_max_deviation_em * px16)
@@ -348,9 +366,12 @@ void print_report(const Arguments& args, const crisp::FontInfo& info, const cris
         static_cast<unsigned long long>(r.band_count), r.max_bands_per_glyph, r.mean_curves_per_band,
         r.max_curves_per_band, r.mean_curve_tests_per_ray);
     if (r.cubic_count > 0) {
-        std::printf("  cubics        tolerance %.3g em; largest deviation %.3g em (%.4f px at 16 px) in %llu pieces\n",
-                    static_cast<double>(info.tolerance_em), r.max_deviation_em, r.max_deviation_em * px16,
+        std::printf("  cubics        tolerance %.3g em; largest deviation %.3g em in %llu pieces\n",
+                    static_cast<double>(info.tolerance_em), r.max_deviation_em,
                     static_cast<unsigned long long>(r.cubic_pieces));
+        std::printf(
+            "                at %g px and below: %.5f px (an edge across a third-pixel channel: up to %.4f of it)\n",
+            r.report_size_px, r.max_deviation_px, 3.0 * r.max_deviation_px);
         std::printf("                the seed's split in two: %.3g em (%.4f px at 16 px) in %llu pieces\n",
                     r.seed_max_deviation_em, r.seed_max_deviation_em * px16,
                     static_cast<unsigned long long>(r.seed_cubic_pieces));

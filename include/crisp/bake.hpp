@@ -28,9 +28,18 @@
 
 namespace crisp {
 
-// The default cubic-to-quadratic tolerance in em; docs/cubic-lowering.md shows the measurement
-// behind it (1/4096 em is 1/16 px at 256 px per em).
-inline constexpr float kDefaultToleranceEm = 1.0f / 4096.0f;
+// The cubic-to-quadratic tolerance follows the sizes an asset is drawn at: a lowered cubic
+// deviates from the font's by at most kPixelTolerance px at the largest size it is baked for
+// (BakeOptions::max_size_px), kDefaultMaxSizePx unless told. An edge moved by d px across a
+// channel a third of a pixel wide (subpixel thirds) changes its coverage by at most 3 d: 3/1024
+// here, within the 1/255 of an 8-bit code (docs/cubic-lowering.md has the measurement).
+inline constexpr float kPixelTolerance = 1.0f / 1024.0f;
+inline constexpr float kDefaultMaxSizePx = 16.0f;
+// The largest size BakeOptions::max_size_px takes: it bounds how finely a bake cuts cubics (the
+// pieces grow as the cube root of the size, and a glyph past kMaxCurvesPerGlyph fails).
+inline constexpr float kMaxBakeSizePx = 1024.0f;
+// kPixelTolerance at kDefaultMaxSizePx: 1/16384 em (it was 1/4096 em before issue 31).
+inline constexpr float kDefaultToleranceEm = kPixelTolerance / kDefaultMaxSizePx;
 
 // Bands are added until the fullest band holds at most this many curves, or until kMaxBands.
 inline constexpr uint32_t kTargetCurvesPerBand = 4;
@@ -75,7 +84,11 @@ struct BakeOptions {
     std::vector<uint32_t> codepoints;
     bool all_glyphs = true;                    // false: bake only `codepoints` (and their closure)
     float tolerance_em = kDefaultToleranceEm;  // largest cubic-to-quadratic deviation, in (0, 0.1]
-    bool split_y_extrema = false;              // split quadratics at y-extrema (docs/cubic-lowering.md)
+    // The largest size (px per em) the asset is drawn at, in [1, kMaxBakeSizePx]; when set (not
+    // 0), cubics are lowered within kPixelTolerance / max_size_px em and tolerance_em is not read.
+    // 0: not given, tolerance_em holds. Anything else outside that range, or NaN: invalid_argument.
+    float max_size_px = 0.0f;
+    bool split_y_extrema = false;  // split quadratics at y-extrema (docs/cubic-lowering.md)
     // A glyph with more curves fails; at most kMaxCurvesPerGlyph (asset.hpp).
     uint32_t max_curves_per_glyph = kMaxCurvesPerGlyph;
     // Keep going past failed glyphs, baking them empty; past malformed colour glyphs, drawing
@@ -110,7 +123,14 @@ struct BakeReport {
     // Mean curves a sample ray tests: per glyph, the band curve counts weighted by band height,
     // then averaged over glyphs with an outline. The cost model of the rasterizer.
     double mean_curve_tests_per_ray = 0.0;
-    double max_deviation_em = 0.0;       // largest measured cubic-to-quadratic deviation
+    double tolerance_em = 0.0;  // the tolerance the cubics were lowered within
+    // The size the deviation is reported at: max_size_px where given, else kDefaultMaxSizePx.
+    double report_size_px = 0.0;
+    double max_deviation_em = 0.0;  // largest measured cubic-to-quadratic deviation
+    // max_deviation_em at report_size_px, in px: a bound on how far a lowered edge lies from the
+    // font's at that size and below. An edge that crosses a channel a third of a pixel wide from
+    // top to bottom moves its coverage by at most 3 times it (more edges in one channel add up).
+    double max_deviation_px = 0.0;
     double seed_max_deviation_em = 0.0;  // the same for the seed's fixed split in two
     uint64_t seed_cubic_pieces = 0;      // 2 per cubic
     uint64_t asset_bytes = 0;            // size of the serialized asset
@@ -142,7 +162,8 @@ struct BakeResult {
 // check_font_container says; neither scalable outlines nor colour bitmaps; units per em outside
 // 16..16384; a variation on a face without axes or an unknown axis tag; an asset that would pass
 // kMaxAssetPointBytes, kMaxAssetBandBytes or 1 GiB, at the glyph that would pass it),
-// invalid_argument (a tolerance outside (0, 0.1] or a non-finite axis value), glyph_failed (a
+// invalid_argument (a tolerance outside (0, 0.1], a max_size_px neither 0 nor in [1,
+// kMaxBakeSizePx], or a non-finite axis value), glyph_failed (a
 // glyph could not be converted, its advance or bearing is past +-64 em, or a colour glyph's paint
 // graph is malformed: a cycle, a limit passed, a bad offset or palette index; with allow_failed
 // false, the message names the first glyph and why). A COLR or CPAL table that

@@ -336,6 +336,11 @@ Status check_options(std::span<const std::byte> font_bytes, const BakeOptions& o
     if (!(options.tolerance_em > 0.0f && options.tolerance_em <= 0.1f)) {
         return Error{ErrorCode::invalid_argument, "tolerance must be in (0, 0.1] em"};
     }
+    if (!(options.max_size_px == 0.0f || (options.max_size_px >= 1.0f && options.max_size_px <= kMaxBakeSizePx))) {
+        return Error{ErrorCode::invalid_argument, "the largest size to bake for must be in [1, " +
+                                                      std::to_string(static_cast<int>(kMaxBakeSizePx)) +
+                                                      "] px per em (0: not given)"};
+    }
     if (options.max_curves_per_glyph == 0 || options.max_curves_per_glyph > kMaxCurvesPerGlyph) {
         return Error{ErrorCode::invalid_argument,
                      "the curve limit per glyph must be 1 to " + std::to_string(kMaxCurvesPerGlyph)};
@@ -511,9 +516,12 @@ void finish_report(const OutlineCounters& counters, BakeReport& report) {
 
 }  // namespace
 
-Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& options) {
+Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOptions& given) {
     const auto started = std::chrono::steady_clock::now();
-    if (Status status = check_options(font_bytes, options); !status) return status.error();
+    if (Status status = check_options(font_bytes, given); !status) return status.error();
+    // A size to bake for sets the tolerance: kPixelTolerance at that size.
+    BakeOptions options = given;
+    if (given.max_size_px > 0.0f) options.tolerance_em = kPixelTolerance / given.max_size_px;
     if (Status status = check_font_tables(font_bytes, options.face_index); !status) return status.error();
     Result<OpenedFace> opened = open_face(font_bytes, options);
     if (!opened) return opened.error();
@@ -558,6 +566,9 @@ Result<BakeResult> bake_font(std::span<const std::byte> font_bytes, const BakeOp
     info.max_deviation_em = static_cast<float>(counters.max_deviation);
     asset.font_bytes.assign(font_bytes.begin(), font_bytes.end());
     finish_report(counters, report);
+    report.tolerance_em = static_cast<double>(options.tolerance_em);
+    report.report_size_px = static_cast<double>(given.max_size_px > 0.0f ? given.max_size_px : kDefaultMaxSizePx);
+    report.max_deviation_px = report.max_deviation_em * report.report_size_px;
 
     if (report.failed_glyphs > 0 && !options.allow_failed) {
         return Error{ErrorCode::glyph_failed, std::to_string(report.failed_glyphs) + " of " + std::to_string(*to_do) +

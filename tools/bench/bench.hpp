@@ -90,6 +90,14 @@ struct Options {
     // coverage
     uint32_t cells_gray = 16;
     uint32_t cells_rgb = 64;
+    // --glyph PATH:PX:TEXT, repeatable: these glyphs instead of the suite's set.
+    struct CoverageGlyph {
+        std::string path;
+        float size = 16.0f;
+        std::string text;
+    };
+    std::vector<CoverageGlyph> coverage_glyphs;
+    std::optional<float> tolerance;  // --tolerance: the bake's cubic-to-quadratic tolerance, em
 
     // colour
     std::optional<uint32_t> glyphs;

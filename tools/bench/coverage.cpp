@@ -2,8 +2,10 @@
 // (N = 1, 2, 4, ..., --samples), per sample kind (rows, points) and layout (gray, rgb thirds), on a
 // varied set of glyphs, with FreeType's CPU rasterizer as a peer on the same texels. The reference
 // is not crisp's own sampler: FreeType's area coverage of the original outline on a grid of S x S
-// cells per texel (support/freetype_reference.hpp, docs/coverage.md).
+// cells per texel (support/freetype_reference.hpp, docs/coverage.md). At the largest sample count
+// each glyph's error is split into sampling, cubic lowering and the reference's own error.
 #include "bench.hpp"
+#include "coverage.hpp"
 #include "freetype_reference.hpp"
 #include "harness.hpp"
 #include "core/utf8.hpp"
@@ -45,12 +47,19 @@ constexpr uint32_t tag(const char (&name)[5]) {
 
 const char* const kNotoCjk = "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc";
 const char* const kDejaVuSerifItalic = "/usr/share/fonts/truetype/dejavu/DejaVuSerif-Italic.ttf";
+const char* const kCantarellThin = "/usr/share/fonts/opentype/cantarell/Cantarell-Thin.otf";
 
 // The glyph set: TrueType and CFF, a hairline (Inter at weight 100), a variable font's overlapping
-// contours (Inter's default instance keeps them), italic, CJK, and 4 to 240 px. The system fonts
-// (scripts/setup.sh installs them) are left out, with a warning, where they are missing.
+// contours (Inter's default instance keeps them), italic, a thin CFF face, CJK, and 4 to 240 px.
+// The system fonts (scripts/setup.sh installs them) are left out, with a warning, where they are
+// missing. --glyph replaces the set.
 std::vector<GlyphSpec> glyph_set(const Options& options) {
     std::vector<GlyphSpec> set;
+    if (!options.coverage_glyphs.empty()) {
+        for (const Options::CoverageGlyph& g : options.coverage_glyphs)
+            set.push_back({g.path, 0, {}, g.text, g.size, "--glyph"});
+        return set;
+    }
     if (options.quick) {
         set = {{data_file("fonts/DejaVuSans.ttf"), 0, {}, "g", 13.0f, "TrueType"},
                {data_file("fonts/Inter-Regular.otf"), 0, {}, "S", 9.0f, "CFF"},
@@ -76,6 +85,7 @@ std::vector<GlyphSpec> glyph_set(const Options& options) {
              "variable, wght 100 (hairline)"},
             {data_file("fonts/Inter-roman.var.ttf"), 0, {}, "Ak$", 20.0f, "variable, overlapping contours"},
             {kDejaVuSerifItalic, 0, {}, "fy", 18.0f, "italic"},
+            {kCantarellThin, 0, {}, "S", 23.3f, "thin CFF (issue 31's worst texel)"},
             {kNotoCjk, 0, {}, "\u6c38", 13.0f, "CJK, CFF"},
             {kNotoCjk, 0, {}, "\u9f98", 24.0f, "CJK, hundreds of curves"},
         };
@@ -90,7 +100,13 @@ struct LoadedFont {
     std::vector<Variation> variations;
     std::unique_ptr<Font> font;
     std::unique_ptr<freetype::Face> face;
+    // The same glyphs baked at kFineToleranceEm: the outline with no lowering error to speak of.
+    FontAsset fine;
 };
+
+// The tolerance of the bake that stands for the unlowered outline in the split of the error:
+// 1e-6 em is 2.4e-4 px at 240 px, far below every other part measured.
+constexpr float kFineToleranceEm = 1e-6f;
 
 // One glyph instance of the set, where it is drawn, and what it is.
 struct SetGlyph {
@@ -163,6 +179,8 @@ public:
             }
             print_table(layout_name, kinds, by_kind);
             peers(layout_name, references);
+            std::fputs(split_md_.c_str(), session_.md);
+            split_md_.clear();
         }
         session_.json.end_array();
         write_peers_json();
@@ -177,24 +195,38 @@ private:
             }
         }
         std::string text;
+        float largest = 0.0f;
         for (const GlyphSpec& s : specs_) {
             if (s.path == spec.path && describe_variations(s.variations) == describe_variations(spec.variations)) {
                 text += s.text;
+                largest = std::max(largest, s.size);
             }
         }
         BakeOptions bake;
+        // Baked for the largest size it is drawn at, as an application bakes for its sizes
+        // (crisp-bake --max-size); --tolerance instead sets the tolerance in em.
+        bake.max_size_px = std::clamp(largest, 1.0f, kMaxBakeSizePx);
         bake.all_glyphs = false;
         bake.codepoints = decode_utf8(text);
         bake.face_index = spec.face;
         bake.variations = spec.variations;
+        if (options_.tolerance) {
+            bake.tolerance_em = *options_.tolerance;
+            bake.max_size_px = 0.0f;
+        }
         auto baked = bake_font_file(spec.path, bake);
         if (!baked) fail(kSuite, spec.path + ": " + baked.error().message);
+        bake_notes_.push_back({std::filesystem::path(spec.path).filename().string(), baked->report});
+        bake.max_size_px = 0.0f;
+        bake.tolerance_em = kFineToleranceEm;
+        auto fine = bake_font_file(spec.path, bake);
+        if (!fine) fail(kSuite, spec.path + ": " + fine.error().message);
         auto font = Font::create(std::move(baked->asset), static_cast<FontId>(fonts_.size() + 1));
         if (!font) fail(kSuite, spec.path + ": " + font.error().message);
         auto face = freetype::Face::open_file(spec.path, spec.face, spec.variations);
         if (!face) fail(kSuite, spec.path + ": FreeType: " + face.error().message);
         fonts_.push_back({spec.path, spec.variations, std::make_unique<Font>(std::move(*font)),
-                          std::make_unique<freetype::Face>(std::move(*face))});
+                          std::make_unique<freetype::Face>(std::move(*face)), std::move(fine->asset)});
         return fonts_.back();
     }
 
@@ -256,7 +288,9 @@ private:
             points.push_back(errors_at(*renderer, expected, references));
             if (expected == max_samples) break;
         }
-        session_.json.end_array().end_object();
+        session_.json.end_array().key("split");
+        split(layout, layout_name, kind, last_images_, references);
+        session_.json.end_object();
         session_.coverage_error[{layout_name, sample_kind_name(kind)}] = points;
         return points;
     }
@@ -295,12 +329,14 @@ private:
                 }
             }
         }
+        last_images_ = images;
         if (wrong_counts > 0) {
             session_.warn(kSuite, std::to_string(wrong_counts) + " texels did not hold " + std::to_string(samples) +
                                       " samples when read");
         }
         ErrorPoint point;
         point.samples = samples;
+        last_samples_ = samples;
         std::vector<double> means, worsts;
         for (size_t i = 0; i < glyphs_.size(); ++i) {
             auto error = freetype::compare_coverage(images[i], references[i]);
@@ -318,6 +354,114 @@ private:
             .field("glyph_worst", worsts)
             .end_object();
         return point;
+    }
+
+    // The exact area coverage of the glyph's curves in `asset` over the texels of its rect as the
+    // GPU drew it, per channel rectangle of `layout` (the mapping of test_accuracy.cpp).
+    freetype::CoverageImage exact_image(const FontAsset& asset, const GlyphInstance& g, const SubpixelLayout& layout) {
+        const GlyphRect rect = rect_of(g);
+        const ExactCoverage exact(asset, asset.glyphs[g.key.glyph]);
+        const TexelToEm map = texel_to_em(rect, g.key);
+        freetype::CoverageImage image;
+        image.width = rect.width;
+        image.height = rect.height;
+        image.values.assign(size_t{rect.width} * rect.height * 3, 0.0f);
+        const double ox = map.offset_x, oy = map.offset_y, sx = map.scale_x, sy = map.scale_y;
+        for (uint32_t row = 0; row < rect.height; ++row) {
+            for (uint32_t column = 0; column < rect.width; ++column) {
+                for (size_t c = 0; c < 3; ++c) {
+                    const SampleRect& r = layout.channels[c];
+                    const double x0 = ox + sx * (column + static_cast<double>(r.x0));
+                    const double x1 = ox + sx * (column + static_cast<double>(r.x1));
+                    const double ya = oy + sy * (row + static_cast<double>(r.y0));
+                    const double yb = oy + sy * (row + static_cast<double>(r.y1));
+                    image.values[(size_t{row} * rect.width + column) * 3 + c] =
+                        static_cast<float>(exact.coverage(x0, std::min(ya, yb), x1, std::max(ya, yb)));
+                }
+            }
+        }
+        return image;
+    }
+
+    // The error at the largest sample count split into its parts, per glyph, on the CPU: sampling
+    // (the atlas against the exact area of the curves it was drawn from), lowering (those curves'
+    // exact area against the same glyph baked at kFineToleranceEm) and the reference's own error
+    // (FreeType's cells against that fine bake). At the worst texel of the total (atlas against
+    // FreeType), the three signed parts add up to it.
+    void split(const SubpixelLayout& layout, const char* layout_name, SampleKind kind,
+               const std::vector<freetype::CoverageImage>& atlas,
+               const std::vector<freetype::CoverageImage>& references) {
+        split_md_ += format(
+            "\nThe error at %u samples (%s, %s) split into its parts: sampling (atlas against the exact "
+            "area of the baked curves), lowering (baked curves against the glyph baked at %g em), "
+            "reference (FreeType's cells against that). Worst of each over the glyph's texels; then the "
+            "worst texel of the total and its three signed parts.\n\n"
+            "| glyph | px | total: mean | worst | sampling: worst | lowering: worst | reference: worst "
+            "| worst texel: total = sampling + lowering + reference |\n"
+            "|---|---:|---:|---:|---:|---:|---:|---|\n",
+            last_samples_, layout_name, sample_kind_name(kind), static_cast<double>(kFineToleranceEm));
+        session_.json.begin_object()
+            .field("layout", layout_name)
+            .field("sample_kind", sample_kind_name(kind))
+            .field("samples", last_samples_)
+            .field("fine_tolerance_em", static_cast<double>(kFineToleranceEm))
+            .key("glyphs")
+            .begin_array();
+        for (size_t i = 0; i < glyphs_.size(); ++i) {
+            const GlyphInstance& g = glyphs_[i].instance;
+            const freetype::CoverageImage baked = exact_image(font_of(g).font->asset(), g, layout);
+            const freetype::CoverageImage fine = exact_image(font_of(g).fine, g, layout);
+            auto total = freetype::compare_coverage(atlas[i], references[i]);
+            auto sampling = freetype::compare_coverage(atlas[i], baked);
+            auto lowering = freetype::compare_coverage(baked, fine);
+            auto reference = freetype::compare_coverage(fine, references[i]);
+            if (!total || !sampling || !lowering || !reference) fail(kSuite, "split: images of different sizes");
+            const uint32_t at_column = total->worst_column, at_row = total->worst_row,
+                           at_channel = total->worst_channel;
+            auto at = [&](const freetype::CoverageImage& image) {
+                return static_cast<double>(image.at(at_column, at_row, at_channel));
+            };
+            const double part_sampling = at(atlas[i]) - at(baked);
+            const double part_lowering = at(baked) - at(fine);
+            const double part_reference = at(fine) - at(references[i]);
+            const std::string name =
+                std::filesystem::path(glyphs_[i].spec->path).filename().string() + " U+" + hex(glyphs_[i].codepoint);
+            split_md_ += format("| %s | %g | %.4f | %.4f | %.4f | %.4f | %.4f | %+.4f = %+.4f %+.4f %+.4f |\n",
+                                name.c_str(), static_cast<double>(glyphs_[i].spec->size), total->mean, total->worst,
+                                sampling->worst, lowering->worst, reference->worst, at(atlas[i]) - at(references[i]),
+                                part_sampling, part_lowering, part_reference);
+            session_.json.begin_object()
+                .field("glyph", name)
+                .field("size", glyphs_[i].spec->size)
+                .field("total_mean", total->mean)
+                .field("total_worst", total->worst)
+                .field("sampling_mean", sampling->mean)
+                .field("sampling_worst", sampling->worst)
+                .field("lowering_mean", lowering->mean)
+                .field("lowering_worst", lowering->worst)
+                .field("reference_mean", reference->mean)
+                .field("reference_worst", reference->worst)
+                .field("worst_texel_sampling", part_sampling)
+                .field("worst_texel_lowering", part_lowering)
+                .field("worst_texel_reference", part_reference)
+                .end_object();
+        }
+        session_.json.end_array().end_object();
+    }
+
+    template <class... Args>
+    static std::string format(const char* pattern, Args... args) {
+        const int n = std::snprintf(nullptr, 0, pattern, args...);
+        std::string text(static_cast<size_t>(std::max(n, 0)) + 1, '\0');
+        std::snprintf(text.data(), text.size(), pattern, args...);
+        text.pop_back();
+        return text;
+    }
+
+    static std::string hex(uint32_t codepoint) {
+        char text[16];
+        std::snprintf(text, sizeof text, "%04X", codepoint);
+        return text;
     }
 
     // FreeType as an application renders: gray against the gray reference; LCD, with and without
@@ -382,6 +526,19 @@ private:
                          variations.empty() ? "" : (" " + variations).c_str(), static_cast<double>(spec.size),
                          spec.what.c_str(), static_cast<unsigned long long>(texels));
         }
+        std::fprintf(session_.md,
+                     "\nEach font baked with the glyphs it draws here, for the largest size it draws them at "
+                     "(BakeOptions::max_size_px, crisp-bake --max-size) unless --tolerance is given:\n\n"
+                     "| font | tolerance (em) | cubics | quadratic pieces | largest deviation (px at size) | curves "
+                     "|\n|---|---:|---:|---:|---:|---:|\n");
+        for (const BakeNote& note : bake_notes_) {
+            const BakeReport& r = note.report;
+            std::fprintf(session_.md, "| %s | %.3g | %llu | %llu | %.5f at %g | %llu |\n", note.font.c_str(),
+                         r.tolerance_em, static_cast<unsigned long long>(r.cubic_count),
+                         static_cast<unsigned long long>(r.cubic_pieces), r.max_deviation_px, r.report_size_px,
+                         static_cast<unsigned long long>(r.curve_count));
+        }
+        std::fprintf(session_.md, "\n");
     }
 
     void print_table(const char* layout_name, const std::vector<SampleKind>& kinds,
@@ -406,9 +563,20 @@ private:
     void write_glyph_set_json(uint32_t max_samples) {
         session_.json.field("max_samples", max_samples)
             .field("cells_gray", options_.cells_gray)
-            .field("cells_rgb", options_.cells_rgb)
-            .key("glyphs")
-            .begin_array();
+            .field("cells_rgb", options_.cells_rgb);
+        session_.json.key("bakes").begin_array();
+        for (const BakeNote& note : bake_notes_) {
+            session_.json.begin_object()
+                .field("font", note.font)
+                .field("tolerance_em", note.report.tolerance_em)
+                .field("size_px", note.report.report_size_px)
+                .field("max_deviation_px", note.report.max_deviation_px)
+                .field("cubics", note.report.cubic_count)
+                .field("cubic_pieces", note.report.cubic_pieces)
+                .field("curves", note.report.curve_count)
+                .end_object();
+        }
+        session_.json.end_array().key("glyphs").begin_array();
         for (const SetGlyph& g : glyphs_) {
             session_.json.begin_object()
                 .field("font", g.spec->path)
@@ -455,6 +623,14 @@ private:
     std::vector<LoadedFont> fonts_;
     std::vector<SetGlyph> glyphs_;
     std::vector<PeerJson> freetype_json_;
+    std::vector<freetype::CoverageImage> last_images_;  // the atlas's texels at the last count read
+    uint32_t last_samples_ = 0;
+    std::string split_md_;  // split()'s tables, printed after the layout's table and peers
+    struct BakeNote {
+        std::string font;
+        BakeReport report;
+    };
+    std::vector<BakeNote> bake_notes_;  // each font's bake: its tolerance, deviation and curves
 };
 
 }  // namespace

@@ -33,6 +33,20 @@ cli::CommandLine::Apply name_list(std::vector<std::string>& target) {
     };
 }
 
+// --glyph PATH:PX:TEXT; the path ends at the first colon, the size at the second, the text may hold more.
+Status parse_coverage_glyph(Options& options, std::string_view text) {
+    const size_t first = text.find(':');
+    const size_t second = first == std::string_view::npos ? first : text.find(':', first + 1);
+    const Error usage{
+        ErrorCode::invalid_argument,
+        "--glyph: PATH:PX:TEXT (a font, pixels per em in [1, 4096], text), not '" + cli::printable(text) + "'"};
+    if (second == std::string_view::npos || first == 0 || second + 1 == text.size()) return usage;
+    const std::optional<float> px = cli::parse_number<float>(text.substr(first + 1, second - first - 1));
+    if (!px || !(*px >= 1.0f && *px <= 4096.0f)) return usage;
+    options.coverage_glyphs.push_back({std::string(text.substr(0, first)), *px, std::string(text.substr(second + 1))});
+    return {};
+}
+
 // --canvas W,H or WxH, each side 16..16384.
 Status parse_canvas(Options& options, std::string_view text) {
     auto size =
@@ -150,6 +164,12 @@ void declare_suite_options(cli::CommandLine& cli, Options& o) {
     cli.number<uint32_t>("--cells-gray", "S", "reference cells per texel side for gray (default 16)", o.cells_gray,
                          {1, 256});
     cli.number<uint32_t>("--cells-rgb", "S", "... for rgb thirds (default 64)", o.cells_rgb, {1, 256});
+    cli.option("--glyph", "PATH:PX:TEXT",
+               "the glyphs of TEXT in the font at PATH at PX pixels per em, instead of\n"
+               "the suite's set (repeatable; PX in [1, 4096])",
+               [&o](std::string_view text) { return parse_coverage_glyph(o, text); });
+    cli.number<float>("--tolerance", "EM", "the bake's cubic-to-quadratic tolerance (default: crisp-bake's)",
+                      o.tolerance, {1e-7f, 0.1f});
 
     cli.section("compositing:");
     cli.option("--modes", "LIST",
