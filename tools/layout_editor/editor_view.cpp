@@ -850,9 +850,15 @@ void EditorView::draw_fields(Canvas& canvas, std::vector<TextItem>& text) const 
             value = field_text(field);
         }
         if (!active) {
-            // Text longer than the field shows its end (where a path's file name is).
+            // Text longer than the field shows its end (where a path's file name is); the
+            // preview's text, its start.
             value = cli::printable(value, 1000);
-            if (measure_(value, kFieldTextSize) > room) {
+            if (field.kind == Field::Kind::text && measure_(value, kFieldTextSize) > room) {
+                while (!value.empty() && measure_(value + "...", kFieldTextSize) > room) value.pop_back();
+                while (!value.empty() && (static_cast<unsigned char>(value.back()) & 0xC0) == 0x80) value.pop_back();
+                if (!value.empty() && (static_cast<unsigned char>(value.back()) & 0x80) != 0) value.pop_back();
+                value += "...";
+            } else if (measure_(value, kFieldTextSize) > room) {
                 const std::string_view ellipsis = "...";
                 size_t start = 0;
                 while (start < value.size() &&
