@@ -16,7 +16,7 @@
 # line drawn at the bottom; and the editor idles (next to no CPU) once the preview has converged.
 # Files: the path field edited in place (click, Home, type, End, Backspace, Enter) and saved
 # under that name; Ctrl+Q with unsaved changes asks (the prompt in a screenshot, the editor still
-# running) and D discards; the recent files written and, at the next start, Up in the path field
+# running), Escape cancels, closing the window asks again, and D discards; the recent files written and, at the next start, Up in the path field
 # brings the newest back; a bad recent-files list is reported, not fatal. The preview: a text
 # typed into its field changes the paragraphs' pixels; --text, --sizes, --colours and --zoom.
 # XDG_CONFIG_HOME points into WORK_DIR: a person's own recent files are never touched.
@@ -342,6 +342,41 @@ PY
 # ---- Screenshots: each region present (not blank) and changed by the edit.
 python3 screens.py compare before.xwd after.xwd || fail "screenshots"
 
+cat >close.py <<'PY'
+# close.py WINDOW: asks the window to close as a window manager's close button does (a
+# WM_DELETE_WINDOW client message), through libX11 (xdotool 3.2016 has no windowclose).
+import ctypes, ctypes.util, sys
+x11 = ctypes.CDLL(ctypes.util.find_library("X11"))
+x11.XOpenDisplay.restype = ctypes.c_void_p
+x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+x11.XInternAtom.restype = ctypes.c_ulong
+x11.XInternAtom.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int]
+x11.XSendEvent.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_int, ctypes.c_long, ctypes.c_void_p]
+x11.XFlush.argtypes = [ctypes.c_void_p]
+x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+
+class ClientMessage(ctypes.Structure):
+    _fields_ = [("type", ctypes.c_int), ("serial", ctypes.c_ulong), ("send_event", ctypes.c_int),
+                ("display", ctypes.c_void_p), ("window", ctypes.c_ulong), ("message_type", ctypes.c_ulong),
+                ("format", ctypes.c_int), ("data", ctypes.c_long * 5), ("pad", ctypes.c_long * 24)]
+
+display = x11.XOpenDisplay(None)
+if not display:
+    sys.exit("close.py: no display")
+window = int(sys.argv[1], 0)
+event = ClientMessage()
+event.type = 33  # ClientMessage
+event.window = window
+event.message_type = x11.XInternAtom(display, b"WM_PROTOCOLS", 0)
+event.format = 32
+event.data[0] = x11.XInternAtom(display, b"WM_DELETE_WINDOW", 0)
+event.data[1] = 0  # CurrentTime
+ok = x11.XSendEvent(display, window, 0, 0, ctypes.byref(event))
+x11.XFlush(display)
+x11.XCloseDisplay(display)
+sys.exit(0 if ok else 1)
+PY
+
 # ---- Files: the path field edited in place. Click into "name.json", Home, "my-", End, Backspace:
 # saved as my-name.jso (before, the first key typed replaced the whole path).
 click_rect() {  # click_rect X Y W H [DX]: clicks DX pixels into the rectangle (default its centre)
@@ -378,6 +413,18 @@ sleep 4
 if kill -0 "$pid" 2>/dev/null; then
   shot_when_drawn prompt.xwd 0
   python3 screens.py prompt prompt.xwd || fail "the quit prompt is not in the screenshot"
+  # Escape cancels; then the close button (WM_DELETE_WINDOW, as a window manager sends it) asks
+  # again, since Cancel cleared the window's close request.
+  xdotool key Escape
+  sleep 2
+  python3 close.py "$window" || fail "close.py could not send WM_DELETE_WINDOW"
+  sleep 4
+  if kill -0 "$pid" 2>/dev/null; then
+    shot_when_drawn prompt-close.xwd 0
+    python3 screens.py prompt prompt-close.xwd || fail "closing the window: the prompt is not in the screenshot"
+  else
+    fail "closing the window with unsaved changes (after a Cancel) quit without asking"
+  fi
   xdotool key d
   for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
   kill -0 "$pid" 2>/dev/null && { fail "D (Discard) did not quit"; kill "$pid"; }
