@@ -16,8 +16,9 @@
 # line drawn at the bottom; and the editor idles (next to no CPU) once the preview has converged.
 # Files: the path field edited in place (click, Home, type, End, Backspace, Enter) and saved
 # under that name; Ctrl+Q with unsaved changes asks (the prompt in a screenshot, the editor still
-# running), Escape cancels, closing the window asks again, and D discards; the recent files written and, at the next start, Up in the path field
-# brings the newest back; a bad recent-files list is reported, not fatal. The preview: a text
+# running), Escape cancels, closing the window asks again, and D discards; the recent files
+# written and, at the next start, Up in the path field brings the newest back and a click in the
+# Recent list chooses another; a bad recent-files list is reported, not fatal. The preview: a text
 # typed into its field changes the paragraphs' pixels; --text, --sizes, --colours and --zoom.
 # XDG_CONFIG_HOME points into WORK_DIR: a person's own recent files are never touched.
 set -uo pipefail
@@ -458,6 +459,14 @@ xdotool key Up Return
 sleep 0.5
 xdotool key ctrl+o
 sleep 1
+# The Recent button's list: its second row (saved.json) clicked is put into the file field.
+# shellcheck disable=SC2046
+click_rect $(rect_of recent_button)
+sleep 1
+read -r rx ry < <(python3 -c 'import json; r=json.load(open("geometry.json"))["recent_rows"][1]
+print(int(r[0] + r[2] / 2), int(r[1] + r[3] / 2))')
+xdotool mousemove "$rx" "$ry" click 1
+sleep 1
 # shellcheck disable=SC2046
 click_rect $(rect_of preview_controls text)
 sleep 0.5
@@ -474,6 +483,8 @@ wait "$pid"
 code=$?
 [ "$code" -eq 0 ] || fail "recent: the editor exited $code: $(head -c 1500 recent.err)"
 grep -q "Loaded $work/my-name.jso" recent.err || fail "Up did not bring back the recent file: $(cat recent.err)"
+grep -q "File: $work/saved.json (Load or Save it)" recent.err ||
+  fail "a click in the Recent list did not choose its file: $(cat recent.err)"
 
 # ---- A bad recent-files list: reported, ignored, not fatal (and --frames runs do not rewrite it).
 printf '/ok
