@@ -73,7 +73,7 @@ struct Args {
     std::string text = kDefaultPreviewText;
     std::vector<float> sizes = {9.0f, 11.0f, 13.0f, 16.0f, 20.0f};
     PreviewColours colours;
-    uint32_t zoom = 1;
+    std::string zoom = "1";
 };
 
 // The window sizes --window takes, each side.
@@ -158,10 +158,10 @@ Args parse_args(int argc, char** argv) {
                    args.colours = *colours;
                    return {};
                });
-    cli.number<uint32_t>("--zoom", "N",
-                         "start with the preview zoomed N times (1, 2 or 4; Z cycles them): the\n"
-                         "other panel shows the outlined area's pixels magnified",
-                         args.zoom, {1, 4});
+    cli.choice("--zoom", "N",
+               "start with the preview zoomed N times (1, 2 or 4; Z cycles them): the\n"
+               "other panel shows the outlined area's pixels magnified",
+               args.zoom, {"1", "2", "4"});
     cli.flag("--print-geometry",
              "print the widgets' positions (window pixels, for the --window size, default\n"
              "1280x800, at --ui-scale, default 1) as JSON and quit (for scripted input)",
@@ -175,7 +175,6 @@ Args parse_args(int argc, char** argv) {
                args.export_form, std::move(forms));
     cli.parse(argc, argv);
     if (!args.screenshot.empty() && args.frames == 0) cli.fail("--screenshot needs --frames N");
-    if (args.zoom == 3) cli.fail("--zoom: 3 is not 1, 2 or 4");
     if (!args.export_form.empty() && (!args.screenshot.empty() || args.frames != 0)) {
         cli.fail("--export prints and quits: it takes no --frames or --screenshot");
     }
@@ -489,7 +488,7 @@ int main(int argc, char** argv) {
     EditorView view(model, path);
     if (load_error) view.report("Load failed: " + *load_error, true);
     view.set_preview(args.text, args.sizes, args.colours);
-    view.set_zoom(static_cast<int>(args.zoom));
+    view.set_zoom(args.zoom[0] - '0');  // "1", "2" or "4": --zoom's choices
     // Scripted runs (--frames) quit without asking, and show the recent files without changing them.
     view.set_prompt_on_quit(args.frames == 0);
     const std::filesystem::path recent = recent_files_path();
