@@ -14,6 +14,13 @@
 # onto its own --layout or --font file; FIFOs as --font or --layout are refused without a hang.
 # The window: --window WxH screenshots are that size, filled (not mostly black), with the status
 # line drawn at the bottom; and the editor idles (next to no CPU) once the preview has converged.
+# Files: the path field edited in place (click, Home, type, End, Backspace, Enter) and saved
+# under that name; Ctrl+Q with unsaved changes asks (the prompt in a screenshot, the editor still
+# running), Escape cancels, closing the window asks again, and D discards; the recent files
+# written and, at the next start, Up in the path field brings the newest back and a click in the
+# Recent list chooses another; a bad recent-files list is reported, not fatal. The preview: a text
+# typed into its field changes the paragraphs' pixels; --text, --sizes, --colours and --zoom.
+# XDG_CONFIG_HOME points into WORK_DIR: a person's own recent files are never touched.
 set -uo pipefail
 editor=$1 render=$2 bake=$3 source=$4 work=$5
 
@@ -26,6 +33,8 @@ if [ "${LAYOUT_EDITOR_TEST_INNER:-}" != 1 ]; then
 fi
 
 cd "$work"
+export XDG_CONFIG_HOME="$work/config"
+recent_list="$XDG_CONFIG_HOME/crisp/layout-editor-recent"
 failures=0
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
 geometry=$("$editor" --print-geometry) || { echo "FAIL: --print-geometry" >&2; exit 1; }
@@ -48,7 +57,7 @@ def read_xwd(path):
     ncolors = header[19]
     assert bits_per_pixel == 32, bits_per_pixel
     pixels = data[header_size + 12 * ncolors:]
-    masks = header[15:18]
+    masks = header[14:17]  # red, green and blue masks
     def at(x, y):
         off = y * bytes_per_line + 4 * x
         value = int.from_bytes(pixels[off:off + 4], "little" if byte_order == 0 else "big")
@@ -68,6 +77,26 @@ g = json.load(open("geometry.json"))
 if sys.argv[1] == "ready":  # ready SHOT: exit 0 once every view is drawn (more than 20 colours)
     w, h, image = read_xwd(sys.argv[2])
     sys.exit(1 if blank_views(g, image) else 0)
+
+if sys.argv[1] == "changed":  # changed NAME BEFORE AFTER: the region NAME differs
+    _, _, before = read_xwd(sys.argv[3])
+    _, _, after = read_xwd(sys.argv[4])
+    points = region(g, sys.argv[2])
+    count = sum(1 for x, y in points if max(abs(a - b) for a, b in zip(before(x, y), after(x, y))) > 40)
+    print(f"{sys.argv[2]}: {count} of {len(points)} samples changed")
+    sys.exit(0 if count > len(points) // 100 else 1)
+
+if sys.argv[1] == "prompt":  # prompt SHOT: the quit prompt is drawn (its box, border and text)
+    _, _, image = read_xwd(sys.argv[2])
+    x, y, w, h = (int(v) for v in g["prompt"]["box"])
+    inside = [image(px, py) for py in range(y + 2, y + h - 2, 2) for px in range(x + 2, x + w - 2, 2)]
+    near = lambda p, q: max(abs(a - b) for a, b in zip(p, q)) <= 3
+    box = sum(1 for p in inside if near(p, (30, 32, 36)))
+    light = sum(1 for p in inside if min(p) > 150)
+    border = [image(px, y) for px in range(x, x + w)]
+    gold = sum(1 for p in border if near(p, (230, 180, 60)))
+    print(f"prompt: {box} of {len(inside)} samples its colour, {light} light, border {gold} of {len(border)}")
+    sys.exit(0 if box > len(inside) // 2 and light > 40 and gold > len(border) * 9 // 10 else 1)
 
 # compare BEFORE AFTER
 w0, h0, before = read_xwd(sys.argv[2])
@@ -313,6 +342,191 @@ PY
 
 # ---- Screenshots: each region present (not blank) and changed by the edit.
 python3 screens.py compare before.xwd after.xwd || fail "screenshots"
+
+cat >close.py <<'PY'
+# close.py WINDOW: asks the window to close as a window manager's close button does (a
+# WM_DELETE_WINDOW client message), through libX11 (xdotool 3.2016 has no windowclose).
+import ctypes, ctypes.util, sys
+x11 = ctypes.CDLL(ctypes.util.find_library("X11"))
+x11.XOpenDisplay.restype = ctypes.c_void_p
+x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+x11.XInternAtom.restype = ctypes.c_ulong
+x11.XInternAtom.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int]
+x11.XSendEvent.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_int, ctypes.c_long, ctypes.c_void_p]
+x11.XFlush.argtypes = [ctypes.c_void_p]
+x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+
+class ClientMessage(ctypes.Structure):
+    _fields_ = [("type", ctypes.c_int), ("serial", ctypes.c_ulong), ("send_event", ctypes.c_int),
+                ("display", ctypes.c_void_p), ("window", ctypes.c_ulong), ("message_type", ctypes.c_ulong),
+                ("format", ctypes.c_int), ("data", ctypes.c_long * 5), ("pad", ctypes.c_long * 24)]
+
+display = x11.XOpenDisplay(None)
+if not display:
+    sys.exit("close.py: no display")
+window = int(sys.argv[1], 0)
+event = ClientMessage()
+event.type = 33  # ClientMessage
+event.window = window
+event.message_type = x11.XInternAtom(display, b"WM_PROTOCOLS", 0)
+event.format = 32
+event.data[0] = x11.XInternAtom(display, b"WM_DELETE_WINDOW", 0)
+event.data[1] = 0  # CurrentTime
+ok = x11.XSendEvent(display, window, 0, 0, ctypes.byref(event))
+x11.XFlush(display)
+x11.XCloseDisplay(display)
+sys.exit(0 if ok else 1)
+PY
+
+# ---- Files: the path field edited in place. Click into "name.json", Home, "my-", End, Backspace:
+# saved as my-name.jso (before, the first key typed replaced the whole path).
+click_rect() {  # click_rect X Y W H [DX]: clicks DX pixels into the rectangle (default its centre)
+  local x=${1%.*} y=${2%.*} w=${3%.*} h=${4%.*}
+  xdotool mousemove $((x + ${5:-$((w / 2))})) $((y + h / 2)) click 1
+}
+rect_of() {  # rect_of KEY [SUBKEY]: a widget's rectangle from geometry.json, as "x y w h"
+  python3 -c 'import json,sys; g=json.load(open("geometry.json")); r=g[sys.argv[1]]
+r=r[sys.argv[2]] if len(sys.argv) > 2 else r; print(*r)' "$@"
+}
+rm -f my-name.jso name.json
+"$editor" --validation --layout rgb --save-to name.json 2>files.err &
+pid=$!
+window=$(timeout 60 xdotool search --sync --name '^crisp layout editor$' | head -n1)
+[ -n "$window" ] || { fail "no editor window (files)"; kill "$pid"; exit 1; }
+shot_when_drawn files-start.xwd 4
+# shellcheck disable=SC2046
+click_rect $(rect_of path_field) 30
+sleep 0.5
+xdotool key Home
+xdotool type --delay 50 my-
+xdotool key End BackSpace Return
+sleep 0.5
+xdotool key ctrl+s
+for _ in $(seq 1 60); do [ -f my-name.jso ] && break; sleep 0.5; done
+[ -f my-name.jso ] || fail "the edited path: no my-name.jso saved ($(ls))"
+[ -f name.json ] && fail "the edited path: saved under the old name too"
+cp my-name.jso my-name.kept 2>/dev/null
+# An unsaved change, then Ctrl+Q: the editor asks and keeps running; D discards and quits.
+xdotool key Right
+sleep 1
+xdotool key ctrl+q
+sleep 4
+if kill -0 "$pid" 2>/dev/null; then
+  shot_when_drawn prompt.xwd 0
+  python3 screens.py prompt prompt.xwd || fail "the quit prompt is not in the screenshot"
+  # Escape cancels; then the close button (WM_DELETE_WINDOW, as a window manager sends it) asks
+  # again, since Cancel cleared the window's close request.
+  xdotool key Escape
+  sleep 2
+  python3 close.py "$window" || fail "close.py could not send WM_DELETE_WINDOW"
+  sleep 4
+  if kill -0 "$pid" 2>/dev/null; then
+    shot_when_drawn prompt-close.xwd 0
+    python3 screens.py prompt prompt-close.xwd || fail "closing the window: the prompt is not in the screenshot"
+  else
+    fail "closing the window with unsaved changes (after a Cancel) quit without asking"
+  fi
+  xdotool key d
+  for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
+  kill -0 "$pid" 2>/dev/null && { fail "D (Discard) did not quit"; kill "$pid"; }
+else
+  fail "Ctrl+Q with unsaved changes quit without asking"
+fi
+wait "$pid"
+code=$?
+[ "$code" -eq 0 ] || fail "files: the editor exited $code: $(head -c 1500 files.err)"
+cmp -s my-name.jso my-name.kept || fail "Discard changed the saved file"
+# The recent files: the ones saved or loaded, newest first, absolute.
+if [ -f "$recent_list" ]; then
+  [ "$(head -n1 "$recent_list")" = "$work/my-name.jso" ] || fail "recent files: $(cat "$recent_list")"
+  grep -qx "$work/saved.json" "$recent_list" || fail "recent files lack saved.json: $(cat "$recent_list")"
+  grep -qx "$work/start.json" "$recent_list" || fail "recent files lack start.json: $(cat "$recent_list")"
+else
+  fail "no recent files list at $recent_list"
+fi
+
+# ---- The next start reads them back: Up in the empty path field brings the newest, Ctrl+O loads
+# it. Then the preview's text: typed into its field, the paragraphs change.
+"$editor" --validation --layout rgb 2>recent.err &
+pid=$!
+window=$(timeout 60 xdotool search --sync --name '^crisp layout editor$' | head -n1)
+[ -n "$window" ] || { fail "no editor window (recent)"; kill "$pid"; exit 1; }
+shot_when_drawn text-before.xwd 6
+# shellcheck disable=SC2046
+click_rect $(rect_of path_field)
+sleep 0.5
+xdotool key Up Return
+sleep 0.5
+xdotool key ctrl+o
+sleep 1
+# The Recent button's list: its second row (saved.json) clicked is put into the file field.
+# shellcheck disable=SC2046
+click_rect $(rect_of recent_button)
+sleep 1
+read -r rx ry < <(python3 -c 'import json; r=json.load(open("geometry.json"))["recent_rows"][1]
+print(int(r[0] + r[2] / 2), int(r[1] + r[3] / 2))')
+xdotool mousemove "$rx" "$ry" click 1
+sleep 1
+# shellcheck disable=SC2046
+click_rect $(rect_of preview_controls text)
+sleep 0.5
+xdotool key ctrl+a
+xdotool type --delay 30 "Quick zephyrs blow, vexing daft Jim"
+xdotool key Return
+shot_when_drawn text-after.xwd 8
+python3 screens.py changed preview_paragraphs text-before.xwd text-after.xwd ||
+  fail "the typed preview text did not change the preview"
+xdotool key ctrl+q
+for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
+kill -0 "$pid" 2>/dev/null && { fail "the editor did not quit (recent)"; kill "$pid"; }
+wait "$pid"
+code=$?
+[ "$code" -eq 0 ] || fail "recent: the editor exited $code: $(head -c 1500 recent.err)"
+grep -q "Loaded $work/my-name.jso" recent.err || fail "Up did not bring back the recent file: $(cat recent.err)"
+grep -q "File: $work/saved.json (Load or Save it)" recent.err ||
+  fail "a click in the Recent list did not choose its file: $(cat recent.err)"
+
+# ---- A bad recent-files list: reported, ignored, not fatal (and --frames runs do not rewrite it).
+printf '/ok
+not/absolute
+' >"$recent_list"
+cp "$recent_list" recent.kept
+timeout 120 "$editor" --validation --frames 2 2>bad-recent.err
+code=$?
+[ "$code" -eq 0 ] || fail "a bad recent-files list: exit $code: $(head -c 600 bad-recent.err)"
+grep -q "Recent files ignored: .*line 2" bad-recent.err || fail "a bad recent-files list: $(cat bad-recent.err)"
+cmp -s "$recent_list" recent.kept || fail "a --frames run rewrote the recent files"
+
+# ---- The preview from the command line: --text, --sizes, --colours and --zoom change the
+# screenshot; bad sizes and colours are usage errors that say why.
+timeout 120 "$editor" --validation --frames 3 --screenshot preview-default.png 2>preview.err ||
+  fail "preview default: $(head -c 600 preview.err)"
+timeout 120 "$editor" --validation --frames 3 --screenshot preview-own.png --text "Hamburgefonstiv"   --sizes "12 24" --colours "#FFE27A on #1B3A8C" --zoom 2 2>preview.err ||
+  fail "preview options: $(head -c 600 preview.err)"
+python3 - preview-default.png preview-own.png geometry.json <<'PY' || fail "the preview options changed nothing"
+import json, sys
+exec(open("pngcheck.py").read().split("shot, geometry")[0])
+g = json.load(open(sys.argv[3]))
+_, _, a = read_png(sys.argv[1])
+_, _, b = read_png(sys.argv[2])
+for name in ("light_panel", "dark_panel"):
+    x, y, w, h = (int(v) for v in g[name])
+    points = [(px, py) for py in range(y, y + h, 3) for px in range(x, x + w, 3)]
+    changed = sum(1 for p in points if max(abs(i - j) for i, j in zip(a(*p), b(*p))) > 40)
+    print(f"{name}: {changed} of {len(points)} samples changed")
+    assert changed > len(points) // 4, name
+# The first panel's background is the colour asked for.
+x, y, w, h = (int(v) for v in g["light_panel"])
+assert b(x + w - 3, y + h - 3) == (0x1B, 0x3A, 0x8C), b(x + w - 3, y + h - 3)
+PY
+for bad in "--sizes 9,x:'x'" "--sizes 100:outside 4 to 72" "--colours #12345 #000000:is not a colour" \
+  "--zoom 3:1, 2 or 4"; do
+  option=${bad%%:*} want=${bad#*:}
+  # shellcheck disable=SC2086
+  "$editor" ${option%% *} "${option#* }" --print-geometry >/dev/null 2>bad-option.err
+  code=$?
+  [ "$code" -eq 1 ] && grep -q -- "$want" bad-option.err || fail "$option: exit $code: $(cat bad-option.err)"
+done
 
 if [ "$failures" -ne 0 ]; then
   echo "$failures check(s) failed; files in $work" >&2

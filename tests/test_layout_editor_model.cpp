@@ -10,9 +10,13 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -384,6 +388,250 @@ TEST(LayoutEditorExport, TheFormsCarryTheirValuesAndNotesAndOnlyKnownNamesAreFor
     EXPECT_EQ(occurrences(fontconfig.text, "-->"), occurrences(fontconfig.text, "<!--"));
     EXPECT_EQ(occurrences(fontconfig.text, "--"), 2 * occurrences(fontconfig.text, "<!--"));
     EXPECT_EQ(occurrences(freetype.text, "*/"), occurrences(freetype.text, "/*"));
+}
+
+}  // namespace
+
+namespace {
+
+using crisp::editor::TextEdit;
+
+// Ten pixels a byte: positions in tests are easy to state.
+float ten_per_byte(std::string_view text, float) {
+    return 10.0f * static_cast<float>(text.size());
+}
+
+TEST(LayoutEditorTextEdit, TypingInsertsAtTheCursorAndTheKeysMoveAndDeleteAroundIt) {
+    TextEdit edit("layout.json");
+    EXPECT_EQ(edit.cursor(), 11u);
+    EXPECT_FALSE(edit.has_selection());
+    edit.home();
+    edit.insert("my-");
+    EXPECT_EQ(edit.text(), "my-layout.json");
+    EXPECT_EQ(edit.cursor(), 3u);
+    edit.end();
+    edit.backspace();
+    edit.backspace();
+    edit.backspace();
+    edit.backspace();
+    edit.insert("txt");
+    EXPECT_EQ(edit.text(), "my-layout.txt");
+    edit.home();
+    edit.right();
+    edit.right();
+    edit.erase();  // the '-'
+    EXPECT_EQ(edit.text(), "mylayout.txt");
+    edit.left();
+    edit.insert("_");
+    EXPECT_EQ(edit.text(), "m_ylayout.txt");
+    // At the ends, the keys that would leave the text do nothing.
+    edit.home();
+    edit.left();
+    edit.backspace();
+    EXPECT_EQ(edit.cursor(), 0u);
+    edit.end();
+    edit.right();
+    edit.erase();
+    EXPECT_EQ(edit.text(), "m_ylayout.txt");
+    // A field holds one line: control characters typed or pasted are left out.
+    edit.insert("a\nb\tc\x7f");
+    EXPECT_EQ(edit.text(), "m_ylayout.txtabc");
+}
+
+TEST(LayoutEditorTextEdit, SelectAllIsReplacedByTypingAndShiftArrowsExtendASelection) {
+    TextEdit edit("0.33333");
+    edit.select_all();
+    EXPECT_EQ(edit.selection(), (std::pair<size_t, size_t>{0, 7}));
+    edit.insert("1/3");
+    EXPECT_EQ(edit.text(), "1/3");
+    EXPECT_FALSE(edit.has_selection());
+    edit.home();
+    edit.right(true);
+    edit.right(true);
+    EXPECT_EQ(edit.selection(), (std::pair<size_t, size_t>{0, 2}));
+    edit.backspace();  // deletes the selection only
+    EXPECT_EQ(edit.text(), "3");
+    edit.select_all();
+    edit.left();  // collapses to the selection's start
+    EXPECT_EQ(edit.cursor(), 0u);
+    EXPECT_FALSE(edit.has_selection());
+    edit.select_all();
+    edit.right();
+    EXPECT_EQ(edit.cursor(), 1u);
+    edit.select_all();
+    edit.erase();
+    EXPECT_EQ(edit.text(), "");
+}
+
+TEST(LayoutEditorTextEdit, TheCursorStepsOverWholeUtf8Characters) {
+    TextEdit edit("a\xC3\xA9\xE2\x80\x94z");  // a, e acute (2 bytes), em dash (3 bytes), z
+    edit.left();
+    edit.left();
+    EXPECT_EQ(edit.cursor(), 3u);
+    edit.backspace();
+    EXPECT_EQ(edit.text(), "a\xE2\x80\x94z");
+    edit.move_to(2);  // inside the dash: moved to its start
+    EXPECT_EQ(edit.cursor(), 1u);
+    edit.erase();
+    EXPECT_EQ(edit.text(), "az");
+    edit.insert_codepoint(0x2014);
+    edit.insert_codepoint(0xD800);    // a surrogate: not a character
+    edit.insert_codepoint(0x110000);  // past Unicode
+    EXPECT_EQ(edit.text(), "a\xE2\x80\x94z");
+}
+
+TEST(LayoutEditorTextEdit, AClickFindsTheNearestCaretAndTheFieldScrollsToKeepTheCursorInView) {
+    TextEdit edit("abcdefghij");
+    EXPECT_EQ(edit.offset_at(-5.0f, 12.0f, ten_per_byte), 0u);
+    EXPECT_EQ(edit.offset_at(14.0f, 12.0f, ten_per_byte), 1u);
+    EXPECT_EQ(edit.offset_at(16.0f, 12.0f, ten_per_byte), 2u);
+    EXPECT_EQ(edit.offset_at(500.0f, 12.0f, ten_per_byte), 10u);
+    EXPECT_EQ(edit.offset_at(16.0f, 12.0f, ten_per_byte, 4), 6u);  // scrolled by 4 bytes
+    // 40 pixels hold four bytes: the cursor at the end shows the last four.
+    EXPECT_EQ(edit.visible(40.0f, 12.0f, ten_per_byte, 0), (std::pair<size_t, size_t>{6, 10}));
+    edit.home();
+    EXPECT_EQ(edit.visible(40.0f, 12.0f, ten_per_byte, 6), (std::pair<size_t, size_t>{0, 4}));
+    edit.move_to(5);
+    EXPECT_EQ(edit.visible(40.0f, 12.0f, ten_per_byte, 3), (std::pair<size_t, size_t>{3, 7}));
+    EXPECT_EQ(edit.visible(400.0f, 12.0f, ten_per_byte, 0), (std::pair<size_t, size_t>{0, 10}));
+}
+
+// XDG_CONFIG_HOME set for the test's length, as the editor's tests set it.
+class ScopedConfigHome {
+public:
+    explicit ScopedConfigHome(const std::filesystem::path& dir) {
+        if (const char* old = std::getenv("XDG_CONFIG_HOME")) old_ = old;
+        setenv("XDG_CONFIG_HOME", dir.c_str(), 1);
+    }
+    ~ScopedConfigHome() {
+        if (old_) {
+            setenv("XDG_CONFIG_HOME", old_->c_str(), 1);
+        } else {
+            unsetenv("XDG_CONFIG_HOME");
+        }
+    }
+
+private:
+    std::optional<std::string> old_;
+};
+
+void write_text(const std::filesystem::path& path, std::string_view text) {
+    std::FILE* file = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(file, nullptr);
+    std::fwrite(text.data(), 1, text.size(), file);
+    std::fclose(file);
+}
+
+TEST(LayoutEditorRecentFiles, KeptNewestFirstOnceEachAtMostEightAbsoluteAndReadBack) {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crisp-layout-editor-recent-test";
+    std::filesystem::remove_all(dir);
+    const ScopedConfigHome config(dir);
+    const std::filesystem::path file = crisp::editor::recent_files_path();
+    EXPECT_EQ(file, dir / "crisp" / "layout-editor-recent");
+    // None yet: an empty list, not an error.
+    crisp::Result<std::vector<std::string>> read = crisp::editor::read_recent_files(file);
+    ASSERT_TRUE(read) << read.error().message;
+    EXPECT_TRUE(read->empty());
+    std::vector<std::string> recent;
+    for (int i = 0; i < 10; ++i) recent = crisp::editor::add_recent_file(recent, "/layouts/" + std::to_string(i));
+    recent = crisp::editor::add_recent_file(recent, "/layouts/5");
+    recent = crisp::editor::add_recent_file(recent, "relative.json");
+    recent = crisp::editor::add_recent_file(recent, "/bad\nname");  // not one line: not kept
+    ASSERT_EQ(recent.size(), 8u);
+    EXPECT_EQ(recent[0], (std::filesystem::current_path() / "relative.json").string());
+    EXPECT_EQ(recent[1], "/layouts/5");
+    EXPECT_EQ(recent[2], "/layouts/9");
+    EXPECT_EQ(recent[7], "/layouts/3");
+    ASSERT_TRUE(crisp::editor::write_recent_files(file, recent));  // makes the directory
+    read = crisp::editor::read_recent_files(file);
+    ASSERT_TRUE(read) << read.error().message;
+    EXPECT_EQ(*read, recent);
+    std::filesystem::remove_all(dir);
+}
+
+TEST(LayoutEditorRecentFiles, ABadListIsRefusedWithTheReasonAndARelativeConfigHomeIsIgnored) {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crisp-layout-editor-recent-bad";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path file = dir / "recent";
+    const std::pair<std::string_view, std::string_view> bad[] = {
+        {std::string_view("/a\0/b\n", 6), "NUL"},
+        {"/a\xff\n", "UTF-8"},
+        {"/a\nrelative/b\n", "line 2"},
+        {"/1\n/2\n/3\n/4\n/5\n/6\n/7\n/8\n/9\n", "more than 8"},
+    };
+    for (const auto& [text, why] : bad) {
+        write_text(file, text);
+        const crisp::Result<std::vector<std::string>> read = crisp::editor::read_recent_files(file);
+        ASSERT_FALSE(read) << why;
+        EXPECT_NE(read.error().message.find(why), std::string::npos) << read.error().message;
+    }
+    // A directory where the file should be: an error, not a crash.
+    EXPECT_FALSE(crisp::editor::read_recent_files(dir));
+    {
+        const ScopedConfigHome config("relative/dir");  // not absolute: ignored, HOME's used
+        const char* home = std::getenv("HOME");
+        if (home && home[0] != '\0') {
+            EXPECT_EQ(crisp::editor::recent_files_path(),
+                      std::filesystem::path(home) / ".config" / "crisp" / "layout-editor-recent");
+        }
+    }
+    std::filesystem::remove_all(dir);
+}
+
+TEST(LayoutEditorPreview, SizesAreReadFromSpacesOrCommasAndBadOnesSayWhy) {
+    std::string why;
+    const std::optional<std::vector<float>> sizes = crisp::editor::parse_preview_sizes(" 9, 11 13.5\t20 ", &why);
+    ASSERT_TRUE(sizes) << why;
+    EXPECT_EQ(*sizes, (std::vector<float>{9.0f, 11.0f, 13.5f, 20.0f}));
+    EXPECT_EQ(crisp::editor::format_preview_sizes(*sizes), "9 11 13.5 20");
+    const std::pair<const char*, const char*> bad[] = {
+        {"", "has no sizes"},
+        {" , ", "has no sizes"},
+        {"9 x 13", "'x'"},
+        {"9 200", "200 is outside 4 to 72 pixels"},
+        {"3", "3 is outside"},
+        {"nan", "'nan'"},
+        {"9 10 11 12 13 14 15 16 17", "more than 8 sizes"},
+    };
+    for (const auto& [text, want] : bad) {
+        EXPECT_FALSE(crisp::editor::parse_preview_sizes(text, &why)) << text;
+        EXPECT_NE(why.find(want), std::string::npos) << text << ": " << why;
+    }
+}
+
+TEST(LayoutEditorPreview, ColoursAreTwoHexColoursOrAPresetAndBadOnesSayWhy) {
+    using crisp::editor::Color;
+    std::string why;
+    std::optional<crisp::editor::PreviewColours> colours =
+        crisp::editor::parse_preview_colours("#141418 on #faF8F0", &why);
+    ASSERT_TRUE(colours) << why;
+    EXPECT_EQ(colours->foreground, (Color{0x14, 0x14, 0x18}));
+    EXPECT_EQ(colours->background, (Color{0xFA, 0xF8, 0xF0}));
+    EXPECT_EQ(crisp::editor::format_preview_colours(*colours), "#141418 on #FAF8F0");
+    colours = crisp::editor::parse_preview_colours("FFFFFF/000000", &why);
+    ASSERT_TRUE(colours) << why;
+    EXPECT_EQ(colours->background, (Color{0, 0, 0}));
+    for (const auto& [name, preset] : crisp::editor::preview_colour_presets()) {
+        colours = crisp::editor::parse_preview_colours(name, &why);
+        ASSERT_TRUE(colours) << name;
+        EXPECT_EQ(*colours, preset);
+        // Formatted, a preset reads back as itself.
+        EXPECT_EQ(crisp::editor::parse_preview_colours(crisp::editor::format_preview_colours(preset)), preset);
+    }
+    const std::pair<const char*, const char*> bad[] = {
+        {"", "is not two colours"},
+        {"#123456", "is not two colours"},
+        {"#12345 #000000", "'#12345' is not a colour: expected #RRGGBB"},
+        {"#12345G #000000", "'#12345G' is not a colour"},
+        {"#102030 on #102030", "the same colour"},
+        {"red on blue", "'red' is not a colour"},
+        {"dark-on-lite", "nor a preset (dark-on-light, light-on-dark, yellow-on-blue)"},
+    };
+    for (const auto& [text, want] : bad) {
+        EXPECT_FALSE(crisp::editor::parse_preview_colours(text, &why)) << text;
+        EXPECT_NE(why.find(want), std::string::npos) << text << ": " << why;
+    }
 }
 
 }  // namespace

@@ -13,6 +13,7 @@ namespace crisp::editor {
 
 struct Color {
     uint8_t r = 0, g = 0, b = 0;
+    friend bool operator==(const Color&, const Color&) = default;
 };
 
 struct Rect {

@@ -2,6 +2,7 @@
 
 #include "cli.hpp"
 #include "core/file_io.hpp"
+#include "core/utf8.hpp"
 #include "json_writer.hpp"
 
 #include <crisp/glyph.hpp>
@@ -10,6 +11,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <system_error>
@@ -63,6 +66,47 @@ void shift_span(float& lo, float& hi, float delta) {
     delta = std::clamp(delta, kLow - lo, kHigh - hi);
     lo += delta;
     hi += delta;
+}
+
+void append_utf8(std::string& out, uint32_t codepoint) {
+    if (codepoint < 0x80) {
+        out += static_cast<char>(codepoint);
+    } else if (codepoint < 0x800) {
+        out += static_cast<char>(0xC0 | (codepoint >> 6));
+        out += static_cast<char>(0x80 | (codepoint & 0x3F));
+    } else if (codepoint < 0x10000) {
+        out += static_cast<char>(0xE0 | (codepoint >> 12));
+        out += static_cast<char>(0x80 | ((codepoint >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (codepoint & 0x3F));
+    } else {
+        out += static_cast<char>(0xF0 | (codepoint >> 18));
+        out += static_cast<char>(0x80 | ((codepoint >> 12) & 0x3F));
+        out += static_cast<char>(0x80 | ((codepoint >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (codepoint & 0x3F));
+    }
+}
+
+bool continuation(char c) {
+    return (static_cast<unsigned char>(c) & 0xC0) == 0x80;
+}
+
+// Valid UTF-8 decodes and encodes back to itself; anything ill-formed became U+FFFD.
+bool valid_utf8(std::string_view text) {
+    std::string again;
+    for (const uint32_t codepoint : decode_utf8(text)) append_utf8(again, codepoint);
+    return again == text;
+}
+
+// Words separated by any of `separators`, empty ones left out.
+std::vector<std::string_view> words(std::string_view text, std::string_view separators) {
+    std::vector<std::string_view> out;
+    size_t start = 0;
+    while (start < text.size()) {
+        const size_t end = std::min(text.find_first_of(separators, start), text.size());
+        if (end > start) out.push_back(text.substr(start, end - start));
+        start = end + 1;
+    }
+    return out;
 }
 
 std::string_view trim_spaces(std::string_view text) {
@@ -227,6 +271,253 @@ float contrast_parameter(const TextContrast& contrast, ContrastParameter paramet
 
 std::pair<float, float> contrast_range(ContrastParameter parameter) {
     return parameter == ContrastParameter::gamma ? std::pair{1.0f, 4.0f} : std::pair{0.0f, 4.0f};
+}
+
+TextEdit::TextEdit(std::string text) : text_(std::move(text)), cursor_(text_.size()), anchor_(cursor_) {}
+
+size_t TextEdit::boundary_at_or_before(size_t offset) const {
+    offset = std::min(offset, text_.size());
+    while (offset > 0 && offset < text_.size() && continuation(text_[offset])) --offset;
+    return offset;
+}
+
+size_t TextEdit::next_boundary(size_t offset) const {
+    if (offset >= text_.size()) return text_.size();
+    ++offset;
+    while (offset < text_.size() && continuation(text_[offset])) ++offset;
+    return offset;
+}
+
+size_t TextEdit::previous_boundary(size_t offset) const {
+    return offset == 0 ? 0 : boundary_at_or_before(offset - 1);
+}
+
+void TextEdit::move_to(size_t offset, bool extend) {
+    cursor_ = boundary_at_or_before(offset);
+    if (!extend) anchor_ = cursor_;
+}
+
+void TextEdit::left(bool extend) {
+    if (has_selection() && !extend) {
+        move_to(selection().first);
+    } else {
+        move_to(previous_boundary(cursor_), extend);
+    }
+}
+
+void TextEdit::right(bool extend) {
+    if (has_selection() && !extend) {
+        move_to(selection().second);
+    } else {
+        move_to(next_boundary(cursor_), extend);
+    }
+}
+
+void TextEdit::select_all() {
+    anchor_ = 0;
+    cursor_ = text_.size();
+}
+
+void TextEdit::insert(std::string_view utf8) {
+    std::string kept;
+    for (const char c : utf8) {
+        if (static_cast<unsigned char>(c) >= 0x20 && c != 0x7F) kept += c;
+    }
+    const auto [first, last] = selection();
+    text_.replace(first, last - first, kept);
+    cursor_ = anchor_ = first + kept.size();
+}
+
+void TextEdit::insert_codepoint(uint32_t codepoint) {
+    if (codepoint > 0x10FFFF || (codepoint >= 0xD800 && codepoint <= 0xDFFF)) return;
+    std::string utf8;
+    append_utf8(utf8, codepoint);
+    insert(utf8);
+}
+
+void TextEdit::backspace() {
+    if (!has_selection()) anchor_ = previous_boundary(cursor_);
+    insert("");
+}
+
+void TextEdit::erase() {
+    if (!has_selection()) anchor_ = next_boundary(cursor_);
+    insert("");
+}
+
+size_t TextEdit::offset_at(float x, float size, const MeasureText& measure, size_t first) const {
+    first = boundary_at_or_before(first);
+    const std::string_view text = text_;
+    size_t best = first;
+    float best_distance = std::fabs(x);
+    for (size_t offset = next_boundary(first); offset > first && offset <= text_.size();) {
+        const float distance = std::fabs(x - measure(text.substr(first, offset - first), size));
+        if (distance < best_distance) {
+            best = offset;
+            best_distance = distance;
+        }
+        if (offset == text_.size()) break;
+        offset = next_boundary(offset);
+    }
+    return best;
+}
+
+std::pair<size_t, size_t> TextEdit::visible(float room, float size, const MeasureText& measure, size_t first) const {
+    const std::string_view text = text_;
+    first = std::min(boundary_at_or_before(first), cursor_);
+    // Scrolled right as little as puts the cursor inside.
+    while (first < cursor_ && measure(text.substr(first, cursor_ - first), size) > room) first = next_boundary(first);
+    size_t last = cursor_;
+    while (last < text_.size()) {
+        const size_t next = next_boundary(last);
+        if (measure(text.substr(first, next - first), size) > room) break;
+        last = next;
+    }
+    return {first, last};
+}
+
+std::filesystem::path recent_files_path() {
+    const char* config = std::getenv("XDG_CONFIG_HOME");
+    std::filesystem::path base;
+    if (config && config[0] != '\0' && std::filesystem::path(config).is_absolute()) {
+        base = config;
+    } else if (const char* home = std::getenv("HOME"); home && home[0] != '\0') {
+        base = std::filesystem::path(home) / ".config";
+    } else {
+        return {};
+    }
+    return base / "crisp" / "layout-editor-recent";
+}
+
+Result<std::vector<std::string>> read_recent_files(const std::filesystem::path& file) {
+    std::error_code error;
+    if (!std::filesystem::exists(std::filesystem::symlink_status(file, error))) return std::vector<std::string>{};
+    Result<std::vector<std::byte>> bytes = read_file(file, 64 * 1024);
+    if (!bytes) return bytes.error();
+    const std::string text(reinterpret_cast<const char*>(bytes->data()), bytes->size());
+    const std::string name = cli::printable_path(file.string());
+    auto refuse = [&](const std::string& why) { return Error{ErrorCode::invalid_argument, name + ": " + why}; };
+    if (text.find('\0') != std::string::npos) return refuse("holds a NUL byte: not a list of paths");
+    if (!valid_utf8(text)) return refuse("is not UTF-8 text");
+    std::vector<std::string> recent;
+    for (const std::string_view line : words(text, "\n")) {
+        if (!std::filesystem::path(line).is_absolute()) {
+            return refuse("line " + std::to_string(recent.size() + 1) + " ('" + cli::printable(line) +
+                          "') is not an absolute path");
+        }
+        if (recent.size() == kMaxRecentFiles) {
+            return refuse("holds more than " + std::to_string(kMaxRecentFiles) + " paths");
+        }
+        recent.emplace_back(line);
+    }
+    return recent;
+}
+
+std::vector<std::string> add_recent_file(std::vector<std::string> recent, const std::string& path) {
+    if (path.empty() || path.find_first_of("\r\n") != std::string::npos) return recent;
+    std::error_code error;
+    const std::filesystem::path absolute = std::filesystem::absolute(path, error).lexically_normal();
+    if (error) return recent;
+    const std::string entry = absolute.string();
+    recent.erase(std::remove(recent.begin(), recent.end(), entry), recent.end());
+    recent.insert(recent.begin(), entry);
+    if (recent.size() > kMaxRecentFiles) recent.resize(kMaxRecentFiles);
+    return recent;
+}
+
+Status write_recent_files(const std::filesystem::path& file, const std::vector<std::string>& recent) {
+    std::error_code error;
+    std::filesystem::create_directories(file.parent_path(), error);
+    if (error) {
+        return Error{ErrorCode::io, cli::printable_path(file.parent_path().string()) + ": " + error.message()};
+    }
+    std::string text;
+    for (const std::string& path : recent) text += path + "\n";
+    return write_file_atomically(file, std::as_bytes(std::span(text.data(), text.size())));
+}
+
+std::optional<std::vector<float>> parse_preview_sizes(std::string_view text, std::string* why) {
+    auto refuse = [&](std::string reason) -> std::optional<std::vector<float>> {
+        if (why) *why = std::move(reason);
+        return std::nullopt;
+    };
+    std::vector<float> sizes;
+    for (const std::string_view word : words(text, " ,\t")) {
+        std::string number_why;
+        const std::optional<float> size = cli::parse_number<float>(word, &number_why);
+        if (!size) return refuse("'" + cli::printable(word) + "' " + number_why);
+        if (!(*size >= kMinPreviewSize && *size <= kMaxPreviewSize)) {
+            return refuse(format_number(*size) + " is outside " + format_number(kMinPreviewSize) + " to " +
+                          format_number(kMaxPreviewSize) + " pixels");
+        }
+        if (sizes.size() == kMaxPreviewSizes) {
+            return refuse("more than " + std::to_string(kMaxPreviewSizes) + " sizes");
+        }
+        sizes.push_back(*size);
+    }
+    if (sizes.empty()) return refuse("has no sizes: expected pixel sizes such as \"9 11 13 16 20\"");
+    return sizes;
+}
+
+std::string format_preview_sizes(const std::vector<float>& sizes) {
+    std::string text;
+    for (const float size : sizes) text += (text.empty() ? "" : " ") + format_number(size);
+    return text;
+}
+
+std::span<const std::pair<const char*, PreviewColours>> preview_colour_presets() {
+    static constexpr std::pair<const char*, PreviewColours> kPresets[] = {
+        {"dark-on-light", {{20, 20, 24}, {250, 248, 240}}},
+        {"light-on-dark", {{236, 236, 230}, {16, 17, 20}}},
+        {"yellow-on-blue", {{255, 226, 122}, {27, 58, 140}}},
+    };
+    return kPresets;
+}
+
+std::optional<PreviewColours> parse_preview_colours(std::string_view text, std::string* why) {
+    auto refuse = [&](std::string reason) -> std::optional<PreviewColours> {
+        if (why) *why = std::move(reason);
+        return std::nullopt;
+    };
+    const std::string_view trimmed = trim_spaces(text);
+    for (const auto& [name, colours] : preview_colour_presets()) {
+        if (trimmed == name) return colours;
+    }
+    std::vector<std::string_view> parts = words(text, " /\t");
+    if (parts.size() == 3 && parts[1] == "on") parts.erase(parts.begin() + 1);
+    std::string presets;
+    for (const auto& [name, colours] : preview_colour_presets())
+        presets += (presets.empty() ? "" : ", ") + std::string(name);
+    if (parts.size() != 2) {
+        return refuse("is not two colours (text and background, such as \"#141418 on #FAF8F0\") nor a preset (" +
+                      presets + ")");
+    }
+    Color colour[2];
+    for (size_t i = 0; i < 2; ++i) {
+        std::string_view hex = parts[i];
+        if (!hex.empty() && hex.front() == '#') hex.remove_prefix(1);
+        const bool digits = hex.size() == 6 && std::all_of(hex.begin(), hex.end(), [](char c) {
+                                return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
+                            });
+        if (!digits)
+            return refuse("'" + cli::printable(parts[i]) + "' is not a colour: expected #RRGGBB (six hex digits)");
+        const auto channel = [&](size_t at) {
+            return static_cast<uint8_t>(std::strtoul(std::string(hex.substr(at, 2)).c_str(), nullptr, 16));
+        };
+        colour[i] = {channel(0), channel(2), channel(4)};
+    }
+    const PreviewColours colours{colour[0], colour[1]};
+    if (colours.foreground == colours.background) {
+        return refuse("has the same colour for the text and its background: the text would not show");
+    }
+    return colours;
+}
+
+std::string format_preview_colours(const PreviewColours& colours) {
+    char text[32];
+    std::snprintf(text, sizeof text, "#%02X%02X%02X on #%02X%02X%02X", colours.foreground.r, colours.foreground.g,
+                  colours.foreground.b, colours.background.r, colours.background.g, colours.background.b);
+    return text;
 }
 
 LayoutModel::LayoutModel(SubpixelLayout initial) : layout_(std::move(initial)), saved_(layout_) {}

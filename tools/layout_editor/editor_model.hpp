@@ -3,13 +3,18 @@
 // No window, no GPU: tests/test_layout_editor_model.cpp drives it directly.
 #pragma once
 
+#include "canvas.hpp"
+
 #include <crisp/contrast.hpp>
 #include <crisp/result.hpp>
 #include <crisp/subpixel.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -79,6 +84,106 @@ std::string layout_file_text(const SubpixelLayout& layout);
 // Writes layout_file_text atomically. Refused (invalid_argument) when validate_subpixel_layout
 // refuses the layout; the file's errors are crisp's (ErrorCode::io, naming the path).
 Status save_layout_file(const SubpixelLayout& layout, const std::filesystem::path& path);
+
+// How wide `text` is at `size` pixels, interface pixels. The window measures with crisp's layout
+// of its font; tests and --print-geometry with estimated_text_width.
+using MeasureText = std::function<float(std::string_view text, float size)>;
+
+// One line of text being edited in a field: the text, the cursor (a byte offset, always at the
+// start of a UTF-8 sequence) and the selection, between the anchor and the cursor. Every field
+// (the file's path, the numbers, the preview's text, sizes and colours) edits through one.
+class TextEdit {
+public:
+    TextEdit() = default;
+    // The cursor at the end, nothing selected.
+    explicit TextEdit(std::string text);
+
+    const std::string& text() const { return text_; }
+    size_t cursor() const { return cursor_; }
+    // The selected bytes [first, second); first == second when nothing is selected.
+    std::pair<size_t, size_t> selection() const { return std::minmax(anchor_, cursor_); }
+    bool has_selection() const { return anchor_ != cursor_; }
+
+    // Puts the cursor at `offset` (past the end: at the end; inside a UTF-8 sequence: at its
+    // start). With `extend` the selection runs from the anchor to it, else nothing is selected.
+    void move_to(size_t offset, bool extend = false);
+    // One character left or right; without `extend`, a selection collapses to its start or end
+    // instead. Home and End: the start and the end of the text.
+    void left(bool extend = false);
+    void right(bool extend = false);
+    void home(bool extend = false) { move_to(0, extend); }
+    void end(bool extend = false) { move_to(text_.size(), extend); }
+    void select_all();
+
+    // Inserts `utf8` at the cursor in place of the selection; the cursor ends after it. Control
+    // characters (below U+0020, and U+007F) are left out: a field holds one line.
+    void insert(std::string_view utf8);
+    // The same for one code point; surrogates and values past U+10FFFF are ignored.
+    void insert_codepoint(uint32_t codepoint);
+    // Deletes the selection, else the character before (backspace) or at (erase) the cursor.
+    void backspace();
+    void erase();
+
+    // The byte offset whose caret is nearest `x` interface pixels right of where the text from
+    // byte `first` starts, at `size` (a click in a field scrolled to `first`).
+    size_t offset_at(float x, float size, const MeasureText& measure, size_t first = 0) const;
+    // What a field `room` pixels wide shows: the bytes [first, last) of the text, scrolled as
+    // little as keeps the cursor in view from `first` (the field's previous scroll).
+    std::pair<size_t, size_t> visible(float room, float size, const MeasureText& measure, size_t first) const;
+
+private:
+    size_t boundary_at_or_before(size_t offset) const;
+    size_t next_boundary(size_t offset) const;
+    size_t previous_boundary(size_t offset) const;
+
+    std::string text_;
+    size_t cursor_ = 0;
+    size_t anchor_ = 0;
+};
+
+// The files saved or loaded lately, newest first, kept between runs in recent_files_path().
+inline constexpr size_t kMaxRecentFiles = 8;
+// $XDG_CONFIG_HOME/crisp/layout-editor-recent, or ~/.config/crisp/layout-editor-recent where
+// XDG_CONFIG_HOME is unset, empty or relative (the XDG base directory rules); empty where HOME
+// is not set either.
+std::filesystem::path recent_files_path();
+// Reads the list: one absolute path a line, newest first. A missing file is an empty list, not an
+// error (the first run). Refused (ErrorCode::io or invalid_argument, naming the file and what is
+// wrong) where it cannot be read, is over 64 KiB, holds a NUL byte or invalid UTF-8, a relative
+// path or more than kMaxRecentFiles lines: the caller goes on without it.
+Result<std::vector<std::string>> read_recent_files(const std::filesystem::path& file);
+// `path` made absolute and put first in `recent`, once, the list cut to kMaxRecentFiles. A path
+// that cannot be kept on one line (it holds a line break) or is empty leaves the list as it was.
+std::vector<std::string> add_recent_file(std::vector<std::string> recent, const std::string& path);
+// Writes the list atomically (write_file_atomically), making its directory first; crisp's errors.
+Status write_recent_files(const std::filesystem::path& file, const std::vector<std::string>& recent);
+
+// The preview's settings (issue 29, item 5): its text, the sizes it is shown at, its colours.
+inline constexpr const char* kDefaultPreviewText =
+    "Subpixel text fitted to your own monitor: sharp stems, no fringes. 0123456789 (fi fl)";
+inline constexpr float kMinPreviewSize = 4.0f, kMaxPreviewSize = 72.0f;
+inline constexpr size_t kMaxPreviewSizes = 8;
+// Sizes in pixels, separated by spaces or commas ("9 11 13 16 20"): 1 to kMaxPreviewSizes of
+// them, each kMinPreviewSize..kMaxPreviewSize. Anything else is nullopt with the reason in `why`
+// ("'x' is not a number", "200 is past 72 pixels").
+std::optional<std::vector<float>> parse_preview_sizes(std::string_view text, std::string* why = nullptr);
+// The sizes as parse_preview_sizes reads them, separated by spaces.
+std::string format_preview_sizes(const std::vector<float>& sizes);
+
+// The first panel's text on its background; the second panel shows them swapped.
+struct PreviewColours {
+    Color foreground{20, 20, 24};
+    Color background{250, 248, 240};
+    friend bool operator==(const PreviewColours&, const PreviewColours&) = default;
+};
+// The presets, by name: dark-on-light (the default), light-on-dark, yellow-on-blue.
+std::span<const std::pair<const char*, PreviewColours>> preview_colour_presets();
+// A preset's name, or two colours as #RRGGBB (the '#' optional, any case) separated by spaces,
+// a slash or " on " ("#141418 on #FAF8F0"). Anything else, and two equal colours (invisible
+// text), is nullopt with the reason in `why`.
+std::optional<PreviewColours> parse_preview_colours(std::string_view text, std::string* why = nullptr);
+// "#141418 on #FAF8F0", which parse_preview_colours reads back.
+std::string format_preview_colours(const PreviewColours& colours);
 
 class LayoutModel {
 public:

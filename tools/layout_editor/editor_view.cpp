@@ -22,14 +22,21 @@ constexpr float kMargin = 16.0f;
 constexpr float kToolbarY = 10.0f, kButtonHeight = 28.0f;
 constexpr float kPresetX = kMargin, kPresetWidth = 82.0f, kPresetStride = 88.0f;
 constexpr float kCommandX = 736.0f, kCommandWidth = 64.0f, kCommandStride = 70.0f;
-constexpr float kPathFieldX = 1016.0f;
+constexpr float kPathFieldX = 1016.0f, kRecentButtonWidth = 60.0f, kRecentWidth = 520.0f, kRecentRow = 24.0f;
+// The preview's controls, a row above it: its text, sizes and colours, the colour presets, zoom.
+constexpr float kPreviewRowY = 44.0f, kPreviewRowHeight = 26.0f;
+constexpr float kTextLabelWidth = 34.0f, kSizesLabelWidth = 36.0f, kColoursLabelWidth = 50.0f;
+constexpr float kSizesFieldWidth = 110.0f, kColoursFieldWidth = 150.0f, kColoursButtonWidth = 64.0f,
+                kZoomButtonWidth = 70.0f, kRowGap = 6.0f;
+// The quit prompt, centred in the window.
+constexpr float kPromptWidth = 440.0f, kPromptHeight = 124.0f, kPromptButtonWidth = 96.0f;
 // The number fields: wide enough for "-0.08333" (fitted_number shortens what is longer).
 constexpr float kFieldsX = 52.0f, kFieldsY = 384.0f, kFieldWidth = 68.0f, kFieldStrideX = 72.0f, kFieldHeight = 26.0f,
                 kFieldStrideY = 30.0f;
 constexpr float kFieldTextSize = 12.0f, kFieldPadding = 5.0f;
 // The preview: two panels of paragraphs and two strips below them (the moving line and the
 // fringe test), light left and dark right; what the window adds goes half to the panels' height.
-constexpr float kPreviewX = 360.0f, kPreviewY = 52.0f, kPreviewGap = 12.0f;
+constexpr float kPreviewX = 360.0f, kPreviewY = kPreviewRowY + kPreviewRowHeight + 8.0f, kPreviewGap = 12.0f;
 constexpr float kPanelWidth = 446.0f, kPanelHeight = 278.0f, kStripHeight = 92.0f, kStripGap = 6.0f;
 // The contrast controls: the preview's mode, gamma, contrast and stem darkening, and Reset; a row
 // below the strips.
@@ -39,9 +46,8 @@ constexpr float kContrastFieldX[] = {572.0f, 696.0f, 862.0f};  // gamma, contras
 constexpr float kContrastLabelWidth[] = {48.0f, 56.0f, 96.0f};
 constexpr float kContrastFieldWidth = 56.0f;
 constexpr float kResetButtonX = 932.0f, kResetButtonWidth = 60.0f;
-constexpr int kContrastChannel = 3;  // Field::channel of the contrast fields
 // The magnified rendered pixels, below the contrast row down to the status line.
-constexpr float kRenderedViewGap = 20.0f, kRenderedViewHeight = 272.0f, kStatusHeight = 34.0f;
+constexpr float kRenderedViewGap = 20.0f, kRenderedViewHeight = 246.0f, kStatusHeight = 34.0f;
 // The left column's text: the layout's name, the messages below it, the help at the bottom.
 constexpr float kLayoutNameY = 490.0f, kMessagesY = 514.0f, kHelpY = 628.0f;
 constexpr float kMessageSize = 11.0f, kMessageLine = 14.0f, kMessageWidth = 330.0f;
@@ -68,9 +74,24 @@ constexpr const char* kCommands[] = {"Undo", "Redo", "Load", "Save"};
 constexpr const char* kContrastLabels[] = {"gamma", "contrast", "stem darkening"};
 constexpr const char* kContrastKeys[] = {"gamma", "contrast", "stem_darkening"};  // geometry_json, JSON
 
-constexpr const char* kParagraph =
-    "Subpixel text fitted to your own monitor: sharp stems, no fringes. 0123456789 (fi fl)";
-constexpr float kParagraphSizes[] = {9.0f, 11.0f, 13.0f, 16.0f, 20.0f};
+constexpr const char* kPromptButtons[] = {"Save (S)", "Discard (D)", "Cancel (Esc)"};
+constexpr int kZooms[] = {1, 2, 4};
+
+// A text item's box, about: its width estimated (or its wrap width), its lines as wrap_text says.
+Rect item_box(const TextItem& item) {
+    float width = estimated_text_width(item.text, item.size);
+    float lines = 1.0f;
+    if (item.wrap_width > 0.0f) {
+        lines = static_cast<float>(std::max<size_t>(1, wrap_text(item.text, item.wrap_width, item.size).size()));
+        if (item.max_lines > 0) lines = std::min(lines, static_cast<float>(item.max_lines));
+        width = item.wrap_width;
+    }
+    return {item.x, item.y - item.size, width, item.size * 1.2f * lines};
+}
+
+bool overlaps(const Rect& a, const Rect& b) {
+    return a.x < b.x + b.width && b.x < a.x + a.width && a.y < b.y + b.height && b.y < a.y + a.height;
+}
 
 Rect preset_button(size_t i) {
     return {kPresetX + static_cast<float>(i) * kPresetStride, kToolbarY, kPresetWidth, kButtonHeight};
@@ -116,7 +137,8 @@ void EditorView::resize(uint32_t width, uint32_t height, float content_scale) {
     const float extra_width = std::max(0.0f, width_ - kMinimumWidth);
     const float extra_height = std::max(0.0f, height_ - kMinimumHeight);
     Geometry& g = geometry_;
-    g.path_field = {kPathFieldX, kToolbarY, width_ - kMargin - kPathFieldX, kButtonHeight};
+    g.recent_button = {width_ - kMargin - kRecentButtonWidth, kToolbarY, kRecentButtonWidth, kButtonHeight};
+    g.path_field = {kPathFieldX, kToolbarY, g.recent_button.x - kRowGap - kPathFieldX, kButtonHeight};
     const float panel_width = kPanelWidth + extra_width / 2.0f, panel_height = kPanelHeight + extra_height / 2.0f;
     const float dark_x = kPreviewX + panel_width + kPreviewGap;
     g.light_panel = {kPreviewX, kPreviewY, panel_width, panel_height};
@@ -128,6 +150,18 @@ void EditorView::resize(uint32_t width, uint32_t height, float content_scale) {
     g.mode_button = {kModeButtonX, g.contrast_y, kModeButtonWidth, kContrastHeight};
     g.reset_button = {kResetButtonX, g.contrast_y, kResetButtonWidth, kContrastHeight};
     g.status_bar = {0.0f, height_ - kStatusHeight, width_, kStatusHeight};
+    // The preview's row, from its right end: zoom, colour presets, colours, sizes; the text field
+    // takes what is left.
+    const float right = dark_x + panel_width;
+    g.zoom_button = {right - kZoomButtonWidth, kPreviewRowY, kZoomButtonWidth, kPreviewRowHeight};
+    g.colours_button = {g.zoom_button.x - kRowGap - kColoursButtonWidth, kPreviewRowY, kColoursButtonWidth,
+                        kPreviewRowHeight};
+    g.colours_field = {g.colours_button.x - kRowGap - kColoursFieldWidth, kPreviewRowY, kColoursFieldWidth,
+                       kPreviewRowHeight};
+    g.sizes_field = {g.colours_field.x - kColoursLabelWidth - kSizesFieldWidth, kPreviewRowY, kSizesFieldWidth,
+                     kPreviewRowHeight};
+    const float text_x = kPreviewX + kTextLabelWidth;
+    g.text_field = {text_x, kPreviewRowY, g.sizes_field.x - kSizesLabelWidth - text_x, kPreviewRowHeight};
     const float rendered_y = g.contrast_y + kContrastHeight + kRenderedViewGap;
     g.rendered_view = {kPreviewX, rendered_y, dark_x + panel_width - kPreviewX,
                        std::max(kRenderedViewHeight, g.status_bar.y - 10.0f - rendered_y)};
@@ -172,7 +206,7 @@ void EditorView::clamp_crop() {
 }
 
 float EditorView::field_number(const Field& field) const {
-    if (field.channel == kContrastChannel) {
+    if (field.kind == Field::Kind::contrast) {
         return contrast_parameter(model_.contrast(), static_cast<ContrastParameter>(field.coordinate));
     }
     return rect_coordinate(model_.layout().channels[static_cast<size_t>(field.channel)], field.coordinate);
@@ -184,14 +218,18 @@ std::vector<EditorView::Field> EditorView::fields() const {
         for (int coordinate = 0; coordinate < 4; ++coordinate) {
             out.push_back({{kFieldsX + static_cast<float>(coordinate) * kFieldStrideX,
                             kFieldsY + static_cast<float>(channel) * kFieldStrideY, kFieldWidth, kFieldHeight},
+                           Field::Kind::coordinate,
                            channel,
                            coordinate});
         }
     }
     for (int parameter = 0; parameter < 3; ++parameter) {
-        out.push_back({contrast_field(parameter), kContrastChannel, parameter});
+        out.push_back({contrast_field(parameter), Field::Kind::contrast, -1, parameter});
     }
-    out.push_back({geometry_.path_field, -1, 0});
+    out.push_back({geometry_.path_field, Field::Kind::path});
+    out.push_back({geometry_.text_field, Field::Kind::text});
+    out.push_back({geometry_.sizes_field, Field::Kind::sizes});
+    out.push_back({geometry_.colours_field, Field::Kind::colours});
     return out;
 }
 
@@ -216,7 +254,7 @@ std::string EditorView::geometry_json() const {
     json.end_object().key("fields").begin_object();
     const std::vector<Field> all = fields();
     for (const Field& field : all) {
-        if (field.channel < 0 || field.channel >= 3) continue;
+        if (field.kind != Field::Kind::coordinate) continue;
         rect(std::string(1, "rgb"[field.channel]) + "." + kCoordinateNames[field.coordinate], field.rect);
     }
     json.end_object().key("contrast").begin_object();
@@ -225,12 +263,33 @@ std::string EditorView::geometry_json() const {
     rect("reset", g.reset_button);
     json.end_object();
     rect("path_field", g.path_field);
+    rect("recent_button", g.recent_button);
+    json.key("recent_rows").begin_array();
+    for (size_t i = 0; i < kMaxRecentFiles; ++i) {
+        const Rect r = recent_row(i);
+        json.begin_array().value(r.x * scale_).value(r.y * scale_).value(r.width * scale_);
+        json.value(r.height * scale_).end_array();
+    }
+    json.end_array();
+    json.key("preview_controls").begin_object();
+    rect("text", g.text_field);
+    rect("sizes", g.sizes_field);
+    rect("colours", g.colours_field);
+    rect("colour_presets", g.colours_button);
+    rect("zoom", g.zoom_button);
+    json.end_object();
+    json.key("prompt").begin_object();
+    rect("box", prompt_box());
+    for (size_t i = 0; i < 3; ++i) rect(std::array{"save", "discard", "cancel"}[i], prompt_button(i));
+    json.end_object();
     rect("magnified_pixel", {kPixelOriginX - kMagnifiedPixelScale, kPixelOriginY - kMagnifiedPixelScale,
                              3 * kMagnifiedPixelScale, 3 * kMagnifiedPixelScale});
     rect("preview", preview_area());
     // The paragraphs only: no moving text, so they change only when the layout does.
     rect("preview_paragraphs", {g.light_panel.x, g.light_panel.y, g.dark_panel.x + g.dark_panel.width - g.light_panel.x,
                                 g.light_panel.height});
+    rect("light_panel", g.light_panel);
+    rect("dark_panel", g.dark_panel);
     rect("rendered_pixels", g.rendered_view);
     rect("status", g.status_bar);
     rect("messages", {kMargin, kMessagesY - kMessageLine, kMessageWidth, kHelpY - kMessagesY});
@@ -246,6 +305,47 @@ void EditorView::report(std::string text, bool error) {
     if (messages_.size() > 4) messages_.erase(messages_.begin());
 }
 
+void EditorView::remember(const std::string& path) {
+    if (recent_file_.empty() || !write_recent_) return;
+    recent_ = add_recent_file(std::move(recent_), path);
+    if (Status status = write_recent_files(recent_file_, recent_); !status) {
+        report("Recent files not kept: " + status.error().message, true);
+    }
+}
+
+void EditorView::set_recent_file(std::filesystem::path file, bool write) {
+    recent_file_ = std::move(file);
+    write_recent_ = write;
+    recent_.clear();
+    if (recent_file_.empty()) return;
+    Result<std::vector<std::string>> read = read_recent_files(recent_file_);
+    if (!read) {
+        report("Recent files ignored: " + read.error().message, true);
+        return;
+    }
+    recent_ = std::move(*read);
+}
+
+void EditorView::set_preview(std::string text, std::vector<float> sizes, PreviewColours colours) {
+    preview_text_ = std::move(text);
+    preview_sizes_ = std::move(sizes);
+    colours_ = colours;
+}
+
+void EditorView::set_zoom(int zoom) {
+    if (std::find(std::begin(kZooms), std::end(kZooms), zoom) != std::end(kZooms)) zoom_ = zoom;
+}
+
+void EditorView::request_quit() {
+    commit_field_edit();  // a number typed and not yet kept counts as a change
+    if (prompt_on_quit_ && model_.modified()) {
+        recent_open_ = false;
+        prompting_ = true;
+    } else {
+        quit_ = true;
+    }
+}
+
 bool EditorView::save() {
     if (path_.empty()) {
         report("Save: no file; type a path in the file field first", true);
@@ -257,6 +357,7 @@ bool EditorView::save() {
     }
     model_.mark_saved();
     report("Saved " + path_, false);
+    remember(path_);
     return true;
 }
 
@@ -276,33 +377,72 @@ bool EditorView::load() {
     }
     model_.mark_saved();
     report("Loaded " + path_, false);
+    remember(path_);
     return true;
+}
+
+std::string EditorView::field_text(const Field& field) const {
+    switch (field.kind) {
+        case Field::Kind::path:
+            return path_;
+        case Field::Kind::text:
+            return preview_text_;
+        case Field::Kind::sizes:
+            return format_preview_sizes(preview_sizes_);
+        case Field::Kind::colours:
+            return format_preview_colours(colours_);
+        default:
+            return format_number(field_number(field));
+    }
 }
 
 void EditorView::begin_field_edit(int index) {
     active_field_ = index;
-    field_fresh_ = true;
     const Field field = fields()[static_cast<size_t>(index)];
-    field_text_ = field.channel < 0 ? path_ : format_number(field_number(field));
-    model_.select(field.channel);
+    // All of it selected, shown so: typing replaces it, an arrow key or a click keeps it.
+    edit_ = TextEdit(field_text(field));
+    edit_.select_all();
+    edit_scroll_ = 0;
+    if (field.kind == Field::Kind::coordinate) model_.select(field.channel);
 }
 
 void EditorView::commit_field_edit() {
     if (active_field_ < 0) return;
     const Field field = fields()[static_cast<size_t>(active_field_)];
     active_field_ = -2;
-    if (field.channel < 0) {
-        path_ = field_text_;
-        return;
-    }
+    const std::string& typed = edit_.text();
     std::string why;
-    const std::optional<float> value = parse_typed_number(field_text_, &why);
-    const bool contrast = field.channel == kContrastChannel;
+    switch (field.kind) {
+        case Field::Kind::path:
+            path_ = typed;
+            return;
+        case Field::Kind::text:
+            preview_text_ = typed;
+            return;
+        case Field::Kind::sizes:
+            if (std::optional<std::vector<float>> sizes = parse_preview_sizes(typed, &why); sizes) {
+                preview_sizes_ = std::move(*sizes);
+            } else {
+                report("Sizes: \"" + cli::printable(typed) + "\" " + why, true);
+            }
+            return;
+        case Field::Kind::colours:
+            if (std::optional<PreviewColours> colours = parse_preview_colours(typed, &why); colours) {
+                colours_ = *colours;
+            } else {
+                report("Colours: \"" + cli::printable(typed) + "\" " + why, true);
+            }
+            return;
+        default:
+            break;
+    }
+    const std::optional<float> value = parse_typed_number(typed, &why);
+    const bool contrast = field.kind == Field::Kind::contrast;
     const std::string what = contrast
                                  ? std::string(kContrastLabels[field.coordinate])
                                  : std::string(kChannelNames[field.channel]) + " " + kCoordinateNames[field.coordinate];
     if (!value) {
-        report(what + ": \"" + cli::printable(field_text_) + "\" " + why, true);
+        report(what + ": \"" + cli::printable(typed) + "\" " + why, true);
         return;
     }
     const Status status = contrast
@@ -330,39 +470,109 @@ void EditorView::handle(const InputEvent& window_event) {
             if (event.button == GLFW_MOUSE_BUTTON_LEFT) model_.end_drag();
             break;
         case InputEvent::Kind::key:
-            handle_key(event);
+            if (prompting_) {
+                handle_prompt_key(event);
+            } else {
+                handle_key(event);
+            }
             break;
         case InputEvent::Kind::character:
-            if (active_field_ >= 0 && event.codepoint >= 0x20 && event.codepoint < 0x7F) {
-                // The first character typed replaces the value shown, as in a selected field.
-                if (field_fresh_) field_text_.clear();
-                field_fresh_ = false;
-                field_text_ += static_cast<char>(event.codepoint);
+            if (prompting_ || active_field_ < 0) break;
+            // The font holds ASCII and a few more: other characters only in the preview's text,
+            // where one the font lacks shows as its missing-glyph box.
+            if (fields()[static_cast<size_t>(active_field_)].kind == Field::Kind::text ||
+                (event.codepoint >= 0x20 && event.codepoint < 0x7F)) {
+                edit_.insert_codepoint(event.codepoint);
             }
             break;
     }
 }
 
-void EditorView::handle_key(const InputEvent& event) {
+void EditorView::handle_prompt_key(const InputEvent& event) {
+    if (event.key == GLFW_KEY_S) {
+        prompting_ = false;
+        if (save()) quit_ = true;
+    } else if (event.key == GLFW_KEY_D) {
+        quit_ = true;
+    } else if (event.key == GLFW_KEY_ESCAPE) {
+        prompting_ = false;
+    }
+}
+
+bool EditorView::handle_field_key(const InputEvent& event) {
     const bool control = (event.mods & GLFW_MOD_CONTROL) != 0;
     const bool shift = (event.mods & GLFW_MOD_SHIFT) != 0;
-    if (active_field_ >= 0) {
-        if (event.key == GLFW_KEY_TAB) {
+    const Field field = fields()[static_cast<size_t>(active_field_)];
+    switch (event.key) {
+        case GLFW_KEY_TAB: {
             // Commits, and the next keys go to the next field (Shift: the previous one).
             const int count = static_cast<int>(fields().size());
             const int next = (active_field_ + (shift ? count - 1 : 1)) % count;
             commit_field_edit();
             begin_field_edit(next);
-        } else if (event.key == GLFW_KEY_ENTER || event.key == GLFW_KEY_KP_ENTER) {
-            commit_field_edit();
-        } else if (event.key == GLFW_KEY_ESCAPE) {
-            active_field_ = -2;
-        } else if (event.key == GLFW_KEY_BACKSPACE && !field_text_.empty()) {
-            field_fresh_ = false;
-            field_text_.pop_back();
+            return true;
         }
+        case GLFW_KEY_ENTER:
+        case GLFW_KEY_KP_ENTER:
+            commit_field_edit();
+            return true;
+        case GLFW_KEY_ESCAPE:
+            active_field_ = -2;  // what the field held stays
+            return true;
+        case GLFW_KEY_LEFT:
+            edit_.left(shift);
+            return true;
+        case GLFW_KEY_RIGHT:
+            edit_.right(shift);
+            return true;
+        case GLFW_KEY_HOME:
+            edit_.home(shift);
+            return true;
+        case GLFW_KEY_END:
+            edit_.end(shift);
+            return true;
+        case GLFW_KEY_BACKSPACE:
+            edit_.backspace();
+            return true;
+        case GLFW_KEY_DELETE:
+            edit_.erase();
+            return true;
+        case GLFW_KEY_UP:
+        case GLFW_KEY_DOWN:
+            // In the file field, the recent files in turn.
+            if (field.kind == Field::Kind::path && !recent_.empty()) {
+                const auto at = std::find(recent_.begin(), recent_.end(), edit_.text());
+                size_t index = 0;
+                if (at != recent_.end()) {
+                    const size_t current = static_cast<size_t>(at - recent_.begin());
+                    index = (current + (event.key == GLFW_KEY_DOWN ? 1 : recent_.size() - 1)) % recent_.size();
+                }
+                edit_ = TextEdit(recent_[index]);
+            }
+            return true;
+        default:
+            break;
+    }
+    if (control && event.key == GLFW_KEY_A) {
+        edit_.select_all();
+        return true;
+    }
+    // Ctrl+S, Ctrl+Q and the rest act on the field's text once it is committed.
+    if (control) {
+        commit_field_edit();
+        return false;
+    }
+    return true;
+}
+
+void EditorView::handle_key(const InputEvent& event) {
+    const bool control = (event.mods & GLFW_MOD_CONTROL) != 0;
+    const bool shift = (event.mods & GLFW_MOD_SHIFT) != 0;
+    if (recent_open_ && event.key == GLFW_KEY_ESCAPE) {
+        recent_open_ = false;
         return;
     }
+    if (active_field_ >= 0 && handle_field_key(event)) return;
     if (control && event.key == GLFW_KEY_Z) {
         shift ? model_.redo() : model_.undo();
     } else if (control && event.key == GLFW_KEY_Y) {
@@ -372,7 +582,10 @@ void EditorView::handle_key(const InputEvent& event) {
     } else if (control && event.key == GLFW_KEY_O) {
         load();
     } else if (control && event.key == GLFW_KEY_Q) {
-        quit_ = true;
+        request_quit();
+    } else if (!control && event.key == GLFW_KEY_Z) {
+        const auto at = std::find(std::begin(kZooms), std::end(kZooms), zoom_);
+        zoom_ = at + 1 == std::end(kZooms) || at == std::end(kZooms) ? kZooms[0] : *(at + 1);
     } else if (event.key == GLFW_KEY_TAB) {
         model_.select((model_.selected() + (shift ? 2 : 1)) % 3);
     } else if (!control && event.key == GLFW_KEY_M) {
@@ -403,9 +616,64 @@ void EditorView::handle_key(const InputEvent& event) {
     }
 }
 
+// The prompt takes every click while it shows; the open list of recent files takes the next one.
+bool EditorView::handle_overlay_click(float x, float y) {
+    if (prompting_) {
+        for (size_t i = 0; i < 3; ++i) {
+            if (!prompt_button(i).contains(x, y)) continue;
+            handle_prompt_key(
+                {InputEvent::Kind::key, 0.0, 0.0, 0, std::array{GLFW_KEY_S, GLFW_KEY_D, GLFW_KEY_ESCAPE}[i]});
+        }
+        return true;
+    }
+    if (!recent_open_) return false;
+    recent_open_ = false;
+    for (size_t i = 0; i < recent_.size(); ++i) {
+        if (!recent_row(i).contains(x, y)) continue;
+        path_ = recent_[i];
+        report("File: " + path_ + " (Load or Save it)", false);
+    }
+    return true;
+}
+
 void EditorView::handle_mouse_down(const InputEvent& event) {
     const float x = static_cast<float>(event.x), y = static_cast<float>(event.y);
+    if (handle_overlay_click(x, y)) return;
+    const std::vector<Field> all = fields();
+    // A click in a text field puts the cursor there; in a number field it selects the number (to
+    // be typed over), and a second click puts the cursor.
+    for (size_t i = 0; i < all.size(); ++i) {
+        const Field& field = all[i];
+        if (!field.rect.contains(x, y)) continue;
+        const bool number = field.kind == Field::Kind::coordinate || field.kind == Field::Kind::contrast;
+        if (static_cast<int>(i) != active_field_) {
+            commit_field_edit();
+            begin_field_edit(static_cast<int>(i));
+            if (number) return;
+        }
+        edit_.move_to(edit_.offset_at(x - field.rect.x - kFieldPadding, kFieldTextSize, measure_, edit_scroll_));
+        return;
+    }
     commit_field_edit();
+    const Geometry& g = geometry_;
+    if (g.recent_button.contains(x, y)) {
+        recent_open_ = true;
+        return;
+    }
+    if (g.zoom_button.contains(x, y)) {
+        handle_key({InputEvent::Kind::key, 0.0, 0.0, 0, GLFW_KEY_Z});
+        return;
+    }
+    if (g.colours_button.contains(x, y)) {
+        // The next preset after the colours shown (the first where they are none).
+        const auto presets = preview_colour_presets();
+        size_t next = 0;
+        for (size_t i = 0; i < presets.size(); ++i) {
+            if (presets[i].second == colours_) next = (i + 1) % presets.size();
+        }
+        colours_ = presets[next].second;
+        return;
+    }
     const auto names = subpixel_preset_names();
     for (size_t i = 0; i < names.size(); ++i) {
         if (!preset_button(i).contains(x, y)) continue;
@@ -428,15 +696,7 @@ void EditorView::handle_mouse_down(const InputEvent& event) {
         (void)model_.set_contrast(std::nullopt);  // none is always accepted
         return;
     }
-    const std::vector<Field> all = fields();
-    for (size_t i = 0; i < all.size(); ++i) {
-        if (all[i].rect.contains(x, y)) {
-            begin_field_edit(static_cast<int>(i));
-            return;
-        }
-    }
     if (start_drag(x, y)) return;
-    const Geometry& g = geometry_;
     for (const Rect& panel : {g.light_panel, g.dark_panel, g.light_strip, g.dark_strip}) {
         if (panel.contains(x, y)) {
             crop_x_ = x - static_cast<float>(crop_columns() / 2) / scale_;
@@ -482,12 +742,20 @@ void EditorView::draw(Canvas& canvas, std::span<const uint8_t> previous, const F
     canvas.clear(kBackground);
     draw_toolbar(canvas, text);
     draw_magnified_pixel(canvas, text);
+    if (active_field_ >= 0) {
+        const Rect field = fields()[static_cast<size_t>(active_field_)].rect;
+        edit_scroll_ = edit_.visible(field.width - 2.0f * kFieldPadding, kFieldTextSize, measure_, edit_scroll_).first;
+    }
     draw_fields(canvas, text);
     draw_contrast(canvas, text);
     draw_side_text(text);
     draw_preview(canvas, stats, text);
+    draw_zoom(canvas, previous, text);
+    draw_preview_controls(canvas, text);
     draw_rendered_pixels(canvas, previous, text);
     draw_status(canvas, stats, text);
+    if (recent_open_) draw_recent(canvas, text);
+    if (prompting_) draw_prompt(canvas, text);
 }
 
 void EditorView::draw_toolbar(Canvas& canvas, std::vector<TextItem>& text) const {
@@ -498,6 +766,7 @@ void EditorView::draw_toolbar(Canvas& canvas, std::vector<TextItem>& text) const
     }
     const bool enabled[] = {model_.can_undo(), model_.can_redo(), true, true};
     for (size_t i = 0; i < 4; ++i) button(canvas, text, command_button(i), kCommands[i], false, enabled[i]);
+    button(canvas, text, geometry_.recent_button, "Recent", recent_open_, true);
 }
 
 void EditorView::draw_magnified_pixel(Canvas& canvas, std::vector<TextItem>& text) const {
@@ -555,27 +824,53 @@ void EditorView::draw_fields(Canvas& canvas, std::vector<TextItem>& text) const 
         canvas.fill(field.rect, active ? Color{20, 20, 22} : Color{28, 30, 34});
         canvas.outline(field.rect, active ? kActive : kButtonBorder);
         const float room = field.rect.width - 2.0f * kFieldPadding;
+        const float text_x = field.rect.x + kFieldPadding;
         std::string value;
         if (active) {
-            value = field_text_ + "_";
-        } else if (field.channel < 0) {
-            value = path_.empty() ? "(no file)" : path_;
-        } else {
-            value = fitted_number(field_number(field), room, kFieldTextSize);
-        }
-        // Text longer than the field shows its end (where a path's file name is, and the caret).
-        value = cli::printable(value);
-        if (estimated_text_width(value, kFieldTextSize) > room) {
-            const std::string_view ellipsis = "...";
-            size_t start = 0;
-            while (start < value.size() &&
-                   estimated_text_width(std::string(ellipsis) + value.substr(start), kFieldTextSize) > room) {
-                ++start;
+            // The part in view, the selection behind it and the cursor.
+            const std::string_view all_text = edit_.text();
+            const auto [first, last] = edit_.visible(room, kFieldTextSize, measure_, edit_scroll_);
+            value = std::string(all_text.substr(first, last - first));
+            const auto x_of = [&](size_t offset) {
+                offset = std::clamp(offset, first, last);
+                return text_x + measure_(all_text.substr(first, offset - first), kFieldTextSize);
+            };
+            const auto [begin, end] = edit_.selection();
+            if (begin != end) {
+                const float x0 = x_of(begin), x1 = x_of(end);
+                canvas.fill({x0, field.rect.y + 4.0f, std::max(1.0f, x1 - x0), field.rect.height - 8.0f},
+                            Color{60, 90, 150});
             }
-            value = std::string(ellipsis) + value.substr(start);
+            canvas.fill({x_of(edit_.cursor()), field.rect.y + 4.0f, 1.0f, field.rect.height - 8.0f}, kActive);
+        } else if (field.kind == Field::Kind::path) {
+            value = path_.empty() ? "(no file)" : path_;
+        } else if (field.kind == Field::Kind::coordinate || field.kind == Field::Kind::contrast) {
+            value = fitted_number(field_number(field), room, kFieldTextSize);
+        } else {
+            value = field_text(field);
         }
-        text.push_back({value, field.rect.x + kFieldPadding, field.rect.y + 18.0f, kFieldTextSize, kPanelText});
-        if (field.coordinate == 0 && field.channel >= 0 && field.channel < 3) {
+        if (!active) {
+            // Text longer than the field shows its end (where a path's file name is); the
+            // preview's text, its start.
+            value = cli::printable(value, 1000);
+            if (field.kind == Field::Kind::text && measure_(value, kFieldTextSize) > room) {
+                while (!value.empty() && measure_(value + "...", kFieldTextSize) > room) value.pop_back();
+                while (!value.empty() && (static_cast<unsigned char>(value.back()) & 0xC0) == 0x80) value.pop_back();
+                if (!value.empty() && (static_cast<unsigned char>(value.back()) & 0x80) != 0) value.pop_back();
+                value += "...";
+            } else if (measure_(value, kFieldTextSize) > room) {
+                const std::string_view ellipsis = "...";
+                size_t start = 0;
+                while (start < value.size() &&
+                       measure_(std::string(ellipsis) + value.substr(start), kFieldTextSize) > room) {
+                    ++start;
+                }
+                while (start < value.size() && (static_cast<unsigned char>(value[start]) & 0xC0) == 0x80) ++start;
+                value = std::string(ellipsis) + value.substr(start);
+            }
+        }
+        text.push_back({value, text_x, field.rect.y + 18.0f, kFieldTextSize, kPanelText});
+        if (field.kind == Field::Kind::coordinate && field.coordinate == 0) {
             const bool selected = field.channel == model_.selected();
             const Rect swatch{kMargin + 6.0f, field.rect.y + 3.0f, 20.0f, 20.0f};
             canvas.fill(swatch, kChannelColors[static_cast<size_t>(field.channel)]);
@@ -635,10 +930,10 @@ void EditorView::draw_side_text(std::vector<TextItem>& text) const {
     const char* help[] = {
         "Drag an edge or a rectangle in the magnified pixel.",
         "Arrows nudge the selected one 1/96 px (Shift: 1/12).",
-        "Tab selects the next channel; click a number to type,",
-        "Tab or Shift+Tab to the next or previous field.",
+        "Tab: next channel. Click a field to edit: Home, End, Ctrl+A;",
+        "Enter keeps, Esc restores, Tab moves on; Up: recent files.",
         "Ctrl+Z/Y undo/redo, Ctrl+S save, Ctrl+O load, Ctrl+Q quit.",
-        "Click the preview to choose what is magnified.",
+        "Click the preview to choose what is magnified; Z zooms.",
         "G, C, D raise gamma, contrast, stem darkening by 0.1,",
         "with Shift lower them; M: linear or corrected.",
     };
@@ -651,18 +946,34 @@ void EditorView::draw_side_text(std::vector<TextItem>& text) const {
 
 void EditorView::draw_preview(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const {
     const Geometry& g = geometry_;
-    text.push_back({"Preview at native pixels, drawn with this layout", g.light_panel.x, 46.0f, 12.0f, kDimText});
-    const std::pair<Rect, Color> panels[] = {{g.light_panel, kLightInk}, {g.dark_panel, kDarkInk}};
-    for (const auto& [panel, ink] : panels) {
+    Rect zoomed{}, zoom_source{};
+    const bool zooming = zoom_target(zoomed, zoom_source);
+    // The first panel shows the colours as chosen, the second swapped: both polarities in view.
+    const std::pair<Rect, PreviewColours> panels[] = {{g.light_panel, colours_},
+                                                      {g.dark_panel, {colours_.background, colours_.foreground}}};
+    for (const auto& [panel, colours] : panels) {
         const bool light = panel.x == g.light_panel.x;
-        canvas.fill(panel, light ? kLightBackground : kDarkBackground);
-        float y = panel.y + 16.0f;
-        for (float size : kParagraphSizes) {
-            text.push_back({kParagraph, panel.x + 10.0f, y, size, ink, panel.width - 20.0f, true});
-            y += size * 2.0f * 1.17f + 10.0f;  // two lines of DejaVu Sans and a gap
+        const Color ink = colours.foreground;
+        canvas.fill(panel, colours.background);
+        const bool covered = zooming && zoomed.x == panel.x;
+        // Each size's paragraph below the last, as many lines as fit in the panel; wrap_text's
+        // estimate is never narrower than the text, so its count of lines is never too few.
+        float top = panel.y + 6.0f;
+        const float bottom = panel.y + panel.height - 4.0f;
+        for (const float size : preview_sizes_) {
+            const float line = size * 1.17f;  // DejaVu Sans's line height
+            const float wrap = panel.width - 20.0f;
+            const auto fit = static_cast<uint32_t>(std::max(0.0f, std::floor((bottom - top) / line)));
+            if (fit == 0) break;
+            const auto lines = static_cast<uint32_t>(
+                std::min<size_t>(fit, std::max<size_t>(1, wrap_text(preview_text_, wrap, size).size())));
+            TextItem item{preview_text_, panel.x + 10.0f, top + size * 0.93f, size, ink, wrap, true};
+            item.max_lines = fit;
+            if (!covered) text.push_back(std::move(item));
+            top += static_cast<float>(lines) * line + 8.0f;
         }
         const Rect strip = light ? g.light_strip : g.dark_strip;
-        canvas.fill(strip, light ? kLightBackground : kDarkBackground);
+        canvas.fill(strip, colours.background);
         // A line moving 1/16 px a frame while the preview converges: a new subpixel offset, and
         // new samples, every frame; then it stops, so that the editor can idle.
         const float shift = stats.line_moving ? static_cast<float>(stats.frame % 16) / 16.0f : 0.0f;
@@ -679,6 +990,129 @@ void EditorView::draw_preview(Canvas& canvas, const FrameStats& stats, std::vect
     canvas.outline({crop_x_ - one, crop_y_ - one, static_cast<float>(crop_columns()) / scale_ + 2.0f * one,
                     static_cast<float>(crop_rows()) / scale_ + 2.0f * one},
                    kActive, one);
+    if (zooming) {
+        canvas.outline(
+            {zoom_source.x - one, zoom_source.y - one, zoom_source.width + 2.0f * one, zoom_source.height + 2.0f * one},
+            Color{90, 150, 255}, one);
+    }
+}
+
+bool EditorView::zoom_target(Rect& target, Rect& source) const {
+    if (zoom_ == 1) return false;
+    const Geometry& g = geometry_;
+    // The magnified area is centred where the magnified view of rendered pixels looks; it covers
+    // the other side's panel.
+    const float centre_x = crop_x_ + static_cast<float>(crop_columns()) / scale_ / 2.0f;
+    const float centre_y = crop_y_ + static_cast<float>(crop_rows()) / scale_ / 2.0f;
+    const bool from_light = centre_x < g.dark_panel.x;
+    target = from_light ? g.dark_panel : g.light_panel;
+    const Rect panel = from_light ? g.light_panel : g.dark_panel;
+    const Rect side{panel.x, panel.y, panel.width, g.light_strip.y + g.light_strip.height - panel.y};
+    // Whole window pixels of the source, each zoom_ window pixels in the target.
+    const float k = static_cast<float>(zoom_);
+    const float width = std::floor(target.width * scale_ / k) / scale_;
+    const float height = std::floor(target.height * scale_ / k) / scale_;
+    float x = std::clamp(centre_x - width / 2.0f, side.x, side.x + side.width - width);
+    float y = std::clamp(centre_y - height / 2.0f, side.y, side.y + side.height - height);
+    x = std::ceil(x * scale_) / scale_;
+    y = std::ceil(y * scale_) / scale_;
+    source = {x, y, width, height};
+    return true;
+}
+
+void EditorView::draw_zoom(Canvas& canvas, std::span<const uint8_t> previous, std::vector<TextItem>& text) const {
+    Rect target{}, source{};
+    if (!zoom_target(target, source)) return;
+    char caption[96];
+    std::snprintf(caption, sizeof caption, "x%d, nearest neighbour: the blue outline's pixels", zoom_);
+    const size_t columns = static_cast<size_t>(std::lround(source.width * scale_));
+    const size_t rows = static_cast<size_t>(std::lround(source.height * scale_));
+    if (previous.size() == size_t{window_width_} * window_height_ * 4) {
+        const size_t left = static_cast<size_t>(std::lround(source.x * scale_));
+        const size_t top = static_cast<size_t>(std::lround(source.y * scale_));
+        const float cell = static_cast<float>(zoom_) / scale_;
+        for (size_t row = 0; row < rows && top + row < window_height_; ++row) {
+            for (size_t column = 0; column < columns && left + column < window_width_; ++column) {
+                const size_t at = ((top + row) * window_width_ + left + column) * 4;
+                canvas.fill({target.x + static_cast<float>(column) * cell, target.y + static_cast<float>(row) * cell,
+                             cell, cell},
+                            Color{previous[at], previous[at + 1], previous[at + 2]});
+            }
+        }
+    }
+    const Rect label{target.x, target.y + target.height - 20.0f, estimated_text_width(caption, 11.0f) + 12.0f, 20.0f};
+    canvas.fill(label, Color{24, 25, 28});
+    text.push_back({caption, label.x + 6.0f, label.y + 14.0f, 11.0f, kPanelText});
+}
+
+void EditorView::draw_preview_controls(Canvas& canvas, std::vector<TextItem>& text) const {
+    const Geometry& g = geometry_;
+    const float baseline = kPreviewRowY + 17.0f;
+    text.push_back({"Text", kPreviewX, baseline, 12.0f, kDimText});
+    text.push_back({"sizes", g.sizes_field.x - kSizesLabelWidth + 2.0f, baseline, 12.0f, kDimText});
+    text.push_back({"colours", g.colours_field.x - kColoursLabelWidth + 4.0f, baseline, 12.0f, kDimText});
+    const Rect presets = g.colours_button, zoom = g.zoom_button;
+    canvas.fill(presets, kButton);
+    canvas.outline(presets, kButtonBorder);
+    text.push_back({"Presets", presets.x + 8.0f, baseline, 12.0f, kPanelText});
+    canvas.fill(zoom, zoom_ > 1 ? Color{92, 84, 52} : kButton);
+    canvas.outline(zoom, zoom_ > 1 ? kActive : kButtonBorder);
+    text.push_back({"Zoom " + std::to_string(zoom_) + "x", zoom.x + 8.0f, baseline, 12.0f, kPanelText});
+}
+
+Rect EditorView::recent_row(size_t i) const {
+    const Rect button = geometry_.recent_button;
+    const float width = std::min(kRecentWidth, width_ - 2.0f * kMargin);
+    return {button.x + button.width - width, button.y + button.height + 2.0f + static_cast<float>(i) * kRecentRow,
+            width, kRecentRow};
+}
+
+Rect EditorView::prompt_box() const {
+    return {std::floor((width_ - kPromptWidth) / 2.0f), std::floor((height_ - kPromptHeight) / 2.0f), kPromptWidth,
+            kPromptHeight};
+}
+
+Rect EditorView::prompt_button(size_t i) const {
+    const Rect box = prompt_box();
+    const float gap = (kPromptWidth - 3.0f * kPromptButtonWidth) / 4.0f;
+    return {box.x + gap + static_cast<float>(i) * (kPromptButtonWidth + gap), box.y + box.height - 44.0f,
+            kPromptButtonWidth, kButtonHeight};
+}
+
+// A box over the rest: the text beneath it is left out (crisp draws text over the canvas).
+void EditorView::draw_overlay(Canvas& canvas, const Rect& area, std::vector<TextItem>& text) const {
+    std::erase_if(text, [&area](const TextItem& item) { return overlaps(item_box(item), area); });
+    canvas.fill(area, Color{30, 32, 36});
+    canvas.outline(area, kActive);
+}
+
+void EditorView::draw_recent(Canvas& canvas, std::vector<TextItem>& text) const {
+    const size_t rows = std::max<size_t>(1, recent_.size());
+    const Rect first = recent_row(0);
+    draw_overlay(canvas, {first.x, first.y, first.width, static_cast<float>(rows) * kRecentRow}, text);
+    if (recent_.empty()) {
+        text.push_back(
+            {"No recent files yet: they are those saved or loaded", first.x + 8.0f, first.y + 17.0f, 12.0f, kDimText});
+        return;
+    }
+    for (size_t i = 0; i < recent_.size(); ++i) {
+        const Rect row = recent_row(i);
+        std::string shown = cli::printable(recent_[i], 1000);
+        while (shown.size() > 4 && measure_(shown, 12.0f) > row.width - 16.0f) shown.erase(0, 1);
+        text.push_back({shown, row.x + 8.0f, row.y + 17.0f, 12.0f, recent_[i] == path_ ? kActive : kPanelText});
+    }
+}
+
+void EditorView::draw_prompt(Canvas& canvas, std::vector<TextItem>& text) const {
+    const Rect box = prompt_box();
+    draw_overlay(canvas, box, text);
+    text.push_back({"Save changes?", box.x + 16.0f, box.y + 28.0f, 16.0f, kPanelText});
+    std::string file = path_.empty() ? "(no file: type a path first)" : cli::printable(path_, 1000);
+    while (file.size() > 4 && measure_("The layout is modified. File: " + file, 12.0f) > box.width - 32.0f) {
+        file.erase(0, 1);
+    }
+    text.push_back({"The layout is modified. File: " + file, box.x + 16.0f, box.y + 52.0f, 12.0f, kDimText});
+    for (size_t i = 0; i < 3; ++i) button(canvas, text, prompt_button(i), kPromptButtons[i], i == 0);
 }
 
 void EditorView::draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> previous,

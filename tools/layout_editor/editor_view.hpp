@@ -40,9 +40,10 @@ struct TextItem {
     float size = 13.0f;
     Color color{};
     float wrap_width = 0.0f;
-    bool preview = false;  // drawn with the edited layout (else with the interface's gray one)
-    bool moving = false;   // moves every frame while the preview converges
-    bool live = false;     // changes every frame (the status line): left out of settling
+    bool preview = false;    // drawn with the edited layout (else with the interface's gray one)
+    bool moving = false;     // moves every frame while the preview converges
+    bool live = false;       // changes every frame (the status line): left out of settling
+    uint32_t max_lines = 0;  // wrapped text: lines past this many are left out; 0: all
 };
 
 // What the status line reports, measured by the frame loop.
@@ -89,8 +90,30 @@ public:
     bool load();
     void report(std::string text, bool error);
 
-    // Ctrl+Q was pressed.
+    // Quitting: Ctrl+Q, or the window's close button (the frame loop calls request_quit()). With
+    // unsaved changes (and prompt_on_quit) the window asks "Save changes?" first: S saves and
+    // quits (a failed save keeps the editor open, the failure shown), D quits, Escape cancels.
+    void request_quit();
     bool quit_requested() const { return quit_; }
+    bool prompting() const { return prompting_; }
+    // False for scripted runs (--frames): they quit at once.
+    void set_prompt_on_quit(bool prompt) { prompt_on_quit_ = prompt; }
+
+    // How the window measures text (crisp's layout of its font); estimated_text_width until set.
+    void set_measure(MeasureText measure) { measure_ = std::move(measure); }
+
+    // The recent files' list (recent_files_path()): read now, a bad file reported and ignored;
+    // with `write`, written on every save and load. An empty path keeps no list.
+    void set_recent_file(std::filesystem::path file, bool write);
+    const std::vector<std::string>& recent_files() const { return recent_; }
+    // Puts `path` first in the list and writes it (a failure reported); nothing without a list.
+    void remember(const std::string& path);
+
+    // The preview's text, sizes and colours (--text, --sizes, --colours), as checked by
+    // parse_preview_sizes and parse_preview_colours.
+    void set_preview(std::string text, std::vector<float> sizes, PreviewColours colours);
+    // The preview's zoom: 1, 2 or 4 (Z cycles them); others are ignored.
+    void set_zoom(int zoom);
 
     // The widgets' positions in window pixels, as JSON, for scripts that drive the window.
     std::string geometry_json() const;
@@ -101,15 +124,21 @@ public:
 
 private:
     struct Field {
+        enum class Kind : uint8_t { coordinate, contrast, path, text, sizes, colours };
         Rect rect;
-        int channel = -1;  // -1: the file path field; 3: a contrast parameter (ContrastParameter)
-        int coordinate = 0;
+        Kind kind = Kind::coordinate;
+        int channel = -1;    // Kind::coordinate: the channel
+        int coordinate = 0;  // Kind::coordinate: rect_coordinate's; Kind::contrast: the ContrastParameter
     };
+    std::string field_text(const Field& field) const;  // what a field shows when not being edited
     std::vector<Field> fields() const;
     float field_number(const Field& field) const;  // a number field's value
     void begin_field_edit(int index);
     void commit_field_edit();
     void handle_key(const InputEvent& event);
+    bool handle_field_key(const InputEvent& event);
+    void handle_prompt_key(const InputEvent& event);
+    bool handle_overlay_click(float x, float y);
     void handle_mouse_down(const InputEvent& event);
     bool start_drag(float x, float y);
 
@@ -121,10 +150,16 @@ private:
     void draw_preview(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const;
     void draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> previous, std::vector<TextItem>& text) const;
     void draw_status(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const;
+    void draw_preview_controls(Canvas& canvas, std::vector<TextItem>& text) const;
+    void draw_zoom(Canvas& canvas, std::span<const uint8_t> previous, std::vector<TextItem>& text) const;
+    void draw_overlay(Canvas& canvas, const Rect& area, std::vector<TextItem>& text) const;
+    void draw_recent(Canvas& canvas, std::vector<TextItem>& text) const;
+    void draw_prompt(Canvas& canvas, std::vector<TextItem>& text) const;
 
     // Where the widgets that move with the window's size are, interface pixels.
     struct Geometry {
-        Rect path_field;
+        Rect path_field, recent_button;
+        Rect text_field, sizes_field, colours_field, colours_button, zoom_button;
         Rect light_panel, dark_panel, light_strip, dark_strip;
         float contrast_y = 0.0f;
         Rect mode_button, reset_button;
@@ -133,6 +168,11 @@ private:
     };
     Rect contrast_field(int parameter) const;
     Rect preview_area() const;  // the panels and strips
+    Rect recent_row(size_t i) const;
+    Rect prompt_box() const;
+    Rect prompt_button(size_t i) const;  // 0 Save, 1 Discard, 2 Cancel
+    // Zoomed: the panel the magnified preview covers, and the area of the other side it shows.
+    bool zoom_target(Rect& target, Rect& source) const;
     // The rendered pixels the magnified view shows: columns and rows.
     int crop_columns() const;
     int crop_rows() const;
@@ -146,9 +186,20 @@ private:
     float content_scale_ = 1.0f;
     std::string path_;
     std::vector<Message> messages_;
-    int active_field_ = -2;  // index into fields(); -2: none
-    std::string field_text_;
-    bool field_fresh_ = false;  // nothing typed since the field was clicked
+    int active_field_ = -2;   // index into fields(); -2: none
+    TextEdit edit_;           // the active field's text
+    size_t edit_scroll_ = 0;  // its first byte shown (kept by draw())
+    MeasureText measure_ = estimated_text_width;
+    std::filesystem::path recent_file_;
+    std::vector<std::string> recent_;
+    bool write_recent_ = false;
+    bool recent_open_ = false;
+    bool prompting_ = false;
+    bool prompt_on_quit_ = true;
+    std::string preview_text_ = kDefaultPreviewText;
+    std::vector<float> preview_sizes_ = {9.0f, 11.0f, 13.0f, 16.0f, 20.0f};
+    PreviewColours colours_;
+    int zoom_ = 1;
     float drag_x_ = 0.0f, drag_y_ = 0.0f;
     // Top-left of the preview area shown magnified, interface pixels.
     float crop_x_ = 0.0f, crop_y_ = 0.0f;

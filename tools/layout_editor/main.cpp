@@ -9,6 +9,8 @@
 #include "image_io.hpp"
 #include "output_files.hpp"
 
+#include "core/utf8.hpp"
+
 #include <crisp/bake.hpp>
 #include <crisp/font.hpp>
 #include <crisp/layout.hpp>
@@ -67,6 +69,11 @@ struct Args {
     // content scale, within its work area.
     std::optional<std::pair<uint32_t, uint32_t>> window;
     float ui_scale = 0.0f;  // window pixels per interface pixel; 0: the monitor's content scale
+    // The preview's text, sizes, colours and zoom.
+    std::string text = kDefaultPreviewText;
+    std::vector<float> sizes = {9.0f, 11.0f, 13.0f, 16.0f, 20.0f};
+    PreviewColours colours;
+    std::string zoom = "1";
 };
 
 // The window sizes --window takes, each side.
@@ -120,6 +127,41 @@ Args parse_args(int argc, char** argv) {
                "scale (1 where the window system does not say). A window smaller than\n"
                "1280x800 interface pixels draws everything smaller",
                args.ui_scale, crisp::cli::Range<float>{0.25f, 4.0f});
+    cli.text("--text", "TEXT",
+             "the preview's text, in place of its sample paragraph (it can also be typed\n"
+             "in the window's Text field)",
+             args.text);
+    cli.option("--sizes", "LIST",
+               "the sizes the preview shows its text at, pixels, separated by spaces or\n"
+               "commas: 1 to 8 of them, each 4..72; default \"9 11 13 16 20\"",
+               [&args](std::string_view text) -> crisp::Status {
+                   std::string why;
+                   std::optional<std::vector<float>> sizes = parse_preview_sizes(text, &why);
+                   if (!sizes) {
+                       return crisp::Error{crisp::ErrorCode::invalid_argument,
+                                           "--sizes: '" + crisp::cli::printable(text) + "' " + why};
+                   }
+                   args.sizes = std::move(*sizes);
+                   return {};
+               });
+    cli.option("--colours", "COLOURS",
+               "the first preview panel's text and background colours, \"#RRGGBB on #RRGGBB\",\n"
+               "or a preset: dark-on-light (default), light-on-dark, yellow-on-blue; the\n"
+               "second panel shows them swapped",
+               [&args](std::string_view text) -> crisp::Status {
+                   std::string why;
+                   std::optional<PreviewColours> colours = parse_preview_colours(text, &why);
+                   if (!colours) {
+                       return crisp::Error{crisp::ErrorCode::invalid_argument,
+                                           "--colours: '" + crisp::cli::printable(text) + "' " + why};
+                   }
+                   args.colours = *colours;
+                   return {};
+               });
+    cli.choice("--zoom", "N",
+               "start with the preview zoomed N times (1, 2 or 4; Z cycles them): the\n"
+               "other panel shows the outlined area's pixels magnified",
+               args.zoom, {"1", "2", "4"});
     cli.flag("--print-geometry",
              "print the widgets' positions (window pixels, for the --window size, default\n"
              "1280x800, at --ui-scale, default 1) as JSON and quit (for scripted input)",
@@ -140,16 +182,21 @@ Args parse_args(int argc, char** argv) {
 }
 
 // The characters the editor's text uses: printable ASCII, the em dash and a few more.
-std::vector<uint32_t> editor_codepoints() {
+// The --text's characters too, so that the person's own text shows.
+std::vector<uint32_t> editor_codepoints(std::string_view text) {
     std::vector<uint32_t> codepoints;
     for (uint32_t c = 0x20; c < 0x7F; ++c) codepoints.push_back(c);
     for (uint32_t c : {0x00D7u, 0x2013u, 0x2014u, 0x2026u, 0xFFFDu}) codepoints.push_back(c);
+    for (const uint32_t c : crisp::decode_utf8(text)) {
+        if (c >= 0x20 && std::find(codepoints.begin(), codepoints.end(), c) == codepoints.end())
+            codepoints.push_back(c);
+    }
     return codepoints;
 }
 
-std::optional<crisp::Font> load_font(const std::string& path) {
+std::optional<crisp::Font> load_font(const std::string& path, std::string_view text) {
     crisp::BakeOptions options;
-    options.codepoints = editor_codepoints();
+    options.codepoints = editor_codepoints(text);
     options.all_glyphs = false;
     options.allow_failed = true;
     crisp::Result<crisp::BakeResult> baked = crisp::bake_font_file(path, options);
@@ -203,6 +250,7 @@ void lay_out(crisp::Layouter& layouter, const crisp::Font& font, const std::vect
         options.origin_y = item.y * scale;
         options.wrap_width = item.wrap_width * scale;
         options.first_paint_order = paint_order;
+        options.max_lines = item.max_lines;
         if (crisp::Status status = layouter.layout(fonts, item.text, style, options, laid); !status) {
             errors.push_back(status.error().message);
             continue;
@@ -306,7 +354,13 @@ int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, V
     // same frame again; it also sleeps while the window is minimized.
     uint32_t settled_frames = 0;
     uint64_t converged_since = UINT64_MAX;  // the frame the preview's paragraphs converged in
-    while (!window.should_close() && !view.quit_requested()) {
+    while (!view.quit_requested()) {
+        // The close button asks as Ctrl+Q does; the request is cleared so that Cancel goes on.
+        if (window.should_close()) {
+            window.set_should_close(false);
+            view.request_quit();
+            if (view.quit_requested()) break;
+        }
         if (crisp::Status status = gpu.wait(); !status) {
             std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
             return kExitVulkan;
@@ -433,9 +487,30 @@ int main(int argc, char** argv) {
     LayoutModel model(initial);
     EditorView view(model, path);
     if (load_error) view.report("Load failed: " + *load_error, true);
+    view.set_preview(args.text, args.sizes, args.colours);
+    view.set_zoom(args.zoom[0] - '0');  // "1", "2" or "4": --zoom's choices
+    // Scripted runs (--frames) quit without asking, and show the recent files without changing them.
+    view.set_prompt_on_quit(args.frames == 0);
+    const std::filesystem::path recent = recent_files_path();
+    if (recent.empty()) view.report("Recent files not kept: neither XDG_CONFIG_HOME nor HOME is set", true);
+    view.set_recent_file(recent, args.frames == 0);
+    if (args.frames == 0 && !load_error && !crisp::subpixel_preset(args.layout)) view.remember(args.layout);
 
-    std::optional<crisp::Font> font = load_font(args.font);
+    std::optional<crisp::Font> font = load_font(args.font, args.text);
     if (!font) return kExitFont;
+    // Fields place their cursors by the font's own advances (blank clusters' too: a caret after
+    // a space), at the window's scale.
+    crisp::Layouter measurer;
+    view.set_measure([&measurer, &font, &view](std::string_view text, float size) {
+        const crisp::Font* fonts[] = {&*font};
+        crisp::TextStyle style;
+        style.size = size * view.scale();
+        crisp::TextLayout laid;
+        if (!measurer.layout(fonts, text, style, {}, laid)) return estimated_text_width(text, size);
+        float width = 0.0f;
+        for (const crisp::TextCluster& cluster : laid.clusters) width += cluster.advance;
+        return width / view.scale();
+    });
 
     WindowOptions window_options;
     window_options.width = args.window ? args.window->first : kWindowWidth;

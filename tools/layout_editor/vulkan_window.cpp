@@ -272,6 +272,10 @@ bool VulkanWindow::should_close() const {
     return glfwWindowShouldClose(window_) != 0;
 }
 
+void VulkanWindow::set_should_close(bool close) {
+    glfwSetWindowShouldClose(window_, close ? GLFW_TRUE : GLFW_FALSE);
+}
+
 float VulkanWindow::content_scale() const {
     float x = 1.0f, y = 1.0f;
     glfwGetWindowContentScale(window_, &x, &y);

@@ -78,6 +78,9 @@ public:
     bool drawable() const;
 
     bool should_close() const;
+    // Sets or clears the close request (glfwSetWindowShouldClose): cleared while the editor
+    // asks whether to save, so that Cancel keeps the window.
+    void set_should_close(bool close);
     // Polls the window system and returns the events since the last call, oldest first. With
     // `wait`, sleeps until the window system has something (input, a resize, an exposure).
     std::vector<InputEvent> poll_events(bool wait = false);
