@@ -209,6 +209,10 @@ TEST(LayoutEditorModel, TypedNumbersAreDecimalsOrFractions) {
     EXPECT_NE(why.find("out of range"), std::string::npos) << why;
     EXPECT_FALSE(parse_typed_number("third", &why));
     EXPECT_EQ(why, "is not a number");
+    // Issue 29, item 8: a typed 1e308 was "expected a number"; it is a number, out of range.
+    EXPECT_FALSE(parse_typed_number("1e308", &why));
+    EXPECT_NE(why.find("out of range"), std::string::npos) << why;
+    EXPECT_EQ(why.find("not a number"), std::string::npos) << why;
 }
 
 using crisp::editor::export_form;
