@@ -663,8 +663,8 @@ TEST(LayoutEditorCompare, CandidatesAreDistinctValidAndStartWithTheCurrentLayout
     EXPECT_EQ(rgb[1].layout.channels, preset("bgr").channels);
     EXPECT_EQ(rgb[1].layout.name, "bgr");
     EXPECT_EQ(rgb[2].layout.name, "rgb-edited");
-    EXPECT_FLOAT_EQ(rgb[2].layout.channels[1].x0, 1.0f / 3.0f + 2.0f * kEditStep);
-    EXPECT_FLOAT_EQ(rgb[3].layout.channels[1].x1, 2.0f / 3.0f + 2.0f * kEditStep);
+    EXPECT_FLOAT_EQ(rgb[2].layout.channels[1].x0, 1.0f / 3.0f + crisp::editor::kCandidateSteps * kEditStep);
+    EXPECT_FLOAT_EQ(rgb[3].layout.channels[1].x1, 2.0f / 3.0f + crisp::editor::kCandidateSteps * kEditStep);
     // Gray is its own mirror both ways: no "order reversed" candidate.
     for (const auto& candidate : crisp::editor::layout_candidates(preset("gray"))) {
         EXPECT_NE(candidate.label, "Order reversed");
@@ -688,7 +688,7 @@ TEST(LayoutEditorCompare, PickingACandidateMakesItCurrentAsOneUndoStepAndRefines
     candidates = crisp::editor::layout_candidates(model.layout());
     EXPECT_EQ(candidates[0].layout, model.layout());
     ASSERT_TRUE(model.pick(candidates[2]));
-    EXPECT_FLOAT_EQ(model.layout().channels[1].x0, 1.0f / 3.0f + 4.0f * kEditStep);
+    EXPECT_FLOAT_EQ(model.layout().channels[1].x0, 1.0f / 3.0f + 2 * crisp::editor::kCandidateSteps * kEditStep);
     EXPECT_EQ(model.layout().name, "rgb-edited");
     ASSERT_TRUE(model.undo());
     ASSERT_TRUE(model.undo());

@@ -188,7 +188,7 @@ std::string format_preview_colours(const PreviewColours& colours);
 // Compare mode (issue 29, item 1): candidate layouts shown side by side, one picked.
 inline constexpr size_t kMaxCandidates = 4;
 // How far each side of every rectangle moves in the narrower and wider candidates: edit steps.
-inline constexpr int kCandidateSteps = 2;
+inline constexpr int kCandidateSteps = 4;
 struct Candidate {
     std::string label;  // what its panel says: "Current", "Order reversed", "Narrower", "Wider"
     SubpixelLayout layout;
