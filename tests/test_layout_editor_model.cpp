@@ -665,10 +665,15 @@ TEST(LayoutEditorCompare, CandidatesAreDistinctValidAndStartWithTheCurrentLayout
     EXPECT_EQ(rgb[2].layout.name, "rgb-edited");
     EXPECT_FLOAT_EQ(rgb[2].layout.channels[1].x0, 1.0f / 3.0f + crisp::editor::kCandidateSteps * kEditStep);
     EXPECT_FLOAT_EQ(rgb[3].layout.channels[1].x1, 2.0f / 3.0f + crisp::editor::kCandidateSteps * kEditStep);
-    // Gray is its own mirror both ways: no "order reversed" candidate.
-    for (const auto& candidate : crisp::editor::layout_candidates(preset("gray"))) {
-        EXPECT_NE(candidate.label, "Order reversed");
-    }
+    // vrgb's stripes mirrored left to right are the same: its order reversed is top to bottom.
+    const std::vector<crisp::editor::Candidate> vrgb = crisp::editor::layout_candidates(preset("vrgb"));
+    ASSERT_GE(vrgb.size(), 2u);
+    EXPECT_EQ(vrgb[1].label, "Order reversed");
+    EXPECT_EQ(vrgb[1].layout.name, "vbgr");
+    // Gray is its own mirror both ways: no "order reversed" candidate, three in all.
+    const std::vector<crisp::editor::Candidate> gray = crisp::editor::layout_candidates(preset("gray"));
+    EXPECT_EQ(gray.size(), 3u);
+    for (const auto& candidate : gray) EXPECT_NE(candidate.label, "Order reversed");
     SubpixelLayout invalid = preset("rgb");
     invalid.channels[0].x1 = invalid.channels[0].x0;
     EXPECT_TRUE(crisp::editor::layout_candidates(invalid).empty());
