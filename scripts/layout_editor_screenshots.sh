@@ -28,6 +28,8 @@ printf '{"name": "bgr-heavy", "r": [0.6666667, 0, 1, 1], "g": [0.33333334, 0, 0.
 # outlined pixels of the left one magnified.
 shoot docs/images/layout-editor-preview.png 80 --layout rgb --text "Hamburgefonstiv: the quick brown fox, 0123456789" \
   --sizes "12 24" --colours yellow-on-blue --zoom 4
+# Compare mode: rgb's candidates side by side (itself, the order reversed, narrower, wider).
+shoot docs/images/layout-editor-compare.png 100 --layout rgb --compare
 # A layout file with a fault: crisp's reader's error, shown in the window.
 printf '{"name": "broken", "r": [0, 0, 0.3, 1], "g": [0.3, 0, 0.6], "b": [0.6, 0, 1, 1]}\n' >"$work/broken.json"
 (cd "$work" && shoot "$images/layout-editor-bad-file.png" 3 --layout broken.json)

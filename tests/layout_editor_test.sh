@@ -20,6 +20,8 @@
 # written and, at the next start, Up in the path field brings the newest back and a click in the
 # Recent list chooses another; a bad recent-files list is reported, not fatal. The preview: a text
 # typed into its field changes the paragraphs' pixels; --text, --sizes, --colours and --zoom.
+# Compare mode: candidate panels that differ where the text is, picked by a click and a key,
+# left with Escape and V, the picked layout saved; --compare.
 # XDG_CONFIG_HOME points into WORK_DIR: a person's own recent files are never touched.
 set -uo pipefail
 editor=$1 render=$2 bake=$3 source=$4 work=$5
@@ -97,6 +99,36 @@ if sys.argv[1] == "prompt":  # prompt SHOT: the quit prompt is drawn (its box, b
     gold = sum(1 for p in border if near(p, (230, 180, 60)))
     print(f"prompt: {box} of {len(inside)} samples its colour, {light} light, border {gold} of {len(border)}")
     sys.exit(0 if box > len(inside) // 2 and light > 40 and gold > len(border) * 9 // 10 else 1)
+
+if sys.argv[1] == "panels":  # panels SHOT yes|no: compare mode's candidate panels are shown (or not)
+    _, _, image = read_xwd(sys.argv[2])
+    panels = [[int(v) for v in r] for r in g["candidates"]]
+    near = lambda p, q: max(abs(a - b) for a, b in zip(p, q)) <= 3
+    # Each panel's label bar (the button colour) across its top.
+    bars = [sum(1 for px in range(x + 2, x + w - 2, 4) if near(image(px, y + 4), (64, 68, 76))) * 4 > w * 3 // 4
+            for x, y, w, h in panels]
+    print(f"panels {sys.argv[2]}: label bars {bars}")
+    if sys.argv[3] == "no":
+        sys.exit(0 if not any(bars) else 1)
+    if not all(bars):
+        sys.exit(1)
+    # Where the text is (below the label bar, a sample dark in either panel), every two panels
+    # differ: each is rendered with its own layout. Converging samples move a pixel by less than 8.
+    x0, y0, w, h = panels[0]
+    offsets = [(dx, dy) for dy in range(26, h - 4) for dx in range(4, w - 4)]
+    ok = True
+    for i in range(len(panels)):
+        for j in range(i):
+            (xi, yi, _, _), (xj, yj, _, _) = panels[i], panels[j]
+            ink = differ = 0
+            for dx, dy in offsets:
+                p, q = image(xi + dx, yi + dy), image(xj + dx, yj + dy)
+                if min(p) < 200 or min(q) < 200:
+                    ink += 1
+                    differ += max(abs(a - b) for a, b in zip(p, q)) >= 8
+            print(f"panels {i + 1} and {j + 1}: {differ} of {ink} text samples differ")
+            ok = ok and ink > 1000 and differ > ink // 20
+    sys.exit(0 if ok else 1)
 
 # compare BEFORE AFTER
 w0, h0, before = read_xwd(sys.argv[2])
@@ -496,6 +528,64 @@ code=$?
 [ "$code" -eq 0 ] || fail "a bad recent-files list: exit $code: $(head -c 600 bad-recent.err)"
 grep -q "Recent files ignored: .*line 2" bad-recent.err || fail "a bad recent-files list: $(cat bad-recent.err)"
 cmp -s "$recent_list" recent.kept || fail "a --frames run rewrote the recent files"
+
+# ---- Compare mode (issue 29, item 1): the Compare button shows four candidates around rgb side by
+# side, each panel rendered with its own layout (the panels differ where the text is). A click on
+# panel 2 picks the order reversed (bgr), key 3 then its narrower candidate; Escape leaves, V comes
+# back and V leaves again; Ctrl+S saves bgr narrowed, picked only.
+"$editor" --validation --layout rgb --save-to compared.json 2>compare.err &
+pid=$!
+window=$(timeout 60 xdotool search --sync --name '^crisp layout editor$' | head -n1)
+[ -n "$window" ] || { fail "no editor window (compare)"; kill "$pid"; exit 1; }
+sleep 3
+xdotool windowfocus --sync "$window" 2>/dev/null || true
+# shellcheck disable=SC2046
+click_rect $(rect_of preview_controls compare)
+shot_when_drawn compare.xwd 12
+python3 screens.py panels compare.xwd yes || fail "compare mode: the panels are not shown, or do not differ"
+read -r px py < <(python3 -c 'import json; r=json.load(open("geometry.json"))["candidates"][1]
+print(int(r[0] + r[2] / 2), int(r[1] + r[3] / 2))')
+xdotool mousemove "$px" "$py" click 1
+sleep 1
+xdotool key 3
+sleep 1
+xdotool key Escape
+sleep 2
+shot compare-left.xwd
+python3 screens.py panels compare-left.xwd no || fail "Escape did not leave compare mode"
+xdotool key v
+sleep 2
+shot compare-again.xwd
+python3 screens.py panels compare-again.xwd yes || fail "V did not enter compare mode"
+xdotool key v
+sleep 2
+shot compare-off.xwd
+python3 screens.py panels compare-off.xwd no || fail "V did not leave compare mode"
+xdotool key ctrl+s
+for _ in $(seq 1 60); do [ -f compared.json ] && break; sleep 0.5; done
+[ -f compared.json ] || fail "compare: Ctrl+S wrote no compared.json"
+xdotool key ctrl+q
+for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
+kill -0 "$pid" 2>/dev/null && { fail "the editor did not quit (compare)"; kill "$pid"; }
+wait "$pid"
+code=$?
+[ "$code" -eq 0 ] || fail "compare: the editor exited $code: $(head -c 1500 compare.err)"
+grep -q "Picked 2: Order reversed (bgr)" compare.err || fail "compare: the click did not pick bgr: $(cat compare.err)"
+grep -q "Picked 3: Narrower (bgr-edited)" compare.err || fail "compare: key 3 did not pick: $(cat compare.err)"
+python3 - compared.json geometry.json <<'PY' || fail "compare: the saved layout"
+import json, sys
+saved = json.load(open(sys.argv[1]))
+s = 4 * json.load(open(sys.argv[2]))["edit_step"]  # kCandidateSteps steps each side
+want = {"r": [2 / 3 + s, 0, 1 - s, 1], "g": [1 / 3 + s, 0, 2 / 3 - s, 1], "b": [s, 0, 1 / 3 - s, 1]}
+assert saved["name"] == "bgr-edited", saved
+for channel, expected in want.items():
+    got = saved[channel]
+    assert all(abs(a - b) < 1e-5 for a, b in zip(got, expected)), (channel, got, expected)
+print("compare: saved", json.dumps(saved))
+PY
+# --compare: the screenshot mode starts in compare mode (docs/layout-editor.md's picture).
+timeout 120 "$editor" --validation --compare --frames 3 --screenshot compare.png 2>compare-shot.err ||
+  fail "--compare --screenshot: $(head -c 600 compare-shot.err)"
 
 # ---- The preview from the command line: --text, --sizes, --colours and --zoom change the
 # screenshot; bad sizes and colours are usage errors that say why.

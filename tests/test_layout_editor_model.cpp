@@ -639,3 +639,72 @@ TEST(LayoutEditorPreview, ColoursAreTwoHexColoursOrAPresetAndBadOnesSayWhy) {
 }
 
 }  // namespace
+
+TEST(LayoutEditorCompare, CandidatesAreDistinctValidAndStartWithTheCurrentLayout) {
+    for (const std::string_view name : crisp::subpixel_preset_names()) {
+        SubpixelLayout current = *crisp::subpixel_preset(name);
+        current.contrast = TextContrast{};
+        const std::vector<crisp::editor::Candidate> candidates = crisp::editor::layout_candidates(current);
+        ASSERT_GE(candidates.size(), 2u) << name;
+        ASSERT_LE(candidates.size(), crisp::editor::kMaxCandidates) << name;
+        EXPECT_EQ(candidates[0].layout, current) << name;
+        for (size_t i = 0; i < candidates.size(); ++i) {
+            EXPECT_TRUE(crisp::validate_subpixel_layout(candidates[i].layout)) << name << " " << i;
+            EXPECT_EQ(candidates[i].layout.contrast, current.contrast) << name << " " << i;
+            for (const SampleRect& rect : candidates[i].layout.channels) {
+                for (const float v : {rect.x0, rect.y0, rect.x1, rect.y1}) {
+                    EXPECT_EQ(v, crisp::editor::snap_to_grid_if_near(v)) << name << " " << i;
+                }
+            }
+            for (size_t j = 0; j < i; ++j) {
+                EXPECT_NE(candidates[i].layout.channels, candidates[j].layout.channels) << name << " " << i << j;
+            }
+        }
+    }
+    // rgb's candidates: itself, bgr (the order reversed, named after its preset), narrower, wider.
+    const std::vector<crisp::editor::Candidate> rgb = crisp::editor::layout_candidates(preset("rgb"));
+    ASSERT_EQ(rgb.size(), 4u);
+    EXPECT_EQ(rgb[1].layout.channels, preset("bgr").channels);
+    EXPECT_EQ(rgb[1].layout.name, "bgr");
+    EXPECT_EQ(rgb[2].layout.name, "rgb-edited");
+    EXPECT_FLOAT_EQ(rgb[2].layout.channels[1].x0, 1.0f / 3.0f + crisp::editor::kCandidateSteps * kEditStep);
+    EXPECT_FLOAT_EQ(rgb[3].layout.channels[1].x1, 2.0f / 3.0f + crisp::editor::kCandidateSteps * kEditStep);
+    // vrgb's stripes mirrored left to right are the same: its order reversed is top to bottom.
+    const std::vector<crisp::editor::Candidate> vrgb = crisp::editor::layout_candidates(preset("vrgb"));
+    ASSERT_GE(vrgb.size(), 2u);
+    EXPECT_EQ(vrgb[1].label, "Order reversed");
+    EXPECT_EQ(vrgb[1].layout.name, "vbgr");
+    // Gray is its own mirror both ways: no "order reversed" candidate, three in all.
+    const std::vector<crisp::editor::Candidate> gray = crisp::editor::layout_candidates(preset("gray"));
+    EXPECT_EQ(gray.size(), 3u);
+    for (const auto& candidate : gray) EXPECT_NE(candidate.label, "Order reversed");
+    SubpixelLayout invalid = preset("rgb");
+    invalid.channels[0].x1 = invalid.channels[0].x0;
+    EXPECT_TRUE(crisp::editor::layout_candidates(invalid).empty());
+}
+
+TEST(LayoutEditorCompare, PickingACandidateMakesItCurrentAsOneUndoStepAndRefinesAroundIt) {
+    LayoutModel model(preset("rgb"));
+    const uint64_t revision = model.revision();
+    std::vector<crisp::editor::Candidate> candidates = crisp::editor::layout_candidates(model.layout());
+    ASSERT_TRUE(model.pick(candidates[0]));  // the current one: nothing changes
+    EXPECT_FALSE(model.can_undo());
+    EXPECT_EQ(model.revision(), revision);
+    ASSERT_TRUE(model.pick(candidates[2]));  // narrower
+    EXPECT_EQ(model.layout(), candidates[2].layout);
+    EXPECT_GT(model.revision(), revision);
+    // Picking only: narrower again from there, the candidates regenerated around the pick.
+    candidates = crisp::editor::layout_candidates(model.layout());
+    EXPECT_EQ(candidates[0].layout, model.layout());
+    ASSERT_TRUE(model.pick(candidates[2]));
+    EXPECT_FLOAT_EQ(model.layout().channels[1].x0, 1.0f / 3.0f + 2 * crisp::editor::kCandidateSteps * kEditStep);
+    EXPECT_EQ(model.layout().name, "rgb-edited");
+    ASSERT_TRUE(model.undo());
+    ASSERT_TRUE(model.undo());
+    EXPECT_EQ(model.layout(), preset("rgb"));
+    EXPECT_FALSE(model.can_undo());
+    crisp::editor::Candidate bad{"bad", preset("rgb")};
+    bad.layout.channels[2].x0 = std::nanf("");
+    EXPECT_FALSE(model.pick(bad));
+    EXPECT_EQ(model.layout(), preset("rgb"));
+}

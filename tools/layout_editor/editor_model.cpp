@@ -684,4 +684,64 @@ bool LayoutModel::redo() {
     return true;
 }
 
+namespace {
+
+// The rectangles mirrored left to right (horizontal) or top to bottom within the pixel: the order
+// of the channels along that axis reversed, so rgb becomes bgr.
+SubpixelLayout mirrored(const SubpixelLayout& layout, bool horizontal) {
+    SubpixelLayout out = layout;
+    for (SampleRect& rect : out.channels) {
+        float& lo = horizontal ? rect.x0 : rect.y0;
+        float& hi = horizontal ? rect.x1 : rect.y1;
+        const float new_lo = 1.0f - hi, new_hi = 1.0f - lo;
+        lo = new_lo;
+        hi = new_hi;
+        snap_rect_to_grid(rect);
+    }
+    return out;
+}
+
+// Every rectangle `steps` edit steps wider on each side (narrower for negative steps), about its
+// centre: within the bounds, never narrower than kMinRectSize.
+SubpixelLayout widened(const SubpixelLayout& layout, int steps) {
+    SubpixelLayout out = layout;
+    const float delta = static_cast<float>(steps) * kEditStep;
+    for (SampleRect& rect : out.channels) {
+        if (rect.x1 - rect.x0 + 2.0f * delta < kMinRectSize) continue;  // too narrow already
+        rect.x0 = snap(std::max(kLow, rect.x0 - delta));
+        rect.x1 = snap(std::min(kHigh, rect.x1 + delta));
+    }
+    return out;
+}
+
+}  // namespace
+
+std::vector<Candidate> layout_candidates(const SubpixelLayout& current) {
+    std::vector<Candidate> out;
+    if (!validate_subpixel_layout(current)) return out;
+    SubpixelLayout reversed = mirrored(current, true);
+    if (reversed.channels == current.channels) reversed = mirrored(current, false);
+    const std::pair<const char*, SubpixelLayout> tries[] = {{"Current", current},
+                                                            {"Order reversed", std::move(reversed)},
+                                                            {"Narrower", widened(current, -kCandidateSteps)},
+                                                            {"Wider", widened(current, kCandidateSteps)}};
+    std::string edited = current.name;
+    if (!edited.ends_with("-edited")) edited += "-edited";
+    for (const auto& [label, layout] : tries) {
+        if (out.size() == kMaxCandidates || !validate_subpixel_layout(layout)) continue;
+        const bool seen = std::any_of(out.begin(), out.end(),
+                                      [&](const Candidate& c) { return c.layout.channels == layout.channels; });
+        if (seen) continue;
+        Candidate candidate{label, layout};
+        if (!out.empty()) {
+            candidate.layout.name = edited;
+            for (const std::string_view name : subpixel_preset_names()) {
+                if (subpixel_preset(name)->channels == layout.channels) candidate.layout.name = name;
+            }
+        }
+        out.push_back(std::move(candidate));
+    }
+    return out;
+}
+
 }  // namespace crisp::editor

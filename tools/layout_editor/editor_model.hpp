@@ -185,6 +185,25 @@ std::optional<PreviewColours> parse_preview_colours(std::string_view text, std::
 // "#141418 on #FAF8F0", which parse_preview_colours reads back.
 std::string format_preview_colours(const PreviewColours& colours);
 
+// Compare mode (issue 29, item 1): candidate layouts shown side by side, one picked.
+inline constexpr size_t kMaxCandidates = 4;
+// How far each side of every rectangle moves in the narrower and wider candidates: edit steps.
+inline constexpr int kCandidateSteps = 4;
+struct Candidate {
+    std::string label;  // what its panel says: "Current", "Order reversed", "Narrower", "Wider"
+    SubpixelLayout layout;
+    friend bool operator==(const Candidate&, const Candidate&) = default;
+};
+// The candidates around `current`, first `current` itself, then those of: the order reversed
+// (mirrored left to right, or top to bottom where that changes nothing), every rectangle
+// narrower by kCandidateSteps edit steps each side (about its centre, never below kMinRectSize),
+// every rectangle wider by as much (within the bounds). Each passes validate_subpixel_layout, is
+// on the edit grid, keeps current's contrast and differs from the others in its rectangles; one
+// that would not (gray is its own mirror) is left out. A candidate equal to a preset is named
+// after it, any other "NAME-edited" (NAME current's, without a "-edited" it already has). An
+// invalid `current` gives no candidates.
+std::vector<Candidate> layout_candidates(const SubpixelLayout& current);
+
 class LayoutModel {
 public:
     explicit LayoutModel(SubpixelLayout initial);
@@ -232,6 +251,9 @@ public:
     // compares with from then on: only an edit away from it is a modification.
     Status apply_preset(std::string_view name);
     Status replace(const SubpixelLayout& layout);
+    // Makes a candidate's layout the edited one (replace(): validated, one undo step; nothing
+    // when it is the current one already).
+    Status pick(const Candidate& candidate) { return replace(candidate.layout); }
 
     bool can_undo() const { return !undo_.empty(); }
     bool can_redo() const { return !redo_.empty(); }

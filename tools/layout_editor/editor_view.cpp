@@ -27,7 +27,7 @@ constexpr float kPathFieldX = 1016.0f, kRecentButtonWidth = 60.0f, kRecentWidth 
 constexpr float kPreviewRowY = 44.0f, kPreviewRowHeight = 26.0f;
 constexpr float kTextLabelWidth = 34.0f, kSizesLabelWidth = 36.0f, kColoursLabelWidth = 50.0f;
 constexpr float kSizesFieldWidth = 110.0f, kColoursFieldWidth = 150.0f, kColoursButtonWidth = 64.0f,
-                kZoomButtonWidth = 70.0f, kRowGap = 6.0f;
+                kZoomButtonWidth = 70.0f, kCompareButtonWidth = 76.0f, kRowGap = 6.0f;
 // The quit prompt, centred in the window.
 constexpr float kPromptWidth = 440.0f, kPromptHeight = 124.0f, kPromptButtonWidth = 96.0f;
 // The number fields: wide enough for "-0.08333" (fitted_number shortens what is longer).
@@ -154,7 +154,9 @@ void EditorView::resize(uint32_t width, uint32_t height, float content_scale) {
     // takes what is left.
     const float right = dark_x + panel_width;
     g.zoom_button = {right - kZoomButtonWidth, kPreviewRowY, kZoomButtonWidth, kPreviewRowHeight};
-    g.colours_button = {g.zoom_button.x - kRowGap - kColoursButtonWidth, kPreviewRowY, kColoursButtonWidth,
+    g.compare_button = {g.zoom_button.x - kRowGap - kCompareButtonWidth, kPreviewRowY, kCompareButtonWidth,
+                        kPreviewRowHeight};
+    g.colours_button = {g.compare_button.x - kRowGap - kColoursButtonWidth, kPreviewRowY, kColoursButtonWidth,
                         kPreviewRowHeight};
     g.colours_field = {g.colours_button.x - kRowGap - kColoursFieldWidth, kPreviewRowY, kColoursFieldWidth,
                        kPreviewRowHeight};
@@ -276,8 +278,16 @@ std::string EditorView::geometry_json() const {
     rect("sizes", g.sizes_field);
     rect("colours", g.colours_field);
     rect("colour_presets", g.colours_button);
+    rect("compare", g.compare_button);
     rect("zoom", g.zoom_button);
     json.end_object();
+    json.key("candidates").begin_array();
+    for (size_t i = 0; i < kMaxCandidates; ++i) {
+        const Rect r = candidate_panel(i);
+        json.begin_array().value(r.x * scale_).value(r.y * scale_).value(r.width * scale_);
+        json.value(r.height * scale_).end_array();
+    }
+    json.end_array();
     json.key("prompt").begin_object();
     rect("box", prompt_box());
     for (size_t i = 0; i < 3; ++i) rect(std::array{"save", "discard", "cancel"}[i], prompt_button(i));
@@ -573,6 +583,15 @@ void EditorView::handle_key(const InputEvent& event) {
         return;
     }
     if (active_field_ >= 0 && handle_field_key(event)) return;
+    // V rather than C, which steps the contrast.
+    if (!control && (event.key == GLFW_KEY_V || (comparing_ && event.key == GLFW_KEY_ESCAPE))) {
+        set_compare(!comparing_ && event.key == GLFW_KEY_V);
+        return;
+    }
+    if (comparing_ && !control && event.key >= GLFW_KEY_1 && event.key <= GLFW_KEY_4) {
+        pick_candidate(static_cast<size_t>(event.key - GLFW_KEY_1));
+        return;
+    }
     if (control && event.key == GLFW_KEY_Z) {
         shift ? model_.redo() : model_.undo();
     } else if (control && event.key == GLFW_KEY_Y) {
@@ -664,6 +683,17 @@ void EditorView::handle_mouse_down(const InputEvent& event) {
         handle_key({InputEvent::Kind::key, 0.0, 0.0, 0, GLFW_KEY_Z});
         return;
     }
+    if (g.compare_button.contains(x, y)) {
+        set_compare(!comparing_);
+        return;
+    }
+    if (comparing_) {
+        for (size_t i = 0; i < candidates_.size(); ++i) {
+            if (!candidate_panel(i).contains(x, y)) continue;
+            pick_candidate(i);
+            return;
+        }
+    }
     if (g.colours_button.contains(x, y)) {
         // The next preset after the colours shown (the first where they are none).
         const auto presets = preview_colour_presets();
@@ -749,8 +779,16 @@ void EditorView::draw(Canvas& canvas, std::span<const uint8_t> previous, const F
     draw_fields(canvas, text);
     draw_contrast(canvas, text);
     draw_side_text(text);
-    draw_preview(canvas, stats, text);
-    draw_zoom(canvas, previous, text);
+    // An undo, a preset or an edit in compare mode: the candidates follow the edited layout.
+    if (comparing_ && (candidates_.empty() || candidates_[0].layout != model_.layout())) {
+        candidates_ = layout_candidates(model_.layout());
+    }
+    if (comparing_) {
+        draw_candidates(canvas, text);
+    } else {
+        draw_preview(canvas, stats, text);
+        draw_zoom(canvas, previous, text);
+    }
     draw_preview_controls(canvas, text);
     draw_rendered_pixels(canvas, previous, text);
     draw_status(canvas, stats, text);
@@ -933,7 +971,7 @@ void EditorView::draw_side_text(std::vector<TextItem>& text) const {
         "Tab: next channel. Click a field to edit: Home, End, Ctrl+A;",
         "Enter keeps, Esc restores, Tab moves on; Up: recent files.",
         "Ctrl+Z/Y undo/redo, Ctrl+S save, Ctrl+O load, Ctrl+Q quit.",
-        "Click the preview to choose what is magnified; Z zooms.",
+        "Click the preview to magnify it; Z zooms; V compares.",
         "G, C, D raise gamma, contrast, stem darkening by 0.1,",
         "with Shift lower them; M: linear or corrected.",
     };
@@ -994,6 +1032,69 @@ void EditorView::draw_preview(Canvas& canvas, const FrameStats& stats, std::vect
         canvas.outline(
             {zoom_source.x - one, zoom_source.y - one, zoom_source.width + 2.0f * one, zoom_source.height + 2.0f * one},
             Color{90, 150, 255}, one);
+    }
+}
+
+void EditorView::set_compare(bool on) {
+    comparing_ = on;
+    candidates_ = on ? layout_candidates(model_.layout()) : std::vector<Candidate>{};
+}
+
+void EditorView::pick_candidate(size_t i) {
+    if (i >= candidates_.size()) return;
+    const Candidate picked = candidates_[i];
+    if (Status status = model_.pick(picked); !status) {
+        report("Pick failed: " + status.error().message, true);
+        return;
+    }
+    report("Picked " + std::to_string(i + 1) + ": " + picked.label + " (" + picked.layout.name + ")", false);
+    candidates_ = layout_candidates(model_.layout());
+}
+
+Rect EditorView::candidate_panel(size_t i) const {
+    const Rect area = preview_area();
+    const float gap = kPreviewGap;
+    const float width = (area.width - gap) / 2.0f, height = (area.height - gap) / 2.0f;
+    return {area.x + static_cast<float>(i % 2) * (width + gap), area.y + static_cast<float>(i / 2) * (height + gap),
+            width, height};
+}
+
+// Each candidate's panel: its number and label, then the preview's text at its smallest, middle
+// and largest size, two lines each at most, in the first panel's colours. Few glyphs: four
+// renderers converge together on lavapipe.
+void EditorView::draw_candidates(Canvas& canvas, std::vector<TextItem>& text) const {
+    std::vector<float> sizes = {preview_sizes_.front(), preview_sizes_[preview_sizes_.size() / 2],
+                                preview_sizes_.back()};
+    sizes.erase(std::unique(sizes.begin(), sizes.end()), sizes.end());
+    for (size_t i = 0; i < kMaxCandidates; ++i) {
+        const Rect panel = candidate_panel(i);
+        if (i >= candidates_.size()) {
+            canvas.fill(panel, Color{30, 31, 34});
+            continue;
+        }
+        const Candidate& candidate = candidates_[i];
+        canvas.fill(panel, colours_.background);
+        canvas.fill({panel.x, panel.y, panel.width, 22.0f}, kButton);
+        if (i == 0) canvas.outline(panel, kActive);
+        const std::string label =
+            std::to_string(i + 1) + "  " + candidate.label + ": " + candidate.layout.name +
+            (i == 0 ? "  (the edited layout)" : "  (click or " + std::to_string(i + 1) + " to pick)");
+        text.push_back({label, panel.x + 8.0f, panel.y + 16.0f, 12.0f, kPanelText});
+        float top = panel.y + 28.0f;
+        const float bottom = panel.y + panel.height - 4.0f;
+        for (const float size : sizes) {
+            const float line = size * 1.17f;
+            const auto fit = static_cast<uint32_t>(std::max(0.0f, std::floor((bottom - top) / line)));
+            if (fit == 0) break;
+            const float wrap = panel.width - 20.0f;
+            const uint32_t lines = std::min<uint32_t>(
+                {fit, 2u, static_cast<uint32_t>(std::max<size_t>(1, wrap_text(preview_text_, wrap, size).size()))});
+            TextItem item{preview_text_, panel.x + 10.0f, top + size * 0.93f, size, colours_.foreground, wrap};
+            item.max_lines = lines;
+            item.candidate = static_cast<int>(i);
+            text.push_back(std::move(item));
+            top += static_cast<float>(lines) * line + 6.0f;
+        }
     }
 }
 
@@ -1058,6 +1159,10 @@ void EditorView::draw_preview_controls(Canvas& canvas, std::vector<TextItem>& te
     canvas.fill(zoom, zoom_ > 1 ? Color{92, 84, 52} : kButton);
     canvas.outline(zoom, zoom_ > 1 ? kActive : kButtonBorder);
     text.push_back({"Zoom " + std::to_string(zoom_) + "x", zoom.x + 8.0f, baseline, 12.0f, kPanelText});
+    const Rect compare = g.compare_button;
+    canvas.fill(compare, comparing_ ? Color{92, 84, 52} : kButton);
+    canvas.outline(compare, comparing_ ? kActive : kButtonBorder);
+    text.push_back({"Compare", compare.x + 8.0f, baseline, 12.0f, kPanelText});
 }
 
 Rect EditorView::recent_row(size_t i) const {

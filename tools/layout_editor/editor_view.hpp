@@ -44,6 +44,7 @@ struct TextItem {
     bool moving = false;     // moves every frame while the preview converges
     bool live = false;       // changes every frame (the status line): left out of settling
     uint32_t max_lines = 0;  // wrapped text: lines past this many are left out; 0: all
+    int candidate = -1;      // compare mode: drawn with this candidate's layout (else as `preview` says)
 };
 
 // What the status line reports, measured by the frame loop.
@@ -115,6 +116,17 @@ public:
     // The preview's zoom: 1, 2 or 4 (Z cycles them); others are ignored.
     void set_zoom(int zoom);
 
+    // Compare mode (V, the Compare button, --compare): the preview shows layout_candidates() of
+    // the edited layout side by side, each panel with its own renderer; a click on a panel or
+    // keys 1 to 4 pick one (LayoutModel::pick) and the candidates are made again around it.
+    // Escape or V leaves.
+    void set_compare(bool on);
+    bool comparing() const { return comparing_; }
+    // The candidates shown (the frame loop gives each its renderer); empty when not comparing.
+    const std::vector<Candidate>& candidates() const { return candidates_; }
+    // Picks candidate i (reported in the messages); an index with no candidate is ignored.
+    void pick_candidate(size_t i);
+
     // The widgets' positions in window pixels, as JSON, for scripts that drive the window.
     std::string geometry_json() const;
 
@@ -148,6 +160,9 @@ private:
     void draw_contrast(Canvas& canvas, std::vector<TextItem>& text) const;
     void draw_side_text(std::vector<TextItem>& text) const;
     void draw_preview(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const;
+    void draw_candidates(Canvas& canvas, std::vector<TextItem>& text) const;
+    // Compare mode's panel i of kMaxCandidates, two by two over preview_area().
+    Rect candidate_panel(size_t i) const;
     void draw_rendered_pixels(Canvas& canvas, std::span<const uint8_t> previous, std::vector<TextItem>& text) const;
     void draw_status(Canvas& canvas, const FrameStats& stats, std::vector<TextItem>& text) const;
     void draw_preview_controls(Canvas& canvas, std::vector<TextItem>& text) const;
@@ -159,7 +174,7 @@ private:
     // Where the widgets that move with the window's size are, interface pixels.
     struct Geometry {
         Rect path_field, recent_button;
-        Rect text_field, sizes_field, colours_field, colours_button, zoom_button;
+        Rect text_field, sizes_field, colours_field, colours_button, compare_button, zoom_button;
         Rect light_panel, dark_panel, light_strip, dark_strip;
         float contrast_y = 0.0f;
         Rect mode_button, reset_button;
@@ -200,6 +215,8 @@ private:
     std::vector<float> preview_sizes_ = {9.0f, 11.0f, 13.0f, 16.0f, 20.0f};
     PreviewColours colours_;
     int zoom_ = 1;
+    bool comparing_ = false;
+    std::vector<Candidate> candidates_;
     float drag_x_ = 0.0f, drag_y_ = 0.0f;
     // Top-left of the preview area shown magnified, interface pixels.
     float crop_x_ = 0.0f, crop_y_ = 0.0f;

@@ -3,6 +3,7 @@
 
 #include "vk/barriers.hpp"
 
+#include <algorithm>
 #include <utility>
 
 namespace crisp::editor {
@@ -29,6 +30,8 @@ GpuFrame::GpuFrame(VulkanWindow& window) : window_(window) {}
 
 GpuFrame::~GpuFrame() {
     vkDeviceWaitIdle(window_.device());
+    candidate_compositors_.clear();
+    candidate_renderers_.clear();
     preview_compositor_.reset();
     interface_compositor_.reset();
     preview_renderer_.reset();
@@ -121,6 +124,9 @@ Result<std::unique_ptr<GpuFrame>> GpuFrame::create(VulkanWindow& window, const F
         if (!compositor) return compositor.error();
         slot->emplace(std::move(*compositor));
     }
+    self->font_ = &font;
+    self->renderer_info_ = renderer_info;
+    self->compositor_info_ = compositor_info;
     if (!self->preview_compositor_->supports_target_format(VK_FORMAT_R8G8B8A8_UNORM)) {
         return Error{ErrorCode::vulkan, "the compositor cannot write R8G8B8A8_UNORM storage images on this device"};
     }
@@ -194,14 +200,53 @@ Status GpuFrame::set_preview_contrast(const TextContrast& contrast) {
     return preview_renderer_->set_contrast(contrast);
 }
 
+Status GpuFrame::set_candidates(std::span<const SubpixelLayout> layouts, const TextContrast& contrast) {
+    candidate_count_ = 0;
+    for (size_t i = 0; i < layouts.size(); ++i) {
+        if (i == candidate_renderers_.size()) {
+            // A small atlas: the candidates show one short paragraph at a few sizes, and four of
+            // them converge together on lavapipe.
+            RendererCreateInfo info = renderer_info_;
+            info.atlas = atlas_config(512);
+            info.layout = layouts[i];
+            info.contrast = contrast;
+            Result<Renderer> renderer = Renderer::create(info);
+            if (!renderer) return renderer.error();
+            if (Status s = renderer->add_font(*font_); !s) return s.error();
+            Result<Compositor> compositor = Compositor::create(compositor_info_);
+            if (!compositor) return compositor.error();
+            candidate_renderers_.push_back(std::move(*renderer));
+            candidate_compositors_.push_back(std::move(*compositor));
+            candidate_layouts_.push_back(layouts[i]);
+            candidate_contrasts_.push_back(contrast);
+        }
+        if (candidate_layouts_[i].channels != layouts[i].channels) {
+            if (Status s = candidate_renderers_[i].set_subpixel_layout(layouts[i]); !s) return s;
+            candidate_layouts_[i] = layouts[i];
+        }
+        if (candidate_contrasts_[i] != contrast) {
+            if (Status s = candidate_renderers_[i].set_contrast(contrast); !s) return s;
+            candidate_contrasts_[i] = contrast;
+        }
+        candidate_count_ = i + 1;
+    }
+    return {};
+}
+
 Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const GlyphInstance> interface_glyphs,
-                        std::span<const GlyphInstance> preview_glyphs) {
+                        std::span<const GlyphInstance> preview_glyphs,
+                        std::span<const std::vector<GlyphInstance>> candidate_glyphs) {
     const uint32_t width = width_, height = height_;
     const VkRect2D whole{{0, 0}, {width, height}};
+    const size_t candidates = std::min(candidate_count_, candidate_glyphs.size());
     interface_renderer_->begin_frame();
     interface_renderer_->draw(interface_glyphs, whole);
     preview_renderer_->begin_frame();
     preview_renderer_->draw(preview_glyphs, whole);
+    for (size_t i = 0; i < candidates; ++i) {
+        candidate_renderers_[i].begin_frame();
+        candidate_renderers_[i].draw(candidate_glyphs[i], whole);
+    }
 
     VkCommandBuffer cb = command_buffer_;
     vkResetCommandBuffer(cb, 0);
@@ -232,10 +277,16 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
         // Each renderer's current frame: never refused.
         (void)interface_renderer_->abandon_frame(interface_renderer_->frame());
         (void)preview_renderer_->abandon_frame(preview_renderer_->frame());
+        for (size_t i = 0; i < candidates; ++i) {
+            (void)candidate_renderers_[i].abandon_frame(candidate_renderers_[i].frame());
+        }
         return error;
     };
     if (Status s = interface_renderer_->record(cb); !s) return fail(s.error());
     if (Status s = preview_renderer_->record(cb); !s) return fail(s.error());
+    for (size_t i = 0; i < candidates; ++i) {
+        if (Status s = candidate_renderers_[i].record(cb); !s) return fail(s.error());
+    }
     CompositeTarget composite_target;
     composite_target.view = canvas_.view;
     composite_target.format = VK_FORMAT_R8G8B8A8_UNORM;
@@ -249,6 +300,16 @@ Status GpuFrame::render(const VulkanWindow::Acquired& target, std::span<const Gl
                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     if (Status s = preview_compositor_->record(cb, preview_renderer_->drawn_frame(), composite_target); !s) {
         return fail(s.error());
+    }
+    // Each candidate's text over the canvas, in its own panel (its glyphs are placed there).
+    for (size_t i = 0; i < candidates; ++i) {
+        image_barrier(functions_, cb, canvas_.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+        if (Status s = candidate_compositors_[i].record(cb, candidate_renderers_[i].drawn_frame(), composite_target);
+            !s) {
+            return fail(s.error());
+        }
     }
     image_barrier(functions_, cb, canvas_.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,

@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <vector>
 
 namespace crisp::editor {
 
@@ -54,9 +55,19 @@ public:
     // The preview's contrast settings, from the next frame on (the samples stay).
     Status set_preview_contrast(const TextContrast& contrast);
 
-    // Records and submits one frame into the acquired swapchain image.
+    // Compare mode: one renderer (a small atlas, its own compositor) per candidate layout, made
+    // on first use and kept; a changed layout restarts that renderer's samples. An empty span
+    // leaves compare mode (the renderers stay, idle). crisp's error for an invalid layout or
+    // contrast, or where a renderer cannot be made (the candidates before it stay in use).
+    Status set_candidates(std::span<const SubpixelLayout> layouts, const TextContrast& contrast);
+    size_t candidate_count() const { return candidate_count_; }
+    const Renderer& candidate_renderer(size_t i) const { return candidate_renderers_[i]; }
+
+    // Records and submits one frame into the acquired swapchain image. `candidate_glyphs[i]` is
+    // drawn with candidate i's renderer (those past candidate_count() are ignored).
     Status render(const VulkanWindow::Acquired& target, std::span<const GlyphInstance> interface_glyphs,
-                  std::span<const GlyphInstance> preview_glyphs);
+                  std::span<const GlyphInstance> preview_glyphs,
+                  std::span<const std::vector<GlyphInstance>> candidate_glyphs);
 
     const Renderer& preview_renderer() const { return *preview_renderer_; }
     const Renderer& interface_renderer() const { return *interface_renderer_; }
@@ -84,6 +95,15 @@ private:
     std::optional<Renderer> preview_renderer_;
     std::optional<Compositor> interface_compositor_;
     std::optional<Compositor> preview_compositor_;
+    // Kept for making the candidates' renderers.
+    const Font* font_ = nullptr;
+    RendererCreateInfo renderer_info_;
+    CompositorCreateInfo compositor_info_;
+    std::vector<Renderer> candidate_renderers_;
+    std::vector<Compositor> candidate_compositors_;
+    std::vector<SubpixelLayout> candidate_layouts_;  // as each renderer has it
+    std::vector<TextContrast> candidate_contrasts_;
+    size_t candidate_count_ = 0;
 };
 
 }  // namespace crisp::editor

@@ -74,6 +74,7 @@ struct Args {
     std::vector<float> sizes = {9.0f, 11.0f, 13.0f, 16.0f, 20.0f};
     PreviewColours colours;
     std::string zoom = "1";
+    bool compare = false;
 };
 
 // The window sizes --window takes, each side.
@@ -162,6 +163,10 @@ Args parse_args(int argc, char** argv) {
                "start with the preview zoomed N times (1, 2 or 4; Z cycles them): the\n"
                "other panel shows the outlined area's pixels magnified",
                args.zoom, {"1", "2", "4"});
+    cli.flag("--compare",
+             "start in compare mode: candidate layouts around the --layout side by side\n"
+             "(V or the Compare button toggles it; a click or 1-4 picks one)",
+             args.compare);
     cli.flag("--print-geometry",
              "print the widgets' positions (window pixels, for the --window size, default\n"
              "1280x800, at --ui-scale, default 1) as JSON and quit (for scripted input)",
@@ -218,6 +223,8 @@ std::optional<crisp::Font> load_font(const std::string& path, std::string_view t
 struct FrameText {
     std::vector<crisp::GlyphInstance> interface_glyphs;
     std::vector<crisp::GlyphInstance> preview_glyphs;
+    // Compare mode: each candidate's text, for its own renderer.
+    std::vector<std::vector<crisp::GlyphInstance>> candidate_glyphs;
     // Paint orders of moving preview text: it never converges, so the status line leaves it out.
     std::vector<std::pair<uint32_t, uint32_t>> moving;
     // Paint orders of text that changes every frame (the status line): left out of settling.
@@ -234,6 +241,7 @@ void lay_out(crisp::Layouter& layouter, const crisp::Font& font, const std::vect
              FrameText& out, std::vector<std::string>& errors) {
     out.interface_glyphs.clear();
     out.preview_glyphs.clear();
+    out.candidate_glyphs.assign(kMaxCandidates, {});
     out.moving.clear();
     out.live.clear();
     const crisp::Font* fonts[] = {&font};
@@ -258,9 +266,19 @@ void lay_out(crisp::Layouter& layouter, const crisp::Font& font, const std::vect
         if (item.moving) out.moving.emplace_back(paint_order, laid.next_paint_order);
         if (item.live) out.live.emplace_back(paint_order, laid.next_paint_order);
         paint_order = laid.next_paint_order;
-        auto& target = item.preview ? out.preview_glyphs : out.interface_glyphs;
+        auto& target = item.candidate >= 0 && static_cast<size_t>(item.candidate) < kMaxCandidates
+                           ? out.candidate_glyphs[static_cast<size_t>(item.candidate)]
+                       : item.preview ? out.preview_glyphs
+                                      : out.interface_glyphs;
         target.insert(target.end(), laid.glyphs.begin(), laid.glyphs.end());
     }
+}
+
+// The renderers of the preview's text: the preview's, and in compare mode the candidates'.
+std::vector<const crisp::Renderer*> preview_renderers(const GpuFrame& gpu) {
+    std::vector<const crisp::Renderer*> renderers = {&gpu.preview_renderer()};
+    for (size_t i = 0; i < gpu.candidate_count(); ++i) renderers.push_back(&gpu.candidate_renderer(i));
+    return renderers;
 }
 
 FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
@@ -268,14 +286,17 @@ FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
     stats.frame = frame;
     stats.target_samples = kPreviewMaxSamples;
     stats.gpu_ms = gpu.gpu_milliseconds().value_or(-1.0);
-    stats.atlas_occupancy = gpu.preview_renderer().atlas().stats().occupancy;
     bool first = true;
-    for (const crisp::DrawnGlyph& glyph : gpu.preview_renderer().drawn()) {
-        if (in_ranges(text.moving, glyph.instance.paint_order)) continue;
-        stats.min_samples = first ? glyph.samples : std::min(stats.min_samples, glyph.samples);
-        stats.max_samples = first ? glyph.samples : std::max(stats.max_samples, glyph.samples);
-        first = false;
-        ++stats.glyphs;
+    for (const crisp::Renderer* renderer : preview_renderers(gpu)) {
+        // The fullest atlas: the one that would run out first.
+        stats.atlas_occupancy = std::max(stats.atlas_occupancy, renderer->atlas().stats().occupancy);
+        for (const crisp::DrawnGlyph& glyph : renderer->drawn()) {
+            if (in_ranges(text.moving, glyph.instance.paint_order)) continue;
+            stats.min_samples = first ? glyph.samples : std::min(stats.min_samples, glyph.samples);
+            stats.max_samples = first ? glyph.samples : std::max(stats.max_samples, glyph.samples);
+            first = false;
+            ++stats.glyphs;
+        }
     }
     return stats;
 }
@@ -283,7 +304,9 @@ FrameStats measure(const GpuFrame& gpu, const FrameText& text, uint64_t frame) {
 // Whether the last frame drawn shows every glyph converged, but those of text that changes every
 // frame: the next frame would look the same, so the editor can wait for input.
 bool settled(const GpuFrame& gpu, const FrameText& text) {
-    for (const crisp::Renderer* renderer : {&gpu.preview_renderer(), &gpu.interface_renderer()}) {
+    std::vector<const crisp::Renderer*> renderers = preview_renderers(gpu);
+    renderers.push_back(&gpu.interface_renderer());
+    for (const crisp::Renderer* renderer : renderers) {
         for (const crisp::DrawnGlyph& glyph : renderer->drawn()) {
             if (glyph.samples < kPreviewMaxSamples && !in_ranges(text.live, glyph.instance.paint_order)) return false;
         }
@@ -348,6 +371,8 @@ int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, V
     // What the preview's renderer has: a change of contrast alone keeps the samples.
     std::array<crisp::SampleRect, 3> applied_channels = model.layout().channels;
     crisp::TextContrast applied_contrast = model.contrast();
+    std::vector<crisp::SubpixelLayout> applied_candidates;  // compare mode's, as the renderers have them
+    crisp::TextContrast candidates_contrast = model.contrast();
     uint64_t frame = 0;
     // With no --frames, once two frames in a row show every glyph converged and the moving line
     // has stopped, the loop sleeps until the window system has something rather than drawing the
@@ -413,7 +438,20 @@ int run(const Args& args, const std::optional<crisp::OutputFiles>& screenshot, V
         std::vector<std::string> errors;
         lay_out(layouter, font, items, view.scale(), text, errors);
         for (const std::string& error : errors) view.report("Text layout: " + error, true);
-        if (crisp::Status status = gpu.render(*acquired, text.interface_glyphs, text.preview_glyphs); !status) {
+        // The candidates drawn this frame, each with its renderer (none out of compare mode).
+        std::vector<crisp::SubpixelLayout> candidate_layouts;
+        for (const Candidate& candidate : view.candidates()) candidate_layouts.push_back(candidate.layout);
+        if (candidate_layouts != applied_candidates || model.contrast() != candidates_contrast) {
+            applied_candidates = candidate_layouts;
+            candidates_contrast = model.contrast();
+            converged_since = UINT64_MAX;
+            if (crisp::Status status = gpu.set_candidates(candidate_layouts, candidates_contrast); !status) {
+                view.report("Compare: " + status.error().message, true);
+            }
+        }
+        if (crisp::Status status =
+                gpu.render(*acquired, text.interface_glyphs, text.preview_glyphs, text.candidate_glyphs);
+            !status) {
             std::fprintf(stderr, "crisp-layout-editor: %s\n", status.error().message.c_str());
             return kExitVulkan;
         }
@@ -489,6 +527,7 @@ int main(int argc, char** argv) {
     if (load_error) view.report("Load failed: " + *load_error, true);
     view.set_preview(args.text, args.sizes, args.colours);
     view.set_zoom(args.zoom[0] - '0');  // "1", "2" or "4": --zoom's choices
+    view.set_compare(args.compare);
     // Scripted runs (--frames) quit without asking, and show the recent files without changing them.
     view.set_prompt_on_quit(args.frames == 0);
     const std::filesystem::path recent = recent_files_path();
