@@ -1,4 +1,4 @@
-// UTF-8 decoding, for layout's clusters, the JSON reader and the tools; text from an input made safe
+// UTF-8 decoding and encoding, for layout's clusters, the JSON reader and the tools; text from an input made safe
 // to print in a message.
 #pragma once
 
@@ -13,6 +13,9 @@ namespace crisp {
 // (Unicode 15, 3.9 U+FFFD substitution), so a truncated sequence costs one replacement, not one
 // per byte.
 std::vector<uint32_t> decode_utf8(std::string_view text);
+
+// Appends `codepoint` (at most U+10FFFF; callers pass scalar values) to `out` as UTF-8.
+void append_utf8(std::string& out, uint32_t codepoint);
 
 // Decodes like decode_utf8 into `codepoints`, and the byte offset of every code point, plus a final
 // entry holding text.size(), into `offsets` (both cleared first; their capacity is reused).
