@@ -318,6 +318,14 @@ shot_when_drawn after.xwd 6
 # Idle once converged: the CPU seconds of 5 s are far below a busy loop's (about 1.5 cores on
 # lavapipe, 2 cores: 7 to 8 s). Converging takes about 150 frames after the last edit.
 ticks=$(getconf CLK_TCK)
+# await_quit MESSAGE: gives the editor ($pid) 30 s to quit; past that, fails with MESSAGE and kills it.
+await_quit() {
+  for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
+  if kill -0 "$pid" 2>/dev/null; then
+    fail "$1"
+    kill "$pid"
+  fi
+}
 cpu_ticks() { awk '{print $14 + $15}' "/proc/$pid/stat"; }
 idle=""
 for _ in $(seq 1 36); do
@@ -330,11 +338,7 @@ done
 [ -n "$idle" ] && echo "idle: $idle/100 CPU seconds in 5 s" ||
   fail "the editor never idled: still $used/100 CPU seconds in 5 s after 3 minutes"
 xdotool key ctrl+q
-for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
-if kill -0 "$pid" 2>/dev/null; then
-  fail "the editor did not quit on Ctrl+Q"
-  kill "$pid"
-fi
+await_quit "the editor did not quit on Ctrl+Q"
 wait "$pid"
 code=$?
 [ "$code" -eq 0 ] || fail "the editor exited $code (4: the validation layer spoke): $(head -c 1500 editor.err)"
@@ -459,8 +463,7 @@ if kill -0 "$pid" 2>/dev/null; then
     fail "closing the window with unsaved changes (after a Cancel) quit without asking"
   fi
   xdotool key d
-  for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
-  kill -0 "$pid" 2>/dev/null && { fail "D (Discard) did not quit"; kill "$pid"; }
+  await_quit "D (Discard) did not quit"
 else
   fail "Ctrl+Q with unsaved changes quit without asking"
 fi
@@ -509,8 +512,7 @@ shot_when_drawn text-after.xwd 8
 python3 screens.py changed preview_paragraphs text-before.xwd text-after.xwd ||
   fail "the typed preview text did not change the preview"
 xdotool key ctrl+q
-for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
-kill -0 "$pid" 2>/dev/null && { fail "the editor did not quit (recent)"; kill "$pid"; }
+await_quit "the editor did not quit (recent)"
 wait "$pid"
 code=$?
 [ "$code" -eq 0 ] || fail "recent: the editor exited $code: $(head -c 1500 recent.err)"
@@ -565,8 +567,7 @@ xdotool key ctrl+s
 for _ in $(seq 1 60); do [ -f compared.json ] && break; sleep 0.5; done
 [ -f compared.json ] || fail "compare: Ctrl+S wrote no compared.json"
 xdotool key ctrl+q
-for _ in $(seq 1 60); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
-kill -0 "$pid" 2>/dev/null && { fail "the editor did not quit (compare)"; kill "$pid"; }
+await_quit "the editor did not quit (compare)"
 wait "$pid"
 code=$?
 [ "$code" -eq 0 ] || fail "compare: the editor exited $code: $(head -c 1500 compare.err)"

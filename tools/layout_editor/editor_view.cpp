@@ -238,9 +238,13 @@ std::vector<EditorView::Field> EditorView::fields() const {
 std::string EditorView::geometry_json() const {
     crisp::JsonWriter json;
     // Window pixels, where scripted input clicks.
-    auto rect = [&json, this](std::string_view key, const Rect& r) {
-        json.key(key).begin_array().value(r.x * scale_).value(r.y * scale_).value(r.width * scale_);
+    auto box = [&json, this](const Rect& r) {
+        json.begin_array().value(r.x * scale_).value(r.y * scale_).value(r.width * scale_);
         json.value(r.height * scale_).end_array();
+    };
+    auto rect = [&json, &box](std::string_view key, const Rect& r) {
+        json.key(key);
+        box(r);
     };
     const Geometry& g = geometry_;
     json.begin_object();
@@ -267,11 +271,7 @@ std::string EditorView::geometry_json() const {
     rect("path_field", g.path_field);
     rect("recent_button", g.recent_button);
     json.key("recent_rows").begin_array();
-    for (size_t i = 0; i < kMaxRecentFiles; ++i) {
-        const Rect r = recent_row(i);
-        json.begin_array().value(r.x * scale_).value(r.y * scale_).value(r.width * scale_);
-        json.value(r.height * scale_).end_array();
-    }
+    for (size_t i = 0; i < kMaxRecentFiles; ++i) box(recent_row(i));
     json.end_array();
     json.key("preview_controls").begin_object();
     rect("text", g.text_field);
@@ -282,11 +282,7 @@ std::string EditorView::geometry_json() const {
     rect("zoom", g.zoom_button);
     json.end_object();
     json.key("candidates").begin_array();
-    for (size_t i = 0; i < kMaxCandidates; ++i) {
-        const Rect r = candidate_panel(i);
-        json.begin_array().value(r.x * scale_).value(r.y * scale_).value(r.width * scale_);
-        json.value(r.height * scale_).end_array();
-    }
+    for (size_t i = 0; i < kMaxCandidates; ++i) box(candidate_panel(i));
     json.end_array();
     json.key("prompt").begin_object();
     rect("box", prompt_box());
